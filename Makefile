@@ -1,0 +1,158 @@
+# fovea: GNU make build. No generated build system.
+#   make [all] | deps | test | run | bench | check-asan | check-tsan | install | clean
+#   CROSS=aarch64-linux-gnu-   cross-builds into build-aarch64/ (tests run under qemu-aarch64)
+#   CC, CXX, CFLAGS, LDFLAGS, PREFIX, DESTDIR are respected.
+
+CROSS ?=
+ifeq ($(origin CC),default)
+CC := $(CROSS)gcc
+endif
+ifeq ($(origin CXX),default)
+CXX := $(CROSS)g++
+endif
+AR := $(CROSS)ar
+
+MACHINE := $(shell $(CC) -dumpmachine 2>/dev/null)
+ifneq ($(findstring aarch64,$(MACHINE)),)
+ARCH := aarch64
+else ifneq ($(findstring x86_64,$(MACHINE)),)
+ARCH := x86_64
+else
+ARCH := generic
+endif
+
+SAN ?=
+ifeq ($(SAN),asan)
+BUILD ?= build-asan
+SANFLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+else ifeq ($(SAN),tsan)
+BUILD ?= build-tsan
+SANFLAGS := -fsanitize=thread
+else ifneq ($(CROSS),)
+BUILD ?= build-$(ARCH)
+else
+BUILD ?= build
+endif
+
+OPT ?= -O2 -g
+CFLAGS ?=
+LDFLAGS ?=
+WARN := -Wall -Wextra -Werror
+# ISO C: no silent FMA contraction, so the plain-C references give the same bits everywhere.
+BASE_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) $(WARN) -ffp-contract=off -pthread -Icore -Iplatform $(SANFLAGS)
+BASE_CXXFLAGS := -std=c++17 $(OPT) $(WARN) -Wno-unused-parameter -pthread -Icore $(SANFLAGS)
+LIBS := -lembree3 -ltinygltf -lstb -lstdc++ -lm -lpthread
+TEST_LIBS := -lcmocka
+
+ALL_CFLAGS = $(BASE_CFLAGS) $(CFLAGS)
+ALL_CXXFLAGS = $(BASE_CXXFLAGS) $(CXXFLAGS)
+ALL_LDFLAGS = $(SANFLAGS) -pthread $(LDFLAGS)
+
+CORE_C := $(wildcard core/*.c)
+CORE_CXX := $(wildcard core/*.cpp)
+ifeq ($(ARCH),x86_64)
+CORE_ISA := $(wildcard core/x86/*.c)
+else ifeq ($(ARCH),aarch64)
+CORE_ISA := $(wildcard core/arm/*.c)
+endif
+PLATFORM_C := $(wildcard platform/*.c)
+APPS := $(patsubst apps/%.c,$(BUILD)/bin/%,$(wildcard apps/fovea-*.c))
+TOOLS := $(patsubst tools/%.c,$(BUILD)/tools/%,$(wildcard tools/*.c))
+TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
+
+CORE_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(CORE_C) $(CORE_ISA)) $(patsubst %.cpp,$(BUILD)/%.o,$(CORE_CXX))
+PLATFORM_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(PLATFORM_C))
+LIB := $(BUILD)/libfovea.a
+PLIB := $(BUILD)/libfovea-platform.a
+
+# The bundled "space shooting range" scene is generated (deterministically) at build time.
+RANGE := assets/range.glb
+# Where the shared assets live (scenes, eye images); tests read them from here.
+SHARED ?= ../shared
+
+.PHONY: all deps test run bench check-asan check-tsan install clean test-bin
+all: $(LIB) $(PLIB) $(APPS) $(TOOLS)
+
+$(BUILD)/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -MMD -MP -c $< -o $@
+$(BUILD)/core/x86/%_sse41.o: core/x86/%_sse41.c
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -msse4.1 -MMD -MP -c $< -o $@
+$(BUILD)/core/x86/%_avx2.o: core/x86/%_avx2.c
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -mavx2 -mfma -MMD -MP -c $< -o $@
+$(BUILD)/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(ALL_CXXFLAGS) -MMD -MP -c $< -o $@
+
+$(LIB): $(CORE_OBJ)
+	@rm -f $@
+	$(AR) rcs $@ $^
+$(PLIB): $(PLATFORM_OBJ)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+$(BUILD)/bin/%: apps/%.c $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) -o $@
+$(BUILD)/tools/%: tools/%.c $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) $< $(LIB) $(ALL_LDFLAGS) $(LIBS) -o $@
+$(BUILD)/tests/%: tests/%.c tests/testutil.h $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(TEST_LIBS) -o $@
+
+$(RANGE): tools/gen_range.c
+	$(MAKE) --no-print-directory $(BUILD)/tools/gen_range
+	$(BUILD)/tools/gen_range --out $@
+
+deps:
+	@tools/deps.sh $(if $(CROSS),--cross)
+
+test-bin: $(LIB) $(PLIB) $(APPS) $(TOOLS) $(TESTS) $(RANGE)
+
+# The suite: unit + kernel tests (cmocka) and the command-line tests; one summary line at the end.
+test: deps
+	@$(MAKE) --no-print-directory test-bin
+	@BUILD=$(BUILD) SHARED=$(SHARED) tests/run.sh
+
+# Cross leg: build everything for aarch64 and run the core's tests under qemu-aarch64.
+check-aarch64:
+	@tools/deps.sh --cross
+	@$(MAKE) --no-print-directory CROSS=aarch64-linux-gnu- test-bin
+	@BUILD=build-aarch64 SHARED=$(SHARED) RUNNER="qemu-aarch64 -L /usr/aarch64-linux-gnu" tests/run.sh --core
+
+check-asan:
+	@tools/deps.sh
+	@$(MAKE) --no-print-directory SAN=asan test-bin
+	@BUILD=build-asan SHARED=$(SHARED) ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 tests/run.sh
+
+check-tsan:
+	@tools/deps.sh
+	@$(MAKE) --no-print-directory SAN=tsan test-bin
+	@BUILD=build-tsan SHARED=$(SHARED) TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp halt_on_error=1" tests/run.sh
+
+run: deps
+	@$(MAKE) --no-print-directory all $(RANGE)
+	@rm -rf out/run
+	$(BUILD)/bin/fovea-replay --scene $(RANGE) --trace assets/gaze_sweep.csv --frames 120 --out out/run
+	@echo "frames: out/run/frame_*.png   stats: out/run/stats.csv"
+
+bench: deps
+	@$(MAKE) --no-print-directory all $(RANGE)
+	@mkdir -p out/bench
+	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 30 --json out/bench/range.json
+
+PREFIX ?= /usr/local
+install: all
+	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/fovea $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 $(LIB) $(PLIB) $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 core/*.h platform/*.h $(DESTDIR)$(PREFIX)/include/fovea/
+	install -m 755 $(APPS) $(DESTDIR)$(PREFIX)/bin/
+	sed -e 's|@PREFIX@|$(PREFIX)|g' tools/fovea.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/fovea.pc
+
+clean:
+	rm -rf build build-asan build-tsan build-aarch64 out $(RANGE)
+
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

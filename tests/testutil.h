@@ -1,0 +1,28 @@
+/* fovea test helpers shared by the cmocka suites. */
+#pragma once
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <stdlib.h>
+#include <cmocka.h>
+
+/* Path of ../shared (scenes, eye images): $SHARED, else ../shared from the repo root. */
+static inline const char *fv_test_shared(void)
+{
+    const char *s = getenv("SHARED");
+    return (s && *s) ? s : "../shared";
+}
+
+/* Small deterministic PRNG (splitmix64) so failures reproduce. */
+static inline uint64_t fv_test_rand(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+static inline float fv_test_randf(uint64_t *state) /* [0,1) */
+{
+    return (float)(fv_test_rand(state) >> 40) * (1.0f / 16777216.0f);
+}
