@@ -1,0 +1,158 @@
+#define _GNU_SOURCE
+#include "pool.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <unistd.h>
+#if defined(__x86_64__) || defined(__i386__)
+#include <xmmintrin.h>
+#include <pmmintrin.h>
+#endif
+
+struct fv_pool {
+    int threads;
+    pthread_t *tids;
+    pthread_mutex_t mu;
+    pthread_cond_t start_cv, done_cv;
+    /* current job, published under mu */
+    fv_task_fn fn;
+    void *ctx;
+    int count;
+    unsigned long generation; /* bumped per job so sleepers know there is new work */
+    int busy;                 /* workers still inside the current job */
+    int quit;
+    atomic_int next;          /* next item to claim */
+};
+
+typedef struct { fv_pool *pool; int id; } worker_arg;
+
+void fv_set_ftz(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#elif defined(__aarch64__)
+    unsigned long fpcr;
+    __asm__ volatile("mrs %0, fpcr" : "=r"(fpcr));
+    fpcr |= 1ul << 24; /* FZ */
+    __asm__ volatile("msr fpcr, %0" : : "r"(fpcr));
+#endif
+}
+
+int fv_online_cpus(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : (int)n;
+}
+
+static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, int id)
+{
+    for (;;) {
+        int i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed);
+        if (i >= count)
+            break;
+        fn(ctx, i, id);
+    }
+}
+
+static void *worker_main(void *arg)
+{
+    worker_arg wa = *(worker_arg *)arg;
+    free(arg);
+    fv_pool *p = wa.pool;
+    fv_set_ftz();
+    unsigned long seen = 0;
+    pthread_mutex_lock(&p->mu);
+    for (;;) {
+        while (!p->quit && p->generation == seen)
+            pthread_cond_wait(&p->start_cv, &p->mu);
+        if (p->quit)
+            break;
+        seen = p->generation;
+        fv_task_fn fn = p->fn;
+        void *ctx = p->ctx;
+        int count = p->count;
+        pthread_mutex_unlock(&p->mu);
+        drain(p, fn, ctx, count, wa.id);
+        pthread_mutex_lock(&p->mu);
+        if (--p->busy == 0)
+            pthread_cond_signal(&p->done_cv);
+    }
+    pthread_mutex_unlock(&p->mu);
+    return NULL;
+}
+
+fv_pool *fv_pool_create(int threads)
+{
+    if (threads <= 0)
+        threads = fv_online_cpus();
+    fv_pool *p = calloc(1, sizeof *p);
+    if (!p)
+        return NULL;
+    p->threads = threads;
+    atomic_init(&p->next, 0);
+    pthread_mutex_init(&p->mu, NULL);
+    pthread_cond_init(&p->start_cv, NULL);
+    pthread_cond_init(&p->done_cv, NULL);
+    p->tids = calloc((size_t)threads, sizeof *p->tids);
+    if (!p->tids) {
+        free(p);
+        return NULL;
+    }
+    for (int i = 1; i < threads; i++) {
+        worker_arg *wa = malloc(sizeof *wa);
+        if (!wa || (wa->pool = p, wa->id = i, pthread_create(&p->tids[i], NULL, worker_main, wa)) != 0) {
+            free(wa);
+            p->threads = i; /* destroy joins only the started ones */
+            fv_pool_destroy(p);
+            return NULL;
+        }
+    }
+    fv_set_ftz();
+    return p;
+}
+
+void fv_pool_destroy(fv_pool *p)
+{
+    if (!p)
+        return;
+    pthread_mutex_lock(&p->mu);
+    p->quit = 1;
+    pthread_cond_broadcast(&p->start_cv);
+    pthread_mutex_unlock(&p->mu);
+    for (int i = 1; i < p->threads; i++)
+        pthread_join(p->tids[i], NULL);
+    pthread_mutex_destroy(&p->mu);
+    pthread_cond_destroy(&p->start_cv);
+    pthread_cond_destroy(&p->done_cv);
+    free(p->tids);
+    free(p);
+}
+
+int fv_pool_threads(const fv_pool *p) { return p ? p->threads : 1; }
+
+void fv_pool_run(fv_pool *p, int count, fv_task_fn fn, void *ctx)
+{
+    if (count <= 0)
+        return;
+    if (!p || p->threads == 1 || count == 1) {
+        for (int i = 0; i < count; i++)
+            fn(ctx, i, 0);
+        return;
+    }
+    pthread_mutex_lock(&p->mu);
+    p->fn = fn;
+    p->ctx = ctx;
+    p->count = count;
+    atomic_store_explicit(&p->next, 0, memory_order_relaxed);
+    p->busy = p->threads - 1;
+    p->generation++;
+    pthread_cond_broadcast(&p->start_cv);
+    pthread_mutex_unlock(&p->mu);
+    drain(p, fn, ctx, count, 0);
+    pthread_mutex_lock(&p->mu);
+    while (p->busy > 0)
+        pthread_cond_wait(&p->done_cv, &p->mu);
+    pthread_mutex_unlock(&p->mu);
+}

@@ -1,0 +1,162 @@
+#include "sampling.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI_D 3.14159265358979323846
+
+void fv_sampling_params_default(fv_sampling_params *p)
+{
+    p->r0_deg = 10.0f;
+    p->r1_deg = 20.0f;
+    p->p_min = 0.2f;
+    p->full = 0;
+}
+
+float fv_sampling_radius(const fv_sampling_params *p, float u)
+{
+    double pm = p->p_min, r0 = p->r0_deg, r1 = p->r1_deg;
+    if (fabs(pm - 1.0) < 1e-6) /* f(x) is flat: uniform in r */
+        return (float)(r0 + (r1 - r0) * u);
+    double x = (sqrt((pm * pm - 1.0) * u + 1.0) - 1.0) / (pm - 1.0);
+    return (float)(r0 + (r1 - r0) * x);
+}
+
+/* Eq. (1) draws r with pdf c*f(x)/(r1-r0), f(x) = 1 - x(1 - p_min), c = 2/(1 + p_min). Spread
+ * over the ring 2*pi*r, N points give an areal density N*c*f(x)/((r1-r0)*2*pi*r). N is chosen so
+ * the density meets S_out's p_min at r1 (no seam), which gives (r1/r)*f(x): 2 at r0 for the
+ * defaults, saturating to full coverage there, falling to p_min at r1. */
+float fv_sampling_transition_density(const fv_sampling_params *p, float r_deg)
+{
+    double x = (r_deg - p->r0_deg) / (p->r1_deg - p->r0_deg);
+    double f = 1.0 - x * (1.0 - p->p_min);
+    return (float)(p->r1_deg / r_deg * f);
+}
+
+static double halton(uint32_t i, uint32_t base)
+{
+    double f = 1.0, r = 0.0;
+    while (i > 0) {
+        f /= base;
+        r += f * (i % base);
+        i /= base;
+    }
+    return r;
+}
+
+static inline void set_bit(uint64_t *row, int x) { row[x >> 6] |= 1ull << (x & 63); }
+
+int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const fv_sampling_params *p)
+{
+    memset(s, 0, sizeof *s);
+    if (width < 1 || height < 1 || !(focal_px > 0.0f))
+        return -1;
+    if (!(p->r0_deg > 0.0f && p->r0_deg <= p->r1_deg && p->r1_deg <= 90.0f && p->p_min > 0.0f && p->p_min <= 1.0f))
+        return -1;
+    s->prm = *p;
+    s->width = width;
+    s->height = height;
+    s->ppd = focal_px * (float)(PI_D / 180.0);
+    s->r0_px = p->r0_deg * s->ppd;
+    s->r1_px = p->r1_deg * s->ppd;
+    s->rin = (int)ceilf(s->r1_px);
+    int side = 2 * s->rin + 1;
+    s->in_stride = (side + 63) / 64;
+    s->out_stride = (width + 63) / 64;
+    s->s_in = calloc((size_t)side * (size_t)s->in_stride, sizeof(uint64_t));
+    s->s_out = calloc((size_t)height * (size_t)s->out_stride, sizeof(uint64_t));
+    if (!s->s_in || !s->s_out) {
+        fv_sampler_free(s);
+        return -1;
+    }
+
+    /* S_out: rank-1 lattice dither (the R2 sequence, Roberts 2018): a pixel is sampled when
+     * frac(a1 x + a2 y) < p_min. Exact density p_min with evenly spread samples and no clumps
+     * or large holes, unlike white noise. */
+    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
+    for (int y = 0; y < height; y++) {
+        uint64_t *row = s->s_out + (size_t)y * s->out_stride;
+        for (int x = 0; x < width; x++) {
+            double v = a1 * x + a2 * y;
+            if (v - floor(v) < p->p_min)
+                set_bit(row, x);
+        }
+    }
+
+    /* S_in: every offset inside r0, then Halton (2, 3) points placed with eq. (1)-(2). */
+    int c = s->rin;
+    double r0sq = (double)s->r0_px * s->r0_px;
+    for (int dy = -c; dy <= c; dy++) {
+        uint64_t *row = s->s_in + (size_t)(dy + c) * s->in_stride;
+        for (int dx = -c; dx <= c; dx++)
+            if ((double)dx * dx + (double)dy * dy < r0sq)
+                set_bit(row, dx + c);
+    }
+    if (p->r1_deg > p->r0_deg) {
+        double cnorm = 2.0 / (1.0 + p->p_min);
+        double n = (p->r1_deg - p->r0_deg) * 2.0 * PI_D * p->r1_deg / cnorm * (double)s->ppd * s->ppd;
+        s->transition_points = (long)ceil(n);
+        double r1sq = (double)s->r1_px * s->r1_px;
+        for (long i = 1; i <= s->transition_points; i++) {
+            double r = fv_sampling_radius(p, (float)halton((uint32_t)i, 2)) * (double)s->ppd;
+            double phi = 2.0 * PI_D * halton((uint32_t)i, 3);
+            int dx = (int)floor(r * cos(phi) + 0.5), dy = (int)floor(r * sin(phi) + 0.5);
+            double d2 = (double)dx * dx + (double)dy * dy;
+            if (d2 < r0sq || d2 >= r1sq) /* rounding pushed it out of the ring */
+                continue;
+            set_bit(s->s_in + (size_t)(dy + c) * s->in_stride, dx + c);
+        }
+    }
+    return 0;
+}
+
+void fv_sampler_free(fv_sampler *s)
+{
+    free(s->s_in);
+    free(s->s_out);
+    s->s_in = s->s_out = NULL;
+}
+
+/* n <= 64 bits starting at bit x of a bit row (bits past the row's end read as 0). */
+static inline uint64_t get_bits(const uint64_t *row, int words, int x, int n)
+{
+    int w = x >> 6, b = x & 63;
+    uint64_t v = w < words ? row[w] >> b : 0;
+    if (b && w + 1 < words)
+        v |= row[w + 1] << (64 - b);
+    return n == 64 ? v : v & ((1ull << n) - 1);
+}
+
+uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy)
+{
+    uint64_t all = n == 64 ? ~0ull : (1ull << n) - 1;
+    if (s->prm.full)
+        return all;
+    uint64_t out = get_bits(s->s_out + (size_t)y * s->out_stride, s->out_stride, x0, n);
+    int dy = y - gy;
+    if (dy < -s->rin || dy > s->rin)
+        return out;
+    /* Pixels with dx^2 + dy^2 < r1^2 take S_in, the rest S_out. The span of this row inside
+     * the r1 disc is [gx - h, gx + h]. */
+    double r1sq = (double)s->r1_px * s->r1_px, rem = r1sq - (double)dy * dy;
+    if (rem <= 0.0)
+        return out;
+    int h = (int)floor(sqrt(rem));
+    while ((double)h * h + (double)dy * dy >= r1sq) /* keep the strict < of the disc test */
+        h--;
+    if (h < 0)
+        return out;
+    int lo = gx - h, hi = gx + h; /* inclusive */
+    if (hi < x0 || lo > x0 + n - 1)
+        return out;
+    if (lo < x0)
+        lo = x0;
+    if (hi > x0 + n - 1)
+        hi = x0 + n - 1;
+    int len = hi - lo + 1;
+    uint64_t span = (len == 64 ? ~0ull : (1ull << len) - 1) << (lo - x0);
+    const uint64_t *inrow = s->s_in + (size_t)(dy + s->rin) * s->in_stride;
+    uint64_t in = get_bits(inrow, s->in_stride, lo - gx + s->rin, len) << (lo - x0);
+    return (out & ~span) | (in & span);
+}

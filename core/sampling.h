@@ -1,0 +1,48 @@
+/* fovea: acuity-driven sampling pattern (Weier et al. 2018, section 3.1).
+ * Two precomputed bit tables: S_in, centred on the point of regard and moved with it (probability
+ * 1 inside r0, importance-sampled with eq. (1)-(2) from a Halton sequence in r0..r1), and S_out,
+ * a static uniform pattern of probability p_min for the periphery (static so it does not flicker).
+ * Eccentricity is measured in pixels from the point of regard divided by the pixels per degree at
+ * the optical axis, as the table is a fixed pixel pattern that moves with the gaze. */
+#ifndef FOVEA_SAMPLING_H
+#define FOVEA_SAMPLING_H
+
+#include <stdint.h>
+
+typedef struct fv_sampling_params {
+    float r0_deg;  /* fully sampled fovea radius, default 10 */
+    float r1_deg;  /* end of the transition region, default 20 */
+    float p_min;   /* peripheral sampling probability, default 0.2 */
+    int full;      /* 1: sample every pixel */
+} fv_sampling_params;
+
+typedef struct fv_sampler {
+    fv_sampling_params prm;
+    int width, height;
+    float ppd;              /* pixels per degree at the optical axis */
+    float r0_px, r1_px;
+    int rin;                /* S_in covers offsets -rin..rin in x and y */
+    int in_stride;          /* 64-bit words per S_in row */
+    uint64_t *s_in;         /* (2*rin+1) rows */
+    int out_stride;         /* 64-bit words per S_out row */
+    uint64_t *s_out;        /* height rows */
+    long transition_points; /* Halton points thrown into the transition ring */
+} fv_sampler;
+
+void fv_sampling_params_default(fv_sampling_params *p);
+/* focal_px: pixels per unit tangent at the optical axis (fv_camera.focal_px). 0 on success,
+ * -1 on parameters out of range (0 < r0 <= r1 <= 90, 0 < p_min <= 1) or no memory. */
+int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const fv_sampling_params *p);
+void fv_sampler_free(fv_sampler *s);
+
+/* Eq. (1): radius (degrees) of the transition sample for a uniform variate u in [0,1]. */
+float fv_sampling_radius(const fv_sampling_params *p, float u);
+/* Expected areal sample density (samples per pixel, before collisions) of the S_in transition
+ * points at eccentricity r_deg in [r0, r1]; equals p_min at r1 by the choice of point count. */
+float fv_sampling_transition_density(const fv_sampling_params *p, float r_deg);
+
+/* Sampling bits of the n <= 64 pixels x0..x0+n-1 of row y (bit i = pixel x0+i) for the point of
+ * regard at pixel (gx, gy) (integer pixel the pattern is centred on). */
+uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy);
+
+#endif

@@ -1,0 +1,32 @@
+/* fovea: gaze / head-pose traces (CSV, see DESIGN.md):
+ *   t_ms,gaze_x,gaze_y[,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw]
+ * Gaze is in normalised image coordinates of the eye's image (x right, y down, [0,1]).
+ * A header line is required; lines starting with '#' and blank lines are ignored. */
+#ifndef FOVEA_TRACE_H
+#define FOVEA_TRACE_H
+
+#include <stddef.h>
+#include "camera.h"
+
+typedef struct fv_trace_sample {
+    double t_ms;
+    float gaze_x, gaze_y;
+    fv_pose head; /* valid when the trace has head columns */
+} fv_trace_sample;
+
+typedef struct fv_trace {
+    fv_trace_sample *s;
+    int n;
+    int has_head;
+} fv_trace;
+
+/* 0 on success; -1 with a one-line reason (file and line) in err. */
+int fv_trace_load(fv_trace *tr, const char *path, char *err, size_t err_len);
+/* Parses CSV text already in memory (name is used in messages only). */
+int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name, char *err, size_t err_len);
+void fv_trace_free(fv_trace *tr);
+
+/* State at time t_ms: linear gaze and position, slerped rotation; held at the ends. */
+void fv_trace_at(const fv_trace *tr, double t_ms, fv_trace_sample *out);
+
+#endif

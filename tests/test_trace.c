@@ -1,0 +1,96 @@
+/* Gaze / head trace parsing and interpolation. */
+#include <math.h>
+#include <string.h>
+
+#include "testutil.h"
+#include "trace.h"
+
+static int parse(fv_trace *t, const char *text, char *err)
+{
+    return fv_trace_parse(t, text, strlen(text), "t.csv", err, 256);
+}
+
+static void test_good(void **st)
+{
+    (void)st;
+    fv_trace t;
+    char err[256];
+    assert_int_equal(parse(&t, "# comment\nt_ms,gaze_x,gaze_y\n\n0,0.2,0.4\r\n 10 , 0.6 , 0.8\n# end\n", err), 0);
+    assert_int_equal(t.n, 2);
+    assert_false(t.has_head);
+    fv_trace_sample s;
+    fv_trace_at(&t, 2.5, &s);
+    assert_float_equal(s.gaze_x, 0.3f, 1e-6);
+    assert_float_equal(s.gaze_y, 0.5f, 1e-6);
+    fv_trace_at(&t, -5.0, &s); /* held at the ends */
+    assert_float_equal(s.gaze_x, 0.2f, 0.0f);
+    fv_trace_at(&t, 99.0, &s);
+    assert_float_equal(s.gaze_y, 0.8f, 0.0f);
+    fv_trace_free(&t);
+}
+
+static void test_head(void **st)
+{
+    (void)st;
+    fv_trace t;
+    char err[256];
+    /* 0 -> 90 degrees about +Y (quaternion given unnormalised, x2) */
+    assert_int_equal(parse(&t,
+                           "t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw\n"
+                           "0,0.5,0.5,0,1.6,0,0,0,0,2\n"
+                           "100,0.5,0.5,1,1.6,-2,0,1.41421356,0,1.41421356\n",
+                           err),
+                     0);
+    assert_true(t.has_head);
+    assert_float_equal(t.s[0].head.quat[3], 1.0f, 1e-6);
+    fv_trace_sample s;
+    fv_trace_at(&t, 50.0, &s);
+    assert_float_equal(s.head.pos[0], 0.5f, 1e-6);
+    assert_float_equal(s.head.pos[2], -1.0f, 1e-6);
+    /* halfway: 45 degrees about +Y */
+    assert_float_equal(s.head.quat[1], sinf(0.3926991f), 1e-5);
+    assert_float_equal(s.head.quat[3], cosf(0.3926991f), 1e-5);
+    fv_trace_free(&t);
+}
+
+static void test_bad(void **st)
+{
+    (void)st;
+    const char *bad[] = {
+        "",                                                   /* empty */
+        "# only a comment\n",                                 /* no header */
+        "t_ms,gaze_x,gaze_y\n",                               /* no samples */
+        "time,x,y\n0,0.5,0.5\n",                              /* wrong header */
+        "t_ms,gaze_x,gaze_y\n0,0.5,0.5\n11,0.5\n",            /* truncated line */
+        "t_ms,gaze_x,gaze_y\n0,0.5,0.5,7\n",                  /* extra field */
+        "t_ms,gaze_x,gaze_y\n0,0.5,nan\n",                    /* not finite */
+        "t_ms,gaze_x,gaze_y\n0,0.5,0.5x\n",                   /* junk after a number */
+        "t_ms,gaze_x,gaze_y\n0,0.5,\n",                       /* empty field */
+        "t_ms,gaze_x,gaze_y\n10,0.5,0.5\n5,0.5,0.5\n",        /* time going backwards */
+        "t_ms,gaze_x,gaze_y\n0,40,0.5\n",                     /* absurd gaze */
+        "t_ms,gaze_x,gaze_y,head_px\n0,0.5,0.5,1\n",          /* partial head columns */
+        "t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw\n0,0.5,0.5,0,0,0,0,0,0,0\n",
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        fv_trace t;
+        char err[256] = "";
+        assert_int_equal(parse(&t, bad[i], err), -1);
+        assert_true(strlen(err) > 5);
+        assert_null(t.s);
+    }
+    fv_trace t;
+    char err[256];
+    assert_int_equal(fv_trace_parse(&t, "t_ms,gaze_x,gaze_y\n0,0.5\0,0.5\n", 29, "nul.csv", err, sizeof err), -1);
+    assert_int_equal(fv_trace_load(&t, "/nonexistent/trace.csv", err, sizeof err), -1);
+    assert_non_null(strstr(err, "/nonexistent/trace.csv"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_good),
+        cmocka_unit_test(test_head),
+        cmocka_unit_test(test_bad),
+    };
+    return cmocka_run_group_tests_name("trace", tests, NULL, NULL);
+}
