@@ -1,0 +1,732 @@
+// fovea: C API over Debian's tinygltf (libtinygltf.so holds the implementation, so
+// TINYGLTF_IMPLEMENTATION is not defined here; the declarations need no json/stb headers).
+// tinygltf parses; everything it does not check (accessor bounds, component types, index
+// ranges, node graph shape, finiteness) is checked here, because the data it hands back is
+// untrusted. Any failure becomes a one-line message; no exception escapes.
+#include "gltf_shim.h"
+
+#include <tiny_gltf.h>
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+// Caps that keep a hostile file from asking for absurd allocations.
+constexpr size_t kMaxFileBytes = 0x7fffffff;  // tinygltf takes lengths as int/unsigned
+constexpr size_t kMaxCount = size_t(1) << 28; // elements per accessor
+constexpr size_t kMaxZeroCount = size_t(1) << 22; // elements of an accessor without a bufferView
+constexpr int kMaxImageSide = 16384;
+constexpr size_t kMaxImageTexels = size_t(1) << 26; // as scene.c accepts
+constexpr int kMaxJsonDepth = 100;            // tinygltf converts extras/extensions recursively
+
+struct Fail : std::runtime_error {
+    explicit Fail(const std::string &s) : std::runtime_error(s) {}
+};
+
+std::string str(size_t v) { return std::to_string(v); }
+std::string str(int v) { return std::to_string(v); }
+
+// ---- files --------------------------------------------------------------------------
+
+bool read_file(const std::string &path, std::vector<unsigned char> *out, std::string *err)
+{
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0) {
+        *err = std::strerror(errno);
+        return false;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        *err = "not a regular file";
+        return false;
+    }
+    if (uint64_t(st.st_size) > kMaxFileBytes) {
+        *err = "file larger than 2 GiB";
+        return false;
+    }
+    FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f) {
+        *err = std::strerror(errno);
+        return false;
+    }
+    out->resize(size_t(st.st_size));
+    size_t got = out->empty() ? 0 : std::fread(out->data(), 1, out->size(), f);
+    std::fclose(f);
+    if (got != out->size()) {
+        *err = "short read";
+        return false;
+    }
+    return true;
+}
+
+// tinygltf's filesystem hooks: regular files only, same size cap.
+bool fs_exists(const std::string &path, void *)
+{
+    struct stat st;
+    return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+{
+    std::string e;
+    if (read_file(path, out, &e)) return true;
+    if (err) *err += e;
+    return false;
+}
+
+std::string fs_expand(const std::string &path, void *) { return path; }
+
+bool fs_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
+{
+    if (err) *err += "writing is not supported";
+    return false;
+}
+
+// Rejects JSON nested deeper than kMaxJsonDepth before tinygltf recurses into it.
+bool json_depth_ok(const unsigned char *s, size_t n)
+{
+    int depth = 0;
+    bool in_str = false, esc = false;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = s[i];
+        if (in_str) {
+            if (esc) esc = false;
+            else if (c == '\\') esc = true;
+            else if (c == '"') in_str = false;
+        } else if (c == '"') {
+            in_str = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth) return false;
+        } else if (c == ']' || c == '}') {
+            depth--;
+        }
+    }
+    return true;
+}
+
+// Image loader hook: keep the encoded bytes (decoded later, only for base colour images)
+// and bounds-check bufferView images, which tinygltf itself does not.
+struct ImageHookCtx {
+    const tinygltf::Model *model;
+};
+
+bool keep_encoded_image(tinygltf::Image *image, const int image_idx, std::string *err,
+                        std::string *, int, int, const unsigned char *bytes, int size, void *user)
+{
+    const ImageHookCtx *ctx = static_cast<const ImageHookCtx *>(user);
+    if (image->bufferView >= 0) {
+        const tinygltf::Model &m = *ctx->model;
+        const size_t bvi = size_t(image->bufferView);
+        bool ok = bvi < m.bufferViews.size();
+        if (ok) {
+            const tinygltf::BufferView &bv = m.bufferViews[bvi];
+            ok = bv.buffer >= 0 && size_t(bv.buffer) < m.buffers.size();
+            if (ok) {
+                const size_t have = m.buffers[size_t(bv.buffer)].data.size();
+                ok = bv.byteOffset <= have && bv.byteLength <= have - bv.byteOffset && bv.byteLength > 0;
+            }
+        }
+        if (!ok) {
+            if (err) *err += "image " + str(image_idx) + ": bufferView out of bounds of its buffer";
+            return false;
+        }
+    }
+    if (size <= 0 || !bytes) {
+        if (err) *err += "image " + str(image_idx) + ": no data";
+        return false;
+    }
+    image->image.assign(bytes, bytes + size);
+    image->as_is = true;
+    return true;
+}
+
+// ---- accessors ----------------------------------------------------------------------
+
+size_t component_bytes(int ct)
+{
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0; // INT and DOUBLE are not glTF 2.0 accessor types
+    }
+}
+
+int type_components(int type)
+{
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    case TINYGLTF_TYPE_MAT2: return 4;
+    case TINYGLTF_TYPE_MAT3: return 9;
+    case TINYGLTF_TYPE_MAT4: return 16;
+    default: return 0;
+    }
+}
+
+// Start and length of a bufferView inside its buffer, checked.
+const unsigned char *view_bytes(const tinygltf::Model &m, int bvi, size_t *len, const std::string &what)
+{
+    if (bvi < 0 || size_t(bvi) >= m.bufferViews.size())
+        throw Fail(what + ": bufferView " + str(bvi) + " does not exist");
+    const tinygltf::BufferView &bv = m.bufferViews[size_t(bvi)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= m.buffers.size())
+        throw Fail(what + ": bufferView " + str(bvi) + " names missing buffer " + str(bv.buffer));
+    const std::vector<unsigned char> &b = m.buffers[size_t(bv.buffer)].data;
+    if (bv.byteOffset > b.size() || bv.byteLength > b.size() - bv.byteOffset)
+        throw Fail(what + ": bufferView " + str(bvi) + " (offset " + str(bv.byteOffset) + ", length " +
+                   str(bv.byteLength) + ") exceeds buffer " + str(bv.buffer) + " (" + str(b.size()) +
+                   " bytes)");
+    *len = bv.byteLength;
+    return b.data() + bv.byteOffset;
+}
+
+// Checks that count elements of elem bytes at offset with stride fit in len bytes.
+bool span_fits(size_t offset, size_t stride, size_t count, size_t elem, size_t len)
+{
+    if (count == 0) return true;
+    if (offset > len || len - offset < elem) return false;
+    return count - 1 <= (len - offset - elem) / stride;
+}
+
+// Calls fn(i, element bytes) for every element of accessor ai, sparse substitutions
+// included; every byte touched has been bounds-checked.
+template <class Fn>
+void for_each_element(const tinygltf::Model &m, int ai, int want_comps, const std::string &what, Fn fn)
+{
+    if (ai < 0 || size_t(ai) >= m.accessors.size())
+        throw Fail(what + ": accessor " + str(ai) + " does not exist");
+    const tinygltf::Accessor &a = m.accessors[size_t(ai)];
+    const std::string at = what + ": accessor " + str(ai);
+    const int comps = type_components(a.type);
+    if (comps != want_comps)
+        throw Fail(at + ": has " + str(comps) + " components per element, expected " + str(want_comps));
+    const size_t cb = component_bytes(a.componentType);
+    if (cb == 0) throw Fail(at + ": invalid componentType " + str(a.componentType));
+    if (a.count == 0 || a.count > kMaxCount) throw Fail(at + ": invalid count " + str(a.count));
+    const size_t elem = cb * size_t(comps);
+
+    if (a.bufferView >= 0) {
+        size_t len;
+        const unsigned char *base = view_bytes(m, a.bufferView, &len, at);
+        const size_t vstride = m.bufferViews[size_t(a.bufferView)].byteStride;
+        const size_t stride = vstride ? vstride : elem;
+        if (stride < elem) throw Fail(at + ": byteStride " + str(stride) + " < element size " + str(elem));
+        if (!span_fits(a.byteOffset, stride, a.count, elem, len))
+            throw Fail(at + ": " + str(a.count) + " elements at offset " + str(a.byteOffset) +
+                       " exceed bufferView " + str(a.bufferView) + " (" + str(len) + " bytes)");
+        for (size_t i = 0; i < a.count; i++) fn(i, base + a.byteOffset + i * stride);
+    } else {
+        // No bufferView: all zeros (spec), usually sparse. Not backed by file bytes, so a tiny
+        // file could ask for gigabytes; cap it lower.
+        if (a.count > kMaxZeroCount) throw Fail(at + ": count " + str(a.count) + " without a bufferView");
+        static const unsigned char zeros[64] = {0};
+        for (size_t i = 0; i < a.count; i++) fn(i, zeros);
+    }
+
+    if (!a.sparse.isSparse) return;
+    const int n = a.sparse.count;
+    if (n < 1 || size_t(n) > a.count) throw Fail(at + ": invalid sparse count " + str(n));
+    const int ict = a.sparse.indices.componentType;
+    const size_t icb = component_bytes(ict);
+    if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        throw Fail(at + ": invalid sparse index componentType " + str(ict));
+    if (a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0)
+        throw Fail(at + ": negative sparse byteOffset");
+    size_t ilen, vlen;
+    const unsigned char *ib = view_bytes(m, a.sparse.indices.bufferView, &ilen, at + " sparse indices");
+    const unsigned char *vb = view_bytes(m, a.sparse.values.bufferView, &vlen, at + " sparse values");
+    const size_t ioff = size_t(a.sparse.indices.byteOffset), voff = size_t(a.sparse.values.byteOffset);
+    if (!span_fits(ioff, icb, size_t(n), icb, ilen) || !span_fits(voff, elem, size_t(n), elem, vlen))
+        throw Fail(at + ": sparse data exceeds its bufferViews");
+    for (size_t k = 0; k < size_t(n); k++) {
+        const unsigned char *p = ib + ioff + k * icb;
+        uint32_t idx;
+        if (icb == 1) idx = p[0];
+        else if (icb == 2) { uint16_t v; std::memcpy(&v, p, 2); idx = v; }
+        else std::memcpy(&idx, p, 4);
+        if (idx >= a.count) throw Fail(at + ": sparse index " + str(size_t(idx)) + " >= count " + str(a.count));
+        fn(idx, vb + voff + k * elem);
+    }
+}
+
+float component_to_float(const unsigned char *p, int ct, bool normalized)
+{
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0f : float(p[0]);
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        int8_t v; std::memcpy(&v, p, 1);
+        return normalized ? std::fmax(v / 127.0f, -1.0f) : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v; std::memcpy(&v, p, 2);
+        return normalized ? v / 65535.0f : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v; std::memcpy(&v, p, 2);
+        return normalized ? std::fmax(v / 32767.0f, -1.0f) : float(v);
+    }
+    default: { uint32_t v; std::memcpy(&v, p, 4); return float(v); } // UNSIGNED_INT
+    }
+}
+
+std::vector<float> read_floats(const tinygltf::Model &m, int ai, int comps, const std::string &what)
+{
+    std::vector<float> out;
+    const tinygltf::Accessor *a = (ai >= 0 && size_t(ai) < m.accessors.size()) ? &m.accessors[size_t(ai)] : nullptr;
+    if (a && a->count <= kMaxCount) out.resize(a->count * size_t(comps));
+    const size_t cb = a ? component_bytes(a->componentType) : 0;
+    for_each_element(m, ai, comps, what, [&](size_t i, const unsigned char *p) {
+        for (int c = 0; c < comps; c++)
+            out[i * size_t(comps) + size_t(c)] = component_to_float(p + size_t(c) * cb, a->componentType, a->normalized);
+    });
+    for (size_t i = 0; i < out.size(); i++)
+        if (!std::isfinite(out[i]))
+            throw Fail(what + ": accessor " + str(ai) + ": element " + str(i / size_t(comps)) + " is not finite");
+    return out;
+}
+
+std::vector<uint32_t> read_indices(const tinygltf::Model &m, int ai, size_t vertex_count, const std::string &what)
+{
+    if (ai < 0 || size_t(ai) >= m.accessors.size())
+        throw Fail(what + ": index accessor " + str(ai) + " does not exist");
+    const tinygltf::Accessor &a = m.accessors[size_t(ai)];
+    const int ct = a.componentType;
+    if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        throw Fail(what + ": index accessor " + str(ai) + ": componentType " + str(ct) +
+                   " is not an unsigned byte/short/int");
+    if (a.count % 3 != 0)
+        throw Fail(what + ": index accessor " + str(ai) + ": count " + str(a.count) + " is not a multiple of 3");
+    std::vector<uint32_t> out;
+    if (a.count <= kMaxCount) out.resize(a.count);
+    for_each_element(m, ai, 1, what + " indices", [&](size_t i, const unsigned char *p) {
+        uint32_t v;
+        if (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) v = p[0];
+        else if (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) { uint16_t s; std::memcpy(&s, p, 2); v = s; }
+        else std::memcpy(&v, p, 4);
+        out[i] = v;
+    });
+    for (size_t i = 0; i < out.size(); i++)
+        if (out[i] >= vertex_count)
+            throw Fail(what + ": index accessor " + str(ai) + ": index " + str(size_t(out[i])) + " at " + str(i) +
+                       " out of range (vertex count " + str(vertex_count) + ")");
+    return out;
+}
+
+// ---- transforms ---------------------------------------------------------------------
+
+void mat_mul(const double a[16], const double b[16], double out[16]) // column-major out = a*b
+{
+    for (int c = 0; c < 4; c++)
+        for (int r = 0; r < 4; r++) {
+            double s = 0;
+            for (int k = 0; k < 4; k++) s += a[k * 4 + r] * b[c * 4 + k];
+            out[c * 4 + r] = s;
+        }
+}
+
+void node_local(const tinygltf::Node &n, size_t ni, double out[16])
+{
+    const std::string at = "node " + str(ni);
+    auto finite = [&](const std::vector<double> &v, const char *name) {
+        for (double d : v)
+            if (!std::isfinite(d)) throw Fail(at + ": " + name + " is not finite");
+    };
+    if (!n.matrix.empty()) {
+        if (n.matrix.size() != 16) throw Fail(at + ": matrix needs 16 numbers");
+        finite(n.matrix, "matrix");
+        for (int i = 0; i < 16; i++) out[i] = n.matrix[size_t(i)];
+        return;
+    }
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    if (!n.translation.empty()) {
+        if (n.translation.size() != 3) throw Fail(at + ": translation needs 3 numbers");
+        finite(n.translation, "translation");
+        for (int i = 0; i < 3; i++) t[i] = n.translation[size_t(i)];
+    }
+    if (!n.rotation.empty()) {
+        if (n.rotation.size() != 4) throw Fail(at + ": rotation needs 4 numbers");
+        finite(n.rotation, "rotation");
+        double len = 0;
+        for (int i = 0; i < 4; i++) len += n.rotation[size_t(i)] * n.rotation[size_t(i)];
+        len = std::sqrt(len);
+        if (!(len > 1e-12)) throw Fail(at + ": rotation quaternion has zero length");
+        for (int i = 0; i < 4; i++) q[i] = n.rotation[size_t(i)] / len; // exporters round; renormalise
+    }
+    if (!n.scale.empty()) {
+        if (n.scale.size() != 3) throw Fail(at + ": scale needs 3 numbers");
+        finite(n.scale, "scale");
+        for (int i = 0; i < 3; i++) s[i] = n.scale[size_t(i)];
+    }
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    const double r[9] = {// column-major rotation
+                         1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
+                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+    for (int c = 0; c < 3; c++) {
+        for (int rr = 0; rr < 3; rr++) out[c * 4 + rr] = r[c * 3 + rr] * s[c];
+        out[c * 4 + 3] = 0;
+    }
+    out[12] = t[0], out[13] = t[1], out[14] = t[2], out[15] = 1;
+}
+
+float to_float(double d, const std::string &what)
+{
+    if (!std::isfinite(d) || std::fabs(d) > double(FLT_MAX)) throw Fail(what + " is not a finite float");
+    return float(d);
+}
+
+// Light index from a node's KHR_lights_punctual extension, or -1.
+int node_light(const tinygltf::Node &n, size_t ni, size_t light_count)
+{
+    auto it = n.extensions.find("KHR_lights_punctual");
+    if (it == n.extensions.end()) return -1;
+    const tinygltf::Value &ext = it->second;
+    if (!ext.IsObject() || !ext.Has("light")) throw Fail("node " + str(ni) + ": malformed KHR_lights_punctual");
+    const tinygltf::Value &l = ext.Get("light");
+    const double d = l.IsNumber() ? l.GetNumberAsDouble() : -1.0;
+    if (!(d >= 0 && d < double(light_count) && d == std::floor(d)))
+        throw Fail("node " + str(ni) + ": KHR_lights_punctual light index out of range");
+    return int(d);
+}
+
+// ---- the model ----------------------------------------------------------------------
+
+struct Holder {
+    fv_gltf_model pub{};
+    std::vector<std::vector<float>> floats;
+    std::vector<std::vector<uint32_t>> uints;
+    std::vector<std::vector<uint8_t>> pixels;
+    std::vector<fv_gltf_prim> prims;
+    std::vector<size_t> mesh_first_prim;
+    std::vector<fv_gltf_mesh> meshes;
+    std::vector<fv_gltf_node> nodes;
+    std::vector<fv_gltf_material> materials;
+    std::vector<fv_gltf_image> images;
+    std::vector<fv_gltf_light> lights;
+    std::vector<int> material_texcoord; // TEXCOORD_n set of each material's base colour texture
+};
+
+const float *keep(Holder &h, std::vector<float> &&v)
+{
+    h.floats.push_back(std::move(v)); // moving a vector keeps its heap buffer
+    return h.floats.back().data();
+}
+
+void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *image_used)
+{
+    for (size_t i = 0; i < m.materials.size(); i++) {
+        const std::string at = "material " + str(i);
+        const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
+        fv_gltf_material mat = {{1, 1, 1, 1}, -1};
+        if (!pbr.baseColorFactor.empty()) {
+            if (pbr.baseColorFactor.size() != 4) throw Fail(at + ": baseColorFactor needs 4 numbers");
+            for (int c = 0; c < 4; c++) mat.base_color[c] = to_float(pbr.baseColorFactor[size_t(c)], at + " baseColorFactor");
+        }
+        int texcoord = 0;
+        const int ti = pbr.baseColorTexture.index;
+        if (ti >= 0) {
+            if (size_t(ti) >= m.textures.size()) throw Fail(at + ": base colour texture " + str(ti) + " does not exist");
+            const int src = m.textures[size_t(ti)].source;
+            if (src >= 0 && size_t(src) >= m.images.size())
+                throw Fail("texture " + str(ti) + ": image " + str(src) + " does not exist");
+            texcoord = pbr.baseColorTexture.texCoord;
+            if (texcoord < 0) throw Fail(at + ": negative texCoord");
+            mat.image = src; // -1 (e.g. an extension-only source) means factor only
+            if (src >= 0) (*image_used)[size_t(src)] = 1;
+        }
+        h.materials.push_back(mat);
+        h.material_texcoord.push_back(texcoord);
+    }
+}
+
+void decode_images(const tinygltf::Model &m, Holder &h, const std::vector<char> &used)
+{
+    h.images.resize(m.images.size());
+    h.pixels.resize(m.images.size());
+    for (size_t i = 0; i < m.images.size(); i++) {
+        h.images[i] = fv_gltf_image{nullptr, 0, 0};
+        if (!used[i]) continue;
+        const tinygltf::Image &src = m.images[i];
+        const std::string at = "image " + str(i) + (src.uri.empty() ? "" : " (" + src.uri + ")");
+        if (src.image.empty()) throw Fail(at + ": could not be read");
+        tinygltf::Image img;
+        img.name = src.name;
+        std::string e, w;
+        if (!tinygltf::LoadImageData(&img, int(i), &e, &w, 0, 0, src.image.data(), int(src.image.size()), nullptr))
+            throw Fail(at + ": cannot decode" + (e.empty() ? "" : ": " + e));
+        const size_t bytes_per = img.bits == 16 ? 2 : 1;
+        if (img.width < 1 || img.height < 1 || img.width > kMaxImageSide || img.height > kMaxImageSide ||
+            size_t(img.width) * size_t(img.height) > kMaxImageTexels || img.component != 4 ||
+            (img.bits != 8 && img.bits != 16) ||
+            img.image.size() != size_t(img.width) * size_t(img.height) * 4 * bytes_per)
+            throw Fail(at + ": unsupported decoded layout");
+        std::vector<uint8_t> &px = h.pixels[i];
+        px.resize(size_t(img.width) * size_t(img.height) * 4);
+        if (bytes_per == 1) {
+            std::memcpy(px.data(), img.image.data(), px.size());
+        } else { // 16-bit PNG: keep the high byte (stb returns native-endian uint16)
+            for (size_t k = 0; k < px.size(); k++) {
+                uint16_t v;
+                std::memcpy(&v, img.image.data() + 2 * k, 2);
+                px[k] = uint8_t(v >> 8);
+            }
+        }
+        h.images[i] = fv_gltf_image{px.data(), img.width, img.height};
+    }
+}
+
+void convert_meshes(const tinygltf::Model &m, Holder &h)
+{
+    for (size_t mi = 0; mi < m.meshes.size(); mi++) {
+        h.mesh_first_prim.push_back(h.prims.size());
+        const std::vector<tinygltf::Primitive> &prims = m.meshes[mi].primitives;
+        for (size_t pi = 0; pi < prims.size(); pi++) {
+            const tinygltf::Primitive &p = prims[pi];
+            if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES) continue; // points, lines, strips
+            const std::string at = "mesh " + str(mi) + " primitive " + str(pi);
+            if (p.material < -1 || (p.material >= 0 && size_t(p.material) >= m.materials.size()))
+                throw Fail(at + ": material " + str(p.material) + " does not exist");
+            auto pos_it = p.attributes.find("POSITION");
+            if (pos_it == p.attributes.end()) throw Fail(at + ": no POSITION attribute");
+            fv_gltf_prim out{};
+            out.material = p.material;
+            std::vector<float> pos = read_floats(m, pos_it->second, 3, at + " POSITION");
+            out.vertex_count = pos.size() / 3;
+            out.positions = keep(h, std::move(pos));
+
+            auto attr = [&](const std::string &name, int comps) -> const float * {
+                auto it = p.attributes.find(name);
+                if (it == p.attributes.end()) return nullptr;
+                std::vector<float> v = read_floats(m, it->second, comps, at + " " + name);
+                if (v.size() / size_t(comps) != out.vertex_count)
+                    throw Fail(at + ": " + name + " count " + str(v.size() / size_t(comps)) +
+                               " differs from POSITION count " + str(out.vertex_count));
+                return keep(h, std::move(v));
+            };
+            out.normals = attr("NORMAL", 3);
+            const int set = out.material >= 0 && h.materials[size_t(out.material)].image >= 0
+                                ? h.material_texcoord[size_t(out.material)] : -1;
+            out.uvs = set >= 0 ? attr("TEXCOORD_" + str(set), 2) : nullptr;
+
+            if (p.indices >= 0) {
+                h.uints.push_back(read_indices(m, p.indices, out.vertex_count, at));
+                out.indices = h.uints.back().data();
+                out.index_count = h.uints.back().size();
+            } else if (out.vertex_count % 3 != 0) {
+                throw Fail(at + ": non-indexed vertex count " + str(out.vertex_count) + " is not a multiple of 3");
+            }
+            h.prims.push_back(out);
+        }
+    }
+    for (size_t mi = 0; mi < m.meshes.size(); mi++) {
+        const size_t first = h.mesh_first_prim[mi];
+        const size_t end = mi + 1 < m.meshes.size() ? h.mesh_first_prim[mi + 1] : h.prims.size();
+        h.meshes.push_back(fv_gltf_mesh{h.prims.data() + first, end - first});
+    }
+}
+
+void convert_lights(const tinygltf::Model &m, Holder &h, std::vector<char> *supported)
+{
+    for (size_t i = 0; i < m.lights.size(); i++) {
+        const tinygltf::Light &l = m.lights[i];
+        const std::string at = "light " + str(i);
+        fv_gltf_light out{};
+        (*supported)[i] = 1;
+        if (l.type == "directional") out.type = 0;
+        else if (l.type == "point") out.type = 1;
+        else if (l.type == "spot") out.type = 2;
+        else (*supported)[i] = 0; // unknown future type: nodes referencing it get no light
+        for (int c = 0; c < 3; c++) out.color[c] = 1.0f;
+        if (!l.color.empty()) {
+            if (l.color.size() != 3) throw Fail(at + ": color needs 3 numbers");
+            for (int c = 0; c < 3; c++) out.color[c] = to_float(l.color[size_t(c)], at + " color");
+        }
+        out.intensity = to_float(l.intensity, at + " intensity");
+        out.range = to_float(l.range, at + " range");
+        out.inner_cone_rad = to_float(l.spot.innerConeAngle, at + " innerConeAngle");
+        out.outer_cone_rad = to_float(l.spot.outerConeAngle, at + " outerConeAngle");
+        if (out.intensity < 0 || out.range < 0) throw Fail(at + ": negative intensity or range");
+        if (out.type == 2 && !(out.inner_cone_rad >= 0 && out.inner_cone_rad < out.outer_cone_rad &&
+                               out.outer_cone_rad <= 1.5707964f))
+            throw Fail(at + ": spot cone angles need 0 <= inner < outer <= pi/2");
+        h.lights.push_back(out);
+    }
+}
+
+void convert_nodes(const tinygltf::Model &m, Holder &h, const std::vector<char> &light_ok)
+{
+    const size_t n = m.nodes.size();
+    std::vector<double> local(n * 16);
+    std::vector<char> has_parent(n, 0);
+    for (size_t i = 0; i < n; i++) {
+        const tinygltf::Node &nd = m.nodes[i];
+        const std::string at = "node " + str(i);
+        if (nd.mesh < -1 || (nd.mesh >= 0 && size_t(nd.mesh) >= m.meshes.size()))
+            throw Fail(at + ": mesh " + str(nd.mesh) + " does not exist");
+        if (nd.camera < -1 || (nd.camera >= 0 && size_t(nd.camera) >= m.cameras.size()))
+            throw Fail(at + ": camera " + str(nd.camera) + " does not exist");
+        for (int c : nd.children) {
+            if (c < 0 || size_t(c) >= n) throw Fail(at + ": child " + str(c) + " does not exist");
+            if (has_parent[size_t(c)]) throw Fail("node " + str(c) + " has more than one parent");
+            has_parent[size_t(c)] = 1;
+        }
+        node_local(nd, i, &local[i * 16]);
+    }
+
+    std::vector<int> roots;
+    if (m.defaultScene >= 0) {
+        if (size_t(m.defaultScene) >= m.scenes.size())
+            throw Fail("default scene " + str(m.defaultScene) + " does not exist");
+        roots = m.scenes[size_t(m.defaultScene)].nodes;
+    } else {
+        for (size_t i = 0; i < n; i++)
+            if (!has_parent[i]) roots.push_back(int(i));
+    }
+
+    // Iterative depth-first walk: deep chains cannot overflow the stack, and a node seen
+    // twice (cycle, or listed as root and as child) is an error instead of a hang.
+    struct Item {
+        int node;
+        size_t parent; // index into h.nodes, or SIZE_MAX for roots
+    };
+    std::vector<char> seen(n, 0);
+    std::vector<Item> stack;
+    for (size_t r = roots.size(); r-- > 0;) stack.push_back(Item{roots[r], SIZE_MAX});
+    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    while (!stack.empty()) {
+        const Item it = stack.back();
+        stack.pop_back();
+        if (it.node < 0 || size_t(it.node) >= n) throw Fail("scene root node " + str(it.node) + " does not exist");
+        const size_t ni = size_t(it.node);
+        if (seen[ni]) throw Fail("node " + str(ni) + " is reached twice (the node graph is not a tree)");
+        seen[ni] = 1;
+        const tinygltf::Node &nd = m.nodes[ni];
+        fv_gltf_node out{};
+        const double *parent = it.parent == SIZE_MAX ? identity : h.nodes[it.parent].world;
+        mat_mul(parent, &local[ni * 16], out.world);
+        for (double d : out.world)
+            if (!std::isfinite(d)) throw Fail("node " + str(ni) + ": world transform is not finite");
+        out.mesh = nd.mesh;
+        out.camera = (nd.camera >= 0 && m.cameras[size_t(nd.camera)].type == "perspective") ? nd.camera : -1;
+        const int li = node_light(nd, ni, m.lights.size());
+        out.light = (li >= 0 && light_ok[size_t(li)]) ? li : -1;
+        h.nodes.push_back(out);
+        const size_t self = h.nodes.size() - 1;
+        for (size_t c = nd.children.size(); c-- > 0;) stack.push_back(Item{nd.children[c], self});
+    }
+}
+
+std::string one_line(std::string s)
+{
+    for (char &c : s) // tinygltf quotes raw file bytes into some messages
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = ' ';
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    return s.empty() ? std::string("unknown error") : s;
+}
+
+void set_err(char *err, size_t err_len, const std::string &msg)
+{
+    if (!err || err_len == 0) return;
+    std::snprintf(err, err_len, "%s", msg.c_str());
+}
+
+fv_gltf_model *load(const char *path)
+{
+    std::vector<unsigned char> file;
+    std::string e;
+    if (!read_file(path, &file, &e)) throw Fail(e);
+    const bool glb = file.size() >= 4 && std::memcmp(file.data(), "glTF", 4) == 0;
+    if (glb) {
+        uint32_t json_len = 0;
+        if (file.size() >= 20) std::memcpy(&json_len, file.data() + 12, 4);
+        if (file.size() >= 20 && json_len <= file.size() - 20 && !json_depth_ok(file.data() + 20, json_len))
+            throw Fail("JSON nested too deeply");
+    } else if (!json_depth_ok(file.data(), file.size())) {
+        throw Fail("JSON nested too deeply");
+    }
+
+    std::string dir(path);
+    const size_t slash = dir.find_last_of('/');
+    dir = slash == std::string::npos ? std::string() : dir.substr(0, slash);
+
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{&fs_exists, &fs_expand, &fs_read, &fs_write, nullptr});
+    ImageHookCtx ictx{&model};
+    loader.SetImageLoader(&keep_encoded_image, &ictx);
+    std::string terr, twarn;
+    const bool ok = glb ? loader.LoadBinaryFromMemory(&model, &terr, &twarn, file.data(), unsigned(file.size()), dir)
+                        : loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(file.data()),
+                                                     unsigned(file.size()), dir);
+    if (!ok) throw Fail("tinygltf: " + (terr.empty() ? std::string("parse failed") : terr));
+    file.clear();
+    file.shrink_to_fit();
+
+    // Extensions the file cannot be read without: ours, or ones that only refine materials
+    // beyond this renderer's shading. Anything else (compression, other texture formats)
+    // would give silently wrong geometry or textures.
+    for (const std::string &ext : model.extensionsRequired)
+        if (ext != "KHR_lights_punctual" && ext != "KHR_mesh_quantization" && ext.rfind("KHR_materials_", 0) != 0)
+            throw Fail("required extension " + ext + " is not supported");
+
+    std::unique_ptr<Holder> h(new Holder);
+    std::vector<char> image_used(model.images.size(), 0), light_ok(model.lights.size(), 0);
+    convert_materials(model, *h, &image_used);
+    decode_images(model, *h, image_used);
+    convert_meshes(model, *h);
+    convert_lights(model, *h, &light_ok);
+    convert_nodes(model, *h, light_ok);
+
+    fv_gltf_model &p = h->pub;
+    p.meshes = h->meshes.data(), p.mesh_count = h->meshes.size();
+    p.nodes = h->nodes.data(), p.node_count = h->nodes.size();
+    p.materials = h->materials.data(), p.material_count = h->materials.size();
+    p.images = h->images.data(), p.image_count = h->images.size();
+    p.lights = h->lights.data(), p.light_count = h->lights.size();
+    p.impl = h.get();
+    return &h.release()->pub;
+}
+
+} // namespace
+
+extern "C" fv_gltf_model *fv_gltf_load(const char *path, char *err, size_t err_len)
+{
+    set_err(err, err_len, "");
+    std::string msg;
+    try {
+        if (!path) throw Fail("no path");
+        return load(path);
+    } catch (const std::bad_alloc &) {
+        msg = "out of memory";
+    } catch (const std::exception &ex) {
+        msg = ex.what();
+    } catch (...) {
+        msg = "unknown exception";
+    }
+    set_err(err, err_len, one_line(msg));
+    return nullptr;
+}
+
+extern "C" void fv_gltf_free(fv_gltf_model *m)
+{
+    if (m) delete static_cast<Holder *>(m->impl);
+}

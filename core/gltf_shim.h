@@ -1,0 +1,73 @@
+/* fovea: plain C view of a glTF 2.0 file, read and validated by tinygltf behind a C++17 shim.
+ * Everything scene.c needs is already decoded, checked and flattened into C arrays:
+ * triangle primitives as float/uint32 arrays (mesh-local space), the nodes reachable from
+ * the scene's roots with their world matrices, materials, decoded base colour images and
+ * KHR_lights_punctual lights. The model owns all memory; fv_gltf_free releases it. */
+#ifndef FOVEA_GLTF_SHIM_H
+#define FOVEA_GLTF_SHIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct fv_gltf_prim {
+    const float *positions;  /* 3 per vertex, mesh-local, all finite */
+    const float *normals;    /* 3 per vertex, or NULL */
+    const float *uvs;        /* 2 per vertex (the set the material's base colour texture uses), or NULL */
+    const uint32_t *indices; /* index_count, each < vertex_count; NULL: non-indexed */
+    size_t vertex_count, index_count; /* index_count (or vertex_count if non-indexed) % 3 == 0 */
+    int material;            /* index into materials, or -1 (glTF default material) */
+} fv_gltf_prim;
+
+typedef struct fv_gltf_mesh {
+    const fv_gltf_prim *prims; /* TRIANGLES primitives only; other modes are skipped */
+    size_t prim_count;
+} fv_gltf_mesh;
+
+/* A node reachable from the roots, in depth-first pre-order (roots in scene order). */
+typedef struct fv_gltf_node {
+    double world[16];  /* column-major local-to-world, parents' transforms applied */
+    int mesh;          /* index into meshes, or -1 */
+    int camera;        /* perspective camera index, or -1 (orthographic cameras are ignored) */
+    int light;         /* index into lights (KHR_lights_punctual), or -1 */
+} fv_gltf_node;
+
+typedef struct fv_gltf_material {
+    float base_color[4]; /* pbrMetallicRoughness.baseColorFactor, linear RGBA */
+    int image;           /* base colour texture's image (decoded), or -1 */
+} fv_gltf_material;
+
+typedef struct fv_gltf_image {
+    const uint8_t *rgba8; /* sRGB RGBA8, width*height*4; NULL if no material uses it as base colour */
+    int width, height;
+} fv_gltf_image;
+
+typedef struct fv_gltf_light {
+    int type;          /* 0 directional, 1 point, 2 spot (same order as fv_light_type) */
+    float color[3], intensity;
+    float range;       /* 0 = infinite */
+    float inner_cone_rad, outer_cone_rad;
+} fv_gltf_light;
+
+typedef struct fv_gltf_model {
+    const fv_gltf_mesh *meshes;         size_t mesh_count;
+    const fv_gltf_node *nodes;          size_t node_count;
+    const fv_gltf_material *materials;  size_t material_count;
+    const fv_gltf_image *images;        size_t image_count;
+    const fv_gltf_light *lights;        size_t light_count;
+    void *impl; /* owner of the arrays above */
+} fv_gltf_model;
+
+/* Reads a .gltf or .glb (detected by content). Returns NULL with a one-line reason in err
+ * on any failure; never throws. */
+fv_gltf_model *fv_gltf_load(const char *path, char *err, size_t err_len);
+void fv_gltf_free(fv_gltf_model *m);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

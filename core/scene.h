@@ -1,0 +1,80 @@
+/* fovea: the scene. glTF 2.0 (.gltf/.glb, through a small C++ tinygltf shim) or meshes
+ * added by hand, flattened to world space into one Embree 3 scene (static, high-quality BVH),
+ * with materials (base colour factor + texture with mip chain), lights and shading. */
+#ifndef FOVEA_SCENE_H
+#define FOVEA_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <embree3/rtcore.h>
+
+typedef struct fv_scene fv_scene;
+
+/* Ambient term of fv_scene_shade, a fraction of the base colour. */
+#define FV_SCENE_AMBIENT 0.15f
+
+/* Loads a .gltf or .glb. Returns NULL and writes a one-line reason into err on failure
+ * (missing file, malformed JSON, bad accessor, out-of-range index, unsupported required
+ * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
+ * reachable from the default scene (or all root nodes) are flattened with their world
+ * transforms; skins, morph targets, animations, samplers' wrap modes and materials beyond
+ * the base colour are ignored. The first perspective camera in depth-first node order
+ * becomes the default view. */
+fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
+
+/* Building a scene by hand (tests, generators): create, add meshes, commit. */
+typedef struct fv_mesh_desc {
+    const float *positions; /* 3 floats per vertex, world space (the transform below is applied) */
+    const float *normals;   /* 3 per vertex, or NULL: computed (area-weighted smooth) */
+    const float *uvs;       /* 2 per vertex, or NULL */
+    const uint32_t *indices;/* 3 per triangle, or NULL: non-indexed, vertex_count/3 triangles */
+    size_t vertex_count, index_count;
+    float base_color[4];    /* linear RGBA factor */
+    int texture;            /* index from fv_scene_add_texture, or -1 */
+    float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
+} fv_mesh_desc;
+fv_scene *fv_scene_create(void);
+/* rgba8 is sRGB-encoded 8-bit RGBA, copied. Returns the texture index or -1. */
+int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h);
+/* Validates (indices < vertex_count, counts multiple of 3, finite data, texture index) and
+ * flattens the mesh to world space. Returns 0, or -1 with err (the scene is unchanged).
+ * Meshes get Embree geometry IDs 0, 1, 2, ... in the order they were added successfully. */
+int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_len);
+typedef enum { FV_LIGHT_DIRECTIONAL, FV_LIGHT_POINT, FV_LIGHT_SPOT } fv_light_type;
+typedef struct fv_light {
+    fv_light_type type;
+    float color[3], intensity; /* glTF KHR_lights_punctual units */
+    float pos[3], dir[3];      /* world space; dir is where the light points */
+    float range;               /* 0 = infinite */
+    float inner_cone, outer_cone; /* radians, spot only */
+} fv_light;
+void fv_scene_add_light(fv_scene *s, const fv_light *l);
+/* Sets the pose fv_scene_default_view returns (glTF camera node); quat x,y,z,w as there. */
+void fv_scene_set_default_view(fv_scene *s, const float pos[3], const float quat[4]);
+int fv_scene_commit(fv_scene *s, char *err, size_t err_len); /* builds the BVH; 0 on success */
+void fv_scene_free(fv_scene *s);
+
+RTCScene fv_scene_rtc(const fv_scene *s);
+size_t fv_scene_triangle_count(const fv_scene *s);
+void fv_scene_bounds(const fv_scene *s, float lo[3], float hi[3]);
+int fv_scene_light_count(const fv_scene *s);
+/* Copies light i (world space, dir normalised) into out; 0 on success, -1 if out of range. */
+int fv_scene_get_light(const fv_scene *s, int i, fv_light *out);
+
+/* Default viewpoint: the first glTF camera node if the file has one (returns 1), otherwise
+ * looking down -Z from in front of the bounds, framing them in the vertical FOV (returns 0).
+ * quat is x,y,z,w, rotating eye space (looking down -Z, +Y up) into world space. */
+int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, float pos[3], float quat[4]);
+
+/* Shades one hit: base colour (factor x texture, bilinear, mip level from the ray footprint)
+ * x Lambert over the scene's lights, plus ambient. Without KHR_lights_punctual a head light
+ * at eye_pos is used. footprint_rad is the angular size of one pixel along this ray (the
+ * ray-cone spread), so the footprint at the hit is about t*|dir|*footprint_rad metres.
+ * KHR light contributions are scaled by one exposure per scene, fixed at commit so that the
+ * brightest light gives irradiance 1.0 at the bounds' centre (glTF intensities are often in
+ * the thousands). Normals face the ray (double-sided). Writes linear RGB. */
+void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
+                    const float org[3], const float dir[3], float t, float footprint_rad,
+                    const float eye_pos[3], float rgb[3]);
+
+#endif

@@ -1,0 +1,1056 @@
+/* Scene tests: the builder (hits, shading, textures, normals, lights, default view), the
+ * glTF loader (hierarchy, camera, the shared scenes) and hostile files (truncated,
+ * corrupted, out-of-range), which must fail cleanly. Expected values are worked out by
+ * hand in the comments, or counted from the files with an independent script. */
+#include "testutil.h"
+
+#include "scene.h"
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#define SQ2 0.70710678f
+
+static void assert_near_msg(float got, float want, float tol, const char *what, int line)
+{
+    if (!(fabsf(got - want) <= tol)) {
+        print_error("line %d: %s = %.7g, expected %.7g (tol %g)\n", line, what, (double)got, (double)want, (double)tol);
+        fail();
+    }
+}
+#define assert_near(got, want, tol) assert_near_msg((got), (want), (tol), #got, __LINE__)
+
+static void assert_rgb(const float rgb[3], float r, float g, float b, float tol, int line)
+{
+    assert_near_msg(rgb[0], r, tol, "r", line);
+    assert_near_msg(rgb[1], g, tol, "g", line);
+    assert_near_msg(rgb[2], b, tol, "b", line);
+}
+
+/* ---- helpers --------------------------------------------------------------------------- */
+
+typedef struct hit {
+    float t, u, v;
+    unsigned geom, prim;
+} hit;
+
+/* One ray through rtcIntersect1; returns 1 on a hit. */
+static int cast(const fv_scene *s, const float o[3], const float d[3], hit *h)
+{
+    memset(h, 0, sizeof *h); /* cmocka's fail() is not noreturn: keep callers' reads defined */
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    memset(&rh, 0, sizeof rh);
+    rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
+    rh.ray.dir_x = d[0], rh.ray.dir_y = d[1], rh.ray.dir_z = d[2];
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = INFINITY;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(fv_scene_rtc(s), &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    h->t = rh.ray.tfar, h->u = rh.hit.u, h->v = rh.hit.v, h->geom = rh.hit.geomID, h->prim = rh.hit.primID;
+    return 1;
+}
+
+/* Casts and shades with the head light at the ray origin; asserts a hit. */
+static void cast_shade(const fv_scene *s, const float o[3], const float d[3], float footprint, hit *h, float rgb[3])
+{
+    assert_true(cast(s, o, d, h));
+    fv_scene_shade(s, h->geom, h->prim, h->u, h->v, o, d, h->t, footprint, o, rgb);
+}
+
+static fv_mesh_desc mesh(const float *pos, size_t nv, const uint32_t *idx, size_t ni)
+{
+    fv_mesh_desc m;
+    memset(&m, 0, sizeof m);
+    m.positions = pos, m.vertex_count = nv, m.indices = idx, m.index_count = ni;
+    m.base_color[0] = m.base_color[1] = m.base_color[2] = m.base_color[3] = 1.0f;
+    m.texture = -1;
+    return m;
+}
+
+static fv_scene *commit_or_fail(fv_scene *s)
+{
+    char err[256] = "";
+    assert_int_equal(fv_scene_commit(s, err, sizeof err), 0);
+    return s;
+}
+
+static double srgb_to_linear(int c)
+{
+    const double x = c / 255.0;
+    return x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4);
+}
+
+static char *path_join(char *buf, size_t n, const char *a, const char *b)
+{
+    snprintf(buf, n, "%s/%s", a, b);
+    return buf;
+}
+
+static char *shared_scene(char *buf, size_t n, const char *rel)
+{
+    snprintf(buf, n, "%s/assets/scenes/%s", fv_test_shared(), rel);
+    return buf;
+}
+
+static unsigned char *read_all(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        print_error("cannot open %s\n", path);
+        fail();
+    }
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char *b = malloc((size_t)n + 1);
+    assert_non_null(b);
+    assert_int_equal(fread(b, 1, (size_t)n, f), (size_t)n);
+    fclose(f);
+    b[n] = 0;
+    *len = (size_t)n;
+    return b;
+}
+
+static void write_all(const char *path, const void *data, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, len, f), len);
+    assert_int_equal(fclose(f), 0);
+}
+
+static char *tmpdir_make(void)
+{
+    char tmpl[] = "/tmp/fv_scene_test_XXXXXX";
+    assert_non_null(mkdtemp(tmpl));
+    return strdup(tmpl);
+}
+
+static void tmpdir_remove(char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char p[512];
+        while ((e = readdir(d)))
+            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) unlink(path_join(p, sizeof p, dir, e->d_name));
+        closedir(d);
+    }
+    rmdir(dir);
+    free(dir);
+}
+
+/* Loading must fail with a one-line reason (and, under ASan, without touching bad memory).
+ * Returns 1 if it did, else prints why not and returns 0. */
+static int load_fails(const char *path, const char *must_contain)
+{
+    char err[512];
+    memset(err, 'x', sizeof err);
+    fv_scene *s = fv_scene_load(path, err, sizeof err);
+    if (s) {
+        print_error("%s loaded but should have failed\n", path);
+        fv_scene_free(s);
+        return 0;
+    }
+    const size_t n = strnlen(err, sizeof err);
+    if (n == 0 || n == sizeof err) {
+        print_error("%s: no error message\n", path);
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)err[i] < 0x20) {
+            print_error("%s: error message is not one line\n", path);
+            return 0;
+        }
+    if (must_contain && !strstr(err, must_contain)) {
+        print_error("error \"%s\" does not mention \"%s\"\n", err, must_contain);
+        return 0;
+    }
+    return 1;
+}
+#define expect_load_fails(path, must_contain) assert_true(load_fails((path), (must_contain)))
+
+/* Loading may succeed or fail, but a failure must carry a reason. */
+static void load_any(const char *path)
+{
+    char err[512] = "";
+    fv_scene *s = fv_scene_load(path, err, sizeof err);
+    if (s) fv_scene_free(s);
+    else assert_true(strlen(err) > 0);
+}
+
+static char *base64(const unsigned char *d, size_t n)
+{
+    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    char *o = malloc(4 * ((n + 2) / 3) + 1), *p = o;
+    assert_non_null(o);
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
+        *p++ = tab[v >> 18 & 63];
+        *p++ = tab[v >> 12 & 63];
+        *p++ = i + 1 < n ? tab[v >> 6 & 63] : '=';
+        *p++ = i + 2 < n ? tab[v & 63] : '=';
+    }
+    *p = 0;
+    return o;
+}
+
+/* Writes dir/name as a .gltf with bin as its one embedded buffer plus the given JSON members. */
+static void write_gltf(const char *path, const void *bin, size_t bin_len, const char *members)
+{
+    char *b64 = base64(bin, bin_len);
+    size_t n = strlen(b64) + strlen(members) + 256;
+    char *json = malloc(n);
+    assert_non_null(json);
+    snprintf(json, n,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}],%s}",
+             bin_len, b64, members);
+    write_all(path, json, strlen(json));
+    free(json);
+    free(b64);
+}
+
+/* ---- builder: hits and shading ------------------------------------------------------- */
+
+/* Quad [-1,1]^2 at z=0, colour (0.8, 0.4, 0.2). A ray from (0.25, 0.25, 3) with dir
+ * (0,0,-2) reaches z=0 at t = 3/2. The head light sits at the ray origin, straight above
+ * the hit: lambert 1, so colour = base * (0.15 + 1). */
+static void test_builder_quad_hit_and_headlight(void **state)
+{
+    (void)state;
+    const float pos[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    fv_scene *s = fv_scene_create();
+    assert_non_null(s);
+    fv_mesh_desc m = mesh(pos, 4, idx, 6);
+    m.base_color[0] = 0.8f, m.base_color[1] = 0.4f, m.base_color[2] = 0.2f;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    commit_or_fail(s);
+    assert_int_equal(fv_scene_triangle_count(s), 2);
+    assert_int_equal(fv_scene_light_count(s), 0);
+
+    const float o[3] = {0.25f, 0.25f, 3}, d[3] = {0, 0, -2};
+    hit h;
+    float rgb[3];
+    cast_shade(s, o, d, 0.0f, &h, rgb);
+    assert_near(h.t, 1.5f, 1e-5f);
+    assert_rgb(rgb, 0.8f * 1.15f, 0.4f * 1.15f, 0.2f * 1.15f, 1e-5f, __LINE__);
+
+    /* Oblique head light: the eye is 3 off along x and 4 up, so cos = 4/5 at the hit
+     * (0.25, 0.25, 0): colour = base * (0.15 + 0.8). From below the normal flips (double-sided). */
+    const float o2[3] = {3.25f, 0.25f, 4}, d2[3] = {-3, 0, -4};
+    cast_shade(s, o2, d2, 0.0f, &h, rgb);
+    assert_near(h.t, 1.0f, 1e-5f);
+    assert_rgb(rgb, 0.8f * 0.95f, 0.4f * 0.95f, 0.2f * 0.95f, 1e-5f, __LINE__);
+    const float o3[3] = {0.25f, 0.25f, -4}, d3[3] = {0, 0, 1};
+    cast_shade(s, o3, d3, 0.0f, &h, rgb);
+    assert_near(h.t, 4.0f, 1e-5f);
+    assert_rgb(rgb, 0.8f * 1.15f, 0.4f * 1.15f, 0.2f * 1.15f, 1e-5f, __LINE__);
+
+    /* A miss stays a miss. */
+    const float o4[3] = {1.5f, 0, 3};
+    assert_false(cast(s, o4, d, &h));
+    fv_scene_free(s);
+}
+
+/* Non-indexed triangle moved by the desc transform (column-major, translation (0,0,-2)):
+ * a ray from the origin down -Z hits at t = 2; bounds follow the transform. */
+static void test_builder_transform_non_indexed(void **state)
+{
+    (void)state;
+    const float pos[] = {-1, -1, 0, 1, -1, 0, 0, 1, 0};
+    fv_scene *s = fv_scene_create();
+    fv_mesh_desc m = mesh(pos, 3, NULL, 0);
+    m.transform[0] = m.transform[5] = m.transform[10] = m.transform[15] = 1.0f;
+    m.transform[14] = -2.0f;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    commit_or_fail(s);
+    float lo[3], hi[3];
+    fv_scene_bounds(s, lo, hi);
+    assert_near(lo[0], -1, 0), assert_near(lo[1], -1, 0), assert_near(lo[2], -2, 0);
+    assert_near(hi[0], 1, 0), assert_near(hi[1], 1, 0), assert_near(hi[2], -2, 0);
+    const float o[3] = {0, 0, 0}, d[3] = {0, 0, -1};
+    hit h;
+    assert_true(cast(s, o, d, &h));
+    assert_near(h.t, 2.0f, 1e-6f);
+    assert_int_equal(h.geom, 0);
+    fv_scene_free(s);
+}
+
+/* Smooth area-weighted normals. Triangle 0 (A,B,C) = (0,0,0),(2,0,0),(0,2,0) has
+ * e1 x e2 = (0,0,4); triangle 1 (A,D,B) with D = (0,0,1) has (0,0,1) x (2,0,0) = (0,2,0).
+ * Shared A and B get normalize(0,2,4) = (0, 1/sqrt5, 2/sqrt5); C gets (0,0,1), D (0,1,0).
+ * Shading with the eye straight above (+Z) gives base * (0.15 + n.z). */
+static void test_builder_computed_normals(void **state)
+{
+    (void)state;
+    const float pos[] = {0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 1};
+    const uint32_t idx[] = {0, 1, 2, 0, 3, 1};
+    fv_scene *s = fv_scene_create();
+    fv_mesh_desc m = mesh(pos, 4, idx, 6);
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    commit_or_fail(s);
+    float rgb[3];
+    const float up[3] = {0, 0, -1};
+    const float eye_a[3] = {0, 0, 3}; /* vertex A of triangle 0: u = v = 0 */
+    fv_scene_shade(s, 0, 0, 0, 0, eye_a, up, 3, 0, eye_a, rgb);
+    const float want_a = 0.15f + 2.0f / sqrtf(5.0f);
+    assert_rgb(rgb, want_a, want_a, want_a, 1e-5f, __LINE__);
+    const float eye_b[3] = {2, 0, 3}; /* vertex B = vertex 1 of triangle 0: u = 1 */
+    fv_scene_shade(s, 0, 0, 1, 0, eye_b, up, 3, 0, eye_b, rgb);
+    assert_rgb(rgb, want_a, want_a, want_a, 1e-5f, __LINE__);
+    const float eye_c[3] = {0, 2, 3}; /* vertex C: v = 1 */
+    fv_scene_shade(s, 0, 0, 0, 1, eye_c, up, 3, 0, eye_c, rgb);
+    assert_rgb(rgb, 1.15f, 1.15f, 1.15f, 1e-5f, __LINE__);
+    /* D = vertex 1 of triangle 1, normal (0,1,0): lit from +Y fully, from +Z not at all. */
+    const float eye_d[3] = {0, 3, 1}, toward_d[3] = {0, -1, 0};
+    fv_scene_shade(s, 0, 1, 1, 0, eye_d, toward_d, 3, 0, eye_d, rgb);
+    assert_rgb(rgb, 1.15f, 1.15f, 1.15f, 1e-5f, __LINE__);
+    const float eye_d2[3] = {0, 0, 4};
+    fv_scene_shade(s, 0, 1, 1, 0, eye_d2, up, 3, 0, eye_d2, rgb);
+    assert_rgb(rgb, 0.15f, 0.15f, 0.15f, 1e-5f, __LINE__);
+    fv_scene_free(s);
+}
+
+/* Given normals go through the inverse-transpose. Normal (1,1,0)/sqrt2 under scale (2,1,1)
+ * becomes normalize(1/2, 1, 0) = (1,2,0)/sqrt5 (a plain transform would give (2,1,0)/sqrt5).
+ * The scaled triangle (0,0,0),(2,0,0),(0,1,0) is hit at p = (0.5,0.25,0) from the eye at
+ * p + (1,2,2): L = (1,2,2)/3, lambert = 5/(3 sqrt5) = sqrt5/3. */
+static void test_builder_normals_inverse_transpose(void **state)
+{
+    (void)state;
+    const float pos[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const float nrm[] = {SQ2, SQ2, 0, SQ2, SQ2, 0, SQ2, SQ2, 0};
+    fv_scene *s = fv_scene_create();
+    fv_mesh_desc m = mesh(pos, 3, NULL, 0);
+    m.normals = nrm;
+    m.transform[0] = 2, m.transform[5] = 1, m.transform[10] = 1, m.transform[15] = 1;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    commit_or_fail(s);
+    const float o[3] = {1.5f, 2.25f, 2}, d[3] = {-1, -2, -2};
+    hit h;
+    float rgb[3];
+    cast_shade(s, o, d, 0, &h, rgb);
+    assert_near(h.t, 1.0f, 1e-5f);
+    assert_near(h.u, 0.25f, 1e-5f);
+    assert_near(h.v, 0.25f, 1e-5f);
+    const float want = 0.15f + sqrtf(5.0f) / 3.0f;
+    assert_rgb(rgb, want, want, want, 1e-5f, __LINE__);
+    fv_scene_free(s);
+}
+
+/* ---- builder: textures --------------------------------------------------------------- */
+
+/* Triangle (0,0,0),(1,0,0),(0,1,0) with uvs equal to its xy, so the barycentric (u,v) passed
+ * to shade are the texture coordinates. Head light straight above: colour = texel * 1.15. */
+static fv_scene *textured_triangle(const uint8_t *texels, int w, int h)
+{
+    static const float pos[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    static const float uv[] = {0, 0, 1, 0, 0, 1};
+    fv_scene *s = fv_scene_create();
+    assert_non_null(s);
+    int t = fv_scene_add_texture(s, texels, w, h);
+    assert_int_equal(t, 0);
+    fv_mesh_desc m = mesh(pos, 3, NULL, 0);
+    m.uvs = uv;
+    m.texture = t;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    return commit_or_fail(s);
+}
+
+static void shade_uv(const fv_scene *s, float u, float v, float footprint, float rgb[3])
+{
+    const float o[3] = {u, v, 1}, d[3] = {0, 0, -1};
+    fv_scene_shade(s, 0, 0, u, v, o, d, 1.0f, footprint, o, rgb);
+}
+
+/* 4x2 texture; texel (x,y) has sRGB channels given below. At texel centres the bilinear
+ * sample is the texel; halfway between two centres it is their linear average; at u = 0
+ * REPEAT blends column 3 with column 0, at v = 0 row 1 with row 0; u = 1.25 equals 0.25. */
+static void test_texture_bilinear_wrap(void **state)
+{
+    (void)state;
+    static const int val[2][4][3] = {
+        {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 255}},
+        {{128, 128, 128}, {64, 32, 16}, {200, 100, 50}, {10, 20, 30}},
+    };
+    uint8_t tex[2 * 4 * 4];
+    for (int y = 0; y < 2; y++)
+        for (int x = 0; x < 4; x++) {
+            for (int c = 0; c < 3; c++) tex[(y * 4 + x) * 4 + c] = (uint8_t)val[y][x][c];
+            tex[(y * 4 + x) * 4 + 3] = 255;
+        }
+    fv_scene *s = textured_triangle(tex, 4, 2);
+    float rgb[3];
+#define LIN(y, x, c) ((float)srgb_to_linear(val[y][x][c]) * 1.15f)
+    for (int y = 0; y < 2; y++)
+        for (int x = 0; x < 4; x++) {
+            shade_uv(s, (x + 0.5f) / 4, (y + 0.5f) / 2, 0, rgb);
+            assert_rgb(rgb, LIN(y, x, 0), LIN(y, x, 1), LIN(y, x, 2), 1e-5f, __LINE__);
+        }
+    shade_uv(s, 0.25f, 0.25f, 0, rgb); /* between (0,0) and (1,0) */
+    assert_rgb(rgb, 0.5f * (LIN(0, 0, 0) + LIN(0, 1, 0)), 0.5f * (LIN(0, 0, 1) + LIN(0, 1, 1)),
+               0.5f * (LIN(0, 0, 2) + LIN(0, 1, 2)), 1e-5f, __LINE__);
+    shade_uv(s, 0.0f, 0.25f, 0, rgb); /* wraps: (3,0) with (0,0) */
+    assert_rgb(rgb, 0.5f * (LIN(0, 3, 0) + LIN(0, 0, 0)), 0.5f * (LIN(0, 3, 1) + LIN(0, 0, 1)),
+               0.5f * (LIN(0, 3, 2) + LIN(0, 0, 2)), 1e-5f, __LINE__);
+    shade_uv(s, 0.625f, 0.0f, 0, rgb); /* column 2, wraps vertically: row 1 with row 0 */
+    assert_rgb(rgb, 0.5f * (LIN(1, 2, 0) + LIN(0, 2, 0)), 0.5f * (LIN(1, 2, 1) + LIN(0, 2, 1)),
+               0.5f * (LIN(1, 2, 2) + LIN(0, 2, 2)), 1e-5f, __LINE__);
+    float rgb2[3];
+    shade_uv(s, 0.125f, 0.25f, 0, rgb);
+    shade_uv(s, 1.125f, -0.75f, 0, rgb2);
+    assert_rgb(rgb2, rgb[0], rgb[1], rgb[2], 1e-5f, __LINE__);
+#undef LIN
+    fv_scene_free(s);
+}
+
+/* Mip selection. The triangle has world area 1/2 and uv area 1/2, so a W x H texture has
+ * sqrt(W*H) texels per metre. With t*|dir| = 1 and a perpendicular hit the footprint is
+ * footprint_rad metres, so lod = log2(footprint_rad * sqrt(W*H)). */
+static void test_texture_mips(void **state)
+{
+    (void)state;
+    /* 4x4 grey ramp, texel (x,y) = 16*(y*4+x) in every channel. Level 1 is 2x2 (2x2 box
+     * averages), level 2 is 1x1 (the mean of all 16). */
+    uint8_t tex[4 * 4 * 4];
+    double lin[4][4], mean = 0;
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 4; x++) {
+            const int g = 16 * (y * 4 + x);
+            for (int c = 0; c < 3; c++) tex[(y * 4 + x) * 4 + c] = (uint8_t)g;
+            tex[(y * 4 + x) * 4 + 3] = 255;
+            lin[y][x] = srgb_to_linear(g);
+            mean += lin[y][x] / 16;
+        }
+    fv_scene *s = textured_triangle(tex, 4, 4);
+    float rgb[3];
+    const double l1_00 = (lin[0][0] + lin[0][1] + lin[1][0] + lin[1][1]) / 4;
+    shade_uv(s, 0.25f, 0.25f, 0.5f, rgb); /* 0.5 m * 4 texels/m = 2 texels: lod 1 */
+    assert_near(rgb[1], (float)(l1_00 * 1.15), 1e-5f);
+    shade_uv(s, 0.25f, 0.25f, 0.5f * sqrtf(2.0f), rgb); /* lod 1.5: halfway to level 2 */
+    assert_near(rgb[1], (float)(0.5 * (l1_00 + mean) * 1.15), 1e-4f);
+    shade_uv(s, 0.3f, 0.8f, 1000.0f, rgb); /* far beyond the chain: the 1x1 level */
+    assert_near(rgb[0], (float)(mean * 1.15), 1e-5f);
+    shade_uv(s, 0.125f, 0.125f, 0.1f, rgb); /* under a texel: level 0 */
+    assert_near(rgb[2], (float)(lin[0][0] * 1.15), 1e-5f);
+    /* Grazing hit: cos(theta) = 0.1 widens the footprint 10x; 0.05 m -> 0.5 m -> lod 1.
+     * At uv (0.375, 0.375) level 0 would be texel (1,1) exactly; level 1 (2x2) is sampled at
+     * x = y = 0.25 texels: weights 9/16, 3/16, 3/16, 1/16 over its four texels. */
+    double l1[2][2];
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++)
+            l1[j][i] = (lin[2 * j][2 * i] + lin[2 * j][2 * i + 1] + lin[2 * j + 1][2 * i] + lin[2 * j + 1][2 * i + 1]) / 4;
+    const double want_graze = (9 * l1[0][0] + 3 * l1[0][1] + 3 * l1[1][0] + l1[1][1]) / 16;
+    const float o[3] = {0.375f + 0.99498744f, 0.375f, 0.1f}, d[3] = {-0.99498744f, 0, -0.1f};
+    float rgb_graze[3];
+    fv_scene_shade(s, 0, 0, 0.375f, 0.375f, o, d, 1.0f, 0.05f, o, rgb_graze);
+    assert_near(rgb_graze[0], (float)(want_graze * (0.15 + 0.1)), 1e-5f); /* lambert = cos = 0.1 */
+    fv_scene_free(s);
+
+    /* Odd 5x3: level 1 is 2x1; its texel 0 averages columns 0-1 and texel 1 folds in the odd
+     * last column (columns 2-4), all 3 rows each. lod 1 at uv (0.75, 0.5) is texel 1 exactly. */
+    uint8_t odd[5 * 3 * 4];
+    double right = 0;
+    for (int y = 0; y < 3; y++)
+        for (int x = 0; x < 5; x++) {
+            const int g = 20 * x + 60 * y;
+            for (int c = 0; c < 3; c++) odd[(y * 5 + x) * 4 + c] = (uint8_t)g;
+            odd[(y * 5 + x) * 4 + 3] = 255;
+            if (x >= 2) right += srgb_to_linear(g) / 9;
+        }
+    s = textured_triangle(odd, 5, 3);
+    shade_uv(s, 0.75f, 0.5f, 2.0f / sqrtf(15.0f), rgb);
+    assert_near(rgb[0], (float)(right * 1.15), 1e-4f);
+    fv_scene_free(s);
+}
+
+/* ---- builder: validation ------------------------------------------------------------- */
+
+static void test_builder_rejects_bad_meshes(void **state)
+{
+    (void)state;
+    const float pos[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const float nan_pos[] = {0, 0, 0, NAN, 0, 0, 0, 1, 0};
+    const uint32_t oob[] = {0, 1, 3};
+    const uint32_t two[] = {0, 1};
+    const float uv[] = {0, 0, 1, 0, 0, 1};
+    fv_scene *s = fv_scene_create();
+    char err[256];
+    fv_mesh_desc m;
+    struct {
+        fv_mesh_desc d;
+        const char *why;
+    } bad[8];
+    int n = 0;
+    m = mesh(pos, 3, oob, 3), bad[n].d = m, bad[n++].why = "out-of-range index";
+    m = mesh(pos, 3, two, 2), bad[n].d = m, bad[n++].why = "index count not a multiple of 3";
+    m = mesh(pos, 2, NULL, 0), bad[n].d = m, bad[n++].why = "vertex count not a multiple of 3";
+    m = mesh(nan_pos, 3, NULL, 0), bad[n].d = m, bad[n++].why = "NaN position";
+    m = mesh(pos, 3, NULL, 0), m.texture = 0, m.uvs = uv, bad[n].d = m, bad[n++].why = "missing texture";
+    m = mesh(NULL, 3, NULL, 0), bad[n].d = m, bad[n++].why = "no positions";
+    m = mesh(pos, 3, NULL, 0), m.base_color[1] = INFINITY, bad[n].d = m, bad[n++].why = "infinite colour";
+    for (int i = 0; i < n; i++) {
+        err[0] = 0;
+        if (fv_scene_add_mesh(s, &bad[i].d, err, sizeof err) != -1 || !err[0]) {
+            print_error("accepted: %s\n", bad[i].why);
+            fail();
+        }
+    }
+    assert_non_null(strstr(err, "colour"));
+    /* The scene is still usable: the first good mesh gets geometry 0, the next 1. */
+    m = mesh(pos, 3, NULL, 0);
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    m.transform[0] = m.transform[5] = m.transform[10] = m.transform[15] = 1;
+    m.transform[14] = -1;
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    commit_or_fail(s);
+    assert_int_equal(fv_scene_triangle_count(s), 2);
+    const float o[3] = {0.25f, 0.25f, 1}, d[3] = {0, 0, -1};
+    hit h;
+    assert_true(cast(s, o, d, &h));
+    assert_int_equal(h.geom, 0);
+    assert_near(h.t, 1.0f, 1e-6f);
+    const float o2[3] = {0.25f, 0.25f, -0.5f};
+    assert_true(cast(s, o2, d, &h));
+    assert_int_equal(h.geom, 1);
+    assert_near(h.t, 0.5f, 1e-6f);
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), -1); /* after commit */
+    fv_scene_free(s);
+}
+
+/* ---- builder: KHR lights ------------------------------------------------------------- */
+
+static fv_scene *lit_quad(const fv_light *l, int nlights)
+{
+    static const float pos[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    fv_scene *s = fv_scene_create();
+    fv_mesh_desc m = mesh(pos, 4, idx, 6);
+    m.base_color[0] = 0.5f, m.base_color[1] = 1.0f, m.base_color[2] = 0.25f;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    for (int i = 0; i < nlights; i++) fv_scene_add_light(s, &l[i]);
+    return commit_or_fail(s);
+}
+
+/* Shades the quad point (x, y, 0) seen from straight above. */
+static void shade_at(const fv_scene *s, float x, float y, float rgb[3])
+{
+    const float o[3] = {x, y, 5}, d[3] = {0, 0, -1};
+    hit h;
+    cast_shade(s, o, d, 0, &h, rgb);
+}
+
+/* Bounds centre of the quad is the origin. The exposure makes the brightest light give
+ * irradiance 1 there: for a directional light of intensity 10 and colour (1, 0.5, 0.25)
+ * the exposure is 1/10, and a light straight down gives base * (0.15 + colour). */
+static void test_lights_directional(void **state)
+{
+    (void)state;
+    fv_light l;
+    memset(&l, 0, sizeof l);
+    l.type = FV_LIGHT_DIRECTIONAL;
+    l.color[0] = 1, l.color[1] = 0.5f, l.color[2] = 0.25f;
+    l.intensity = 10;
+    l.dir[2] = -3; /* not normalised on purpose */
+    fv_scene *s = lit_quad(&l, 1);
+    assert_int_equal(fv_scene_light_count(s), 1);
+    fv_light got;
+    assert_int_equal(fv_scene_get_light(s, 0, &got), 0);
+    assert_near(got.dir[2], -1.0f, 1e-6f);
+    assert_int_equal(fv_scene_get_light(s, 1, &got), -1);
+    float rgb[3];
+    shade_at(s, 0.3f, -0.2f, rgb);
+    assert_rgb(rgb, 0.5f * 1.15f, 1.0f * 0.65f, 0.25f * 0.4f, 1e-5f, __LINE__);
+    fv_scene_free(s);
+    /* Tilted 60 degrees from the normal: lambert 1/2. */
+    l.dir[0] = sqrtf(3.0f), l.dir[2] = -1;
+    s = lit_quad(&l, 1);
+    shade_at(s, 0.3f, -0.2f, rgb);
+    assert_rgb(rgb, 0.5f * 0.65f, 1.0f * 0.4f, 0.25f * 0.275f, 1e-5f, __LINE__);
+    fv_scene_free(s);
+}
+
+/* Point light of intensity 8 at (0,0,2): irradiance 8/4 = 2 at the centre, exposure 1/2.
+ * At the centre: 8 * 1/4 * 1/2 = 1. At (0.5,0,0): d^2 = 4.25, lambert = 2/sqrt(4.25), so
+ * 8 * 0.5 * 2 / 4.25^1.5. With range 3 the window 1-(d/3)^4 applies at both places. A spot
+ * with outer cone 0.1 rad pointing down lights the centre fully but not (0.5,0,0), whose
+ * angle off the axis is atan(0.25) = 0.245 rad. */
+static void test_lights_point_spot(void **state)
+{
+    (void)state;
+    fv_light l;
+    memset(&l, 0, sizeof l);
+    l.type = FV_LIGHT_POINT;
+    l.color[0] = l.color[1] = l.color[2] = 1;
+    l.intensity = 8;
+    l.pos[2] = 2;
+    fv_scene *s = lit_quad(&l, 1);
+    float rgb[3];
+    shade_at(s, 0, 0, rgb);
+    assert_rgb(rgb, 0.5f * 1.15f, 1.15f, 0.25f * 1.15f, 1e-5f, __LINE__);
+    shade_at(s, 0.5f, 0, rgb);
+    const float e = (float)(8.0 * 0.5 * 2.0 / pow(4.25, 1.5));
+    assert_near(rgb[1], 0.15f + e, 1e-5f);
+    fv_scene_free(s);
+
+    l.range = 3;
+    s = lit_quad(&l, 1);
+    const double win0 = 1 - pow(2.0 / 3.0, 4), win1 = 1 - pow(4.25 / 9.0, 2);
+    const double exposure = 1.0 / (8.0 * win0 / 4.0);
+    shade_at(s, 0.5f, 0, rgb);
+    assert_near(rgb[1], (float)(0.15 + 8.0 * win1 / 4.25 * (2.0 / sqrt(4.25)) * exposure), 1e-5f);
+    fv_scene_free(s);
+
+    l.type = FV_LIGHT_SPOT;
+    l.range = 0;
+    l.dir[2] = -1;
+    l.inner_cone = 0.05f, l.outer_cone = 0.1f;
+    s = lit_quad(&l, 1);
+    shade_at(s, 0, 0, rgb);
+    assert_near(rgb[1], 1.15f, 1e-5f);
+    shade_at(s, 0.5f, 0, rgb);
+    assert_near(rgb[1], 0.15f, 1e-6f);
+    fv_scene_free(s);
+}
+
+/* ---- default view -------------------------------------------------------------------- */
+
+/* Bounds [-1,1]^3 around (1,2,3): bounding sphere radius sqrt3. With a 90 degree vertical
+ * FOV and aspect 1 the sphere fits at distance sqrt3/sin(45 deg) = sqrt6; with aspect 0.5
+ * the horizontal half-angle atan(0.5) is narrower: sqrt3/sin(atan 0.5) = sqrt3*sqrt5. */
+static void test_default_view_frames_bounds(void **state)
+{
+    (void)state;
+    const float pos[] = {0, 1, 2, 2, 3, 4, 0, 3, 2};
+    fv_scene *s = fv_scene_create();
+    fv_mesh_desc m = mesh(pos, 3, NULL, 0);
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    commit_or_fail(s);
+    float p[3], q[4];
+    assert_int_equal(fv_scene_default_view(s, 90.0f, 1.0f, p, q), 0);
+    assert_near(p[0], 1, 1e-6f), assert_near(p[1], 2, 1e-6f), assert_near(p[2], 3 + sqrtf(6.0f), 1e-5f);
+    assert_near(q[0], 0, 0), assert_near(q[1], 0, 0), assert_near(q[2], 0, 0), assert_near(q[3], 1, 0);
+    assert_int_equal(fv_scene_default_view(s, 90.0f, 0.5f, p, q), 0);
+    assert_near(p[2], 3 + sqrtf(15.0f), 1e-5f);
+    /* Looking down -Z from there the triangle is in front: (0.5, 2.5) is inside its xy shadow. */
+    const float d[3] = {0, 0, -1}, o[3] = {0.5f, 2.5f, p[2]};
+    hit h;
+    assert_true(cast(s, o, d, &h));
+    fv_scene_free(s);
+}
+
+/* ---- glTF files ---------------------------------------------------------------------- */
+
+/* tests/data/scene/hierarchy.gltf: triangle (0,0,0),(1,0,0),(0,1,0), colour (0.5,0.25,1).
+ * Node "child" rotates it 90 deg about +Y ((x,y,z) -> (z,y,-x)) under "parent" translated by
+ * (0,0,-5): world (0,0,-5),(0,0,-6),(0,1,-5), in the plane x = 0, computed normal
+ * (0,0,-1) x (0,1,0) = (1,0,0). Node "matrix" scales by 2 and moves by (10,0,0):
+ * (10,0,0),(12,0,0),(10,2,0). A lines primitive and a node outside the scene add nothing. */
+static void test_gltf_hierarchy(void **state)
+{
+    (void)state;
+    char err[512];
+    fv_scene *s = fv_scene_load("tests/data/scene/hierarchy.gltf", err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    assert_string_equal(err, "");
+    assert_int_equal(fv_scene_triangle_count(s), 2);
+    assert_int_equal(fv_scene_light_count(s), 0);
+    float lo[3], hi[3];
+    fv_scene_bounds(s, lo, hi);
+    const float want_lo[3] = {0, 0, -6}, want_hi[3] = {12, 2, 0};
+    for (int k = 0; k < 3; k++) assert_near(lo[k], want_lo[k], 1e-6f), assert_near(hi[k], want_hi[k], 1e-6f);
+
+    /* (5, 0.25, -5.25) along -X hits (0, 0.25, -5.25) = A' + 0.25 (B'-A') + 0.25 (C'-A'). */
+    const float o[3] = {5, 0.25f, -5.25f}, d[3] = {-1, 0, 0};
+    hit h;
+    float rgb[3];
+    cast_shade(s, o, d, 0, &h, rgb);
+    assert_near(h.t, 5.0f, 1e-5f);
+    assert_near(h.u, 0.25f, 1e-5f);
+    assert_near(h.v, 0.25f, 1e-5f);
+    assert_rgb(rgb, 0.5f * 1.15f, 0.25f * 1.15f, 1.15f, 1e-5f, __LINE__);
+    /* Without the rotation the triangle would be in the plane z = -5 at x in [0,1]. */
+    const float o2[3] = {0.25f, 0.25f, 0}, d2[3] = {0, 0, -1};
+    assert_false(cast(s, o2, d2, &h));
+    /* The matrix node: (10.5, 0.5) is at u = v = 0.25 of the doubled triangle. */
+    const float o3[3] = {10.5f, 0.5f, 5};
+    assert_true(cast(s, o3, d2, &h));
+    assert_near(h.t, 5.0f, 1e-5f);
+    assert_near(h.u, 0.25f, 1e-5f);
+    assert_near(h.v, 0.25f, 1e-5f);
+    const float o4[3] = {100.25f, 0.25f, 5}; /* the unreferenced node's copy does not exist */
+    assert_false(cast(s, o4, d2, &h));
+    float p[3], q[4];
+    assert_int_equal(fv_scene_default_view(s, 60, 1, p, q), 0);
+    fv_scene_free(s);
+}
+
+/* tests/data/scene/camera.gltf: an orthographic camera (ignored), then node "rig" at (1,2,3)
+ * rotated 90 deg about +Y with child camera "cam" at local (0,0,2): world position
+ * (1,2,3) + R*(0,0,2) = (3,2,3), rotation quat (0, sin45, 0, cos45). A later camera is
+ * ignored. */
+static void test_gltf_camera(void **state)
+{
+    (void)state;
+    char err[512];
+    fv_scene *s = fv_scene_load("tests/data/scene/camera.gltf", err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    float p[3], q[4];
+    assert_int_equal(fv_scene_default_view(s, 60, 1.5f, p, q), 1);
+    assert_near(p[0], 3, 1e-5f), assert_near(p[1], 2, 1e-5f), assert_near(p[2], 3, 1e-5f);
+    const float sg = q[3] < 0 ? -1.0f : 1.0f; /* q and -q are the same rotation */
+    assert_near(sg * q[0], 0, 1e-5f), assert_near(sg * q[1], SQ2, 1e-5f);
+    assert_near(sg * q[2], 0, 1e-5f), assert_near(sg * q[3], SQ2, 1e-5f);
+    fv_scene_free(s);
+}
+
+/* Expected counts from summing index counts / 3 over the TRIANGLES primitives of the nodes
+ * reachable from the default scene (python3 json check of the accessors). */
+static fv_scene *load_shared(const char *rel, size_t want_tris)
+{
+    char path[512], err[512];
+    fv_scene *s = fv_scene_load(shared_scene(path, sizeof path, rel), err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    assert_int_equal(fv_scene_triangle_count(s), want_tris);
+    return s;
+}
+
+static void test_load_flight_helmet(void **state)
+{
+    (void)state;
+    fv_scene *s = load_shared("FlightHelmet/FlightHelmet.gltf", 94722);
+    assert_int_equal(fv_scene_light_count(s), 0);
+    float lo[3], hi[3], p[3], q[4];
+    fv_scene_bounds(s, lo, hi);
+    assert_true(hi[1] - lo[1] > 0.5f && hi[1] - lo[1] < 1.0f); /* a helmet about 0.7 m tall */
+    assert_int_equal(fv_scene_default_view(s, 60, 1, p, q), 0);
+    assert_near(p[0], 0.5f * (lo[0] + hi[0]), 1e-6f);
+    assert_near(p[1], 0.5f * (lo[1] + hi[1]), 1e-6f);
+    assert_true(p[2] > hi[2]);
+    /* Looking at the centre from there hits the helmet, and the textured hit is lit. */
+    const float d[3] = {0, 0, -1};
+    hit h;
+    float rgb[3];
+    cast_shade(s, p, d, 0.001f, &h, rgb);
+    assert_true(rgb[0] + rgb[1] + rgb[2] > 0.0f);
+    fv_scene_free(s);
+}
+
+static void test_load_damaged_helmet(void **state)
+{
+    (void)state;
+    fv_scene *s = load_shared("DamagedHelmet/DamagedHelmet.gltf", 15452);
+    assert_int_equal(fv_scene_light_count(s), 0);
+    fv_scene_free(s);
+}
+
+/* DepthOfFieldExample.glb has one KHR_lights_punctual directional light "Sun" of intensity
+ * 6830 on a node with rotation q = (-0.7903, -0.1289, 0.1781, 0.5719): its direction is
+ * R(q) * (0,0,-1) = (0.42885, -0.85809, 0.28243) (python). */
+static void test_load_dof_glb_lights(void **state)
+{
+    (void)state;
+    fv_scene *s = load_shared("DepthOfFieldExample/DepthOfFieldExample.glb", 10610);
+    assert_true(fv_scene_light_count(s) > 0);
+    assert_int_equal(fv_scene_light_count(s), 1);
+    fv_light l;
+    assert_int_equal(fv_scene_get_light(s, 0, &l), 0);
+    assert_int_equal(l.type, FV_LIGHT_DIRECTIONAL);
+    assert_near(l.intensity, 6830.0f, 0);
+    assert_near(l.dir[0], 0.42885029f, 1e-5f);
+    assert_near(l.dir[1], -0.85809007f, 1e-5f);
+    assert_near(l.dir[2], 0.28243381f, 1e-5f);
+    /* The exposure tames 6830: straight down onto the board, irradiance stays near 1. */
+    const float o[3] = {0.3f, 5, 0.2f}, d[3] = {0, -1, 0};
+    hit h;
+    float rgb[3];
+    cast_shade(s, o, d, 0, &h, rgb);
+    for (int k = 0; k < 3; k++) assert_true(rgb[k] >= 0.0f && rgb[k] <= 1.2f);
+    fv_scene_free(s);
+}
+
+/* ---- hostile files ------------------------------------------------------------------- */
+
+static void test_missing_and_garbage(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512];
+    expect_load_fails(path_join(p, sizeof p, dir, "does_not_exist.gltf"), NULL);
+    expect_load_fails(dir, NULL); /* a directory */
+    write_all(path_join(p, sizeof p, dir, "empty.gltf"), "", 0);
+    expect_load_fails(p, NULL);
+    const char *texts[] = {
+        "{ this is not json",
+        "[]",
+        "{}",
+        "{\"asset\":{\"version\":\"2.0\"}, \"nodes\": 5}",
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":4,\"uri\":\"data:application/octet-stream;base64,@@@@\"}]}",
+        "glTF",
+    };
+    for (size_t i = 0; i < sizeof texts / sizeof *texts; i++) {
+        write_all(path_join(p, sizeof p, dir, "garbage.gltf"), texts[i], strlen(texts[i]));
+        expect_load_fails(p, NULL);
+    }
+    /* GLB header whose JSON chunk length wraps a 32-bit sum. */
+    static const unsigned char hdr[] = "glTF\x02\0\0\0\x28\0\0\0\xf0\xff\xff\xffJSON{}  {}  {}  {}  {}";
+    write_all(path_join(p, sizeof p, dir, "wrap.glb"), hdr, sizeof hdr - 1);
+    expect_load_fails(p, NULL);
+    /* Nesting deep enough to overflow a recursive converter. */
+    const size_t depth = 200000;
+    char *deep = malloc(2 * depth + 64);
+    assert_non_null(deep);
+    size_t n = (size_t)sprintf(deep, "{\"asset\":{\"version\":\"2.0\"},\"extras\":");
+    memset(deep + n, '[', depth), n += depth;
+    memset(deep + n, ']', depth), n += depth;
+    deep[n++] = '}';
+    write_all(path_join(p, sizeof p, dir, "deep.gltf"), deep, n);
+    free(deep);
+    expect_load_fails(p, "nested");
+    /* Random bytes. */
+    uint64_t rng = 42;
+    unsigned char junk[4096];
+    for (size_t i = 0; i < sizeof junk; i++) junk[i] = (unsigned char)fv_test_rand(&rng);
+    write_all(path_join(p, sizeof p, dir, "junk.glb"), junk, sizeof junk);
+    expect_load_fails(p, NULL);
+    junk[0] = 'g', junk[1] = 'l', junk[2] = 'T', junk[3] = 'F';
+    write_all(p, junk, sizeof junk);
+    expect_load_fails(p, NULL);
+    tmpdir_remove(dir);
+}
+
+static void test_truncated(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], src[512];
+    size_t len;
+    /* .glb cut anywhere: header, JSON chunk, BIN chunk, last byte. */
+    unsigned char *glb = read_all(shared_scene(src, sizeof src, "DepthOfFieldExample/DepthOfFieldExample.glb"), &len);
+    const size_t cuts[] = {3, 12, 19, 20, 100, len / 3, len / 2, len - 4, len - 1};
+    for (size_t i = 0; i < sizeof cuts / sizeof *cuts; i++) {
+        write_all(path_join(p, sizeof p, dir, "cut.glb"), glb, cuts[i]);
+        expect_load_fails(p, NULL);
+    }
+    free(glb);
+    /* .gltf JSON cut in the middle. */
+    unsigned char *json = read_all(shared_scene(src, sizeof src, "FlightHelmet/FlightHelmet.gltf"), &len);
+    write_all(path_join(p, sizeof p, dir, "FlightHelmet.gltf"), json, len / 2);
+    expect_load_fails(p, NULL);
+    free(json);
+    /* .bin shorter than the buffer's byteLength. */
+    json = read_all(shared_scene(src, sizeof src, "DamagedHelmet/DamagedHelmet.gltf"), &len);
+    write_all(path_join(p, sizeof p, dir, "DamagedHelmet.gltf"), json, len);
+    free(json);
+    unsigned char *bin = read_all(shared_scene(src, sizeof src, "DamagedHelmet/DamagedHelmet.bin"), &len);
+    write_all(path_join(p, sizeof p, dir, "DamagedHelmet.bin"), bin, len - 100);
+    expect_load_fails(path_join(p, sizeof p, dir, "DamagedHelmet.gltf"), NULL);
+    /* Full .bin but the base colour image is missing. */
+    write_all(path_join(p, sizeof p, dir, "DamagedHelmet.bin"), bin, len);
+    expect_load_fails(path_join(p, sizeof p, dir, "DamagedHelmet.gltf"), "image");
+    free(bin);
+    tmpdir_remove(dir);
+}
+
+/* Random byte flips must never crash; the file may still load (e.g. a flipped texel). */
+static void test_corrupted_flips(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], src[512];
+    size_t len;
+    unsigned char *glb = read_all(shared_scene(src, sizeof src, "DepthOfFieldExample/DepthOfFieldExample.glb"), &len);
+    uint32_t json_len;
+    memcpy(&json_len, glb + 12, 4);
+    unsigned char *copy = malloc(len);
+    assert_non_null(copy);
+    uint64_t rng = 7;
+    path_join(p, sizeof p, dir, "flip.glb");
+    for (int iter = 0; iter < 16; iter++) {
+        memcpy(copy, glb, len);
+        /* Even iterations hit the header + JSON chunk, odd ones anywhere. */
+        const size_t span = (iter & 1) ? len : 20 + (size_t)json_len + 8;
+        for (int k = 0; k < 1 + iter; k++) copy[fv_test_rand(&rng) % span] ^= (unsigned char)(1u << (fv_test_rand(&rng) % 8));
+        write_all(p, copy, len);
+        load_any(p);
+    }
+    free(copy);
+    free(glb);
+    /* Flips in the small hand-written file, including its base64 buffer. */
+    unsigned char *txt = read_all("tests/data/scene/hierarchy.gltf", &len);
+    copy = malloc(len);
+    assert_non_null(copy);
+    path_join(p, sizeof p, dir, "flip.gltf");
+    for (int iter = 0; iter < 64; iter++) {
+        memcpy(copy, txt, len);
+        for (int k = 0; k < 1 + iter % 4; k++) copy[fv_test_rand(&rng) % len] = (unsigned char)fv_test_rand(&rng);
+        write_all(p, copy, len);
+        load_any(p);
+    }
+    free(copy);
+    free(txt);
+    tmpdir_remove(dir);
+}
+
+/* Hand-made files whose JSON is valid but whose data is not. The buffer holds 3 float3
+ * positions (36 bytes) then 3 u16 indices (+2 pad); POSITION_NAN's second vertex is NaN. */
+static void test_invalid_data(void **state)
+{
+    (void)state;
+    unsigned char bin[44 + 36];
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const float pos_nan[9] = {0, 0, 0, NAN, 0, 0, 0, 1, 0};
+    const uint16_t idx[4] = {0, 1, 2, 0};
+    memcpy(bin, pos, 36);
+    memcpy(bin + 36, idx, 8);
+    memcpy(bin + 44, pos_nan, 36);
+#define VIEWS "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}," \
+              "{\"buffer\":0,\"byteOffset\":44,\"byteLength\":36}],"
+#define POS "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}"
+#define IDX(ct, count) "{\"bufferView\":1,\"componentType\":" #ct ",\"count\":" #count ",\"type\":\"SCALAR\"}"
+#define SCENE "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0"
+#define MESH(prim) "\"meshes\":[{\"primitives\":[" prim "]}],"
+#define PRIM "{\"attributes\":{\"POSITION\":0},\"indices\":1}"
+    static const struct {
+        const char *members, *must_contain;
+    } cases[] = {
+        /* control: must load */
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) SCENE, NULL},
+        /* index 2 read as u8 from bytes {0,0,1}: fine; as u32 it overruns the view */
+        {VIEWS "\"accessors\":[" POS "," IDX(5125, 3) "]," MESH(PRIM) SCENE, "exceed"},
+        /* out-of-range index: index 256 (bytes 0x00,0x01 of u16 {0,1} read as a u16 at offset 1) */
+        {"\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":37,\"byteLength\":6}],"
+         "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) SCENE, "index"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 2) "]," MESH(PRIM) SCENE, "multiple of 3"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5126, 1) "]," MESH(PRIM) SCENE, "componentType"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5121, 3) "]," MESH(PRIM) SCENE, NULL}, /* u8 {0,0,1}: valid */
+        {VIEWS "\"accessors\":[{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}," IDX(5123, 3)
+               "]," MESH(PRIM) SCENE, "finite"},
+        {VIEWS "\"accessors\":[{\"bufferView\":0,\"byteOffset\":4,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}," IDX(5123, 3)
+               "]," MESH(PRIM) SCENE, "exceed"},
+        {VIEWS "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}," IDX(5123, 3)
+               "]," MESH(PRIM) SCENE, "components"},
+        {"\"bufferViews\":[{\"buffer\":0,\"byteLength\":36,\"byteStride\":8},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+         "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) SCENE, "byteStride"},
+        {"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":60,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+         "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) SCENE, "exceeds buffer"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) "\"nodes\":[{\"mesh\":0,\"children\":[1]},{\"children\":[0]}],"
+               "\"scenes\":[{\"nodes\":[0]}],\"scene\":0", "node"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) "\"nodes\":[{\"mesh\":0,\"children\":[7]}],"
+               "\"scenes\":[{\"nodes\":[0]}],\"scene\":0", "child"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) "\"nodes\":[{\"mesh\":3}],\"scenes\":[{\"nodes\":[0]}]", "mesh"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH("{\"attributes\":{\"NORMAL\":0},\"indices\":1}") SCENE, "POSITION"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH("{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":2}") SCENE,
+         "material"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH("{\"attributes\":{\"POSITION\":0},\"indices\":5}") SCENE, "accessor"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) "\"nodes\":[{\"mesh\":0,\"rotation\":[0,0,0]}],"
+               "\"scenes\":[{\"nodes\":[0]}],\"scene\":0", "rotation"},
+        {VIEWS "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) SCENE ",\"materials\":[{\"pbrMetallicRoughness\":"
+               "{\"baseColorTexture\":{\"index\":0}}}],\"textures\":[{\"source\":0}],"
+               "\"images\":[{\"bufferView\":9,\"mimeType\":\"image/png\"}]", "image"},
+        /* image bufferView beyond its buffer (tinygltf does not check this itself) */
+        {"\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6},"
+         "{\"buffer\":0,\"byteOffset\":40,\"byteLength\":100000}],"
+         "\"accessors\":[" POS "," IDX(5123, 3) "]," MESH(PRIM) SCENE ",\"images\":[{\"bufferView\":2,\"mimeType\":\"image/png\"}]",
+         "image"},
+    };
+    char *dir = tmpdir_make(), p[512];
+    path_join(p, sizeof p, dir, "case.gltf");
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        write_gltf(p, bin, sizeof bin, cases[i].members);
+        const int should_load = i == 0 || i == 5;
+        if (should_load) {
+            char err[512];
+            fv_scene *s = fv_scene_load(p, err, sizeof err);
+            if (!s) print_error("case %zu: %s\n", i, err);
+            assert_non_null(s);
+            assert_int_equal(fv_scene_triangle_count(s), 1);
+            fv_scene_free(s);
+        } else if (!load_fails(p, cases[i].must_contain)) {
+            print_error("case %zu\n", i);
+            fail();
+        }
+    }
+    tmpdir_remove(dir);
+}
+
+/* Sparse accessor: POSITION's vertex 1 (1,0,0) is replaced by (2,0,0), so the ray down -Z
+ * at (1.5, 0.1) hits (it would miss the unsubstituted triangle). A sparse index >= count fails. */
+static void test_gltf_sparse(void **state)
+{
+    (void)state;
+    unsigned char bin[60];
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, moved[3] = {2, 0, 0};
+    const uint16_t idx[4] = {0, 1, 2, 0};
+    memset(bin, 0, sizeof bin);
+    memcpy(bin, pos, 36);
+    memcpy(bin + 36, idx, 8);
+    bin[44] = 1; /* sparse index */
+    memcpy(bin + 48, moved, 12);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6},"
+        "{\"buffer\":0,\"byteOffset\":44,\"byteLength\":1},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"sparse\":{\"count\":1,"
+        "\"indices\":{\"bufferView\":2,\"componentType\":5121},\"values\":{\"bufferView\":3}}},"
+        "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0";
+    char *dir = tmpdir_make(), p[512], err[512];
+    path_join(p, sizeof p, dir, "sparse.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    const float o[3] = {1.5f, 0.1f, 1}, d[3] = {0, 0, -1};
+    hit h;
+    assert_true(cast(s, o, d, &h));
+    assert_near(h.t, 1.0f, 1e-6f);
+    fv_scene_free(s);
+    bin[44] = 3;
+    write_gltf(p, bin, sizeof bin, json);
+    expect_load_fails(p, "sparse index");
+    tmpdir_remove(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_builder_quad_hit_and_headlight),
+        cmocka_unit_test(test_builder_transform_non_indexed),
+        cmocka_unit_test(test_builder_computed_normals),
+        cmocka_unit_test(test_builder_normals_inverse_transpose),
+        cmocka_unit_test(test_texture_bilinear_wrap),
+        cmocka_unit_test(test_texture_mips),
+        cmocka_unit_test(test_builder_rejects_bad_meshes),
+        cmocka_unit_test(test_lights_directional),
+        cmocka_unit_test(test_lights_point_spot),
+        cmocka_unit_test(test_default_view_frames_bounds),
+        cmocka_unit_test(test_gltf_hierarchy),
+        cmocka_unit_test(test_gltf_camera),
+        cmocka_unit_test(test_gltf_sparse),
+        cmocka_unit_test(test_load_flight_helmet),
+        cmocka_unit_test(test_load_damaged_helmet),
+        cmocka_unit_test(test_load_dof_glb_lights),
+        cmocka_unit_test(test_missing_and_garbage),
+        cmocka_unit_test(test_truncated),
+        cmocka_unit_test(test_corrupted_flips),
+        cmocka_unit_test(test_invalid_data),
+    };
+    return cmocka_run_group_tests_name("scene", tests, NULL, NULL);
+}
