@@ -1,0 +1,83 @@
+/* fovea: one small dispatch table of hand-vectorised kernels (dav1d / libjpeg-turbo style).
+ *
+ * Pattern (one per module X, e.g. pullpush; later reproject, dof):
+ *   core/X.c            plain-C reference kernels fv_<k>_c + void fv_X_init_c(fv_dsp *)
+ *   core/x86/X_sse41.c  void fv_X_init_sse41(fv_dsp *)   (built with -msse4.1, x86_64 only)
+ *   core/x86/X_avx2.c   void fv_X_init_avx2(fv_dsp *)    (built with -mavx2 -mfma, x86_64 only)
+ *   core/arm/X_neon.c   void fv_X_init_neon(fv_dsp *)    (aarch64 only)
+ * fv_dsp_init (core/dsp.c) fills the table with the C references, then lets every allowed ISA,
+ * lowest first, overwrite the entries it implements.
+ *
+ * Contract for every ISA version of a kernel: bit-identical to its C reference for all finite
+ * inputs (same IEEE operations in the same order, true division, no FMA contraction: the whole
+ * tree is built with -ffp-contract=off), under the same FTZ/DAZ mode. Kernels read and write
+ * exactly the pixels their contract names (no over-reads, no writes past n), take any row
+ * alignment (4-byte aligned floats), and keep no state. */
+#ifndef FOVEA_DSP_H
+#define FOVEA_DSP_H
+
+enum {
+    FV_ISA_C = 0,
+    FV_ISA_SSE41 = 1 << 0,
+    FV_ISA_AVX2 = 1 << 1,
+    FV_ISA_NEON = 1 << 2,
+};
+
+/* Pixels are 4 floats (r, g, b, depth_m); weights are a separate plane of floats in [0,1].
+ * The colour of a zero-weight pixel is never used (it may hold anything, even NaN); colours of
+ * pixels with weight > 0 must be finite.
+ *
+ * pull_row: one coarse row from the two fine rows below it. For X in [0, n):
+ *   reads fine pixels 2X and 2X+1 of both rows (so 2n pixels per row; pad odd widths with a
+ *   zero-weight pixel), with a = row 0, b = row 1, 0/1 = left/right child, and
+ *   p(w, c) = w > 0 ? w * c : +0:
+ *     sw  = (wa0 + wb0) + (wa1 + wb1)
+ *     t   = (p(wa0, ca0) + p(wb0, cb0)) + (p(wa1, ca1) + p(wb1, cb1))   per channel
+ *     dst = sw > 0 ? t / sw : +0                                         per channel
+ *     dst_w = sw < 1 ? sw : 1
+ *
+ * push_row: fills one fine row (in place) from the coarser, already filled level. Fine pixel
+ *   x (in [0, n)) lies under coarse pixel X = x >> 1; its horizontal neighbour is Xf = X - 1
+ *   (x even) or X + 1 (x odd). coarse_near is the coarse row under the fine row, coarse_far
+ *   the vertical neighbour row (Y - 1 for even fine rows, Y + 1 for odd ones). Both coarse
+ *   rows are read at pixels [-1, (n + 1) / 2] inclusive (a replicated 1-pixel border).
+ *     if !(w < 1): pixel untouched (not even rewritten)
+ *     v(X)   = near[X] + 0.25 * (far[X] - near[X])                (vertical 3/4, 1/4)
+ *     interp = v(X) + 0.25 * (v(Xf) - v(X))                        (so 9/16 3/16 3/16 1/16)
+ *     c      = w > 0 ? fine : +0                                   per channel
+ *     fine   = c + (1 - w) * (interp - c)                          (w = 0: exactly interp,
+ *                                                                   up to the sign of a zero)
+ */
+typedef void (*fv_pull_row_fn)(float *restrict dst_rgbd, float *restrict dst_wgt, const float *src0_rgbd,
+                               const float *src0_wgt, const float *src1_rgbd, const float *src1_wgt, int n);
+typedef void (*fv_push_row_fn)(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
+                               const float *coarse_far, int n);
+
+typedef struct fv_dsp {
+    unsigned isa; /* the ISA actually selected (one FV_ISA_* value) */
+    fv_pull_row_fn pull_row;
+    fv_push_row_fn push_row;
+} fv_dsp;
+
+unsigned fv_cpu_isas(void);            /* FV_ISA_* bits this CPU runs */
+/* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas(); FV_ISA_C gives references.
+ * Every allowed ISA overwrites the entries it implements, lowest first, so
+ * fv_dsp_init(d, FV_ISA_SSE41) gives exactly the SSE4.1 kernels (C where there is none). */
+void fv_dsp_init(fv_dsp *d, unsigned isa_mask);
+const char *fv_isa_name(unsigned isa); /* "c", "sse4.1", "avx2", "neon"; "?" otherwise */
+
+/* ---- internal: reference kernels and per-module, per-ISA table fillers ---- */
+void fv_pull_row_c(float *restrict dst_rgbd, float *restrict dst_wgt, const float *src0_rgbd,
+                   const float *src0_wgt, const float *src1_rgbd, const float *src1_wgt, int n);
+void fv_push_row_c(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
+                   const float *coarse_far, int n);
+
+void fv_pullpush_init_c(fv_dsp *d);
+#if defined(__x86_64__)
+void fv_pullpush_init_sse41(fv_dsp *d);
+void fv_pullpush_init_avx2(fv_dsp *d);
+#elif defined(__aarch64__)
+void fv_pullpush_init_neon(fv_dsp *d);
+#endif
+
+#endif
