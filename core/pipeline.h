@@ -1,0 +1,65 @@
+/* fovea: the per-eye frame pipeline (Weier et al. 2018): sample -> ray cast -> [reproject] ->
+ * pull-push reconstruction -> [focus depth, CoC, layered DoF filter, combine].
+ * Stages in brackets are not built yet: their times are NAN ("-" in tables, null in JSON). */
+#ifndef FOVEA_PIPELINE_H
+#define FOVEA_PIPELINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "camera.h"
+#include "dsp.h"
+#include "pool.h"
+#include "pullpush.h"
+#include "sampling.h"
+#include "scene.h"
+
+enum {
+    FV_STAGE_TRACE,
+    FV_STAGE_REPROJECT,
+    FV_STAGE_RECONSTRUCT,
+    FV_STAGE_COC,
+    FV_STAGE_DOF_FILTER,
+    FV_STAGE_COMBINE,
+    FV_STAGE_COUNT
+};
+/* JSON / CSV names: trace, reproject, reconstruct, coc, dof_filter, combine */
+extern const char *const fv_stage_names[FV_STAGE_COUNT];
+
+typedef struct fv_pipeline_config {
+    fv_camera_desc cam;      /* size, vertical FOV, IPD, frustum shift */
+    fv_sampling_params samp; /* r0, r1, p_min, full */
+    int threads;             /* 0 = online CPUs */
+    unsigned isa_mask;       /* kernels allowed (FV_ISA_* bits); ~0u = the best this CPU runs */
+} fv_pipeline_config;
+
+typedef struct fv_frame_stats {
+    double stage_ms[FV_STAGE_COUNT]; /* NAN for a stage that is not built */
+    double total_ms;                 /* wall time of the whole frame */
+    long samples;                    /* rays cast */
+} fv_frame_stats;
+
+typedef struct fv_pipeline fv_pipeline;
+
+void fv_pipeline_config_default(fv_pipeline_config *c);
+/* The scene must outlive the pipeline. NULL with a reason in err on bad configuration. */
+fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config *cfg, char *err, size_t err_len);
+void fv_pipeline_destroy(fv_pipeline *p);
+
+/* Renders one eye (FV_EYE_CENTER and FV_EYE_LEFT share slot 0, FV_EYE_RIGHT has its own state)
+ * from head pose `head` with the point of regard at normalised image coordinates (gaze_x, gaze_y). */
+int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
+                       fv_frame_stats *stats);
+/* The eye's reconstruction pyramid after its last render (level 0 = the image). */
+const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye);
+const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye);
+const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p);
+fv_pool *fv_pipeline_pool(fv_pipeline *p);
+const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p);
+
+/* The eye's last image as sRGB-encoded 8-bit RGB, rows of dst_stride bytes. */
+void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride);
+
+/* Monotonic clock in nanoseconds (CLOCK_MONOTONIC). */
+int64_t fv_time_ns(void);
+
+#endif

@@ -1,0 +1,24 @@
+/* fovea: ray casting of the sampled pixels with Embree packets over screen tiles. */
+#ifndef FOVEA_RAYCAST_H
+#define FOVEA_RAYCAST_H
+
+#include "camera.h"
+#include "pool.h"
+#include "pullpush.h"
+#include "sampling.h"
+#include "scene.h"
+
+#define FV_TILE 16              /* screen tiles are FV_TILE x FV_TILE pixels */
+#define FV_DEPTH_MISS_M 1000.0f /* depth stored where a ray leaves the scene */
+
+/* Background radiance (linear RGB) where rays miss. */
+extern const float fv_background_rgb[3];
+
+/* Casts a ray for every pixel the sampler selects around the point of regard (gx, gy pixels)
+ * and writes colour + depth with weight 1 into level 0 of pyr; every other pixel gets weight 0
+ * and zero colour. Tiles are claimed atomically by the pool's workers. Returns the number of
+ * rays cast. */
+long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
+                fv_pyramid *pyr, fv_pool *pool);
+
+#endif

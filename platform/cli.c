@@ -1,0 +1,124 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static _Noreturn void vexit(const char *prog, int status, const char *fmt, va_list ap)
+{
+    fprintf(stderr, "%s: ", prog);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    exit(status);
+}
+
+_Noreturn void fv_usage_error(const char *prog, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vexit(prog, FV_EXIT_USAGE, fmt, ap);
+}
+
+_Noreturn void fv_fail(const char *prog, int status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vexit(prog, status, fmt, ap);
+}
+
+long fv_arg_long(const char *prog, const char *flag, const char *s, long lo, long hi)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || errno)
+        fv_usage_error(prog, "%s: '%s' is not a whole number", flag, s);
+    if (v < lo || v > hi)
+        fv_usage_error(prog, "%s: %ld is out of range [%ld, %ld]", flag, v, lo, hi);
+    return v;
+}
+
+float fv_arg_float(const char *prog, const char *flag, const char *s, float lo, float hi)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v))
+        fv_usage_error(prog, "%s: '%s' is not a number", flag, s);
+    if (v < lo || v > hi)
+        fv_usage_error(prog, "%s: %g is out of range [%g, %g]", flag, v, (double)lo, (double)hi);
+    return (float)v;
+}
+
+void fv_arg_size(const char *prog, const char *flag, const char *s, int *w, int *h)
+{
+    char a[32], b[32];
+    const char *x = strchr(s, 'x');
+    if (!x || x == s || (size_t)(x - s) >= sizeof a || strlen(x + 1) >= sizeof b || !x[1])
+        fv_usage_error(prog, "%s: '%s' is not WxH (for example 1280x1440)", flag, s);
+    memcpy(a, s, (size_t)(x - s));
+    a[x - s] = '\0';
+    strcpy(b, x + 1);
+    *w = (int)fv_arg_long(prog, flag, a, 16, 8192);
+    *h = (int)fv_arg_long(prog, flag, b, 16, 8192);
+}
+
+int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg)
+{
+    switch (opt) {
+    case FV_OPT_SIZE:
+        fv_arg_size(prog, "--size", arg, &cfg->cam.width, &cfg->cam.height);
+        return 1;
+    case FV_OPT_THREADS:
+        cfg->threads = (int)fv_arg_long(prog, "--threads", arg, 1, 256);
+        return 1;
+    case FV_OPT_FOV:
+        cfg->cam.fov_y_deg = fv_arg_float(prog, "--fov", arg, 10.0f, 160.0f);
+        return 1;
+    case FV_OPT_IPD:
+        cfg->cam.ipd_m = fv_arg_float(prog, "--ipd", arg, 0.0f, 0.1f);
+        return 1;
+    case FV_OPT_R0:
+        cfg->samp.r0_deg = fv_arg_float(prog, "--r0", arg, 0.5f, 90.0f);
+        return 1;
+    case FV_OPT_R1:
+        cfg->samp.r1_deg = fv_arg_float(prog, "--r1", arg, 0.5f, 90.0f);
+        return 1;
+    case FV_OPT_PMIN:
+        cfg->samp.p_min = fv_arg_float(prog, "--pmin", arg, 0.01f, 1.0f);
+        return 1;
+    case FV_OPT_ISA:
+        if (!strcmp(arg, "c"))
+            cfg->isa_mask = FV_ISA_C;
+        else if (!strcmp(arg, "sse41"))
+            cfg->isa_mask = FV_ISA_SSE41;
+        else if (!strcmp(arg, "avx2"))
+            cfg->isa_mask = FV_ISA_SSE41 | FV_ISA_AVX2;
+        else if (!strcmp(arg, "neon"))
+            cfg->isa_mask = FV_ISA_NEON;
+        else
+            fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", arg);
+        return 1;
+    case FV_OPT_DOF:
+        if (!strcmp(arg, "none"))
+            return 1;
+        if (!strcmp(arg, "weak") || !strcmp(arg, "medium") || !strcmp(arg, "strong"))
+            fv_usage_error(prog, "--dof %s: depth of field is not built yet; only 'none' works", arg);
+        fv_usage_error(prog, "--dof: '%s' is not one of none, weak, medium, strong", arg);
+    case FV_OPT_DOF_MODEL:
+        if (!strcmp(arg, "weier") || !strcmp(arg, "hussain") || !strcmp(arg, "mantiuk") || !strcmp(arg, "konrad") ||
+            !strcmp(arg, "liu"))
+            fv_usage_error(prog, "--dof-model %s: depth of field is not built yet", arg);
+        fv_usage_error(prog, "--dof-model: '%s' is not one of weier, hussain, mantiuk, konrad, liu", arg);
+    }
+    return 0;
+}
+
+void fv_common_validate(const char *prog, const fv_pipeline_config *cfg)
+{
+    if (cfg->samp.r0_deg > cfg->samp.r1_deg)
+        fv_usage_error(prog, "--r0 %g must not exceed --r1 %g", (double)cfg->samp.r0_deg, (double)cfg->samp.r1_deg);
+}

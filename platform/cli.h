@@ -1,0 +1,49 @@
+/* fovea platform: shared command-line helpers for the thin apps (number parsing with range
+ * checks, the one-line usage error, the scene/eye/sampling options every renderer takes). */
+#ifndef FOVEA_CLI_H
+#define FOVEA_CLI_H
+
+#include "camera.h"
+#include "pipeline.h"
+
+#define FV_EXIT_OK 0
+#define FV_EXIT_FAIL 1
+#define FV_EXIT_USAGE 2
+
+/* Prints "PROG: message" and exits with status 2 (bad usage or bad input). */
+_Noreturn void fv_usage_error(const char *prog, const char *fmt, ...);
+_Noreturn void fv_fail(const char *prog, int status, const char *fmt, ...);
+
+/* Strict parsers: the whole string must be a number in [lo, hi]; exit 2 naming the flag otherwise. */
+long fv_arg_long(const char *prog, const char *flag, const char *s, long lo, long hi);
+float fv_arg_float(const char *prog, const char *flag, const char *s, float lo, float hi);
+void fv_arg_size(const char *prog, const char *flag, const char *s, int *w, int *h); /* WxH */
+
+/* Options shared by fovea-replay and fovea-bench, parsed into a pipeline config.
+ * Returns 1 if opt was one of them. */
+enum {
+    FV_OPT_SIZE = 1000, FV_OPT_THREADS, FV_OPT_FOV, FV_OPT_IPD, FV_OPT_R0, FV_OPT_R1, FV_OPT_PMIN, FV_OPT_ISA,
+    FV_OPT_DOF, FV_OPT_DOF_MODEL,
+};
+#define FV_COMMON_LONGOPTS                                                                     \
+    {"size", required_argument, 0, FV_OPT_SIZE}, {"threads", required_argument, 0, FV_OPT_THREADS}, \
+    {"fov", required_argument, 0, FV_OPT_FOV}, {"ipd", required_argument, 0, FV_OPT_IPD},         \
+    {"r0", required_argument, 0, FV_OPT_R0}, {"r1", required_argument, 0, FV_OPT_R1},             \
+    {"pmin", required_argument, 0, FV_OPT_PMIN}, {"isa", required_argument, 0, FV_OPT_ISA},        \
+    {"dof", required_argument, 0, FV_OPT_DOF}, {"dof-model", required_argument, 0, FV_OPT_DOF_MODEL}
+#define FV_COMMON_HELP                                                                             \
+    "  --size WxH         eye image size in pixels (default 1280x1440)\n"                          \
+    "  --fov DEG          vertical field of view (default 100)\n"                                  \
+    "  --ipd M            inter-pupillary distance in metres (default 0.063)\n"                    \
+    "  --r0 DEG           fully sampled fovea radius (default 10)\n"                               \
+    "  --r1 DEG           end of the transition region (default 20)\n"                             \
+    "  --pmin P           peripheral sampling probability (default 0.2)\n"                         \
+    "  --threads N        worker threads (default: online CPUs)\n"                                 \
+    "  --isa c|sse41|avx2|neon  cap the SIMD kernels (default: best available)\n"                  \
+    "  --dof none|weak|medium|strong   depth of field (only 'none' is built yet)\n"                \
+    "  --dof-model weier|hussain|mantiuk|konrad|liu   (needs --dof; not built yet)\n"
+int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
+/* Checks option combinations after parsing (r0 <= r1 ...); exits 2 with a reason. */
+void fv_common_validate(const char *prog, const fv_pipeline_config *cfg);
+
+#endif

@@ -1,0 +1,49 @@
+/* fovea platform: file sinks (PNG, Y4M), CSV files written atomically, and progress on stderr.
+ * Every file is written under a temporary name and renamed when complete, so an interrupted or
+ * failed run never leaves a file that looks finished. */
+#ifndef FOVEA_OUTPUT_H
+#define FOVEA_OUTPUT_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+/* 8-bit RGB, rows of stride bytes. 0 on success, -1 with a reason in err. */
+int fv_write_png(const char *path, const uint8_t *rgb, int w, int h, ptrdiff_t stride, char *err, size_t err_len);
+
+/* A file written as PATH.tmp and renamed to PATH by fv_afile_commit (or removed by _abort). */
+typedef struct fv_afile {
+    FILE *f;
+    char path[4096], tmp[4096 + 8];
+} fv_afile;
+int fv_afile_open(fv_afile *a, const char *path, char *err, size_t err_len);
+int fv_afile_commit(fv_afile *a, char *err, size_t err_len);
+void fv_afile_abort(fv_afile *a);
+
+/* YUV4MPEG2 4:2:0 (C420jpeg, full-range BT.601) from RGB frames. */
+typedef struct fv_y4m_writer {
+    fv_afile file;
+    int w, h;
+    uint8_t *yuv;
+} fv_y4m_writer;
+int fv_y4m_open(fv_y4m_writer *y, const char *path, int w, int h, int fps, char *err, size_t err_len);
+int fv_y4m_write_rgb(fv_y4m_writer *y, const uint8_t *rgb, ptrdiff_t stride, char *err, size_t err_len);
+int fv_y4m_close(fv_y4m_writer *y, char *err, size_t err_len); /* commits */
+void fv_y4m_abort(fv_y4m_writer *y);
+
+/* Progress for long runs: silent for the first 2 s, then a line at most every 0.5 s
+ * (carriage-return updates on a terminal, plain lines every 2 s otherwise). */
+typedef struct fv_progress {
+    const char *what;
+    long total;
+    int64_t start_ns, last_ns;
+    int tty, shown;
+} fv_progress;
+void fv_progress_begin(fv_progress *p, const char *what, long total);
+void fv_progress_update(fv_progress *p, long done);
+void fv_progress_end(fv_progress *p);
+
+/* mkdir -p; 0 on success. */
+int fv_mkdirs(const char *path, char *err, size_t err_len);
+
+#endif

@@ -1,0 +1,109 @@
+#!/bin/sh
+# Command-line contract tests for fovea-replay and fovea-bench: bad input gets a one-line reason
+# and exit 2 with no output left behind as if complete; good runs write what DESIGN.md promises;
+# frames are byte-identical for 1, 2 and 5 threads and across runs.
+set -u
+BUILD=${BUILD:-build}
+B=$BUILD/bin
+SCENE=assets/range.glb
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+pass=0 fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+
+# expect_usage NAME CMD...: exit status 2 and exactly one line on stderr
+expect_usage() {
+    name=$1; shift
+    "$@" >"$T/out" 2>"$T/err"
+    rc=$?
+    lines=$(wc -l <"$T/err")
+    if [ "$rc" -eq 2 ] && [ "$lines" -eq 1 ]; then ok; else bad "$name: exit $rc, $lines stderr lines: $(head -c 300 "$T/err")"; fi
+}
+
+printf 't_ms,gaze_x,gaze_y\n0,0.5,0.5\n11.1,0.5\n' >"$T/truncated.csv"
+printf 't_ms,gaze_x,gaze_y\n0,0.5,abc\n' >"$T/nan.csv"
+printf 'time,x,y\n0,0.5,0.5\n' >"$T/header.csv"
+printf 't_ms,gaze_x,gaze_y\n' >"$T/empty.csv"
+printf 't_ms,gaze_x,gaze_y\n0,0.2,0.3\n50,0.8,0.7\n' >"$T/good.csv"
+printf 'glTF garbage' >"$T/bad.glb"
+
+for p in fovea-replay fovea-bench; do
+    # only the replay takes --out; giving it to the bench would fail for the wrong reason
+    if [ $p = fovea-replay ]; then O="--out $T/o1"; else O=; fi
+    expect_usage "$p unknown flag" $B/$p --scene $SCENE --bogus
+    expect_usage "$p missing scene file" $B/$p --scene "$T/nope.glb" $O
+    expect_usage "$p corrupt scene" $B/$p --scene "$T/bad.glb" $O
+    expect_usage "$p no scene" $B/$p $O
+    expect_usage "$p bad threads" $B/$p --scene $SCENE $O --threads 0
+    expect_usage "$p bad threads text" $B/$p --scene $SCENE $O --threads two
+    expect_usage "$p bad size" $B/$p --scene $SCENE $O --size 640x
+    expect_usage "$p bad pmin" $B/$p --scene $SCENE $O --pmin 1.5
+    expect_usage "$p r0 > r1" $B/$p --scene $SCENE $O --r0 30 --r1 20
+    expect_usage "$p dof not built" $B/$p --scene $SCENE $O --dof medium
+    expect_usage "$p dof bad" $B/$p --scene $SCENE $O --dof blurry
+    expect_usage "$p stray arg" $B/$p --scene $SCENE $O extra
+    if $B/$p --help >"$T/help" 2>&1 && grep -q -- --scene "$T/help"; then ok; else bad "$p --help"; fi
+done
+[ ! -e "$T/o1" ] && ok || bad "bad input left output directory $T/o1 behind"
+
+R=$B/fovea-replay
+expect_usage "replay no out" $R --scene $SCENE
+expect_usage "replay bad frames" $R --scene $SCENE --out "$T/o2" --frames -3
+expect_usage "replay missing trace" $R --scene $SCENE --out "$T/o2" --trace "$T/none.csv"
+expect_usage "replay trace is a directory" $R --scene $SCENE --out "$T/o2" --trace "$T"
+expect_usage "replay truncated trace" $R --scene $SCENE --out "$T/o2" --trace "$T/truncated.csv"
+expect_usage "replay non-numeric trace" $R --scene $SCENE --out "$T/o2" --trace "$T/nan.csv"
+expect_usage "replay wrong header" $R --scene $SCENE --out "$T/o2" --trace "$T/header.csv"
+expect_usage "replay empty trace" $R --scene $SCENE --out "$T/o2" --trace "$T/empty.csv"
+expect_usage "replay reference not built" $R --scene $SCENE --out "$T/o2" --reference 16
+[ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
+expect_usage "bench bad mode" $B/fovea-bench --scene $SCENE --mode fast
+
+# A good run: frames and stats with the documented columns
+if $R --scene $SCENE --trace "$T/good.csv" --frames 3 --size 96x108 --out "$T/run" --quiet 2>"$T/err"; then
+    n=$(ls "$T/run" | grep -c '^frame_0000[0-2]\.png$')
+    head=$(head -n 1 "$T/run/stats.csv")
+    rows=$(wc -l <"$T/run/stats.csv")
+    want="frame,t_ms,gaze_x,gaze_y,samples,trace_ms,reproject_ms,reconstruct_ms,coc_ms,dof_filter_ms,combine_ms,total_ms"
+    [ "$n" -eq 3 ] && ok || bad "replay wrote $n frames, expected 3"
+    [ "$head" = "$want" ] && ok || bad "stats.csv header: $head"
+    [ "$rows" -eq 4 ] && ok || bad "stats.csv has $rows lines, expected 4"
+    ls "$T/run" | grep -q '\.tmp$' && bad "temporary files left in output" || ok
+else
+    bad "replay good run failed: $(cat "$T/err")"
+fi
+# --frames defaults to the trace's length at 90 Hz: 50 ms -> frames 0..4
+if $R --scene $SCENE --trace "$T/good.csv" --size 48x54 --out "$T/run5" --quiet 2>"$T/err"; then
+    n=$(ls "$T/run5" | grep -c '^frame_.*\.png$')
+    [ "$n" -eq 5 ] && ok || bad "default frame count $n, expected 5"
+else
+    bad "replay default frames failed: $(cat "$T/err")"
+fi
+
+# Determinism: same bytes for 1, 2 and 5 threads, and on a second run
+for th in 1 2 5; do
+    $R --scene $SCENE --trace assets/gaze_sweep.csv --frames 2 --size 160x180 --threads $th --out "$T/d$th" --quiet \
+        2>"$T/err" || bad "replay --threads $th failed: $(cat "$T/err")"
+done
+$R --scene $SCENE --trace assets/gaze_sweep.csv --frames 2 --size 160x180 --threads 2 --out "$T/d2b" --quiet 2>/dev/null
+for f in frame_00000.png frame_00001.png; do
+    for d in d2 d5 d2b; do
+        if cmp -s "$T/d1/$f" "$T/$d/$f"; then ok; else bad "$f differs between d1 and $d"; fi
+    done
+done
+$R --scene $SCENE --frames 1 --size 160x180 --stereo --out "$T/st" --quiet 2>"$T/err" && ok || bad "stereo: $(cat "$T/err")"
+
+# Bench JSON has the documented fields; null for stages not built yet
+if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/b.json" >"$T/out" 2>"$T/err"; then
+    for k in '"scene"' '"width": 96' '"height": 108' '"threads"' '"frames": 2' '"mode": "foveated"' '"mode": "full"' \
+        '"samples_per_frame"' '"total_ms"' '"stages_ms"' '"trace": [0-9]' '"reproject": null' '"reconstruct": [0-9]' \
+        '"coc": null' '"dof_filter": null' '"combine": null' '"mrays_per_s"'; do
+        grep -q "$k" "$T/b.json" && ok || bad "bench JSON lacks $k"
+    done
+    grep -q 'Ray Tracing' "$T/out" && ok || bad "bench table header missing"
+else
+    bad "bench failed: $(cat "$T/err")"
+fi
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
