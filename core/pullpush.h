@@ -1,8 +1,8 @@
 /* fovea: pull-push reconstruction (Marroquim et al. 2007, as used by Weier et al. 2018).
  * Level 0 holds the sparse samples: colour + depth (r, g, b, depth_m) and a weight in [0,1]
- * (0 = no sample). Pull averages weighted valid samples up the pyramid; push fills every
- * hole from the (bilinearly interpolated) coarser level on the way down. The filled pyramid
- * is kept: it feeds depth of field and next frame's reprojection. */
+ * (0 = no sample; the colour of a zero-weight pixel is never read, so it need not be cleared).
+ * Pull averages weighted valid samples up the pyramid; push fills every hole from the
+ * (bilinearly interpolated) coarser level on the way down. The filled pyramid is kept: it feeds depth of field and next frame's reprojection. */
 #ifndef FOVEA_PULLPUSH_H
 #define FOVEA_PULLPUSH_H
 

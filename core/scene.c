@@ -133,7 +133,8 @@ fv_scene *fv_scene_create(void)
         free(s);
         return NULL;
     }
-    rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_NONE); /* static */
+    /* static; ROBUST makes shared edges watertight (no background specks through cracks) */
+    rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
     for (int i = 0; i < 3; i++) s->lo[i] = FLT_MAX, s->hi[i] = -FLT_MAX;
     s->light_exposure = 1.0f;
@@ -626,23 +627,24 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     const uint32_t *tri = m->tri + 3 * (size_t)prim_id;
     const float w = 1.0f - u - v; /* Embree: u weights vertex 1, v vertex 2 */
 
-    float e1[3], e2[3], ng[3];
-    tri_edges(m->pos, tri, e1, e2);
-    cross3(e1, e2, ng);
-    const float ng_len = len3(ng);
-    const float dir_len = len3(dir);
-
+    /* The hot path (untextured, head light) costs one sqrt and one divide: the normal stays
+     * unnormalised and the Lambert term divides by |n||L| once. Scalar sqrt/div chains were
+     * most of the shading time. */
     float n[3];
     const float *n0 = m->normals + 3 * (size_t)tri[0], *n1 = m->normals + 3 * (size_t)tri[1],
                 *n2 = m->normals + 3 * (size_t)tri[2];
-    for (int k = 0; k < 3; k++) n[k] = w * n0[k] + u * n1[k] + v * n2[k];
-    float nl = len3(n);
-    if (!(nl > 1e-12f)) { /* degenerate smooth normal: use the face */
-        for (int k = 0; k < 3; k++) n[k] = ng[k];
-        nl = ng_len;
+    /* written out: a 3-iteration loop left n[] on the stack and the 8-byte reload of two
+     * 4-byte stores stalled store forwarding on every call */
+    n[0] = w * n0[0] + u * n1[0] + v * n2[0];
+    n[1] = w * n0[1] + u * n1[1] + v * n2[1];
+    n[2] = w * n0[2] + u * n1[2] + v * n2[2];
+    float nn = dot3(n, n);
+    if (!(nn > 1e-24f)) { /* degenerate smooth normal: use the face */
+        float e1[3], e2[3];
+        tri_edges(m->pos, tri, e1, e2);
+        cross3(e1, e2, n);
+        nn = dot3(n, n);
     }
-    if (nl > 0.0f)
-        for (int k = 0; k < 3; k++) n[k] /= nl;
     if (dot3(n, dir) > 0.0f)
         for (int k = 0; k < 3; k++) n[k] = -n[k];
 
@@ -652,8 +654,12 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         const float tu = w * a[0] + u * b[0] + v * c[0], tv = w * a[1] + u * b[1] + v * c[1];
         const float density = m->texel_density[prim_id];
         float lod = 0.0f;
-        if (footprint_rad > 0.0f && t > 0.0f && density > 0.0f && dir_len > 0.0f) {
-            const float cos_theta = ng_len > 0.0f ? fabsf(dot3(ng, dir)) / (ng_len * dir_len) : 1.0f;
+        if (footprint_rad > 0.0f && t > 0.0f && density > 0.0f) {
+            float e1[3], e2[3], ng[3];
+            tri_edges(m->pos, tri, e1, e2);
+            cross3(e1, e2, ng);
+            const float ng_len = len3(ng), dir_len = len3(dir);
+            const float cos_theta = ng_len > 0.0f && dir_len > 0.0f ? fabsf(dot3(ng, dir)) / (ng_len * dir_len) : 1.0f;
             const float width_m = t * dir_len * footprint_rad / fmaxf(cos_theta, 0.1f);
             lod = log2f(width_m * density);
         }
@@ -666,12 +672,14 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     float light[3] = {FV_SCENE_AMBIENT, FV_SCENE_AMBIENT, FV_SCENE_AMBIENT};
     if (s->light_count == 0) { /* head light: unit intensity, no falloff */
         float L[3] = {eye_pos[0] - p[0], eye_pos[1] - p[1], eye_pos[2] - p[2]};
-        const float d = len3(L);
-        if (d > 0.0f) {
-            const float lam = fmaxf(0.0f, dot3(n, L) / d);
+        const float nl = dot3(n, L), ll = dot3(L, L);
+        if (nl > 0.0f && ll > 0.0f) {
+            const float lam = nl / sqrtf(nn * ll);
             for (int k = 0; k < 3; k++) light[k] += lam;
         }
     } else {
+        const float inv_n = nn > 0.0f ? 1.0f / sqrtf(nn) : 0.0f;
+        for (int k = 0; k < 3; k++) n[k] *= inv_n;
         for (int i = 0; i < s->light_count; i++) {
             const fv_light_rec *lr = &s->lights[i];
             const fv_light *l = &lr->l;
