@@ -275,14 +275,30 @@ static void run_level(fv_pool *pool, fv_task_fn fn, pp_ctx *c)
     fv_pool_run(pool, c->chunks, fn, c);
 }
 
+void fv_pull_block(fv_pyramid *p, const fv_dsp *dsp, int level, int x0, int y0, int w, int h)
+{
+    const fv_pyr_level *s = &p->lv[level], *d = &p->lv[level + 1];
+    /* rows 2Y+1 == s->h and column s->w are the zero-weight border: odd edges need no care */
+    for (int y = y0 >> 1; y < (y0 + h + 1) >> 1; y++) {
+        const ptrdiff_t r0 = (ptrdiff_t)(2 * y) * s->stride + x0, r1 = r0 + s->stride;
+        dsp->pull_row(px_rgbd(d, x0 >> 1, y), d->wgt + (ptrdiff_t)y * d->stride + (x0 >> 1), s->rgbd + 4 * r0,
+                      s->wgt + r0, s->rgbd + 4 * r1, s->wgt + r1, (w + 1) >> 1);
+    }
+}
+
 void fv_pullpush(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool)
+{
+    fv_pullpush_from(p, dsp, pool, 0);
+}
+
+void fv_pullpush_from(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool, int pulled)
 {
     if (!p->mem || p->levels < 1)
         return;
     /* Directions alternate so that each pass starts where the previous pass over the same
      * level ended (most recently touched rows are still in cache): pull 0->1 top-down, 1->2
      * bottom-up, ...; pushing into level l runs opposite to the pull that last read it. */
-    for (int l = 0; l + 1 < p->levels; l++) {
+    for (int l = pulled; l + 1 < p->levels; l++) {
         pp_ctx c = { .dsp = dsp, .src = &p->lv[l], .dst = &p->lv[l + 1], .reverse = l & 1 };
         run_level(pool, pull_task, &c);
     }

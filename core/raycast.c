@@ -12,6 +12,7 @@ typedef struct {
     const fv_sampler *smp;
     int gx, gy, tiles_x, tiles_y;
     fv_pyramid *pyr;
+    const fv_dsp *dsp;
     atomic_long rays;
 } rc_job;
 
@@ -111,13 +112,15 @@ static void trace_tile(void *ctx, int index, int thread_id)
         rays += k;
         k = 0;
     }
+    if (j->pyr->levels > 1)
+        fv_pull_block(j->pyr, j->dsp, 0, x0, y0, tw, th);
     atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
 }
 
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
-                fv_pyramid *pyr, fv_pool *pool)
+                fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool)
 {
-    rc_job j = {.scene = scene, .cam = cam, .smp = smp, .gx = gx, .gy = gy, .pyr = pyr};
+    rc_job j = {.scene = scene, .cam = cam, .smp = smp, .gx = gx, .gy = gy, .pyr = pyr, .dsp = dsp};
     j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
     j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
     atomic_init(&j.rays, 0);

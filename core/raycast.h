@@ -17,8 +17,9 @@ extern const float fv_background_rgb[3];
 /* Casts a ray for every pixel the sampler selects around the point of regard (gx, gy pixels)
  * and writes colour + depth with weight 1 into level 0 of pyr; every other pixel gets weight 0
  * (its colour is left as it was: pull-push never reads it). Tiles are claimed atomically by the pool's workers. Returns the number of
- * rays cast. */
+ * rays cast. Each tile also pulls its pixels into pyramid level 1 while they are in cache, so
+ * reconstruction continues with fv_pullpush_from(pyr, dsp, pool, 1). */
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
-                fv_pyramid *pyr, fv_pool *pool);
+                fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool);
 
 #endif

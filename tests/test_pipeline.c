@@ -217,6 +217,45 @@ static void test_thread_determinism(void **st)
     fv_scene_free(s);
 }
 
+/* The ray caster pulls level 0 into level 1 per tile (fused, while the tile is in cache); the
+ * pyramid must be bit-identical to a plain fv_pullpush of the same samples. Odd sizes so the
+ * right and bottom tiles are partial and odd. */
+static void test_fused_pull_matches_pullpush(void **st)
+{
+    (void)st;
+    fv_scene *s = hand_scene();
+    fv_pipeline_config cfg;
+    fv_pipeline_config_default(&cfg);
+    cfg.cam.width = 203;
+    cfg.cam.height = 229;
+    cfg.threads = 2;
+    char err[256];
+    fv_pipeline *p = fv_pipeline_create(s, &cfg, err, sizeof err);
+    assert_non_null(p);
+    fv_frame_stats stats;
+    assert_int_equal(fv_pipeline_render(p, FV_EYE_CENTER, &origin, 0.2f, 0.7f, &stats), 0);
+    const fv_pyramid *got = fv_pipeline_pyramid(p, FV_EYE_CENTER);
+    fv_pyramid ref;
+    assert_int_equal(fv_pyramid_init(&ref, 203, 229), 0);
+    assert_int_equal(ref.levels, got->levels);
+    /* level 0 keeps its weights and every sampled pixel through push; holes are never read */
+    for (int y = 0; y < 229; y++) {
+        memcpy(ref.lv[0].rgbd + 4 * y * ref.lv[0].stride, got->lv[0].rgbd + 4 * y * got->lv[0].stride, 4 * sizeof(float) * 203);
+        memcpy(ref.lv[0].wgt + y * ref.lv[0].stride, got->lv[0].wgt + y * got->lv[0].stride, sizeof(float) * 203);
+    }
+    fv_pullpush(&ref, fv_pipeline_dsp(p), NULL);
+    for (int l = 0; l < ref.levels; l++)
+        for (int y = 0; y < ref.lv[l].h; y++) {
+            assert_memory_equal(ref.lv[l].rgbd + 4 * y * ref.lv[l].stride, got->lv[l].rgbd + 4 * y * got->lv[l].stride,
+                                4 * sizeof(float) * ref.lv[l].w);
+            assert_memory_equal(ref.lv[l].wgt + y * ref.lv[l].stride, got->lv[l].wgt + y * got->lv[l].stride,
+                                sizeof(float) * ref.lv[l].w);
+        }
+    fv_pyramid_free(&ref);
+    fv_pipeline_destroy(p);
+    fv_scene_free(s);
+}
+
 /* Stereo: the eyes sit IPD/2 either side of the head along its right axis. */
 static void test_stereo_eyes(void **st)
 {
@@ -256,6 +295,7 @@ int main(void)
         cmocka_unit_test(test_hand_scene_full),
         cmocka_unit_test(test_foveated_samples),
         cmocka_unit_test(test_thread_determinism),
+        cmocka_unit_test(test_fused_pull_matches_pullpush),
         cmocka_unit_test(test_stereo_eyes),
     };
     return cmocka_run_group_tests_name("pipeline", tests, NULL, NULL);
