@@ -115,10 +115,7 @@ int main(int argc, char **argv)
             break;
         case OPT_JSON: json_path = optarg; break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
-        case '?':
-            if (optopt)
-                fv_usage_error(prog, "option -%c is unknown or lacks its argument (see --help)", optopt);
-            fv_usage_error(prog, "%s: unknown option or missing argument (see --help)", argv[optind - 1]);
+        case '?': fv_bad_option(prog, argv);
         default:
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");

@@ -70,10 +70,7 @@ int main(int argc, char **argv)
             fv_usage_error(prog, "--reference: the ground-truth depth-of-field renderer is not built yet");
         case OPT_WINDOW: fv_usage_error(prog, "--window: the window display is not built yet; use --out / --y4m");
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
-        case '?':
-            if (optopt)
-                fv_usage_error(prog, "option -%c is unknown or lacks its argument (see --help)", optopt);
-            fv_usage_error(prog, "%s: unknown option or missing argument (see --help)", argv[optind - 1]);
+        case '?': fv_bad_option(prog, argv);
         default:
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");

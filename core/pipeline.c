@@ -1,13 +1,13 @@
 #include "pipeline.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "raycast.h"
+#include "err.h"
 
 const char *const fv_stage_names[FV_STAGE_COUNT] = {"trace", "reproject", "reconstruct", "coc", "dof_filter", "combine"};
 
@@ -44,43 +44,33 @@ void fv_pipeline_config_default(fv_pipeline_config *c)
     c->isa_mask = ~0u;
 }
 
-static int fail(char *err, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    if (err && n)
-        vsnprintf(err, n, fmt, ap);
-    va_end(ap);
-    return -1;
-}
-
 fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config *cfg, char *err, size_t err_len)
 {
     fv_pipeline *p = calloc(1, sizeof *p);
     if (!p) {
-        fail(err, err_len, "out of memory");
+        fv_err(err, err_len, "out of memory");
         return NULL;
     }
     p->scene = scene;
     p->cfg = *cfg;
     static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
     if (fv_camera_setup(&p->eyes[0].cam, &cfg->cam, &origin)) {
-        fail(err, err_len, "eye size %dx%d or vertical FOV %g deg out of range", cfg->cam.width, cfg->cam.height,
+        fv_err(err, err_len, "eye size %dx%d or vertical FOV %g deg out of range", cfg->cam.width, cfg->cam.height,
              (double)cfg->cam.fov_y_deg);
         goto bad;
     }
     if (fv_sampler_init(&p->smp, cfg->cam.width, cfg->cam.height, p->eyes[0].cam.focal_px, &cfg->samp)) {
-        fail(err, err_len, "sampling parameters out of range: need 0 < r0 <= r1 <= 90 deg, 0 < p_min <= 1");
+        fv_err(err, err_len, "sampling parameters out of range: need 0 < r0 <= r1 <= 90 deg, 0 < p_min <= 1");
         goto bad;
     }
     for (int e = 0; e < 2; e++)
         if (fv_pyramid_init(&p->eyes[e].pyr, cfg->cam.width, cfg->cam.height)) {
-            fail(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
+            fv_err(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
             goto bad;
         }
     p->pool = fv_pool_create(cfg->threads);
     if (!p->pool) {
-        fail(err, err_len, "cannot start %d worker threads", cfg->threads);
+        fv_err(err, err_len, "cannot start %d worker threads", cfg->threads);
         goto bad;
     }
     fv_dsp_init(&p->dsp, cfg->isa_mask);

@@ -1,21 +1,11 @@
 #include "trace.h"
+#include "err.h"
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int fail(char *err, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    if (err && n)
-        vsnprintf(err, n, fmt, ap);
-    va_end(ap);
-    return -1;
-}
 
 void fv_trace_free(fv_trace *tr)
 {
@@ -53,12 +43,12 @@ int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name,
     memset(tr, 0, sizeof *tr);
     char *buf = malloc(len + 1);
     if (!buf)
-        return fail(err, err_len, "%s: out of memory", name);
+        return fv_err(err, err_len, "%s: out of memory", name);
     memcpy(buf, text, len);
     buf[len] = '\0';
     if (memchr(text, '\0', len)) {
         free(buf);
-        return fail(err, err_len, "%s: not a text file (NUL byte)", name);
+        return fv_err(err, err_len, "%s: not a text file (NUL byte)", name);
     }
     int cap = 0, lineno = 0, header = 0, ncols = 0, rc = -1;
     char *save = NULL;
@@ -76,16 +66,16 @@ int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name,
         int nf = split(p, f, 11);
         if (!header) {
             if (nf < 3 || strcmp(f[0], "t_ms") || strcmp(f[1], "gaze_x") || strcmp(f[2], "gaze_y")) {
-                fail(err, err_len, "%s:%d: header must start with t_ms,gaze_x,gaze_y", name, lineno);
+                fv_err(err, err_len, "%s:%d: header must start with t_ms,gaze_x,gaze_y", name, lineno);
                 goto out;
             }
             if (nf != 3 && nf != 10) {
-                fail(err, err_len, "%s:%d: header has %d columns; expected 3, or 10 with head pose", name, lineno, nf);
+                fv_err(err, err_len, "%s:%d: header has %d columns; expected 3, or 10 with head pose", name, lineno, nf);
                 goto out;
             }
             for (int i = 3; i < nf; i++)
                 if (strcmp(f[i], head_cols[i - 3])) {
-                    fail(err, err_len, "%s:%d: column %d is '%s', expected '%s'", name, lineno, i + 1, f[i], head_cols[i - 3]);
+                    fv_err(err, err_len, "%s:%d: column %d is '%s', expected '%s'", name, lineno, i + 1, f[i], head_cols[i - 3]);
                     goto out;
                 }
             header = 1;
@@ -94,7 +84,7 @@ int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name,
             continue;
         }
         if (nf != ncols) {
-            fail(err, err_len, "%s:%d: %d fields, expected %d (truncated or malformed line)", name, lineno, nf > 11 ? 11 : nf, ncols);
+            fv_err(err, err_len, "%s:%d: %d fields, expected %d (truncated or malformed line)", name, lineno, nf > 11 ? 11 : nf, ncols);
             goto out;
         }
         double v[10];
@@ -103,24 +93,24 @@ int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name,
             errno = 0;
             v[i] = strtod(f[i], &end);
             if (end == f[i] || *end || errno == ERANGE || !isfinite(v[i])) {
-                fail(err, err_len, "%s:%d: field %d ('%s') is not a finite number", name, lineno, i + 1, f[i]);
+                fv_err(err, err_len, "%s:%d: field %d ('%s') is not a finite number", name, lineno, i + 1, f[i]);
                 goto out;
             }
         }
         if (tr->n && v[0] < tr->s[tr->n - 1].t_ms) {
-            fail(err, err_len, "%s:%d: t_ms goes backwards (%g after %g)", name, lineno, v[0], tr->s[tr->n - 1].t_ms);
+            fv_err(err, err_len, "%s:%d: t_ms goes backwards (%g after %g)", name, lineno, v[0], tr->s[tr->n - 1].t_ms);
             goto out;
         }
         /* Off-image gaze is legal (the eye can look past the panel edge) but not absurd values. */
         if (v[1] < -1.0 || v[1] > 2.0 || v[2] < -1.0 || v[2] > 2.0) {
-            fail(err, err_len, "%s:%d: gaze (%g, %g) is far outside the normalised image [0,1]", name, lineno, v[1], v[2]);
+            fv_err(err, err_len, "%s:%d: gaze (%g, %g) is far outside the normalised image [0,1]", name, lineno, v[1], v[2]);
             goto out;
         }
         if (tr->n == cap) {
             cap = cap ? 2 * cap : 256;
             fv_trace_sample *ns = realloc(tr->s, (size_t)cap * sizeof *ns);
             if (!ns) {
-                fail(err, err_len, "%s: out of memory", name);
+                fv_err(err, err_len, "%s: out of memory", name);
                 goto out;
             }
             tr->s = ns;
@@ -136,7 +126,7 @@ int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name,
                 s->head.pos[i] = (float)v[3 + i];
             double qn = sqrt(v[6] * v[6] + v[7] * v[7] + v[8] * v[8] + v[9] * v[9]);
             if (qn < 0.5 || qn > 2.0) {
-                fail(err, err_len, "%s:%d: head quaternion has length %g, expected about 1", name, lineno, qn);
+                fv_err(err, err_len, "%s:%d: head quaternion has length %g, expected about 1", name, lineno, qn);
                 goto out;
             }
             for (int i = 0; i < 4; i++)
@@ -144,11 +134,11 @@ int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name,
         }
     }
     if (!header) {
-        fail(err, err_len, "%s: no header line (t_ms,gaze_x,gaze_y)", name);
+        fv_err(err, err_len, "%s: no header line (t_ms,gaze_x,gaze_y)", name);
         goto out;
     }
     if (tr->n == 0) {
-        fail(err, err_len, "%s: no samples after the header", name);
+        fv_err(err, err_len, "%s: no samples after the header", name);
         goto out;
     }
     rc = 0;
@@ -164,13 +154,13 @@ int fv_trace_load(fv_trace *tr, const char *path, char *err, size_t err_len)
     memset(tr, 0, sizeof *tr);
     FILE *f = fopen(path, "rb");
     if (!f)
-        return fail(err, err_len, "%s: %s", path, strerror(errno));
+        return fv_err(err, err_len, "%s: %s", path, strerror(errno));
     size_t cap = 1 << 16, len = 0;
     char *buf = malloc(cap);
     for (;;) {
         if (!buf) {
             fclose(f);
-            return fail(err, err_len, "%s: out of memory", path);
+            return fv_err(err, err_len, "%s: out of memory", path);
         }
         len += fread(buf + len, 1, cap - len, f);
         if (len < cap)
@@ -178,7 +168,7 @@ int fv_trace_load(fv_trace *tr, const char *path, char *err, size_t err_len)
         if (cap > ((size_t)1 << 30)) {
             free(buf);
             fclose(f);
-            return fail(err, err_len, "%s: larger than 1 GiB", path);
+            return fv_err(err, err_len, "%s: larger than 1 GiB", path);
         }
         char *nb = realloc(buf, cap *= 2);
         if (!nb)
@@ -189,7 +179,7 @@ int fv_trace_load(fv_trace *tr, const char *path, char *err, size_t err_len)
     fclose(f);
     if (bad) {
         free(buf);
-        return fail(err, err_len, "%s: read error", path);
+        return fv_err(err, err_len, "%s: read error", path);
     }
     int rc = fv_trace_parse(tr, buf, len, path, err, err_len);
     free(buf);

@@ -1,6 +1,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -27,6 +28,18 @@ _Noreturn void fv_fail(const char *prog, int status, const char *fmt, ...)
     va_list ap;
     va_start(ap, fmt);
     vexit(prog, status, fmt, ap);
+}
+
+_Noreturn void fv_bad_option(const char *prog, char **argv)
+{
+    /* getopt_long leaves optind past the offending word; optopt is the short option (or the
+     * long option's value, not printable here) that lacked its argument, 0 for an unknown one */
+    const char *word = argv[optind - 1];
+    if (optopt && strncmp(word, "--", 2))
+        fv_usage_error(prog, "option -%c is unknown or lacks its argument (see --help)", optopt);
+    if (optopt)
+        fv_usage_error(prog, "%s needs an argument (see --help)", word);
+    fv_usage_error(prog, "%s: unknown option (see --help)", word);
 }
 
 long fv_arg_long(const char *prog, const char *flag, const char *s, long lo, long hi)

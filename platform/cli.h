@@ -13,6 +13,8 @@
 /* Prints "PROG: message" and exits with status 2 (bad usage or bad input). */
 _Noreturn void fv_usage_error(const char *prog, const char *fmt, ...);
 _Noreturn void fv_fail(const char *prog, int status, const char *fmt, ...);
+/* For getopt_long's '?': names the unknown option, or the one missing its argument; exits 2. */
+_Noreturn void fv_bad_option(const char *prog, char **argv);
 
 /* Strict parsers: the whole string must be a number in [lo, hi]; exit 2 naming the flag otherwise. */
 long fv_arg_long(const char *prog, const char *flag, const char *s, long lo, long hi);

@@ -1,7 +1,6 @@
 #include "output.h"
 
 #include <errno.h>
-#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -9,45 +8,36 @@
 #include <stb/stb_image_write.h>
 
 #include "pipeline.h" /* fv_time_ns */
-
-static int fail(char *err, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    if (err && n)
-        vsnprintf(err, n, fmt, ap);
-    va_end(ap);
-    return -1;
-}
+#include "err.h"
 
 int fv_afile_open(fv_afile *a, const char *path, char *err, size_t err_len)
 {
     memset(a, 0, sizeof *a);
     if (strlen(path) >= sizeof a->path)
-        return fail(err, err_len, "%s: path too long", path);
+        return fv_err(err, err_len, "%s: path too long", path);
     strcpy(a->path, path);
     snprintf(a->tmp, sizeof a->tmp, "%s.tmp", path);
     a->f = fopen(a->tmp, "wb");
     if (!a->f)
-        return fail(err, err_len, "%s: %s", a->tmp, strerror(errno));
+        return fv_err(err, err_len, "%s: %s", a->tmp, strerror(errno));
     return 0;
 }
 
 int fv_afile_commit(fv_afile *a, char *err, size_t err_len)
 {
     if (!a->f)
-        return fail(err, err_len, "%s: not open", a->path);
+        return fv_err(err, err_len, "%s: not open", a->path);
     int bad = ferror(a->f);
     bad |= fclose(a->f) != 0;
     a->f = NULL;
     if (bad) {
         unlink(a->tmp);
-        return fail(err, err_len, "%s: write error (disk full?)", a->path);
+        return fv_err(err, err_len, "%s: write error (disk full?)", a->path);
     }
     if (rename(a->tmp, a->path)) {
         int e = errno;
         unlink(a->tmp);
-        return fail(err, err_len, "%s: %s", a->path, strerror(e));
+        return fv_err(err, err_len, "%s: %s", a->path, strerror(e));
     }
     return 0;
 }
@@ -74,7 +64,7 @@ int fv_write_png(const char *path, const uint8_t *rgb, int w, int h, ptrdiff_t s
     png_ctx c = {a.f};
     if (!stbi_write_png_to_func(png_write_cb, &c, w, h, 3, rgb, (int)stride)) {
         fv_afile_abort(&a);
-        return fail(err, err_len, "%s: PNG encoding failed", path);
+        return fv_err(err, err_len, "%s: PNG encoding failed", path);
     }
     return fv_afile_commit(&a, err, err_len);
 }
@@ -83,12 +73,12 @@ int fv_y4m_open(fv_y4m_writer *y, const char *path, int w, int h, int fps, char 
 {
     memset(y, 0, sizeof *y);
     if (w < 2 || h < 2 || (w | h) & 1)
-        return fail(err, err_len, "%s: Y4M 4:2:0 needs even frame sizes, got %dx%d", path, w, h);
+        return fv_err(err, err_len, "%s: Y4M 4:2:0 needs even frame sizes, got %dx%d", path, w, h);
     y->w = w;
     y->h = h;
     y->yuv = malloc((size_t)w * h * 3 / 2);
     if (!y->yuv)
-        return fail(err, err_len, "%s: out of memory", path);
+        return fv_err(err, err_len, "%s: out of memory", path);
     if (fv_afile_open(&y->file, path, err, err_len)) {
         free(y->yuv);
         y->yuv = NULL;
@@ -123,7 +113,7 @@ int fv_y4m_write_rgb(fv_y4m_writer *y, const uint8_t *rgb, ptrdiff_t stride, cha
         }
     fputs("FRAME\n", y->file.f);
     if (fwrite(y->yuv, 1, (size_t)w * h * 3 / 2, y->file.f) != (size_t)w * h * 3 / 2)
-        return fail(err, err_len, "%s: write error", y->file.path);
+        return fv_err(err, err_len, "%s: write error", y->file.path);
     return 0;
 }
 
@@ -174,14 +164,14 @@ int fv_mkdirs(const char *path, char *err, size_t err_len)
 {
     char buf[4096];
     if (strlen(path) >= sizeof buf)
-        return fail(err, err_len, "%s: path too long", path);
+        return fv_err(err, err_len, "%s: path too long", path);
     strcpy(buf, path);
     for (char *s = buf + 1;; s++) {
         if (*s == '/' || *s == '\0') {
             char c = *s;
             *s = '\0';
             if (mkdir(buf, 0777) && errno != EEXIST)
-                return fail(err, err_len, "%s: %s", buf, strerror(errno));
+                return fv_err(err, err_len, "%s: %s", buf, strerror(errno));
             *s = c;
             if (!c)
                 break;
@@ -189,6 +179,6 @@ int fv_mkdirs(const char *path, char *err, size_t err_len)
     }
     struct stat st;
     if (stat(path, &st) || !S_ISDIR(st.st_mode))
-        return fail(err, err_len, "%s: not a directory", path);
+        return fv_err(err, err_len, "%s: not a directory", path);
     return 0;
 }

@@ -12,13 +12,15 @@ pass=0 fail=0
 ok() { pass=$((pass + 1)); }
 bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
 
-# expect_usage NAME CMD...: exit status 2 and exactly one line on stderr
+# expect_usage NAME PATTERN CMD...: exit status 2 and exactly one line on stderr, which names
+# the problem (matches the extended regex PATTERN)
 expect_usage() {
-    name=$1; shift
+    name=$1; pat=$2; shift 2
     "$@" >"$T/out" 2>"$T/err"
     rc=$?
     lines=$(wc -l <"$T/err")
-    if [ "$rc" -eq 2 ] && [ "$lines" -eq 1 ]; then ok; else bad "$name: exit $rc, $lines stderr lines: $(head -c 300 "$T/err")"; fi
+    if [ "$rc" -eq 2 ] && [ "$lines" -eq 1 ] && grep -Eq -- "$pat" "$T/err"; then ok
+    else bad "$name: exit $rc, $lines stderr lines, want /$pat/: $(head -c 300 "$T/err")"; fi
 }
 
 printf 't_ms,gaze_x,gaze_y\n0,0.5,0.5\n11.1,0.5\n' >"$T/truncated.csv"
@@ -31,34 +33,34 @@ printf 'glTF garbage' >"$T/bad.glb"
 for p in fovea-replay fovea-bench; do
     # only the replay takes --out; giving it to the bench would fail for the wrong reason
     if [ $p = fovea-replay ]; then O="--out $T/o1"; else O=; fi
-    expect_usage "$p unknown flag" $B/$p --scene $SCENE --bogus
-    expect_usage "$p missing scene file" $B/$p --scene "$T/nope.glb" $O
-    expect_usage "$p corrupt scene" $B/$p --scene "$T/bad.glb" $O
-    expect_usage "$p no scene" $B/$p $O
-    expect_usage "$p bad threads" $B/$p --scene $SCENE $O --threads 0
-    expect_usage "$p bad threads text" $B/$p --scene $SCENE $O --threads two
-    expect_usage "$p bad size" $B/$p --scene $SCENE $O --size 640x
-    expect_usage "$p bad pmin" $B/$p --scene $SCENE $O --pmin 1.5
-    expect_usage "$p r0 > r1" $B/$p --scene $SCENE $O --r0 30 --r1 20
-    expect_usage "$p dof not built" $B/$p --scene $SCENE $O --dof medium
-    expect_usage "$p dof bad" $B/$p --scene $SCENE $O --dof blurry
-    expect_usage "$p stray arg" $B/$p --scene $SCENE $O extra
+    expect_usage "$p unknown flag" '--bogus: unknown option' $B/$p --scene $SCENE --bogus
+    expect_usage "$p missing scene file" 'nope.glb.*No such file' $B/$p --scene "$T/nope.glb" $O
+    expect_usage "$p corrupt scene" 'bad.glb' $B/$p --scene "$T/bad.glb" $O
+    expect_usage "$p no scene" '--scene FILE is required' $B/$p $O
+    expect_usage "$p bad threads" '--threads: 0 is out of range' $B/$p --scene $SCENE $O --threads 0
+    expect_usage "$p bad threads text" '--threads: .two. is not a whole number' $B/$p --scene $SCENE $O --threads two
+    expect_usage "$p bad size" '--size: .640x. is not WxH' $B/$p --scene $SCENE $O --size 640x
+    expect_usage "$p bad pmin" '--pmin: 1.5 is out of range' $B/$p --scene $SCENE $O --pmin 1.5
+    expect_usage "$p r0 > r1" '--r0 30 must not exceed --r1 20' $B/$p --scene $SCENE $O --r0 30 --r1 20
+    expect_usage "$p dof not built" '--dof medium: depth of field is not built yet' $B/$p --scene $SCENE $O --dof medium
+    expect_usage "$p dof bad" '--dof: .blurry. is not one of' $B/$p --scene $SCENE $O --dof blurry
+    expect_usage "$p stray arg" 'unexpected argument .extra.' $B/$p --scene $SCENE $O extra
     if $B/$p --help >"$T/help" 2>&1 && grep -q -- --scene "$T/help"; then ok; else bad "$p --help"; fi
 done
 [ ! -e "$T/o1" ] && ok || bad "bad input left output directory $T/o1 behind"
 
 R=$B/fovea-replay
-expect_usage "replay no out" $R --scene $SCENE
-expect_usage "replay bad frames" $R --scene $SCENE --out "$T/o2" --frames -3
-expect_usage "replay missing trace" $R --scene $SCENE --out "$T/o2" --trace "$T/none.csv"
-expect_usage "replay trace is a directory" $R --scene $SCENE --out "$T/o2" --trace "$T"
-expect_usage "replay truncated trace" $R --scene $SCENE --out "$T/o2" --trace "$T/truncated.csv"
-expect_usage "replay non-numeric trace" $R --scene $SCENE --out "$T/o2" --trace "$T/nan.csv"
-expect_usage "replay wrong header" $R --scene $SCENE --out "$T/o2" --trace "$T/header.csv"
-expect_usage "replay empty trace" $R --scene $SCENE --out "$T/o2" --trace "$T/empty.csv"
-expect_usage "replay reference not built" $R --scene $SCENE --out "$T/o2" --reference 16
+expect_usage "replay no out" '--out DIR is required' $R --scene $SCENE
+expect_usage "replay bad frames" '--frames: -3 is out of range' $R --scene $SCENE --out "$T/o2" --frames -3
+expect_usage "replay missing trace" 'none.csv: No such file' $R --scene $SCENE --out "$T/o2" --trace "$T/none.csv"
+expect_usage "replay trace is a directory" '(directory|read error)' $R --scene $SCENE --out "$T/o2" --trace "$T"
+expect_usage "replay truncated trace" 'truncated.csv:3: 2 fields, expected 3' $R --scene $SCENE --out "$T/o2" --trace "$T/truncated.csv"
+expect_usage "replay non-numeric trace" 'nan.csv:2: field 3 .*abc.* is not a finite number' $R --scene $SCENE --out "$T/o2" --trace "$T/nan.csv"
+expect_usage "replay wrong header" 'header.csv:1: header must start with t_ms,gaze_x,gaze_y' $R --scene $SCENE --out "$T/o2" --trace "$T/header.csv"
+expect_usage "replay empty trace" 'empty.csv: no samples' $R --scene $SCENE --out "$T/o2" --trace "$T/empty.csv"
+expect_usage "replay reference not built" '--reference: .*not built yet' $R --scene $SCENE --out "$T/o2" --reference 16
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
-expect_usage "bench bad mode" $B/fovea-bench --scene $SCENE --mode fast
+expect_usage "bench bad mode" '--mode: .fast. is not one of' $B/fovea-bench --scene $SCENE --mode fast
 
 # A good run: frames and stats with the documented columns
 if $R --scene $SCENE --trace "$T/good.csv" --frames 3 --size 96x108 --out "$T/run" --quiet 2>"$T/err"; then
