@@ -83,6 +83,8 @@ int main(int argc, char **argv)
     if (!out_dir)
         fv_usage_error(prog, "--out DIR is required (see --help)");
     fv_common_validate(prog, &cfg);
+    if (y4m_path && ((cfg.cam.width & 1) || (cfg.cam.height & 1)))
+        fv_usage_error(prog, "--y4m: 4:2:0 video needs even frame sizes, got %dx%d", cfg.cam.width, cfg.cam.height);
 
     char err[512];
     fv_trace tr = {0};

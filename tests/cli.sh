@@ -95,6 +95,18 @@ for f in frame_00000.png frame_00001.png; do
     done
 done
 $R --scene $SCENE --frames 1 --size 160x180 --stereo --out "$T/st" --quiet 2>"$T/err" && ok || bad "stereo: $(cat "$T/err")"
+# Y4M: header, then per frame "FRAME\n" + a 4:2:0 picture (w*h*3/2 bytes); stereo is side by side
+if $R --scene $SCENE --frames 2 --size 64x72 --stereo --y4m "$T/v.y4m" --out "$T/y" --quiet 2>"$T/err"; then
+    hdr=$(head -n 1 "$T/v.y4m")
+    size=$(wc -c <"$T/v.y4m")
+    want=$(( ${#hdr} + 1 + 2 * (6 + 128 * 72 * 3 / 2) ))
+    case "$hdr" in "YUV4MPEG2 W128 H72 F90:1 "*) ok ;; *) bad "y4m header: $hdr" ;; esac
+    [ "$size" -eq "$want" ] && ok || bad "y4m is $size bytes, expected $want"
+else
+    bad "y4m run failed: $(cat "$T/err")"
+fi
+expect_usage "replay odd y4m size" 'even frame sizes' $R --scene $SCENE --frames 1 --size 63x72 --y4m "$T/odd.y4m" --out "$T/odd"
+[ ! -e "$T/odd.y4m" ] && [ ! -e "$T/odd.y4m.tmp" ] && [ ! -e "$T/odd/stats.csv" ] && ok || bad "failed y4m run left files behind"
 
 # Bench JSON has the documented fields; null for stages not built yet
 if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/b.json" >"$T/out" 2>"$T/err"; then
