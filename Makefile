@@ -70,7 +70,18 @@ RANGE := assets/range.glb
 # Where the shared assets live (scenes, eye images); tests read them from here.
 SHARED ?= ../shared
 
-.PHONY: all deps test run bench check-asan check-tsan install clean test-bin
+# Build folders of the checks; BUILD=... on the command line names the one they all use.
+ifeq ($(origin BUILD),command line)
+ASAN_BUILD := $(BUILD)
+TSAN_BUILD := $(BUILD)
+CROSS_BUILD := $(BUILD)
+else
+ASAN_BUILD := build-asan
+TSAN_BUILD := build-tsan
+CROSS_BUILD := build-aarch64
+endif
+
+.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin
 all: $(LIB) $(PLIB) $(APPS) $(TOOLS)
 
 $(BUILD)/%.o: %.c
@@ -121,17 +132,17 @@ test: deps
 check-aarch64:
 	@tools/deps.sh --cross
 	@$(MAKE) --no-print-directory CROSS=aarch64-linux-gnu- test-bin
-	@BUILD=build-aarch64 SHARED=$(SHARED) RUNNER=qemu-aarch64 tests/run.sh --core
+	@BUILD=$(CROSS_BUILD) SHARED=$(SHARED) RUNNER=qemu-aarch64 tests/run.sh --core
 
 check-asan:
 	@tools/deps.sh
 	@$(MAKE) --no-print-directory SAN=asan test-bin
-	@BUILD=build-asan SHARED=$(SHARED) ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 tests/run.sh
+	@BUILD=$(ASAN_BUILD) SHARED=$(SHARED) ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 tests/run.sh
 
 check-tsan:
 	@tools/deps.sh
 	@$(MAKE) --no-print-directory SAN=tsan test-bin
-	@BUILD=build-tsan SHARED=$(SHARED) TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp halt_on_error=1" tests/run.sh
+	@BUILD=$(TSAN_BUILD) SHARED=$(SHARED) TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp halt_on_error=1" tests/run.sh
 
 run: deps
 	@$(MAKE) --no-print-directory all $(RANGE)
