@@ -113,8 +113,8 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
     st->samples = fv_raycast(p->scene, &es->cam, &p->smp, gx, gy, &es->pyr, &p->dsp, p->pool);
     int64_t t1 = fv_time_ns();
-    /* level 0 -> 1 was pulled by the ray-casting tiles (its cost is in the trace time) */
-    fv_pullpush_from(&es->pyr, &p->dsp, p->pool, 1);
+    /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
+    fv_pullpush_from(&es->pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(&es->pyr));
     int64_t t2 = fv_time_ns();
     st->stage_ms[FV_STAGE_TRACE] = (double)(t1 - t0) * 1e-6;
     st->stage_ms[FV_STAGE_RECONSTRUCT] = (double)(t2 - t1) * 1e-6;

@@ -32,7 +32,7 @@ void fv_pyramid_clear(fv_pyramid *p, fv_pool *pool);
 /* Fills every hole of level 0 and every level above it. Deterministic for any pool size. */
 void fv_pullpush(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool);
 /* The same when levels 1..pulled already hold their pull (fv_pull_block): the ray caster pulls
- * level 0 into level 1 tile by tile while the tile is still in cache. Same bits as fv_pullpush. */
+ * each tile up the first levels while it is still in cache. Same bits as fv_pullpush. */
 void fv_pullpush_from(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool, int pulled);
 /* Pulls the block [x0, x0+w) x [y0, y0+h) of `level` (x0, y0 even; w, h reaching the level's
  * edge or even) into level + 1. Disjoint blocks may run concurrently. */

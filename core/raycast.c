@@ -112,8 +112,13 @@ static void trace_tile(void *ctx, int index, int thread_id)
         rays += k;
         k = 0;
     }
-    if (j->pyr->levels > 1)
-        fv_pull_block(j->pyr, j->dsp, 0, x0, y0, tw, th);
+    /* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level
+     * 4. Tiles start on multiples of 16, so every block starts on even coordinates. */
+    int xl = x0, yl = y0, wl = tw, hl = th;
+    for (int l = 0; l < FV_TILE_PULL_LEVELS && l + 1 < j->pyr->levels; l++) {
+        fv_pull_block(j->pyr, j->dsp, l, xl, yl, wl, hl);
+        xl >>= 1, yl >>= 1, wl = (wl + 1) >> 1, hl = (hl + 1) >> 1;
+    }
     atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
 }
 

@@ -9,6 +9,7 @@
 #include "scene.h"
 
 #define FV_TILE 16              /* screen tiles are FV_TILE x FV_TILE pixels */
+#define FV_TILE_PULL_LEVELS 4   /* log2(FV_TILE): pyramid levels each tile pulls itself */
 #define FV_DEPTH_MISS_M 1000.0f /* depth stored where a ray leaves the scene */
 
 /* Background radiance (linear RGB) where rays miss. */
@@ -17,8 +18,13 @@ extern const float fv_background_rgb[3];
 /* Casts a ray for every pixel the sampler selects around the point of regard (gx, gy pixels)
  * and writes colour + depth with weight 1 into level 0 of pyr; every other pixel gets weight 0
  * (its colour is left as it was: pull-push never reads it). Tiles are claimed atomically by the pool's workers. Returns the number of
- * rays cast. Each tile also pulls its pixels into pyramid level 1 while they are in cache, so
- * reconstruction continues with fv_pullpush_from(pyr, dsp, pool, 1). */
+ * rays cast. Each tile also pulls its pixels up to pyramid level FV_TILE_PULL_LEVELS while they
+ * are in cache, so reconstruction continues with fv_pullpush_from(pyr, dsp, pool,
+ * fv_raycast_pulled_levels(pyr)). */
+static inline int fv_raycast_pulled_levels(const fv_pyramid *p)
+{
+    return p->levels - 1 < FV_TILE_PULL_LEVELS ? p->levels - 1 : FV_TILE_PULL_LEVELS;
+}
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
                 fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool);
 
