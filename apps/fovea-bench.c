@@ -121,11 +121,7 @@ int main(int argc, char **argv)
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
     }
-    if (optind < argc)
-        fv_usage_error(prog, "unexpected argument '%s' (see --help)", argv[optind]);
-    if (!scene_path)
-        fv_usage_error(prog, "--scene FILE is required (see --help)");
-    fv_common_validate(prog, &cfg);
+    fv_common_validate(prog, argc, argv, scene_path, &cfg);
 
     char err[512];
     int64_t t0 = fv_time_ns();

@@ -76,13 +76,9 @@ int main(int argc, char **argv)
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
     }
-    if (optind < argc)
-        fv_usage_error(prog, "unexpected argument '%s' (see --help)", argv[optind]);
-    if (!scene_path)
-        fv_usage_error(prog, "--scene FILE is required (see --help)");
+    fv_common_validate(prog, argc, argv, scene_path, &cfg);
     if (!out_dir)
         fv_usage_error(prog, "--out DIR is required (see --help)");
-    fv_common_validate(prog, &cfg);
     if (y4m_path && ((cfg.cam.width & 1) || (cfg.cam.height & 1)))
         fv_usage_error(prog, "--y4m: 4:2:0 video needs even frame sizes, got %dx%d", cfg.cam.width, cfg.cam.height);
 

@@ -2,13 +2,13 @@
  * mesh records (normals, uvs, material, per-triangle texel density) stay here for shading,
  * indexed by Embree geometry ID. The glTF loader is a client of the builder API. */
 #include "scene.h"
+#include "err.h"
 
 #include "gltf_shim.h"
 
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,18 +61,6 @@ struct fv_scene {
     char rtc_err[192];
 };
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static void set_err(char *err, size_t err_len, const char *fmt, ...)
-{
-    if (!err || err_len == 0) return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, err_len, fmt, ap);
-    va_end(ap);
-}
-
 static void on_rtc_error(void *user, enum RTCError code, const char *str)
 {
     fv_scene *s = user;
@@ -86,12 +74,12 @@ static int take_rtc_error(fv_scene *s, char *err, size_t err_len)
 {
     pthread_mutex_lock(&s->rtc_err_lock);
     int have = s->rtc_err[0] != 0;
-    if (have) set_err(err, err_len, "%s", s->rtc_err);
+    if (have) fv_err(err, err_len, "%s", s->rtc_err);
     pthread_mutex_unlock(&s->rtc_err_lock);
     if (!have) {
         enum RTCError e = rtcGetDeviceError(s->device);
         if (e != RTC_ERROR_NONE) {
-            set_err(err, err_len, "embree error %d", (int)e);
+            fv_err(err, err_len, "embree error %d", (int)e);
             have = 1;
         }
     }
@@ -288,52 +276,52 @@ static void tri_edges(const float *pos, const uint32_t *tri, float e1[3], float 
 int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_len)
 {
     if (!s || !m) {
-        set_err(err, err_len, "no scene or mesh");
+        fv_err(err, err_len, "no scene or mesh");
         return -1;
     }
     if (s->committed) {
-        set_err(err, err_len, "scene already committed");
+        fv_err(err, err_len, "scene already committed");
         return -1;
     }
     if (!m->positions || m->vertex_count == 0 || m->vertex_count > FV_MAX_VERTICES) {
-        set_err(err, err_len, "mesh needs 1..%zu vertices", FV_MAX_VERTICES);
+        fv_err(err, err_len, "mesh needs 1..%zu vertices", FV_MAX_VERTICES);
         return -1;
     }
     const size_t nv = m->vertex_count;
     if (m->indices ? m->index_count % 3 != 0 : nv % 3 != 0) {
-        set_err(err, err_len, "%s count %zu is not a multiple of 3", m->indices ? "index" : "vertex",
+        fv_err(err, err_len, "%s count %zu is not a multiple of 3", m->indices ? "index" : "vertex",
                 m->indices ? m->index_count : nv);
         return -1;
     }
     const size_t nt = m->indices ? m->index_count / 3 : nv / 3;
     if (nt == 0 || nt > FV_MAX_TRIANGLES) {
-        set_err(err, err_len, "mesh needs 1..%zu triangles", FV_MAX_TRIANGLES);
+        fv_err(err, err_len, "mesh needs 1..%zu triangles", FV_MAX_TRIANGLES);
         return -1;
     }
     if (m->indices)
         for (size_t i = 0; i < m->index_count; i++)
             if (m->indices[i] >= nv) {
-                set_err(err, err_len, "index %u at %zu out of range (vertex count %zu)", m->indices[i], i, nv);
+                fv_err(err, err_len, "index %u at %zu out of range (vertex count %zu)", m->indices[i], i, nv);
                 return -1;
             }
     if (m->texture < -1 || m->texture >= s->texture_count) {
-        set_err(err, err_len, "texture %d does not exist", m->texture);
+        fv_err(err, err_len, "texture %d does not exist", m->texture);
         return -1;
     }
     if (m->texture >= 0 && !m->uvs) {
-        set_err(err, err_len, "texture without uvs");
+        fv_err(err, err_len, "texture without uvs");
         return -1;
     }
     for (int c = 0; c < 4; c++)
         if (!isfinite(m->base_color[c])) {
-            set_err(err, err_len, "base colour is not finite");
+            fv_err(err, err_len, "base colour is not finite");
             return -1;
         }
     double M[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     int all_zero = 1;
     for (int i = 0; i < 16; i++) {
         if (!isfinite(m->transform[i])) {
-            set_err(err, err_len, "transform is not finite");
+            fv_err(err, err_len, "transform is not finite");
             return -1;
         }
         if (m->transform[i] != 0.0f) all_zero = 0;
@@ -342,7 +330,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         for (int i = 0; i < 16; i++) M[i] = m->transform[i];
 
     if (grow((void **)&s->meshes, &s->mesh_cap, s->mesh_count + 1, sizeof *s->meshes)) {
-        set_err(err, err_len, "out of memory");
+        fv_err(err, err_len, "out of memory");
         return -1;
     }
     fv_mesh_rec r;
@@ -356,7 +344,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     r.texel_density = m->texture >= 0 ? malloc(nt * sizeof(float)) : NULL;
     RTCGeometry g = NULL;
     if (!pos || !tri || !r.normals || (m->uvs && !r.uvs) || (m->texture >= 0 && !r.texel_density)) {
-        set_err(err, err_len, "out of memory");
+        fv_err(err, err_len, "out of memory");
         goto fail;
     }
 
@@ -365,7 +353,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         for (int k = 0; k < 3; k++) {
             double w = M[k] * p[0] + M[4 + k] * p[1] + M[8 + k] * p[2] + M[12 + k];
             if (!isfinite(w) || fabs(w) > FLT_MAX) {
-                set_err(err, err_len, "vertex %zu position is not finite", i);
+                fv_err(err, err_len, "vertex %zu position is not finite", i);
                 goto fail;
             }
             pos[3 * i + (size_t)k] = (float)w;
@@ -388,7 +376,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
             for (int k = 0; k < 3; k++) o[k] = sgn * (k0[k] * n[0] + k1[k] * n[1] + k2[k] * n[2]);
             const float l = len3(o);
             if (!isfinite(l)) {
-                set_err(err, err_len, "vertex %zu normal is not finite", i);
+                fv_err(err, err_len, "vertex %zu normal is not finite", i);
                 goto fail;
             }
             if (l > 0.0f)
@@ -414,7 +402,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     if (m->uvs) {
         for (size_t i = 0; i < 2 * nv; i++)
             if (!isfinite(m->uvs[i])) {
-                set_err(err, err_len, "vertex %zu uv is not finite", i / 2);
+                fv_err(err, err_len, "vertex %zu uv is not finite", i / 2);
                 goto fail;
             }
         memcpy(r.uvs, m->uvs, nv * 2 * sizeof(float));
@@ -439,7 +427,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     float *vb = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv) : NULL;
     uint32_t *ib = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), nt) : NULL;
     if (!vb || !ib) {
-        if (!take_rtc_error(s, err, err_len)) set_err(err, err_len, "embree geometry allocation failed");
+        if (!take_rtc_error(s, err, err_len)) fv_err(err, err_len, "embree geometry allocation failed");
         goto fail;
     }
     memcpy(vb, pos, nv * 3 * sizeof(float));
@@ -556,7 +544,7 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out)
 int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
 {
     if (!s) {
-        set_err(err, err_len, "no scene");
+        fv_err(err, err_len, "no scene");
         return -1;
     }
     if (s->committed) return 0;
@@ -744,7 +732,7 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
     if (g->image_count) {
         tex_of_image = malloc(g->image_count * sizeof *tex_of_image);
         if (!tex_of_image) {
-            set_err(err, err_len, "out of memory");
+            fv_err(err, err_len, "out of memory");
             return -1;
         }
         for (size_t i = 0; i < g->image_count; i++) tex_of_image[i] = -1;
@@ -771,7 +759,7 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                             tex_of_image[img] = fv_scene_add_texture(s, g->images[img].rgba8, g->images[img].width,
                                                                      g->images[img].height);
                         if (tex_of_image[img] < 0) {
-                            set_err(err, err_len, "image %d: cannot add texture", img);
+                            fv_err(err, err_len, "image %d: cannot add texture", img);
                             rc = -1;
                             break;
                         }
@@ -781,7 +769,7 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                 for (int k = 0; k < 16; k++) d.transform[k] = (float)nd->world[k];
                 char e[192];
                 if (fv_scene_add_mesh(s, &d, e, sizeof e) < 0) {
-                    set_err(err, err_len, "mesh %d (node %zu in traversal order): %s", nd->mesh, ni, e);
+                    fv_err(err, err_len, "mesh %d (node %zu in traversal order): %s", nd->mesh, ni, e);
                     rc = -1;
                     break;
                 }
@@ -817,32 +805,32 @@ fv_scene *fv_scene_load(const char *path, char *err, size_t err_len)
 {
     char e[256] = "";
     if (!path) {
-        set_err(err, err_len, "no path");
+        fv_err(err, err_len, "no path");
         return NULL;
     }
     fv_gltf_model *g = fv_gltf_load(path, e, sizeof e);
     if (!g) {
-        set_err(err, err_len, "%s: %s", path, e);
+        fv_err(err, err_len, "%s: %s", path, e);
         return NULL;
     }
     fv_scene *s = fv_scene_create();
     if (!s) {
         fv_gltf_free(g);
-        set_err(err, err_len, "%s: cannot create the Embree device/scene", path);
+        fv_err(err, err_len, "%s: cannot create the Embree device/scene", path);
         return NULL;
     }
     int rc = add_gltf(s, g, e, sizeof e);
     fv_gltf_free(g);
     if (rc == 0 && s->triangle_count == 0) { /* nothing to render: most likely not a real scene */
-        set_err(e, sizeof e, "no triangles reachable from the scene's root nodes");
+        fv_err(e, sizeof e, "no triangles reachable from the scene's root nodes");
         rc = -1;
     }
     if (rc == 0) rc = fv_scene_commit(s, e, sizeof e);
     if (rc != 0) {
-        set_err(err, err_len, "%s: %s", path, e);
+        fv_err(err, err_len, "%s: %s", path, e);
         fv_scene_free(s);
         return NULL;
     }
-    set_err(err, err_len, "%s", "");
+    fv_err(err, err_len, "%s", "");
     return s;
 }

@@ -130,8 +130,12 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
     return 0;
 }
 
-void fv_common_validate(const char *prog, const fv_pipeline_config *cfg)
+void fv_common_validate(const char *prog, int argc, char **argv, const char *scene_path, const fv_pipeline_config *cfg)
 {
+    if (optind < argc)
+        fv_usage_error(prog, "unexpected argument '%s' (see --help)", argv[optind]);
+    if (!scene_path)
+        fv_usage_error(prog, "--scene FILE is required (see --help)");
     if (cfg->samp.r0_deg > cfg->samp.r1_deg)
         fv_usage_error(prog, "--r0 %g must not exceed --r1 %g", (double)cfg->samp.r0_deg, (double)cfg->samp.r1_deg);
 }

@@ -45,7 +45,8 @@ enum {
     "  --dof none|weak|medium|strong   depth of field (only 'none' is built yet)\n"                \
     "  --dof-model weier|hussain|mantiuk|konrad|liu   (needs --dof; not built yet)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
-/* Checks option combinations after parsing (r0 <= r1 ...); exits 2 with a reason. */
-void fv_common_validate(const char *prog, const fv_pipeline_config *cfg);
+/* After getopt_long: no stray words, a scene was given, option combinations agree (r0 <= r1);
+ * exits 2 with a reason otherwise. */
+void fv_common_validate(const char *prog, int argc, char **argv, const char *scene_path, const fv_pipeline_config *cfg);
 
 #endif
