@@ -12,6 +12,7 @@ void fv_sampling_params_default(fv_sampling_params *p)
     p->r1_deg = 20.0f;
     p->p_min = 0.2f;
     p->full = 0;
+    p->rotate = 0;
 }
 
 float fv_sampling_radius(const fv_sampling_params *p, float u)
@@ -61,54 +62,82 @@ int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const 
     s->r0_px = p->r0_deg * s->ppd;
     s->r1_px = p->r1_deg * s->ppd;
     s->rin = (int)ceilf(s->r1_px);
+    /* K phases shifted by 1/K <= p_min tile the lattice's [0, 1) range: every pixel is sampled
+     * at least once per K frames. */
+    int K = 1;
+    if (p->rotate && !p->full) {
+        K = (int)ceil(1.0 / (double)p->p_min - 1e-6);
+        K = K < 1 ? 1 : K > FV_SAMPLER_MAX_PHASES ? FV_SAMPLER_MAX_PHASES : K;
+    }
+    s->phases = K;
     int side = 2 * s->rin + 1;
     s->in_stride = (side + 63) / 64;
     s->out_stride = (width + 63) / 64;
-    s->s_in = calloc((size_t)side * (size_t)s->in_stride, sizeof(uint64_t));
-    s->s_out = calloc((size_t)height * (size_t)s->out_stride, sizeof(uint64_t));
+    s->s_in = calloc((size_t)K * (size_t)side * (size_t)s->in_stride, sizeof(uint64_t));
+    s->s_out = calloc((size_t)K * (size_t)height * (size_t)s->out_stride, sizeof(uint64_t));
     if (!s->s_in || !s->s_out) {
         fv_sampler_free(s);
         return -1;
     }
 
     /* S_out: rank-1 lattice dither (the R2 sequence, Roberts 2018): a pixel is sampled when
-     * frac(a1 x + a2 y) < p_min. Exact density p_min with evenly spread samples and no clumps
-     * or large holes, unlike white noise. */
+     * frac(a1 x + a2 y + k/K) < p_min. Exact density p_min with evenly spread samples and no
+     * clumps or large holes, unlike white noise. */
     const double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
-    for (int y = 0; y < height; y++) {
-        uint64_t *row = s->s_out + (size_t)y * s->out_stride;
-        for (int x = 0; x < width; x++) {
-            double v = a1 * x + a2 * y;
-            if (v - floor(v) < p->p_min)
-                set_bit(row, x);
+    for (int k = 0; k < K; k++)
+        for (int y = 0; y < height; y++) {
+            uint64_t *row = s->s_out + ((size_t)k * height + y) * s->out_stride;
+            for (int x = 0; x < width; x++) {
+                double v = a1 * x + a2 * y + (double)k / K;
+                if (v - floor(v) < p->p_min)
+                    set_bit(row, x);
+            }
         }
-    }
 
-    /* S_in: every offset inside r0, then Halton (2, 3) points placed with eq. (1)-(2). */
+    /* S_in: every offset inside r0, then Halton (2, 3) points placed with eq. (1)-(2); phase k
+     * takes the k-th block of points, so the phases together are one longer Halton sequence. */
     int c = s->rin;
     double r0sq = (double)s->r0_px * s->r0_px;
+    const size_t in_words = (size_t)side * s->in_stride;
     for (int dy = -c; dy <= c; dy++) {
         uint64_t *row = s->s_in + (size_t)(dy + c) * s->in_stride;
         for (int dx = -c; dx <= c; dx++)
             if ((double)dx * dx + (double)dy * dy < r0sq)
                 set_bit(row, dx + c);
     }
+    for (int k = 1; k < K; k++)
+        memcpy(s->s_in + k * in_words, s->s_in, in_words * sizeof(uint64_t));
     if (p->r1_deg > p->r0_deg) {
         double cnorm = 2.0 / (1.0 + p->p_min);
         double n = (p->r1_deg - p->r0_deg) * 2.0 * PI_D * p->r1_deg / cnorm * (double)s->ppd * s->ppd;
         s->transition_points = (long)ceil(n);
         double r1sq = (double)s->r1_px * s->r1_px;
-        for (long i = 1; i <= s->transition_points; i++) {
-            double r = fv_sampling_radius(p, (float)halton((uint32_t)i, 2)) * (double)s->ppd;
-            double phi = 2.0 * PI_D * halton((uint32_t)i, 3);
-            int dx = (int)floor(r * cos(phi) + 0.5), dy = (int)floor(r * sin(phi) + 0.5);
-            double d2 = (double)dx * dx + (double)dy * dy;
-            if (d2 < r0sq || d2 >= r1sq) /* rounding pushed it out of the ring */
-                continue;
-            set_bit(s->s_in + (size_t)(dy + c) * s->in_stride, dx + c);
-        }
+        for (int k = 0; k < K; k++)
+            for (long i = 1; i <= s->transition_points; i++) {
+                uint32_t h = (uint32_t)(k * s->transition_points + i);
+                double r = fv_sampling_radius(p, (float)halton(h, 2)) * (double)s->ppd;
+                double phi = 2.0 * PI_D * halton(h, 3);
+                int dx = (int)floor(r * cos(phi) + 0.5), dy = (int)floor(r * sin(phi) + 0.5);
+                double d2 = (double)dx * dx + (double)dy * dy;
+                if (d2 < r0sq || d2 >= r1sq) /* rounding pushed it out of the ring */
+                    continue;
+                set_bit(s->s_in + k * in_words + (size_t)(dy + c) * s->in_stride, dx + c);
+            }
     }
     return 0;
+}
+
+float fv_sampler_probability(const fv_sampler *s, float dx_px, float dy_px)
+{
+    if (s->prm.full)
+        return 1.0f;
+    float r_px = sqrtf(dx_px * dx_px + dy_px * dy_px);
+    if (r_px < s->r0_px)
+        return 1.0f;
+    if (!(r_px < s->r1_px))
+        return s->prm.p_min;
+    float l = fv_sampling_transition_density(&s->prm, r_px / s->ppd);
+    return l > 1.0f ? 1.0f : l < s->prm.p_min ? s->prm.p_min : l;
 }
 
 void fv_sampler_free(fv_sampler *s)
@@ -128,12 +157,13 @@ static inline uint64_t get_bits(const uint64_t *row, int words, int x, int n)
     return n == 64 ? v : v & ((1ull << n) - 1);
 }
 
-uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy)
+uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy, int phase)
 {
     uint64_t all = n == 64 ? ~0ull : (1ull << n) - 1;
     if (s->prm.full)
         return all;
-    uint64_t out = get_bits(s->s_out + (size_t)y * s->out_stride, s->out_stride, x0, n);
+    const int k = (phase % s->phases + s->phases) % s->phases;
+    uint64_t out = get_bits(s->s_out + ((size_t)k * s->height + y) * s->out_stride, s->out_stride, x0, n);
     int dy = y - gy;
     if (dy < -s->rin || dy > s->rin)
         return out;
@@ -156,7 +186,7 @@ uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int g
         hi = x0 + n - 1;
     int len = hi - lo + 1;
     uint64_t span = (len == 64 ? ~0ull : (1ull << len) - 1) << (lo - x0);
-    const uint64_t *inrow = s->s_in + (size_t)(dy + s->rin) * s->in_stride;
+    const uint64_t *inrow = s->s_in + ((size_t)k * (2 * s->rin + 1) + (size_t)(dy + s->rin)) * s->in_stride;
     uint64_t in = get_bits(inrow, s->in_stride, lo - gx + s->rin, len) << (lo - x0);
     return (out & ~span) | (in & span);
 }

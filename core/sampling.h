@@ -14,6 +14,10 @@ typedef struct fv_sampling_params {
     float r1_deg;  /* end of the transition region, default 20 */
     float p_min;   /* peripheral sampling probability, default 0.2 */
     int full;      /* 1: sample every pixel */
+    /* 1: the pattern changes every frame through fv_sampler.phases phases (temporal
+     * reprojection accumulates them: static content converges to every pixel sampled);
+     * 0: one static pattern, as in Weier et al. (nothing new to accumulate). */
+    int rotate;
 } fv_sampling_params;
 
 typedef struct fv_sampler {
@@ -23,11 +27,17 @@ typedef struct fv_sampler {
     float r0_px, r1_px;
     int rin;                /* S_in covers offsets -rin..rin in x and y */
     int in_stride;          /* 64-bit words per S_in row */
-    uint64_t *s_in;         /* (2*rin+1) rows */
+    uint64_t *s_in;         /* phases x (2*rin+1) rows */
     int out_stride;         /* 64-bit words per S_out row */
-    uint64_t *s_out;        /* height rows */
-    long transition_points; /* Halton points thrown into the transition ring */
+    uint64_t *s_out;        /* phases x height rows */
+    long transition_points; /* Halton points thrown into the transition ring (per phase) */
+    /* Pattern phases K: 1 when static; with rotate, ceil(1/p_min) capped at FV_SAMPLER_MAX_PHASES.
+     * S_out phase k is the lattice shifted by k/K (so K >= 1/p_min phases cover every pixel),
+     * S_in phase k takes the k-th block of transition_points Halton points. */
+    int phases;
 } fv_sampler;
+
+#define FV_SAMPLER_MAX_PHASES 16
 
 void fv_sampling_params_default(fv_sampling_params *p);
 /* focal_px: pixels per unit tangent at the optical axis (fv_camera.focal_px). 0 on success,
@@ -42,7 +52,13 @@ float fv_sampling_radius(const fv_sampling_params *p, float u);
 float fv_sampling_transition_density(const fv_sampling_params *p, float r_deg);
 
 /* Sampling bits of the n <= 64 pixels x0..x0+n-1 of row y (bit i = pixel x0+i) for the point of
- * regard at pixel (gx, gy) (integer pixel the pattern is centred on). */
-uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy);
+ * regard at pixel (gx, gy) (integer pixel the pattern is centred on), in pattern phase
+ * `phase` (taken modulo s->phases; 0 for a static pattern). */
+uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy, int phase);
+
+/* The acuity model's sampling probability per frame at pixel offset (dx, dy) from the point of
+ * regard: 1 inside r0, eq. (1)'s density lambda(r) (clamped to [p_min, 1]) in r0..r1, p_min
+ * outside; 1 everywhere with full. */
+float fv_sampler_probability(const fv_sampler *s, float dx_px, float dy_px);
 
 #endif

@@ -23,7 +23,7 @@ static void make(fv_sampler *s, const fv_sampling_params *p)
 
 static int bit(const fv_sampler *s, int x, int y, int gx, int gy)
 {
-    return (int)(fv_sampler_row(s, x, y, 1, gx, gy) & 1);
+    return (int)(fv_sampler_row(s, x, y, 1, gx, gy, 0) & 1);
 }
 
 /* Eq. (1) inverts the CDF F(x) = c (x - (1 - p) x^2 / 2), c = 2 / (1 + p), of f(x) = 1 - x(1 - p). */
@@ -112,6 +112,69 @@ static void test_transition_density(void **st)
     }
 }
 
+/* Rotating pattern (temporal reprojection): every phase keeps the static pattern's statistics,
+ * phase 0 is the static pattern, the phases are periodic, and together they sample every
+ * pixel of the periphery within K = ceil(1/p_min) frames. */
+static void test_rotating_phases(void **st)
+{
+    (void)st;
+    const float pms[] = {0.2f, 0.3f};
+    for (int k = 0; k < 2; k++) {
+        fv_sampling_params p;
+        fv_sampling_params_default(&p);
+        p.p_min = pms[k];
+        fv_sampler st0, s;
+        make(&st0, &p);
+        p.rotate = 1;
+        make(&s, &p);
+        int K = (int)ceil(1.0 / p.p_min - 1e-6);
+        assert_int_equal(st0.phases, 1);
+        assert_int_equal(s.phases, K);
+        int gx = 640, gy = 720;
+        static uint64_t cover[H][(W + 63) / 64];
+        memset(cover, 0, sizeof cover);
+        for (int ph = 0; ph < K; ph++) {
+            long set = 0, tot = 0;
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x += 64) {
+                    int n = W - x < 64 ? W - x : 64;
+                    uint64_t b = fv_sampler_row(&s, x, y, n, gx, gy, ph);
+                    cover[y][x >> 6] |= b;
+                    assert_true(b == fv_sampler_row(&s, x, y, n, gx, gy, ph + K)); /* periodic */
+                    if (ph == 0)
+                        assert_true(b == fv_sampler_row(&st0, x, y, n, gx, gy, 0));
+                    /* periphery density: pixels beyond r1 + 1 only */
+                    for (int i = 0; i < n; i++) {
+                        double dx = x + i - gx, dy = y - gy;
+                        if (dx * dx + dy * dy < (s.r1_px + 1.0) * (s.r1_px + 1.0))
+                            continue;
+                        tot++;
+                        set += (long)((b >> i) & 1);
+                    }
+                }
+            assert_float_equal((double)set / tot, p.p_min, 0.003);
+        }
+        /* outside r1 every pixel is covered by the K phases together */
+        long holes = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                double dx = x - gx, dy = y - gy;
+                if (dx * dx + dy * dy >= (double)s.r1_px * s.r1_px && !((cover[y][x >> 6] >> (x & 63)) & 1))
+                    holes++;
+            }
+        assert_int_equal(holes, 0);
+        /* the acuity probability the reprojection uses */
+        assert_float_equal(fv_sampler_probability(&s, 0.0f, 0.0f), 1.0f, 0.0);
+        assert_float_equal(fv_sampler_probability(&s, s.r1_px + 5.0f, 0.0f), p.p_min, 0.0);
+        float rmid = 0.5f * (s.r0_px + s.r1_px);
+        float want = fv_sampling_transition_density(&p, rmid / s.ppd);
+        want = want > 1.0f ? 1.0f : want;
+        assert_float_equal(fv_sampler_probability(&s, 0.0f, rmid), want, 1e-5);
+        fv_sampler_free(&st0);
+        fv_sampler_free(&s);
+    }
+}
+
 static void test_sout_density_and_evenness(void **st)
 {
     (void)st;
@@ -127,7 +190,7 @@ static void test_sout_density_and_evenness(void **st)
         for (int y = 0; y < H; y++)
             for (int x = 0; x < W; x += 64) {
                 int n = W - x < 64 ? W - x : 64;
-                set += __builtin_popcountll(fv_sampler_row(&s, x, y, n, gx, gy));
+                set += __builtin_popcountll(fv_sampler_row(&s, x, y, n, gx, gy, 0));
             }
         double d = (double)set / ((double)W * H);
         assert_float_equal(d, p.p_min, 0.002);
@@ -138,7 +201,7 @@ static void test_sout_density_and_evenness(void **st)
             for (int x = 0; x + win <= W; x += 3) {
                 uint64_t any = 0;
                 for (int j = 0; j < win; j++)
-                    any |= fv_sampler_row(&s, x, y + j, win, gx, gy);
+                    any |= fv_sampler_row(&s, x, y + j, win, gx, gy, 0);
                 if (!any)
                     fprintf(stderr, "empty %dx%d window at %d,%d (p_min %.2f)\n", win, win, x, y, (double)p.p_min);
                 assert_true(any != 0);
@@ -163,7 +226,7 @@ static void test_row_matches_per_pixel(void **st)
         int y = (int)(fv_test_rand(&rng) % H);
         int n = 1 + (int)(fv_test_rand(&rng) % 64);
         int x0 = (int)(fv_test_rand(&rng) % (W - n + 1));
-        uint64_t row = fv_sampler_row(&s, x0, y, n, gx, gy);
+        uint64_t row = fv_sampler_row(&s, x0, y, n, gx, gy, 0);
         for (int i = 0; i < n; i++) {
             int x = x0 + i, dx = x - gx, dy = y - gy, want;
             if ((double)dx * dx + (double)dy * dy < r1sq)
@@ -188,7 +251,7 @@ static void test_full_and_ratio(void **st)
     long set = 0;
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x += 64)
-            set += __builtin_popcountll(fv_sampler_row(&s, x, y, W - x < 64 ? W - x : 64, 640, 720));
+            set += __builtin_popcountll(fv_sampler_row(&s, x, y, W - x < 64 ? W - x : 64, 640, 720, 0));
     double ratio = (double)set / ((double)W * H);
     printf("samples at the defaults, gaze centred: %ld of %d (%.3f)\n", set, W * H, ratio);
     /* p_min everywhere plus the fovea and transition: above p_min, far below full */
@@ -196,8 +259,8 @@ static void test_full_and_ratio(void **st)
     fv_sampler_free(&s);
     p.full = 1;
     make(&s, &p);
-    assert_true(fv_sampler_row(&s, 0, 0, 64, 640, 720) == ~0ull);
-    assert_true(fv_sampler_row(&s, 1216, 1439, 64, 0, 0) == ~0ull);
+    assert_true(fv_sampler_row(&s, 0, 0, 64, 640, 720, 0) == ~0ull);
+    assert_true(fv_sampler_row(&s, 1216, 1439, 64, 0, 0, 0) == ~0ull);
     fv_sampler_free(&s);
     /* bad parameters are refused */
     p.full = 0;
@@ -214,6 +277,7 @@ int main(void)
         cmocka_unit_test(test_eq1_inverts_cdf),        cmocka_unit_test(test_fovea_full),
         cmocka_unit_test(test_transition_density),     cmocka_unit_test(test_sout_density_and_evenness),
         cmocka_unit_test(test_row_matches_per_pixel),  cmocka_unit_test(test_full_and_ratio),
+        cmocka_unit_test(test_rotating_phases),
     };
     return cmocka_run_group_tests_name("sampling", tests, NULL, NULL);
 }
