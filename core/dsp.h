@@ -53,10 +53,29 @@ typedef void (*fv_pull_row_fn)(float *restrict dst_rgbd, float *restrict dst_wgt
 typedef void (*fv_push_row_fn)(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
                                const float *coarse_far, int n);
 
+/* Temporal reprojection (core/reproject.h has the model). Rows of n pixels x0 .. x0+n-1 of
+ * level-0 row y; rgbd / wgt point at pixel x0.
+ * taa_blend_row: every pixel with weight 1 (a sample) is blended with its reprojected history;
+ *   the sums of its flow to the previous frame are added to *flow. Other pixels untouched.
+ * taa_fill_row: every pixel with weight 0 (a hole) takes valid history, if any: colour,
+ *   depth in this frame's view, weight = the history's confidence in (0, 1]. Others untouched.
+ * Both read the history pyramid only at texels [-1, w] x [-1, h] of a level (its border).
+ * All arithmetic outside the 4-channel texel accumulation is scalar and shared
+ * (core/reproject_tmpl.h), so every ISA version gives the reference's bits. */
+struct fv_taa_frame;
+struct fv_taa_tile;
+struct fv_taa_flow;
+typedef void (*fv_taa_blend_row_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
+                                    const float *wgt, int x0, int y, int n, struct fv_taa_flow *flow);
+typedef void (*fv_taa_fill_row_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
+                                   float *wgt, int x0, int y, int n);
+
 typedef struct fv_dsp {
     unsigned isa; /* the ISA actually selected (one FV_ISA_* value) */
     fv_pull_row_fn pull_row;
     fv_push_row_fn push_row;
+    fv_taa_blend_row_fn taa_blend_row;
+    fv_taa_fill_row_fn taa_fill_row;
 } fv_dsp;
 
 unsigned fv_cpu_isas(void);            /* FV_ISA_* bits this CPU runs */
@@ -71,13 +90,21 @@ void fv_pull_row_c(float *restrict dst_rgbd, float *restrict dst_wgt, const floa
                    const float *src0_wgt, const float *src1_rgbd, const float *src1_wgt, int n);
 void fv_push_row_c(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
                    const float *coarse_far, int n);
+void fv_taa_blend_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
+                        int x0, int y, int n, struct fv_taa_flow *flow);
+void fv_taa_fill_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt, int x0,
+                       int y, int n);
 
 void fv_pullpush_init_c(fv_dsp *d);
+void fv_reproject_init_c(fv_dsp *d);
 #if defined(__x86_64__)
 void fv_pullpush_init_sse41(fv_dsp *d);
 void fv_pullpush_init_avx2(fv_dsp *d);
+void fv_reproject_init_sse41(fv_dsp *d);
+void fv_reproject_init_avx2(fv_dsp *d);
 #elif defined(__aarch64__)
 void fv_pullpush_init_neon(fv_dsp *d);
+void fv_reproject_init_neon(fv_dsp *d);
 #endif
 
 #endif

@@ -1,0 +1,180 @@
+/* fovea: temporal reprojection, per-frame / per-tile setup and the plain-C reference kernels
+ * (the row loops are in reproject_tmpl.h; the ISA versions in core/x86/, core/arm/ differ only
+ * in the 4-channel texel accumulation below). */
+#include "reproject.h"
+
+#include <math.h>
+#include <string.h>
+
+#include <stdint.h>
+
+#include "dsp.h"
+
+void fv_taa_params_default(fv_taa_params *p)
+{
+    p->enabled = 1;
+    p->alpha_min = 0.3f;
+    p->depth_tol = 0.03f;
+    p->fill = 1;
+}
+
+/* ---------------------------------------------------------------- setup */
+
+/* Rows of the projection into camera c, in double: (U, V, Z) = R (P - eye) with U = px Z,
+ * V = py Z, Z the view depth. */
+static void proj_rows(const fv_camera *c, double R[3][3])
+{
+    const double pt = c->px_tan;
+    for (int k = 0; k < 3; k++) {
+        R[0][k] = ((double)c->right[k] + (double)c->tan_left * c->back[k]) / pt;
+        R[1][k] = -((double)c->up[k] + (double)c->tan_top * c->back[k]) / pt;
+        R[2][k] = -(double)c->back[k];
+    }
+}
+
+/* dir(px, py) = D0 + px Dx + py Dy (fv_camera_ray with pixel-centre offsets folded into px, py) */
+static void ray_basis(const fv_camera *c, double D0[3], double Dx[3], double Dy[3])
+{
+    for (int k = 0; k < 3; k++) {
+        D0[k] = (double)c->tan_left * c->right[k] + (double)c->tan_top * c->up[k] - c->back[k];
+        Dx[k] = (double)c->px_tan * c->right[k];
+        Dy[k] = -(double)c->px_tan * c->up[k];
+    }
+}
+
+static void mapping(const fv_camera *from, const fv_camera *to, float T[3], float M0[3], float MX[3], float MY[3])
+{
+    double R[3][3], D0[3], Dx[3], Dy[3];
+    proj_rows(to, R);
+    ray_basis(from, D0, Dx, Dy);
+    for (int r = 0; r < 3; r++) {
+        double t = 0, m0 = 0, mx = 0, my = 0;
+        for (int k = 0; k < 3; k++) {
+            t += R[r][k] * ((double)from->eye_pos[k] - to->eye_pos[k]);
+            m0 += R[r][k] * D0[k];
+            mx += R[r][k] * Dx[k];
+            my += R[r][k] * Dy[k];
+        }
+        T[r] = (float)t;
+        M0[r] = (float)m0;
+        MX[r] = (float)mx;
+        MY[r] = (float)my;
+    }
+}
+
+void fv_taa_frame_setup(fv_taa_frame *f, const fv_camera *cur, const fv_camera *prev, const fv_pyramid *hist,
+                        float depth_tol)
+{
+    memset(f, 0, sizeof *f);
+    f->hist = hist;
+    mapping(cur, prev, f->T, f->M0, f->MX, f->MY);
+    mapping(prev, cur, f->T2, f->N0, f->NX, f->NY);
+    f->prev_w = (float)prev->width;
+    f->prev_h = (float)prev->height;
+    f->inv_depth_tol = 1.0f / depth_tol;
+    /* a footprint never reads coarser than 32 px texels: beyond that the history says little */
+    f->max_level = hist->levels - 1 < 5 ? hist->levels - 1 : 5;
+    f->identity = !memcmp(cur, prev, sizeof *cur);
+}
+
+void fv_taa_tile_setup(fv_taa_tile *t, const fv_taa_params *prm, float p, float p_min, int phases)
+{
+    p = p > 1.0f ? 1.0f : p > 1e-6f ? p : 1e-6f;
+    /* a rotating pattern samples this pixel every 1/p frames; a static one every frame */
+    const float rate = phases > 1 ? p : 1.0f;
+    const float dens = phases > 1 ? (p * (float)phases < 1.0f ? p * (float)phases : 1.0f) : p;
+    /* History weight: the user's per-frame share compounded over the frames between two samples
+     * of the pixel, scaled by how undersampled the pixel is: full at the periphery's p_min,
+     * none where every pixel is sampled every frame (the fovea has nothing to accumulate, only
+     * lag to gain). */
+    float under = p_min < 1.0f ? (1.0f - p) / (1.0f - p_min) : 0.0f;
+    under = under > 1.0f ? 1.0f : under;
+    t->alpha = 1.0f - powf(1.0f - prm->alpha_min, 1.0f / rate) * under;
+    t->widen = 1.0f / sqrtf(dens);
+    t->flow_x = t->flow_y = 0;
+}
+
+float fv_taa_project(const fv_taa_frame *f, float px, float py, float d, float *u, float *v)
+{
+    const float U = f->T[0] + d * ((f->M0[0] + py * f->MY[0]) + px * f->MX[0]);
+    const float V = f->T[1] + d * ((f->M0[1] + py * f->MY[1]) + px * f->MX[1]);
+    const float Z = f->T[2] + d * ((f->M0[2] + py * f->MY[2]) + px * f->MX[2]);
+    if (Z > 0.0f) {
+        *u = U / Z;
+        *v = V / Z;
+    }
+    return Z;
+}
+
+/* ---------------------------------------------------------------- reference kernels */
+
+typedef struct {
+    float c[4];
+} acc4;
+
+static inline acc4 acc_zero(void)
+{
+    acc4 a = {{0.0f, 0.0f, 0.0f, 0.0f}};
+    return a;
+}
+
+static inline void tap(const fv_pyr_level *L, float s, float t, float zexp, float inv_tol, acc4 *acc, float *accw)
+{
+    const float fs = floorf(s), ft = floorf(t);
+    const int i = (int)fs, j = (int)ft;
+    const float fx = s - fs, fy = t - ft, omx = 1.0f - fx, omy = 1.0f - fy;
+    const ptrdiff_t o00 = (ptrdiff_t)j * L->stride + i, o01 = o00 + L->stride;
+    const float *c00 = L->rgbd + 4 * o00, *c10 = c00 + 4, *c01 = L->rgbd + 4 * o01, *c11 = c01 + 4;
+    const float b00 = omx * omy, b01 = omx * fy, b10 = fx * omy, b11 = fx * fy;
+    float a00 = 1.0f - fabsf(c00[3] - zexp) * inv_tol, a01 = 1.0f - fabsf(c01[3] - zexp) * inv_tol;
+    float a10 = 1.0f - fabsf(c10[3] - zexp) * inv_tol, a11 = 1.0f - fabsf(c11[3] - zexp) * inv_tol;
+    a00 = a00 > 0.0f ? a00 : 0.0f;
+    a01 = a01 > 0.0f ? a01 : 0.0f;
+    a10 = a10 > 0.0f ? a10 : 0.0f;
+    a11 = a11 > 0.0f ? a11 : 0.0f;
+    const float w00 = (b00 * L->wgt[o00]) * a00, w01 = (b01 * L->wgt[o01]) * a01;
+    const float w10 = (b10 * L->wgt[o00 + 1]) * a10, w11 = (b11 * L->wgt[o01 + 1]) * a11;
+    for (int c = 0; c < 4; c++)
+        acc->c[c] = acc->c[c] + ((w00 * c00[c] + w01 * c01[c]) + (w10 * c10[c] + w11 * c11[c]));
+    *accw = *accw + ((w00 + w01) + (w10 + w11));
+}
+
+static inline void out_blend(float *px, acc4 acc, float accw, float alpha)
+{
+    for (int c = 0; c < 3; c++) {
+        const float h = acc.c[c] / accw;
+        px[c] = h + alpha * (px[c] - h);
+    }
+}
+
+static inline uint64_t sample_mask(const float *wgt, int n)
+{
+    uint64_t m = 0;
+    for (int i = 0; i < n; i++)
+        m |= (uint64_t)(wgt[i] == 1.0f) << i;
+    return m;
+}
+
+#define TAA_FN(name) name##_c
+#include "reproject_tmpl.h"
+
+void fv_taa_blend_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
+                        int x0, int y, int n, struct fv_taa_flow *flow)
+{
+    taa_blend_row_c(f, t, rgbd, wgt, x0, y, n, flow);
+}
+
+void fv_taa_fill_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt, int x0,
+                       int y, int n)
+{
+    const float *hw, *hrow;
+    float B[3];
+    if ((hrow = taa_fill_setup(f, t, y, &hw, B)))
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, (float)y + 0.5f, 0, n);
+}
+
+void fv_reproject_init_c(fv_dsp *d)
+{
+    d->taa_blend_row = fv_taa_blend_row_c;
+    d->taa_fill_row = fv_taa_fill_row_c;
+}

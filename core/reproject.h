@@ -1,0 +1,81 @@
+/* fovea: temporal reprojection (TAA) of the previous frame's reconstruction pyramid
+ * (Weier et al. 2018 §3.1; disocclusion rejection after Yang et al. 2009).
+ *
+ * Runs inside each ray-casting tile, after its samples are shaded and before the tile pulls
+ * itself up the pyramid (core/raycast.c), so the tile is still in cache:
+ *   1. blend: every sample cast this frame is moved to world space with its depth, projected
+ *      into the previous frame, and blended with the previous pyramid read over the sample's
+ *      footprint (ray differential: d / z' previous pixels, widened by 1/sqrt of the local
+ *      density of the history) at the matching level, with five quincunx taps when the
+ *      footprint is wider than a texel (one tap otherwise). Each texel of a tap counts with its
+ *      bilinear weight x its confidence (pyramid weight) x its depth agreement
+ *      max(0, 1 - |d_texel - z'| / (tol z')), so history from another surface is rejected
+ *      texel by texel. With H = the mean confidence of the taps, the new sample's weight is
+ *      max(alpha, 1 - H): alpha is the user minimum per frame of history, compounded over the
+ *      frames between two samples of a pixel (1 - (1 - alpha_min)^(1/rate)).
+ *   2. fill: a pixel without a new sample takes the previous frame's texel at the tile's mean
+ *      sample flow (rounded to whole pixels, so a row reads one contiguous run of history),
+ *      kept only if that texel's own world point reprojects to within half a pixel of the
+ *      pixel's centre (so disoccluded pixels are left to pull-push, and repeated fills never
+ *      blur); its confidence becomes the pixel's pull-push weight and its depth is converted to
+ *      this frame's view.
+ * With a rotating sampling pattern (fv_sampling_params.rotate) the history of a static scene
+ * converges to a sample at every pixel.
+ *
+ * Coordinates: continuous pixel coordinates with pixel (x, y) covering [x, x+1) x [y, y+1)
+ * (centre x + 0.5); a camera maps (px, py, view depth d) to the world point
+ * eye + d * dir(px, py), dir with a view-axis component of 1 (fv_camera_ray). */
+#ifndef FOVEA_REPROJECT_H
+#define FOVEA_REPROJECT_H
+
+#include "camera.h"
+#include "pullpush.h"
+
+typedef struct fv_taa_params {
+    int enabled;     /* default 1 (foveated rendering only) */
+    float alpha_min; /* minimum weight of a new sample per frame of history, default 0.3 */
+    float depth_tol; /* relative depth tolerance of history texels, default 0.03 */
+    int fill;        /* fill pixels without a sample from valid history, default 1 */
+} fv_taa_params;
+
+void fv_taa_params_default(fv_taa_params *p);
+
+/* Per-frame constants of the kernels. (U, V, Z) = T + d * (M0 + px * MX + py * MY) gives the
+ * previous frame's pixel (U / Z, V / Z) and view depth Z of the current pixel (px, py) at view
+ * depth d; the N matrices map back (previous pixel and depth -> current). */
+typedef struct fv_taa_frame {
+    const fv_pyramid *hist; /* the previous frame's filled pyramid */
+    float T[3], M0[3], MX[3], MY[3];
+    float T2[3], N0[3], NX[3], NY[3];
+    float prev_w, prev_h;   /* previous level-0 size */
+    float inv_depth_tol;    /* 1 / relative depth tolerance */
+    int max_level;          /* coarsest pyramid level a footprint may read */
+    int identity;           /* the cameras are equal: the mapping is exactly the identity */
+} fv_taa_frame;
+
+/* Per-tile constants. */
+typedef struct fv_taa_tile {
+    float widen;          /* footprint scale 1/sqrt(history density), >= 1 */
+    float alpha;          /* minimum weight of a new sample in this tile */
+    int flow_x, flow_y;   /* fill: the history texel of pixel (x, y) is (x + flow_x, y + flow_y) */
+} fv_taa_tile;
+
+/* Sums a blend row reports for the tile's mean flow. */
+typedef struct fv_taa_flow {
+    float dx, dy; /* sums of (U/Z - px), (V/Z - py) over samples that hit the previous image */
+    float n;
+} fv_taa_flow;
+
+void fv_taa_frame_setup(fv_taa_frame *f, const fv_camera *cur, const fv_camera *prev, const fv_pyramid *hist,
+                        float depth_tol);
+
+/* Tile constants from the acuity model's sampling probability p at the tile (per frame) and the
+ * pattern's phase count K: a rotating pattern samples a pixel every 1/p frames and its history
+ * holds min(1, K p) of the pixels; a static one samples the same pixels every frame. */
+void fv_taa_tile_setup(fv_taa_tile *t, const fv_taa_params *prm, float p, float p_min, int phases);
+
+/* The mapping itself, for tests and tools: current pixel (px, py) at depth d -> previous pixel
+ * (*u, *v); returns the previous view depth (<= 0: behind the previous eye). */
+float fv_taa_project(const fv_taa_frame *f, float px, float py, float d, float *u, float *v);
+
+#endif

@@ -1,0 +1,157 @@
+/* fovea: the temporal reprojection kernels' shared parts (see reproject.h), used by the C
+ * reference and every ISA version (dav1d-style template). Included once per ISA file after it
+ * defines:
+ *   TAA_FN(name)   the ISA's function name
+ *   acc4           a 4-channel accumulator (r, g, b, depth)
+ *   acc_zero()     an accumulator of +0
+ *   tap(L, s, t, zexp, inv_tol, &acc, &accw)
+ *                  adds one bilinear tap of level L at level coordinates (s, t) (texel centres
+ *                  at integers; s, t >= -0.5): texels (i, j), (i, j+1), (i+1, j), (i+1, j+1)
+ *                  with i = floor(s), j = floor(t), fx = s - i, fy = t - j, bilinear weights
+ *                  b00 = (1-fx)(1-fy), b01 = (1-fx) fy, b10 = fx (1-fy), b11 = fx fy, and
+ *                    wt  = (b * conf) * max(0, 1 - |depth - zexp| * inv_tol)
+ *                    acc = acc + ((wt00 c00 + wt01 c01) + (wt10 c10 + wt11 c11))
+ *                    accw = accw + ((wt00 + wt01) + (wt10 + wt11))
+ *   out_blend(px, acc, accw, alpha)   h = acc / accw; px.rgb = h + alpha (px.rgb - h)
+ *   sample_mask(wgt, n)               bit i set where wgt[i] == 1 (n <= 64)
+ * The blend's per-sample arithmetic is scalar IEEE code here, identical for all ISAs; the fill
+ * has a scalar form here (the reference, and the ISAs' row edges) that the ISA files vectorise
+ * across pixels with the same operations per lane. */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "reproject.h"
+
+/* Footprint (previous-frame pixels) -> pyramid level: floor(log2 f) from the exponent bits. */
+static inline int taa_level(float f, int max_level)
+{
+    if (!(f >= 2.0f))
+        return 0; /* also NaN */
+    uint32_t b;
+    memcpy(&b, &f, 4);
+    int e = (int)(b >> 23) - 127;
+    return e < max_level ? e : max_level;
+}
+
+static inline float taa_clampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
+
+static void TAA_FN(taa_blend_row)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
+                                  const float *wgt, int x0, int y, int n, struct fv_taa_flow *flow)
+{
+    const float py = (float)y + 0.5f;
+    const float b0 = f->M0[0] + py * f->MY[0], b1 = f->M0[1] + py * f->MY[1], b2 = f->M0[2] + py * f->MY[2];
+    const float umax = f->prev_w - 0.015625f, vmax = f->prev_h - 0.015625f; /* taps stay inside */
+    float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
+    for (int x = 0; x < n; x += 64) {
+        /* iterate over the samples' bits: no branch on the (dithered) pattern per pixel */
+        uint64_t m = sample_mask(wgt + x, n - x < 64 ? n - x : 64);
+        while (m) {
+            const int i = x + __builtin_ctzll(m);
+            m &= m - 1;
+            float *px = rgbd + 4 * i;
+            const float d = px[3], pxc = (float)(x0 + i) + 0.5f;
+            float u, v, z, rz;
+            if (f->identity) {
+                u = pxc;
+                v = py;
+                z = d;
+                rz = 1.0f / z;
+            } else {
+                const float U = f->T[0] + d * (b0 + pxc * f->MX[0]);
+                const float V = f->T[1] + d * (b1 + pxc * f->MX[1]);
+                z = f->T[2] + d * (b2 + pxc * f->MX[2]);
+                if (!(z > 1e-4f))
+                    continue; /* behind the previous eye: no history */
+                rz = 1.0f / z;
+                u = U * rz;
+                v = V * rz;
+            }
+            if (!(u >= 0.0f && u < f->prev_w && v >= 0.0f && v < f->prev_h))
+                continue; /* outside the previous image */
+            fdx = fdx + (u - pxc);
+            fdy = fdy + (v - py);
+            fn = fn + 1.0f;
+            const float fp = (d * rz) * t->widen;
+            const int l = taa_level(fp, f->max_level);
+            const fv_pyr_level *L = &f->hist->lv[l];
+            const float ts = (float)(1 << l), inv_ts = 1.0f / ts;
+            float o = (fp - ts) * 0.5f;
+            o = o < 0.5f * ts ? o : 0.5f * ts;
+            const float inv_tol = rz * f->inv_depth_tol;
+            acc4 acc = acc_zero();
+            float accw = 0.0f;
+            int taps = 1;
+            tap(L, u * inv_ts - 0.5f, v * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+            if (o >= 0.125f) { /* quincunx: the footprint's four corners at half extent */
+                const float ul = taa_clampf(u - o, 0.0f, umax), ur = taa_clampf(u + o, 0.0f, umax);
+                const float vt = taa_clampf(v - o, 0.0f, vmax), vb = taa_clampf(v + o, 0.0f, vmax);
+                tap(L, ul * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                tap(L, ur * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                tap(L, ul * inv_ts - 0.5f, vb * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                tap(L, ur * inv_ts - 0.5f, vb * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                taps = 5;
+            }
+            if (!(accw > 0.0f))
+                continue; /* no valid history: the sample stands alone */
+            const float a1 = 1.0f - accw / (float)taps;
+            out_blend(px, acc, accw, a1 > t->alpha ? a1 : t->alpha);
+        }
+    }
+    flow->dx = fdx;
+    flow->dy = fdy;
+    flow->n = fn;
+}
+
+/* The fill for pixels i in [i0, i1) of the row (the whole row in the reference). hrow / hw point
+ * at pixel 0 of history row y + flow_y of level 0; B = N0 + vc * NY for that row's centre vc. */
+static inline void taa_fill_px(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                               const float *hrow, const float *hw, const float B[3], int x0, float py, int i0, int i1)
+{
+    for (int i = i0; i < i1; i++) {
+        const int sx = x0 + i + t->flow_x;
+        if (!(wgt[i] == 0.0f && sx >= 0 && (float)sx < f->prev_w))
+            continue;
+        const float ws = hw[sx];
+        if (!(ws > 0.0f))
+            continue;
+        const float *src = hrow + 4 * sx;
+        const float D = src[3];
+        float z = D;
+        if (!f->identity) {
+            /* the history texel's world point must land on this pixel (within half a pixel) */
+            const float uc = (float)sx + 0.5f, pxc = (float)(x0 + i) + 0.5f;
+            const float U = f->T2[0] + D * (B[0] + uc * f->NX[0]);
+            const float V = f->T2[1] + D * (B[1] + uc * f->NX[1]);
+            z = f->T2[2] + D * (B[2] + uc * f->NX[2]);
+            if (!(z > 1e-4f))
+                continue;
+            const float rz = 1.0f / z;
+            const float ex = U * rz - pxc, ey = V * rz - py;
+            if (!(ex <= 0.5f && ex >= -0.5f && ey <= 0.5f && ey >= -0.5f))
+                continue;
+        }
+        float *o = rgbd + 4 * i;
+        o[0] = src[0];
+        o[1] = src[1];
+        o[2] = src[2];
+        o[3] = z;
+        wgt[i] = ws;
+    }
+}
+
+/* Row set-up of the fill: NULL when the history row is outside the previous image. */
+static inline const float *taa_fill_setup(const struct fv_taa_frame *f, const struct fv_taa_tile *t, int y,
+                                          const float **hw, float B[3])
+{
+    const int sy = y + t->flow_y;
+    if (!(sy >= 0 && (float)sy < f->prev_h))
+        return NULL;
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const float vc = (float)sy + 0.5f;
+    for (int k = 0; k < 3; k++)
+        B[k] = f->N0[k] + vc * f->NY[k];
+    const ptrdiff_t o = (ptrdiff_t)sy * L->stride;
+    *hw = L->wgt + o;
+    return L->rgbd + 4 * o;
+}

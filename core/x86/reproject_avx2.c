@@ -1,0 +1,142 @@
+/* fovea: temporal reprojection kernels, AVX2: the two horizontally adjacent texels of a bilinear
+ * tap are contiguous, so each texel row is one 256-bit load and one multiply. Same operations
+ * in the same order as the reference (built with -mfma but -ffp-contract=off, no FMA
+ * intrinsics): bit-identical. Row loops and scalar arithmetic: core/reproject_tmpl.h. */
+#include <immintrin.h>
+
+#include <stdint.h>
+
+#include "dsp.h"
+#include "reproject.h"
+
+typedef __m128 acc4;
+
+static inline acc4 acc_zero(void) { return _mm_setzero_ps(); }
+
+static inline void tap(const fv_pyr_level *L, float s, float t, float zexp, float inv_tol, acc4 *acc, float *accw)
+{
+    const __m128 st = _mm_floor_ps(_mm_setr_ps(s, t, 0.0f, 0.0f));
+    const float fs = _mm_cvtss_f32(st), ft = _mm_cvtss_f32(_mm_shuffle_ps(st, st, 1));
+    const int i = (int)fs, j = (int)ft;
+    const float fx = s - fs, fy = t - ft, omx = 1.0f - fx, omy = 1.0f - fy;
+    const ptrdiff_t o00 = (ptrdiff_t)j * L->stride + i, o01 = o00 + L->stride;
+    const __m256 top = _mm256_loadu_ps(L->rgbd + 4 * o00); /* c00 | c10 */
+    const __m256 bot = _mm256_loadu_ps(L->rgbd + 4 * o01); /* c01 | c11 */
+    /* depths in texel order 00, 01, 10, 11 */
+    const __m256 zw = _mm256_unpackhi_ps(top, bot); /* (c00.b, c01.b, c00.d, c01.d | c10.b, c11.b, c10.d, c11.d) */
+    const __m128 d = _mm_movehl_ps(_mm256_extractf128_ps(zw, 1), _mm256_castps256_ps128(zw));
+    const __m128 b = _mm_mul_ps(_mm_setr_ps(omx, omx, fx, fx), _mm_setr_ps(omy, fy, omy, fy));
+    const __m128 w = _mm_setr_ps(L->wgt[o00], L->wgt[o01], L->wgt[o00 + 1], L->wgt[o01 + 1]);
+    const __m128 absmask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    const __m128 a = _mm_max_ps(_mm_sub_ps(_mm_set1_ps(1.0f),
+                                           _mm_mul_ps(_mm_and_ps(_mm_sub_ps(d, _mm_set1_ps(zexp)), absmask),
+                                                      _mm_set1_ps(inv_tol))),
+                                _mm_setzero_ps());
+    const __m128 wt = _mm_mul_ps(_mm_mul_ps(b, w), a);
+    /* (w00 | w10) for the top row, (w01 | w11) for the bottom row, each broadcast over 4 lanes */
+    const __m256 wt8 = _mm256_castps128_ps256(wt);
+    const __m256 wtop = _mm256_permutevar8x32_ps(wt8, _mm256_setr_epi32(0, 0, 0, 0, 2, 2, 2, 2));
+    const __m256 wbot = _mm256_permutevar8x32_ps(wt8, _mm256_setr_epi32(1, 1, 1, 1, 3, 3, 3, 3));
+    const __m256 s8 = _mm256_add_ps(_mm256_mul_ps(wtop, top), _mm256_mul_ps(wbot, bot)); /* 00+01 | 10+11 */
+    *acc = _mm_add_ps(*acc, _mm_add_ps(_mm256_castps256_ps128(s8), _mm256_extractf128_ps(s8, 1)));
+    const __m128 h = _mm_add_ps(wt, _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(2, 3, 0, 1)));
+    *accw = *accw + _mm_cvtss_f32(_mm_add_ss(h, _mm_movehl_ps(h, h)));
+}
+
+static inline void out_blend(float *px, acc4 acc, float accw, float alpha)
+{
+    const __m128 p = _mm_loadu_ps(px);
+    const __m128 h = _mm_div_ps(acc, _mm_set1_ps(accw));
+    const __m128 r = _mm_add_ps(h, _mm_mul_ps(_mm_set1_ps(alpha), _mm_sub_ps(p, h)));
+    _mm_storeu_ps(px, _mm_blend_ps(r, p, 8));
+}
+
+static inline uint64_t sample_mask(const float *wgt, int n)
+{
+    uint64_t m = 0;
+    int i = 0;
+    for (; i + 8 <= n; i += 8)
+        m |= (uint64_t)_mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(wgt + i), _mm256_set1_ps(1.0f), _CMP_EQ_OQ)) << i;
+    for (; i < n; i++)
+        m |= (uint64_t)(wgt[i] == 1.0f) << i;
+    return m;
+}
+
+#define TAA_FN(name) name##_avx2
+#include "reproject_tmpl.h"
+
+static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1); }
+
+/* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). */
+static void taa_fill_row_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                              int x0, int y, int n)
+{
+    const float *hw, *hrow;
+    float B[3];
+    if (!(hrow = taa_fill_setup(f, t, y, &hw, B)))
+        return;
+    const float py = (float)y + 0.5f;
+    const int sx0 = x0 + t->flow_x, W = (int)f->prev_w;
+    int ilo = sx0 < 0 ? -sx0 : 0, ihi = W - sx0 < n ? W - sx0 : n;
+    if (ilo > n)
+        ilo = n;
+    if (ihi < ilo)
+        ihi = ilo;
+    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
+    const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), mhalf = _mm256_set1_ps(-0.5f);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    int i = ilo;
+    for (; i + 8 <= ihi; i += 8) {
+        const __m256 w = _mm256_loadu_ps(wgt + i);
+        const int sx = sx0 + i;
+        const __m256 ws = _mm256_loadu_ps(hw + sx);
+        __m256 m = _mm256_and_ps(_mm256_cmp_ps(w, zero, _CMP_EQ_OQ), _mm256_cmp_ps(ws, zero, _CMP_GT_OQ));
+        if (!_mm256_movemask_ps(m))
+            continue;
+        const float *src = hrow + 4 * sx;
+        __m128 r0 = _mm_loadu_ps(src), g0 = _mm_loadu_ps(src + 4), b0 = _mm_loadu_ps(src + 8), z0 = _mm_loadu_ps(src + 12);
+        __m128 r1 = _mm_loadu_ps(src + 16), g1 = _mm_loadu_ps(src + 20), b1 = _mm_loadu_ps(src + 24),
+               z1 = _mm_loadu_ps(src + 28);
+        _MM_TRANSPOSE4_PS(r0, g0, b0, z0);
+        _MM_TRANSPOSE4_PS(r1, g1, b1, z1);
+        __m256 z = pair(z0, z1);
+        if (!f->identity) {
+            const __m256 D = z;
+            const __m256 uc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(sx), lane)), half);
+            const __m256 pxc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x0 + i), lane)), half);
+            __m256 c[3];
+            for (int k = 0; k < 3; k++)
+                c[k] = _mm256_add_ps(_mm256_set1_ps(f->T2[k]),
+                                     _mm256_mul_ps(D, _mm256_add_ps(_mm256_set1_ps(B[k]),
+                                                                    _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[k])))));
+            z = c[2];
+            const __m256 rz = _mm256_div_ps(_mm256_set1_ps(1.0f), z);
+            const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(c[0], rz), pxc);
+            const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(c[1], rz), _mm256_set1_ps(py));
+            const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
+                                            _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ)));
+            m = _mm256_and_ps(m, _mm256_and_ps(_mm256_cmp_ps(z, _mm256_set1_ps(1e-4f), _CMP_GT_OQ), ok));
+            if (!_mm256_movemask_ps(m))
+                continue;
+            z0 = _mm256_castps256_ps128(z);
+            z1 = _mm256_extractf128_ps(z, 1);
+        }
+        _MM_TRANSPOSE4_PS(r0, g0, b0, z0); /* back to pixels (r, g, b, depth) */
+        _MM_TRANSPOSE4_PS(r1, g1, b1, z1);
+        float *o = rgbd + 4 * i;
+        const __m256 p[4] = {pair(r0, g0), pair(b0, z0), pair(r1, g1), pair(b1, z1)}; /* pixels 0|1, 2|3, ... */
+        for (int k = 0; k < 4; k++) {
+            const __m256 mk = _mm256_permutevar8x32_ps(
+                m, _mm256_setr_epi32(2 * k, 2 * k, 2 * k, 2 * k, 2 * k + 1, 2 * k + 1, 2 * k + 1, 2 * k + 1));
+            _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), p[k], mk));
+        }
+        _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
+    }
+    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
+}
+
+void fv_reproject_init_avx2(fv_dsp *d)
+{
+    d->taa_blend_row = taa_blend_row_avx2;
+    d->taa_fill_row = taa_fill_row_avx2;
+}

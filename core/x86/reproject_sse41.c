@@ -1,0 +1,131 @@
+/* fovea: temporal reprojection kernels, SSE4.1: one texel = one __m128 (r, g, b, depth). The
+ * row loops and all scalar arithmetic are shared (core/reproject_tmpl.h); the accumulation
+ * below does the reference's operations in the same order, so results are bit-identical. */
+#include <smmintrin.h>
+
+#include <stdint.h>
+
+#include "dsp.h"
+#include "reproject.h"
+
+typedef __m128 acc4;
+
+static inline acc4 acc_zero(void) { return _mm_setzero_ps(); }
+
+static inline void tap(const fv_pyr_level *L, float s, float t, float zexp, float inv_tol, acc4 *acc, float *accw)
+{
+    const __m128 st = _mm_floor_ps(_mm_setr_ps(s, t, 0.0f, 0.0f));
+    const float fs = _mm_cvtss_f32(st), ft = _mm_cvtss_f32(_mm_shuffle_ps(st, st, 1));
+    const int i = (int)fs, j = (int)ft;
+    const float fx = s - fs, fy = t - ft, omx = 1.0f - fx, omy = 1.0f - fy;
+    const ptrdiff_t o00 = (ptrdiff_t)j * L->stride + i, o01 = o00 + L->stride;
+    const __m128 c00 = _mm_loadu_ps(L->rgbd + 4 * o00), c10 = _mm_loadu_ps(L->rgbd + 4 * o00 + 4);
+    const __m128 c01 = _mm_loadu_ps(L->rgbd + 4 * o01), c11 = _mm_loadu_ps(L->rgbd + 4 * o01 + 4);
+    /* lanes in texel order 00, 01, 10, 11 */
+    const __m128 b = _mm_mul_ps(_mm_setr_ps(omx, omx, fx, fx), _mm_setr_ps(omy, fy, omy, fy));
+    const __m128 w = _mm_setr_ps(L->wgt[o00], L->wgt[o01], L->wgt[o00 + 1], L->wgt[o01 + 1]);
+    const __m128 d = _mm_movehl_ps(_mm_unpackhi_ps(c10, c11), _mm_unpackhi_ps(c00, c01));
+    const __m128 absmask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    const __m128 a = _mm_max_ps(_mm_sub_ps(_mm_set1_ps(1.0f),
+                                           _mm_mul_ps(_mm_and_ps(_mm_sub_ps(d, _mm_set1_ps(zexp)), absmask),
+                                                      _mm_set1_ps(inv_tol))),
+                                _mm_setzero_ps());
+    const __m128 wt = _mm_mul_ps(_mm_mul_ps(b, w), a);
+    const __m128 m00 = _mm_mul_ps(_mm_shuffle_ps(wt, wt, 0x00), c00);
+    const __m128 m01 = _mm_mul_ps(_mm_shuffle_ps(wt, wt, 0x55), c01);
+    const __m128 m10 = _mm_mul_ps(_mm_shuffle_ps(wt, wt, 0xaa), c10);
+    const __m128 m11 = _mm_mul_ps(_mm_shuffle_ps(wt, wt, 0xff), c11);
+    *acc = _mm_add_ps(*acc, _mm_add_ps(_mm_add_ps(m00, m01), _mm_add_ps(m10, m11)));
+    /* (w00 + w01) + (w10 + w11) */
+    const __m128 h = _mm_add_ps(wt, _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(2, 3, 0, 1))); /* lane0 = w00+w01, lane2 = w10+w11 */
+    *accw = *accw + _mm_cvtss_f32(_mm_add_ss(h, _mm_movehl_ps(h, h)));
+}
+
+static inline void out_blend(float *px, acc4 acc, float accw, float alpha)
+{
+    const __m128 p = _mm_loadu_ps(px);
+    const __m128 h = _mm_div_ps(acc, _mm_set1_ps(accw));
+    const __m128 r = _mm_add_ps(h, _mm_mul_ps(_mm_set1_ps(alpha), _mm_sub_ps(p, h)));
+    _mm_storeu_ps(px, _mm_blend_ps(r, p, 8)); /* depth stays the sample's */
+}
+
+static inline uint64_t sample_mask(const float *wgt, int n)
+{
+    uint64_t m = 0;
+    int i = 0;
+    for (; i + 4 <= n; i += 4)
+        m |= (uint64_t)_mm_movemask_ps(_mm_cmpeq_ps(_mm_loadu_ps(wgt + i), _mm_set1_ps(1.0f))) << i;
+    for (; i < n; i++)
+        m |= (uint64_t)(wgt[i] == 1.0f) << i;
+    return m;
+}
+
+#define TAA_FN(name) name##_sse41
+#include "reproject_tmpl.h"
+
+/* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px). */
+static void taa_fill_row_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                               int x0, int y, int n)
+{
+    const float *hw, *hrow;
+    float B[3];
+    if (!(hrow = taa_fill_setup(f, t, y, &hw, B)))
+        return;
+    const float py = (float)y + 0.5f;
+    const int sx0 = x0 + t->flow_x, W = (int)f->prev_w;
+    /* vector lanes need their history texels inside the row: sx0 + i in [0, W) */
+    int ilo = sx0 < 0 ? -sx0 : 0, ihi = W - sx0 < n ? W - sx0 : n;
+    if (ilo > n)
+        ilo = n;
+    if (ihi < ilo)
+        ihi = ilo;
+    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
+    const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), mhalf = _mm_set1_ps(-0.5f);
+    const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+    int i = ilo;
+    for (; i + 4 <= ihi; i += 4) {
+        const __m128 w = _mm_loadu_ps(wgt + i);
+        const int sx = sx0 + i;
+        const __m128 ws = _mm_loadu_ps(hw + sx);
+        __m128 m = _mm_and_ps(_mm_cmpeq_ps(w, zero), _mm_cmpgt_ps(ws, zero));
+        if (!_mm_movemask_ps(m))
+            continue;
+        const float *src = hrow + 4 * sx;
+        __m128 r = _mm_loadu_ps(src), g = _mm_loadu_ps(src + 4), b = _mm_loadu_ps(src + 8), z = _mm_loadu_ps(src + 12);
+        _MM_TRANSPOSE4_PS(r, g, b, z); /* now r, g, b, D of the four texels */
+        if (!f->identity) {
+            const __m128 D = z;
+            const __m128 uc = _mm_add_ps(_mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(sx), lane)), half);
+            const __m128 pxc = _mm_add_ps(_mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x0 + i), lane)), half);
+            const __m128 U = _mm_add_ps(_mm_set1_ps(f->T2[0]),
+                                        _mm_mul_ps(D, _mm_add_ps(_mm_set1_ps(B[0]), _mm_mul_ps(uc, _mm_set1_ps(f->NX[0])))));
+            const __m128 V = _mm_add_ps(_mm_set1_ps(f->T2[1]),
+                                        _mm_mul_ps(D, _mm_add_ps(_mm_set1_ps(B[1]), _mm_mul_ps(uc, _mm_set1_ps(f->NX[1])))));
+            z = _mm_add_ps(_mm_set1_ps(f->T2[2]),
+                           _mm_mul_ps(D, _mm_add_ps(_mm_set1_ps(B[2]), _mm_mul_ps(uc, _mm_set1_ps(f->NX[2])))));
+            const __m128 rz = _mm_div_ps(_mm_set1_ps(1.0f), z);
+            const __m128 ex = _mm_sub_ps(_mm_mul_ps(U, rz), pxc), ey = _mm_sub_ps(_mm_mul_ps(V, rz), _mm_set1_ps(py));
+            const __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(ex, half), _mm_cmpge_ps(ex, mhalf)),
+                                         _mm_and_ps(_mm_cmple_ps(ey, half), _mm_cmpge_ps(ey, mhalf)));
+            m = _mm_and_ps(m, _mm_and_ps(_mm_cmpgt_ps(z, _mm_set1_ps(1e-4f)), ok));
+            if (!_mm_movemask_ps(m))
+                continue;
+        }
+        _MM_TRANSPOSE4_PS(r, g, b, z); /* back to four pixels (r, g, b, depth) */
+        float *o = rgbd + 4 * i;
+#define PUT(k, v) _mm_storeu_ps(o + 4 * k, _mm_blendv_ps(_mm_loadu_ps(o + 4 * k), v, _mm_shuffle_ps(m, m, k * 0x55)))
+        PUT(0, r);
+        PUT(1, g);
+        PUT(2, b);
+        PUT(3, z);
+#undef PUT
+        _mm_storeu_ps(wgt + i, _mm_blendv_ps(w, ws, m));
+    }
+    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
+}
+
+void fv_reproject_init_sse41(fv_dsp *d)
+{
+    d->taa_blend_row = taa_blend_row_sse41;
+    d->taa_fill_row = taa_fill_row_sse41;
+}
