@@ -14,8 +14,11 @@ const char *const fv_stage_names[FV_STAGE_COUNT] = {"trace", "reproject", "recon
 #define SRGB_LUT 4096
 
 typedef struct {
-    fv_camera cam;
-    fv_pyramid pyr;
+    fv_camera cam, prev_cam;
+    fv_pyramid pyr[2]; /* with reprojection: the current image and the previous one (history) */
+    int cur;           /* pyr[cur] holds the last rendered frame */
+    int hist_valid;    /* pyr[cur] and prev_cam may be reprojected */
+    long frame;        /* frames rendered: the sampling pattern's phase */
 } eye_state;
 
 struct fv_pipeline {
@@ -24,6 +27,7 @@ struct fv_pipeline {
     fv_pool *pool;
     fv_dsp dsp;
     fv_sampler smp;
+    int taa;           /* reprojection runs (enabled and foveated) */
     eye_state eyes[2];
     uint8_t srgb[SRGB_LUT + 1]; /* linear [0,1] -> sRGB 8-bit */
 };
@@ -40,6 +44,8 @@ void fv_pipeline_config_default(fv_pipeline_config *c)
     memset(c, 0, sizeof *c);
     fv_camera_desc_default(&c->cam);
     fv_sampling_params_default(&c->samp);
+    c->samp.rotate = 1;
+    fv_taa_params_default(&c->taa);
     c->threads = 0;
     c->isa_mask = ~0u;
 }
@@ -59,15 +65,24 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
              (double)cfg->cam.fov_y_deg);
         goto bad;
     }
-    if (fv_sampler_init(&p->smp, cfg->cam.width, cfg->cam.height, p->eyes[0].cam.focal_px, &cfg->samp)) {
+    if (!(cfg->taa.alpha_min > 0.0f && cfg->taa.alpha_min <= 1.0f && cfg->taa.depth_tol > 0.0f)) {
+        fv_err(err, err_len, "reprojection parameters out of range: need 0 < alpha_min <= 1, depth_tol > 0");
+        goto bad;
+    }
+    p->taa = cfg->taa.enabled && !cfg->samp.full;
+    fv_sampling_params sp = cfg->samp;
+    /* a rotating pattern without history filling its holes would only flicker */
+    sp.rotate = sp.rotate && p->taa && cfg->taa.fill;
+    if (fv_sampler_init(&p->smp, cfg->cam.width, cfg->cam.height, p->eyes[0].cam.focal_px, &sp)) {
         fv_err(err, err_len, "sampling parameters out of range: need 0 < r0 <= r1 <= 90 deg, 0 < p_min <= 1");
         goto bad;
     }
     for (int e = 0; e < 2; e++)
-        if (fv_pyramid_init(&p->eyes[e].pyr, cfg->cam.width, cfg->cam.height)) {
-            fv_err(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
-            goto bad;
-        }
+        for (int b = 0; b < (p->taa ? 2 : 1); b++)
+            if (fv_pyramid_init(&p->eyes[e].pyr[b], cfg->cam.width, cfg->cam.height)) {
+                fv_err(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
+                goto bad;
+            }
     p->pool = fv_pool_create(cfg->threads);
     if (!p->pool) {
         fv_err(err, err_len, "cannot start %d worker threads", cfg->threads);
@@ -92,11 +107,18 @@ void fv_pipeline_destroy(fv_pipeline *p)
     fv_pool_destroy(p->pool);
     fv_sampler_free(&p->smp);
     for (int e = 0; e < 2; e++)
-        fv_pyramid_free(&p->eyes[e].pyr);
+        for (int b = 0; b < 2; b++)
+            fv_pyramid_free(&p->eyes[e].pyr[b]);
     free(p);
 }
 
 static inline int slot(fv_eye eye) { return eye == FV_EYE_RIGHT ? 1 : 0; }
+
+void fv_pipeline_reset_history(fv_pipeline *p)
+{
+    for (int e = 0; e < 2; e++)
+        p->eyes[e].hist_valid = 0;
+}
 
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
                        fv_frame_stats *st)
@@ -108,21 +130,48 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         return -1;
     for (int i = 0; i < FV_STAGE_COUNT; i++)
         st->stage_ms[i] = NAN;
+    /* with reprojection, render into the other pyramid and read this one as history */
+    const int dst = p->taa ? es->cur ^ 1 : 0;
+    fv_pyramid *pyr = &es->pyr[dst];
+    fv_taa_frame tf;
+    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp.phases) : 0, .taa_prm = &p->cfg.taa};
     int64_t t0 = fv_time_ns();
+    if (p->taa && es->hist_valid) {
+        fv_taa_frame_setup(&tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
+        opt.taa = &tf;
+    }
     /* The S_in pattern moves by whole pixels with the point of regard. */
     int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
-    st->samples = fv_raycast(p->scene, &es->cam, &p->smp, gx, gy, &es->pyr, &p->dsp, p->pool);
+    double taa_ms = NAN;
+    st->samples = fv_raycast(p->scene, &es->cam, &p->smp, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     int64_t t1 = fv_time_ns();
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
-    fv_pullpush_from(&es->pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(&es->pyr));
+    fv_pullpush_from(pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(pyr));
     int64_t t2 = fv_time_ns();
-    st->stage_ms[FV_STAGE_TRACE] = (double)(t1 - t0) * 1e-6;
+    es->cur = dst;
+    es->prev_cam = es->cam;
+    es->hist_valid = 1;
+    es->frame++;
+    /* reprojection runs inside the ray-casting tiles: its share is the workers' time in it */
+    const double cast_ms = (double)(t1 - t0) * 1e-6;
+    if (p->taa) {
+        if (isnan(taa_ms))
+            taa_ms = 0.0; /* first frame: no history yet */
+        st->stage_ms[FV_STAGE_REPROJECT] = taa_ms;
+        st->stage_ms[FV_STAGE_TRACE] = cast_ms - taa_ms;
+    } else {
+        st->stage_ms[FV_STAGE_TRACE] = cast_ms;
+    }
     st->stage_ms[FV_STAGE_RECONSTRUCT] = (double)(t2 - t1) * 1e-6;
     st->total_ms = (double)(t2 - t0) * 1e-6;
     return 0;
 }
 
-const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye) { return &p->eyes[slot(eye)].pyr; }
+const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye)
+{
+    const eye_state *es = &p->eyes[slot(eye)];
+    return &es->pyr[es->cur];
+}
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye) { return &p->eyes[slot(eye)].cam; }
 const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p) { return &p->smp; }
 fv_pool *fv_pipeline_pool(fv_pipeline *p) { return p->pool; }
@@ -130,7 +179,7 @@ const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p) { return &p->dsp; }
 
 void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride)
 {
-    const fv_pyr_level *l0 = &p->eyes[slot(eye)].pyr.lv[0];
+    const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
     for (int y = 0; y < l0->h; y++) {
         const float *s = l0->rgbd + 4 * y * l0->stride;
         uint8_t *o = dst + y * dst_stride;

@@ -1,5 +1,5 @@
-/* fovea: the per-eye frame pipeline (Weier et al. 2018): sample -> ray cast -> [reproject] ->
- * pull-push reconstruction -> [focus depth, CoC, layered DoF filter, combine].
+/* fovea: the per-eye frame pipeline (Weier et al. 2018): sample -> ray cast -> reproject (TAA)
+ * -> pull-push reconstruction -> [focus depth, CoC, layered DoF filter, combine].
  * Stages in brackets are not built yet: their times are NAN ("-" in tables, null in JSON). */
 #ifndef FOVEA_PIPELINE_H
 #define FOVEA_PIPELINE_H
@@ -10,6 +10,7 @@
 #include "dsp.h"
 #include "pool.h"
 #include "pullpush.h"
+#include "reproject.h"
 #include "sampling.h"
 #include "scene.h"
 
@@ -27,7 +28,8 @@ extern const char *const fv_stage_names[FV_STAGE_COUNT];
 
 typedef struct fv_pipeline_config {
     fv_camera_desc cam;      /* size, vertical FOV, IPD, frustum shift */
-    fv_sampling_params samp; /* r0, r1, p_min, full */
+    fv_sampling_params samp; /* r0, r1, p_min, full; rotate (default 1) with reprojection */
+    fv_taa_params taa;       /* temporal reprojection (foveated only; full sampling needs none) */
     int threads;             /* 0 = online CPUs */
     unsigned isa_mask;       /* kernels allowed (FV_ISA_* bits); ~0u = the best this CPU runs */
 } fv_pipeline_config;
@@ -49,6 +51,8 @@ void fv_pipeline_destroy(fv_pipeline *p);
  * from head pose `head` with the point of regard at normalised image coordinates (gaze_x, gaze_y). */
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
                        fv_frame_stats *stats);
+/* Forgets both eyes' history (a cut, a teleport): the next frame starts afresh. */
+void fv_pipeline_reset_history(fv_pipeline *p);
 /* The eye's reconstruction pyramid after its last render (level 0 = the image). */
 const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye);
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye);

@@ -4,6 +4,8 @@
 #include <stdatomic.h>
 #include <string.h>
 
+#include "pipeline.h"
+
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
 
 typedef struct {
@@ -13,8 +15,89 @@ typedef struct {
     int gx, gy, tiles_x, tiles_y;
     fv_pyramid *pyr;
     const fv_dsp *dsp;
+    int phase;
+    const fv_taa_frame *taa;
+    const fv_taa_params *taa_prm;
     atomic_long rays;
+    atomic_llong taa_ns;
 } rc_job;
+
+/* The history a tile will read lies around the tile moved by the head motion: guess the move
+ * from the previous frame's depth at the tile (one level-4 texel) and prefetch those level-0
+ * rows, so they arrive while the tile's rays are traced (the reads are otherwise latency-bound
+ * misses: each history row is a separate 4-line stretch of a ~37 MB image). */
+static void prefetch_history(const rc_job *j, int x0, int y0, int tw, int th)
+{
+    const fv_taa_frame *f = j->taa;
+    const fv_pyr_level *h0 = &f->hist->lv[0];
+    int dx = 0, dy = 0;
+    if (!f->identity) {
+        const int l = f->hist->levels - 1 < FV_TILE_PULL_LEVELS ? f->hist->levels - 1 : FV_TILE_PULL_LEVELS;
+        const fv_pyr_level *hl = &f->hist->lv[l];
+        const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
+        int hx = (int)cx >> l, hy = (int)cy >> l;
+        hx = hx < hl->w ? hx : hl->w - 1;
+        hy = hy < hl->h ? hy : hl->h - 1;
+        float u, v;
+        if (fv_taa_project(f, cx, cy, hl->rgbd[4 * ((ptrdiff_t)hy * hl->stride + hx) + 3], &u, &v) <= 0.0f ||
+            !(fabsf(u - cx) < 4096.0f && fabsf(v - cy) < 4096.0f))
+            return;
+        dx = (int)floorf(u - cx);
+        dy = (int)floorf(v - cy);
+    }
+    int xa = x0 + dx - 1, xb = x0 + dx + tw + 1, ya = y0 + dy - 1, yb = y0 + dy + th + 1;
+    xa = xa < -1 ? -1 : xa;
+    xb = xb > h0->w ? h0->w : xb;
+    ya = ya < -1 ? -1 : ya;
+    yb = yb > h0->h ? h0->h : yb;
+    if (xa > xb)
+        return;
+    for (int y = ya; y <= yb; y++) {
+        const float *r = h0->rgbd + 4 * ((ptrdiff_t)y * h0->stride + xa);
+        for (int x = 0; x <= 4 * (xb - xa); x += 16) /* one 64-byte line = 4 pixels */
+            __builtin_prefetch(r + x);
+        __builtin_prefetch(r + 4 * (xb - xa));
+        __builtin_prefetch(h0->wgt + (ptrdiff_t)y * h0->stride + xa);
+        __builtin_prefetch(h0->wgt + (ptrdiff_t)y * h0->stride + xb);
+    }
+}
+
+/* Temporal reprojection of one tile (core/reproject.h): blend the samples with their history,
+ * then fill the holes from history at the tile's mean sample flow. */
+static void reproject_tile(rc_job *j, int x0, int y0, int tw, int th)
+{
+    const fv_pyr_level *l0 = &j->pyr->lv[0];
+    fv_taa_tile tt;
+    const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
+    fv_taa_tile_setup(&tt, j->taa_prm, fv_sampler_probability(j->smp, cx - (float)j->gx, cy - (float)j->gy),
+                      j->smp->prm.p_min, j->smp->phases);
+    fv_taa_flow fl = {0.0f, 0.0f, 0.0f};
+    for (int y = y0; y < y0 + th; y++) {
+        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
+        j->dsp->taa_blend_row(j->taa, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw, &fl);
+    }
+    if (!j->taa_prm->fill)
+        return;
+    float fx = 0.0f, fy = 0.0f;
+    if (fl.n > 0.0f) {
+        fx = fl.dx / fl.n;
+        fy = fl.dy / fl.n;
+    } else if (!j->taa->identity) { /* no sample reached the previous image: assume far away */
+        float u, v;
+        if (fv_taa_project(j->taa, cx, cy, FV_DEPTH_MISS_M, &u, &v) > 0.0f) {
+            fx = u - cx;
+            fy = v - cy;
+        }
+    }
+    if (!(fabsf(fx) < 65536.0f && fabsf(fy) < 65536.0f))
+        return;
+    tt.flow_x = (int)floorf(fx + 0.5f);
+    tt.flow_y = (int)floorf(fy + 0.5f);
+    for (int y = y0; y < y0 + th; y++) {
+        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
+        j->dsp->taa_fill_row(j->taa, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw);
+    }
+}
 
 /* Pixels of a tile in 4x2 blocks, so a full packet of 8 is a compact 4x2 footprint and a
  * sparse tile's packets still gather nearby pixels (coherent rays). */
@@ -44,7 +127,7 @@ static void trace_tile(void *ctx, int index, int thread_id)
 
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++) {
-        rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy);
+        rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
         /* Pixels without a sample carry weight 0 into pull-push, which never reads the colour of
          * a zero-weight pixel: clearing the weights is enough (a quarter of the bytes). */
         memset(l0->wgt + (y0 + y) * l0->stride + x0, 0, sizeof(float) * (size_t)tw);
@@ -112,6 +195,12 @@ static void trace_tile(void *ctx, int index, int thread_id)
         rays += k;
         k = 0;
     }
+    if (j->taa) {
+        const int64_t t0 = fv_time_ns();
+        prefetch_history(j, x0, y0, tw, th);
+        reproject_tile(j, x0, y0, tw, th);
+        atomic_fetch_add_explicit(&j->taa_ns, fv_time_ns() - t0, memory_order_relaxed);
+    }
     /* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level
      * 4. Tiles start on multiples of 16, so every block starts on even coordinates. */
     int xl = x0, yl = y0, wl = tw, hl = th;
@@ -123,12 +212,20 @@ static void trace_tile(void *ctx, int index, int thread_id)
 }
 
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
-                fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool)
+                fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool, const fv_raycast_opts *opt, double *taa_ms)
 {
     rc_job j = {.scene = scene, .cam = cam, .smp = smp, .gx = gx, .gy = gy, .pyr = pyr, .dsp = dsp};
+    if (opt) {
+        j.phase = opt->phase;
+        j.taa = opt->taa;
+        j.taa_prm = opt->taa_prm;
+    }
     j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
     j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
     atomic_init(&j.rays, 0);
+    atomic_init(&j.taa_ns, 0);
     fv_pool_run(pool, j.tiles_x * j.tiles_y, trace_tile, &j);
+    if (taa_ms)
+        *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
     return atomic_load(&j.rays);
 }

@@ -5,6 +5,7 @@
 #include "camera.h"
 #include "pool.h"
 #include "pullpush.h"
+#include "reproject.h"
 #include "sampling.h"
 #include "scene.h"
 
@@ -25,7 +26,17 @@ static inline int fv_raycast_pulled_levels(const fv_pyramid *p)
 {
     return p->levels - 1 < FV_TILE_PULL_LEVELS ? p->levels - 1 : FV_TILE_PULL_LEVELS;
 }
+typedef struct fv_raycast_opts {
+    int phase;                     /* sampling pattern phase (fv_sampler_row) */
+    const fv_taa_frame *taa;       /* NULL: no temporal reprojection */
+    const fv_taa_params *taa_prm;  /* with taa */
+} fv_raycast_opts;
+
+/* opt may be NULL (phase 0, no reprojection). With opt->taa each tile reprojects the previous
+ * frame into its samples and holes (core/reproject.h) after shading and before pulling; the
+ * CPU time the workers spent on that, divided by the pool's thread count, goes to *taa_ms
+ * (may be NULL). */
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
-                fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool);
+                fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool, const fv_raycast_opts *opt, double *taa_ms);
 
 #endif

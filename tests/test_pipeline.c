@@ -119,7 +119,7 @@ static void test_foveated_samples(void **st)
     long want = 0;
     for (int y = 0; y < 360; y++)
         for (int x = 0; x < 320; x += 64)
-            want += __builtin_popcountll(fv_sampler_row(smp, x, y, 320 - x < 64 ? 320 - x : 64, px0, py0));
+            want += __builtin_popcountll(fv_sampler_row(smp, x, y, 320 - x < 64 ? 320 - x : 64, px0, py0, 0));
     fv_frame_stats stats;
     assert_int_equal(fv_pipeline_render(p, FV_EYE_CENTER, &origin, gx, gy, &stats), 0);
     assert_int_equal(stats.samples, want);
@@ -132,7 +132,7 @@ static void test_foveated_samples(void **st)
     int checked = 0;
     for (int y = 0; y < 360; y += 7)
         for (int x = 0; x < 320; x += 5) {
-            if (!(fv_sampler_row(smp, x, y, 1, px0, py0) & 1))
+            if (!(fv_sampler_row(smp, x, y, 1, px0, py0, 0) & 1))
                 continue;
             float d[3];
             fv_camera_ray(cam, x + 0.5f, y + 0.5f, d);
