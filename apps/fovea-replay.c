@@ -7,12 +7,16 @@
 #include <string.h>
 
 #include "cli.h"
+#include "metrics.h"
 #include "output.h"
 #include "pipeline.h"
 #include "scene.h"
 #include "trace.h"
 
 static const char *prog = "fovea-replay";
+
+/* A normalised gaze coordinate in pixels (as the pipeline centres its pattern). */
+static float smp_gaze_px(float g, int size) { return floorf(g * (float)size) + 0.5f; }
 
 static void usage(FILE *f)
 {
@@ -29,13 +33,37 @@ static void usage(FILE *f)
             "  --full             sample every pixel (no foveation)\n"
             "  --stereo           render both eyes, side by side\n"
             "  --y4m FILE         also write the frames as a YUV4MPEG2 video\n"
+            "  --vs-full          also render every frame with full sampling and report the luma\n"
+            "                     PSNR against it (whole image, fovea < r0, periphery > r1)\n"
             "  --reference SPP    ground-truth depth of field (not built yet)\n"
             "  --window           show frames in a window (not built yet)\n"
             "  --quiet            no progress output\n" FV_COMMON_HELP "  --help             this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_TRACE, OPT_FRAMES, OPT_OUT, OPT_FULL, OPT_STEREO, OPT_Y4M, OPT_REF, OPT_WINDOW, OPT_HZ,
-       OPT_QUIET, OPT_HELP };
+       OPT_QUIET, OPT_VS_FULL, OPT_HELP };
+
+/* Mean of the finite values of a column (NAN when there are none). */
+typedef struct {
+    double sum;
+    long n, inf; /* inf: PSNR of identical images, left out of the mean */
+} mean_acc;
+static void mean_add(mean_acc *m, double v)
+{
+    if (isfinite(v)) {
+        m->sum += v;
+        m->n++;
+    } else if (isinf(v)) {
+        m->inf++;
+    }
+}
+static double mean_get(const mean_acc *m) { return m->n ? m->sum / (double)m->n : m->inf ? INFINITY : NAN; }
+static void csv_num(FILE *f, double v, const char *fmt)
+{
+    fputc(',', f);
+    if (!isnan(v))
+        fprintf(f, fmt, v); /* inf prints as inf: identical images */
+}
 
 int main(int argc, char **argv)
 {
@@ -43,7 +71,7 @@ int main(int argc, char **argv)
     fv_pipeline_config_default(&cfg);
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL;
     long frames = -1;
-    int stereo = 0, quiet = 0;
+    int stereo = 0, quiet = 0, vs_full = 0;
     float hz = 90.0f;
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, {"trace", required_argument, 0, OPT_TRACE},
@@ -51,7 +79,8 @@ int main(int argc, char **argv)
         {"full", no_argument, 0, OPT_FULL}, {"stereo", no_argument, 0, OPT_STEREO},
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
         {"window", no_argument, 0, OPT_WINDOW}, {"hz", required_argument, 0, OPT_HZ},
-        {"quiet", no_argument, 0, OPT_QUIET}, {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
+        {"quiet", no_argument, 0, OPT_QUIET}, {"vs-full", no_argument, 0, OPT_VS_FULL},
+        {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
     int o;
     while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
@@ -65,6 +94,7 @@ int main(int argc, char **argv)
         case OPT_Y4M: y4m_path = optarg; break;
         case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
         case OPT_QUIET: quiet = 1; break;
+        case OPT_VS_FULL: vs_full = 1; break;
         case OPT_REF:
             fv_arg_long(prog, "--reference", optarg, 1, 65536);
             fv_usage_error(prog, "--reference: the ground-truth depth-of-field renderer is not built yet");
@@ -97,8 +127,14 @@ int main(int argc, char **argv)
     int W = cfg.cam.width, H = cfg.cam.height;
     fv_pose view;
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)W / (float)H, view.pos, view.quat);
-    fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
-    if (!pl) {
+    fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err), *ref = NULL;
+    if (pl && vs_full) {
+        fv_pipeline_config rc = cfg;
+        rc.samp.full = 1;
+        ref = fv_pipeline_create(scene, &rc, err, sizeof err);
+    }
+    if (!pl || (vs_full && !ref)) {
+        fv_pipeline_destroy(pl);
         fv_scene_free(scene);
         fv_trace_free(&tr);
         fv_usage_error(prog, "%s", err);
@@ -106,12 +142,20 @@ int main(int argc, char **argv)
 
     int status = FV_EXIT_FAIL;
     int outw = stereo ? 2 * W : W;
-    uint8_t *rgb = malloc((size_t)outw * H * 3);
+    uint8_t *rgb = malloc((size_t)outw * H * 3), *prev = malloc((size_t)W * H * 3), *full = NULL;
+    float *err_prev = NULL, *err_cur = NULL;
+    if (vs_full) {
+        full = malloc((size_t)W * H * 3);
+        err_prev = malloc((size_t)W * H * sizeof(float));
+        err_cur = malloc((size_t)W * H * sizeof(float));
+    }
+    mean_acc m_dl = {0}, m_all = {0}, m_fov = {0}, m_per = {0}, m_fl = {0};
+    float prev_gx = 0.0f, prev_gy = 0.0f;
     fv_afile csv = {0};
     fv_y4m_writer y4m = {0};
     int y4m_open = 0;
     char path[4200];
-    if (!rgb) {
+    if (!rgb || !prev || (vs_full && (!full || !err_prev || !err_cur))) {
         fprintf(stderr, "%s: out of memory\n", prog);
         goto done;
     }
@@ -134,7 +178,9 @@ int main(int argc, char **argv)
     fprintf(csv.f, "frame,t_ms,gaze_x,gaze_y,samples");
     for (int s = 0; s < FV_STAGE_COUNT; s++)
         fprintf(csv.f, ",%s_ms", fv_stage_names[s]);
-    fprintf(csv.f, ",total_ms\n");
+    /* dluma_periph: mean |luma change| against the previous frame outside r1 of both gazes
+     * (temporal stability); psnr_*: against full sampling of the same frame (--vs-full) */
+    fprintf(csv.f, ",total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph\n");
 
     fv_progress prog_bar;
     fv_progress_begin(&prog_bar, "rendering frame", frames);
@@ -156,6 +202,46 @@ int main(int argc, char **argv)
             sum.total_ms += st[e].total_ms;
             sum.samples += st[e].samples;
         }
+        /* metrics on the (left) eye's image */
+        const float gpx = smp_gaze_px(smp.gaze_x, W), gpy = smp_gaze_px(smp.gaze_y, H);
+        const fv_sampler *sm = fv_pipeline_sampler(pl);
+        double dl = NAN, p_all = NAN, p_fov = NAN, p_per = NAN, fl = NAN;
+        if (f > 0) {
+            fv_region per = {gpx, gpy, sm->r1_px, prev_gx, prev_gy, 1};
+            dl = fv_luma_mad(prev, rgb, W, H, (ptrdiff_t)outw * 3, &per);
+        }
+        if (vs_full) {
+            fv_eye eye = stereo ? FV_EYE_LEFT : FV_EYE_CENTER;
+            fv_frame_stats rs;
+            fv_pipeline_render(ref, eye, &head, smp.gaze_x, smp.gaze_y, &rs);
+            fv_pipeline_to_rgb8(ref, eye, full, (ptrdiff_t)W * 3);
+            fv_region fov = fv_region_disc(gpx, gpy, sm->r0_px, 0), per = fv_region_disc(gpx, gpy, sm->r1_px, 1);
+            /* the foveated image in rgb has row stride outw * 3: compare row by row via a copy */
+            for (int y = 0; y < H; y++)
+                memcpy(prev + (size_t)y * W * 3, rgb + (size_t)y * outw * 3, (size_t)W * 3);
+            p_all = fv_luma_psnr(full, prev, W, H, (ptrdiff_t)W * 3, NULL);
+            p_fov = fv_luma_psnr(full, prev, W, H, (ptrdiff_t)W * 3, &fov);
+            p_per = fv_luma_psnr(full, prev, W, H, (ptrdiff_t)W * 3, &per);
+            /* flicker: how much the error against full sampling changes between frames */
+            fv_luma_error(full, prev, W, H, (ptrdiff_t)W * 3, err_cur);
+            if (f > 0) {
+                fv_region both = {gpx, gpy, sm->r1_px, prev_gx, prev_gy, 1};
+                fl = fv_mean_abs_diff(err_prev, err_cur, W, H, &both);
+            }
+            float *t = err_prev;
+            err_prev = err_cur;
+            err_cur = t;
+        } else {
+            for (int y = 0; y < H; y++)
+                memcpy(prev + (size_t)y * W * 3, rgb + (size_t)y * outw * 3, (size_t)W * 3);
+        }
+        prev_gx = gpx;
+        prev_gy = gpy;
+        mean_add(&m_dl, dl);
+        mean_add(&m_all, p_all);
+        mean_add(&m_fov, p_fov);
+        mean_add(&m_per, p_per);
+        mean_add(&m_fl, fl);
         snprintf(path, sizeof path, "%s/frame_%05ld.png", out_dir, f);
         if (fv_write_png(path, rgb, outw, H, (ptrdiff_t)outw * 3, err, sizeof err) ||
             (y4m_open && fv_y4m_write_rgb(&y4m, rgb, (ptrdiff_t)outw * 3, err, sizeof err))) {
@@ -169,7 +255,13 @@ int main(int argc, char **argv)
             else
                 fprintf(csv.f, ",%.3f", sum.stage_ms[s]);
         }
-        fprintf(csv.f, ",%.3f\n", sum.total_ms);
+        fprintf(csv.f, ",%.3f", sum.total_ms);
+        csv_num(csv.f, dl, "%.4f");
+        csv_num(csv.f, p_all, "%.3f");
+        csv_num(csv.f, p_fov, "%.3f");
+        csv_num(csv.f, p_per, "%.3f");
+        csv_num(csv.f, fl, "%.4f");
+        fputc('\n', csv.f);
         if (!quiet)
             fv_progress_update(&prog_bar, f + 1);
     }
@@ -178,15 +270,27 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: %s\n", prog, err);
         goto done;
     }
-    if (!quiet)
+    if (!quiet) {
         printf("%s: %ld frame%s of %dx%d%s in %s/ (stats.csv)\n", prog, frames, frames == 1 ? "" : "s", W, H,
                stereo ? " x 2 eyes" : "", out_dir);
+        if (frames > 1)
+            printf("%s: mean periphery luma change between frames %.3f (of 255)\n", prog, mean_get(&m_dl));
+        if (vs_full)
+            printf("%s: luma PSNR against full sampling, mean over frames: all %.2f dB, fovea %.2f dB, periphery "
+                   "%.2f dB; periphery flicker (change of the error between frames) %.3f\n",
+                   prog, mean_get(&m_all), mean_get(&m_fov), mean_get(&m_per), mean_get(&m_fl));
+    }
     status = FV_EXIT_OK;
 done:
     fv_afile_abort(&csv);
     if (y4m_open)
         fv_y4m_abort(&y4m);
     free(rgb);
+    free(prev);
+    free(full);
+    free(err_prev);
+    free(err_cur);
+    fv_pipeline_destroy(ref);
     fv_pipeline_destroy(pl);
     fv_scene_free(scene);
     fv_trace_free(&tr);

@@ -79,6 +79,15 @@ void fv_arg_size(const char *prog, const char *flag, const char *s, int *w, int 
     *h = (int)fv_arg_long(prog, flag, b, 16, 8192);
 }
 
+int fv_arg_onoff(const char *prog, const char *flag, const char *s)
+{
+    if (!strcmp(s, "on"))
+        return 1;
+    if (!strcmp(s, "off"))
+        return 0;
+    fv_usage_error(prog, "%s: '%s' is not one of on, off", flag, s);
+}
+
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg)
 {
     switch (opt) {
@@ -114,6 +123,24 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
             cfg->isa_mask = FV_ISA_NEON;
         else
             fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", arg);
+        return 1;
+    case FV_OPT_REPROJECT:
+        cfg->taa.enabled = fv_arg_onoff(prog, "--reproject", arg);
+        return 1;
+    case FV_OPT_TAA_FILL:
+        cfg->taa.fill = fv_arg_onoff(prog, "--taa-fill", arg);
+        return 1;
+    case FV_OPT_TAA_ALPHA:
+        cfg->taa.alpha_min = fv_arg_float(prog, "--taa-alpha", arg, 0.001f, 1.0f);
+        return 1;
+    case FV_OPT_TAA_TOL:
+        cfg->taa.depth_tol = fv_arg_float(prog, "--taa-depth-tol", arg, 0.0001f, 10.0f);
+        return 1;
+    case FV_OPT_PATTERN:
+        if (!strcmp(arg, "rotate") || !strcmp(arg, "static"))
+            cfg->samp.rotate = !strcmp(arg, "rotate");
+        else
+            fv_usage_error(prog, "--pattern: '%s' is not one of rotate, static", arg);
         return 1;
     case FV_OPT_DOF:
         if (!strcmp(arg, "none"))

@@ -19,20 +19,25 @@ _Noreturn void fv_bad_option(const char *prog, char **argv);
 /* Strict parsers: the whole string must be a number in [lo, hi]; exit 2 naming the flag otherwise. */
 long fv_arg_long(const char *prog, const char *flag, const char *s, long lo, long hi);
 float fv_arg_float(const char *prog, const char *flag, const char *s, float lo, float hi);
+int fv_arg_onoff(const char *prog, const char *flag, const char *s); /* "on" 1, "off" 0 */
 void fv_arg_size(const char *prog, const char *flag, const char *s, int *w, int *h); /* WxH */
 
 /* Options shared by fovea-replay and fovea-bench, parsed into a pipeline config.
  * Returns 1 if opt was one of them. */
 enum {
     FV_OPT_SIZE = 1000, FV_OPT_THREADS, FV_OPT_FOV, FV_OPT_IPD, FV_OPT_R0, FV_OPT_R1, FV_OPT_PMIN, FV_OPT_ISA,
-    FV_OPT_DOF, FV_OPT_DOF_MODEL,
+    FV_OPT_DOF, FV_OPT_DOF_MODEL, FV_OPT_REPROJECT, FV_OPT_TAA_ALPHA, FV_OPT_TAA_TOL, FV_OPT_TAA_FILL,
+    FV_OPT_PATTERN,
 };
 #define FV_COMMON_LONGOPTS                                                                     \
     {"size", required_argument, 0, FV_OPT_SIZE}, {"threads", required_argument, 0, FV_OPT_THREADS}, \
     {"fov", required_argument, 0, FV_OPT_FOV}, {"ipd", required_argument, 0, FV_OPT_IPD},         \
     {"r0", required_argument, 0, FV_OPT_R0}, {"r1", required_argument, 0, FV_OPT_R1},             \
     {"pmin", required_argument, 0, FV_OPT_PMIN}, {"isa", required_argument, 0, FV_OPT_ISA},        \
-    {"dof", required_argument, 0, FV_OPT_DOF}, {"dof-model", required_argument, 0, FV_OPT_DOF_MODEL}
+    {"dof", required_argument, 0, FV_OPT_DOF}, {"dof-model", required_argument, 0, FV_OPT_DOF_MODEL},   \
+    {"reproject", required_argument, 0, FV_OPT_REPROJECT}, {"taa-alpha", required_argument, 0, FV_OPT_TAA_ALPHA}, \
+    {"taa-depth-tol", required_argument, 0, FV_OPT_TAA_TOL}, {"taa-fill", required_argument, 0, FV_OPT_TAA_FILL}, \
+    {"pattern", required_argument, 0, FV_OPT_PATTERN}
 #define FV_COMMON_HELP                                                                             \
     "  --size WxH         eye image size in pixels (default 1280x1440)\n"                          \
     "  --fov DEG          vertical field of view (default 100)\n"                                  \
@@ -40,6 +45,13 @@ enum {
     "  --r0 DEG           fully sampled fovea radius (default 10)\n"                               \
     "  --r1 DEG           end of the transition region (default 20)\n"                             \
     "  --pmin P           peripheral sampling probability (default 0.2)\n"                         \
+    "  --reproject on|off temporal reprojection (TAA) of the previous frame (default on;\n"       \
+    "                     foveated only)\n"                                                     \
+    "  --taa-alpha A      minimum weight of a new sample per frame of history (default 0.3)\n"  \
+    "  --taa-depth-tol F  relative depth difference that rejects history (default 0.03)\n"     \
+    "  --taa-fill on|off  fill pixels without a sample from valid history (default on)\n"      \
+    "  --pattern rotate|static   sampling pattern over frames (default rotate with\n"          \
+    "                     reprojection; static always without it)\n"                           \
     "  --threads N        worker threads (default: online CPUs)\n"                                 \
     "  --isa c|sse41|avx2|neon  cap the SIMD kernels (default: best available)\n"                  \
     "  --dof none|weak|medium|strong   depth of field (only 'none' is built yet)\n"                \

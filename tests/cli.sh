@@ -45,6 +45,10 @@ for p in fovea-replay fovea-bench; do
     expect_usage "$p dof not built" '--dof medium: depth of field is not built yet' $B/$p --scene $SCENE $O --dof medium
     expect_usage "$p dof bad" '--dof: .blurry. is not one of' $B/$p --scene $SCENE $O --dof blurry
     expect_usage "$p stray arg" 'unexpected argument .extra.' $B/$p --scene $SCENE $O extra
+    expect_usage "$p bad reproject" '--reproject: .maybe. is not one of on, off' $B/$p --scene $SCENE $O --reproject maybe
+    expect_usage "$p bad taa-alpha" '--taa-alpha: 0 is out of range' $B/$p --scene $SCENE $O --taa-alpha 0
+    expect_usage "$p bad taa-fill" '--taa-fill: .yes. is not one of on, off' $B/$p --scene $SCENE $O --taa-fill yes
+    expect_usage "$p bad pattern" '--pattern: .spiral. is not one of rotate, static' $B/$p --scene $SCENE $O --pattern spiral
     if $B/$p --help >"$T/help" 2>&1 && grep -q -- --scene "$T/help"; then ok; else bad "$p --help"; fi
 done
 [ ! -e "$T/o1" ] && ok || bad "bad input left output directory $T/o1 behind"
@@ -67,13 +71,22 @@ if $R --scene $SCENE --trace "$T/good.csv" --frames 3 --size 96x108 --out "$T/ru
     n=$(ls "$T/run" | grep -c '^frame_0000[0-2]\.png$')
     head=$(head -n 1 "$T/run/stats.csv")
     rows=$(wc -l <"$T/run/stats.csv")
-    want="frame,t_ms,gaze_x,gaze_y,samples,trace_ms,reproject_ms,reconstruct_ms,coc_ms,dof_filter_ms,combine_ms,total_ms"
+    want="frame,t_ms,gaze_x,gaze_y,samples,trace_ms,reproject_ms,reconstruct_ms,coc_ms,dof_filter_ms,combine_ms,total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph"
     [ "$n" -eq 3 ] && ok || bad "replay wrote $n frames, expected 3"
     [ "$head" = "$want" ] && ok || bad "stats.csv header: $head"
     [ "$rows" -eq 4 ] && ok || bad "stats.csv has $rows lines, expected 4"
     ls "$T/run" | grep -q '\.tmp$' && bad "temporary files left in output" || ok
 else
     bad "replay good run failed: $(cat "$T/err")"
+fi
+# --vs-full: every frame also rendered fully sampled; PSNR columns filled from the first frame,
+# the frame-to-frame columns from the second; a static view converges (PSNR rises)
+if $R --scene $SCENE --frames 6 --size 96x108 --vs-full --out "$T/vs" --quiet 2>"$T/err"; then
+    awk -F, 'NR == 2 && $14 != "" && $13 == "" {ok++} NR == 3 && $13 != "" && $17 != "" {ok++}
+             NR == 2 {first = $14} NR == 7 {last = $14} END {exit !(ok == 2 && (last == "inf" || last > first + 10))}' \
+        "$T/vs/stats.csv" && ok || bad "--vs-full columns: $(sed -n '2p;3p;7p' "$T/vs/stats.csv")"
+else
+    bad "replay --vs-full failed: $(cat "$T/err")"
 fi
 # --frames defaults to the trace's length at 90 Hz: 50 ms -> frames 0..4
 if $R --scene $SCENE --trace "$T/good.csv" --size 48x54 --out "$T/run5" --quiet 2>"$T/err"; then
@@ -83,13 +96,14 @@ else
     bad "replay default frames failed: $(cat "$T/err")"
 fi
 
-# Determinism: same bytes for 1, 2 and 5 threads, and on a second run
+# Determinism: same bytes for 1, 2 and 5 threads, and on a second run (the bundled trace moves
+# the head: the later frames reproject their history)
 for th in 1 2 5; do
-    $R --scene $SCENE --trace assets/gaze_sweep.csv --frames 2 --size 160x180 --threads $th --out "$T/d$th" --quiet \
+    $R --scene $SCENE --trace assets/gaze_sweep.csv --frames 3 --size 160x180 --threads $th --out "$T/d$th" --quiet \
         2>"$T/err" || bad "replay --threads $th failed: $(cat "$T/err")"
 done
-$R --scene $SCENE --trace assets/gaze_sweep.csv --frames 2 --size 160x180 --threads 2 --out "$T/d2b" --quiet 2>/dev/null
-for f in frame_00000.png frame_00001.png; do
+$R --scene $SCENE --trace assets/gaze_sweep.csv --frames 3 --size 160x180 --threads 2 --out "$T/d2b" --quiet 2>/dev/null
+for f in frame_00000.png frame_00001.png frame_00002.png; do
     for d in d2 d5 d2b; do
         if cmp -s "$T/d1/$f" "$T/$d/$f"; then ok; else bad "$f differs between d1 and $d"; fi
     done
@@ -108,10 +122,11 @@ fi
 expect_usage "replay odd y4m size" 'even frame sizes' $R --scene $SCENE --frames 1 --size 63x72 --y4m "$T/odd.y4m" --out "$T/odd"
 [ ! -e "$T/odd.y4m" ] && [ ! -e "$T/odd.y4m.tmp" ] && [ ! -e "$T/odd/stats.csv" ] && ok || bad "failed y4m run left files behind"
 
-# Bench JSON has the documented fields; null for stages not built yet
+# Bench JSON has the documented fields; null for stages not built yet (and for reprojection in
+# the full mode, which needs none)
 if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/b.json" >"$T/out" 2>"$T/err"; then
     for k in '"scene"' '"width": 96' '"height": 108' '"threads"' '"frames": 2' '"mode": "foveated"' '"mode": "full"' \
-        '"samples_per_frame"' '"total_ms"' '"stages_ms"' '"trace": [0-9]' '"reproject": null' '"reconstruct": [0-9]' \
+        '"samples_per_frame"' '"total_ms"' '"stages_ms"' '"trace": [0-9]' '"reproject": [0-9]' '"reproject": null' '"reconstruct": [0-9]' \
         '"coc": null' '"dof_filter": null' '"combine": null' '"mrays_per_s"'; do
         grep -q "$k" "$T/b.json" && ok || bad "bench JSON lacks $k"
     done
