@@ -3,12 +3,13 @@
  *
  *   build/tools/gen_trace --out assets/gaze_sweep.csv
  *
- * Format: `t_ms,gaze_x,gaze_y`, gaze in normalised image coordinates (x right, y down, [0,1]),
- * head fixed at the scene's default viewpoint (its camera node: eye at (0, 1.6, 0) looking down
- * -Z, vertical FOV 100 deg, 1280x1440). The path: fixate the centre, saccade to a label-1
- * target at 0.77 m and dwell 25 frames, saccade to the blue ball at 6 m and dwell 25 frames,
- * saccade to the right, sweep smoothly across to the left over three label-2 spheres, saccade
- * back to the centre. Saccades follow a minimum-jerk profile; fixations carry a small drift/tremor.
+ * Format: `t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw`, gaze in
+ * normalised image coordinates (x right, y down, [0,1]); the head sways gently around the scene's
+ * default viewpoint (its camera node: eye at (0, 1.6, 0) looking down -Z, vertical FOV 100 deg,
+ * 1280x1440) so temporal reprojection has motion to follow; --static-head writes the gaze only.
+ * The path: fixate the centre, saccade to a label-1 target at 0.77 m and dwell 25 frames,
+ * saccade to the blue ball at 6 m and dwell 25 frames, saccade to the right, sweep smoothly
+ * across to the left over three label-2 spheres, saccade back to the centre. Saccades follow a minimum-jerk profile; fixations carry a small drift/tremor.
  * Deterministic. Exit status: 0 success, 2 bad usage, 1 cannot write. */
 
 #include <errno.h>
@@ -28,11 +29,43 @@ static const double TARGET_BALL[3] = {0.6, 1.35, -6.0};    /* target3_blue_ball,
 
 static const double PI = 3.14159265358979323846;
 
-static void project(const double p[3], double *x, double *y)
+/* Head pose: the camera node's position plus a slow sway (a lateral shift and a yaw / pitch
+ * swing), so reprojection has head motion to follow. Zero with --static-head. */
+typedef struct {
+    double pos[3], q[4]; /* q: x, y, z, w (yaw about +Y, then pitch about +X) */
+} pose;
+#define SWAY_YAW_DEG 4.0
+#define SWAY_PITCH_DEG 1.5
+#define SWAY_X_M 0.02
+#define SWAY_PERIOD_MS 1333.0
+
+static pose head_at(double t_ms, int moving)
 {
-    double t = tan(YFOV_DEG * 0.5 * PI / 180.0), dz = -(p[2] - EYE[2]);
-    *x = 0.5 + (p[0] - EYE[0]) / dz / (2 * t * ASPECT);
-    *y = 0.5 - (p[1] - EYE[1]) / dz / (2 * t);
+    double a = moving ? sin(2 * PI * t_ms / SWAY_PERIOD_MS) : 0.0, b = moving ? sin(4 * PI * t_ms / SWAY_PERIOD_MS) : 0.0;
+    double yaw = SWAY_YAW_DEG * PI / 180.0 * a, pitch = SWAY_PITCH_DEG * PI / 180.0 * b;
+    double sy = sin(yaw / 2), cy = cos(yaw / 2), sp = sin(pitch / 2), cp = cos(pitch / 2);
+    pose h = {{EYE[0] + SWAY_X_M * a, EYE[1], EYE[2]}, {cy * sp, sy * cp, -sy * sp, cy * cp}};
+    return h;
+}
+
+/* v' = v + 2w (u x v) + 2 u x (u x v) for a unit quaternion (u, w); conj rotates world -> head */
+static void qrot(const double q[4], int conj, const double v[3], double o[3])
+{
+    double ux = conj ? -q[0] : q[0], uy = conj ? -q[1] : q[1], uz = conj ? -q[2] : q[2], w = q[3];
+    double cx = uy * v[2] - uz * v[1], cy = uz * v[0] - ux * v[2], cz = ux * v[1] - uy * v[0];
+    o[0] = v[0] + 2 * (w * cx + uy * cz - uz * cy);
+    o[1] = v[1] + 2 * (w * cy + uz * cx - ux * cz);
+    o[2] = v[2] + 2 * (w * cz + ux * cy - uy * cx);
+}
+
+/* Where world point p appears in the image of head pose h (the eye follows fixated targets). */
+static void project(const pose *h, const double p[3], double *x, double *y)
+{
+    double d[3] = {p[0] - h->pos[0], p[1] - h->pos[1], p[2] - h->pos[2]}, v[3];
+    qrot(h->q, 1, d, v);
+    double t = tan(YFOV_DEG * 0.5 * PI / 180.0), dz = -v[2];
+    *x = 0.5 + v[0] / dz / (2 * t * ASPECT);
+    *y = 0.5 - v[1] / dz / (2 * t);
 }
 
 static double dist(const double p[3])
@@ -57,24 +90,33 @@ static pt jitter(double t_ms)
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: gen_trace --out FILE\n"
+            "usage: gen_trace --out FILE [--static-head]\n"
             "Writes fovea's bundled gaze trace (120 frames at 90 Hz over the gen_range scene) as CSV\n"
-            "t_ms,gaze_x,gaze_y (normalised image coordinates, x right, y down).\n"
-            "  --out FILE   where to write it (FILE.tmp, then renamed), or - for stdout\n"
+            "t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw (gaze in\n"
+            "normalised image coordinates, x right, y down; head pose in world metres / quaternion).\n"
+            "  --out FILE     where to write it (FILE.tmp, then renamed), or - for stdout\n"
+            "  --static-head  no head motion and no head columns (gaze only)\n"
             "  --help       this text\n"
             "Exit status: 0 success, 2 bad usage, 1 the file cannot be written.\n");
 }
 
-static void write_trace(FILE *f)
+static void write_trace(FILE *f, int moving)
 {
     pt centre = {0.5, 0.5}, near, ball, sweep_r = {0.84, 0.415}, sweep_l = {0.16, 0.41};
-    project(TARGET_NEAR, &near.x, &near.y);
-    project(TARGET_BALL, &ball.x, &ball.y);
+    const pose rest = head_at(0.0, 0);
+    project(&rest, TARGET_NEAR, &near.x, &near.y);
+    project(&rest, TARGET_BALL, &ball.x, &ball.y);
 
     fprintf(f, "# fovea bundled gaze trace (tools/gen_trace.c): %d frames at %.0f Hz over assets/range.glb.\n",
             FRAMES, HZ);
     fprintf(f, "# gaze_x, gaze_y: normalised image coordinates of the left eye's image, x right, y down, in [0,1].\n");
-    fprintf(f, "# Head fixed at the scene's camera node: eye (0,1.6,0) looking down -Z, vertical FOV 100 deg, 1280x1440.\n");
+    if (moving)
+        fprintf(f, "# Head at the scene's camera node (0,1.6,0) looking down -Z (vertical FOV 100 deg, 1280x1440),\n"
+                   "# swaying: yaw +-%.1f deg and x +-%.2f m with period %.0f ms, pitch +-%.1f deg at twice the rate.\n"
+                   "# While fixating a target the gaze follows it in the image (vestibulo-ocular reflex).\n",
+                SWAY_YAW_DEG, SWAY_X_M, SWAY_PERIOD_MS, SWAY_PITCH_DEG);
+    else
+        fprintf(f, "# Head fixed at the scene's camera node: eye (0,1.6,0) looking down -Z, vertical FOV 100 deg, 1280x1440.\n");
     fprintf(f, "# frames   0-7   fixate the image centre\n");
     fprintf(f, "# frames   8-15  saccade (minimum jerk) to target1_red_sphere, %.2f m, at (%.4f, %.4f)\n",
             dist(TARGET_NEAR), near.x, near.y);
@@ -87,10 +129,15 @@ static void write_trace(FILE *f)
                "#                magenta (3.5 m), orange (5.1 m) and green (1.8 m) spheres\n",
             sweep_l.x, sweep_l.y);
     fprintf(f, "# frames 112-119 saccade back to the centre\n");
-    fprintf(f, "t_ms,gaze_x,gaze_y\n");
+    fprintf(f, moving ? "t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw\n"
+                      : "t_ms,gaze_x,gaze_y\n");
 
     for (int i = 0; i < FRAMES; i++) {
         double t = i * 1000.0 / HZ;
+        const pose h = head_at(t, moving);
+        /* the saccades' targets move with the head: re-project them for this pose */
+        project(&h, TARGET_NEAR, &near.x, &near.y);
+        project(&h, TARGET_BALL, &ball.x, &ball.y);
         pt g, a, b;
         double s;
         int fix = 0;
@@ -123,13 +170,18 @@ static void write_trace(FILE *f)
             g.x += d.x;
             g.y += d.y;
         }
-        fprintf(f, "%.3f,%.5f,%.5f\n", t, clamp01(g.x), clamp01(g.y));
+        fprintf(f, "%.3f,%.5f,%.5f", t, clamp01(g.x), clamp01(g.y));
+        if (moving)
+            fprintf(f, ",%.5f,%.5f,%.5f,%.6f,%.6f,%.6f,%.6f", h.pos[0], h.pos[1], h.pos[2], h.q[0], h.q[1], h.q[2],
+                    h.q[3]);
+        fputc('\n', f);
     }
 }
 
 int main(int argc, char **argv)
 {
     const char *out = NULL;
+    int moving = 1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             usage(stdout);
@@ -140,6 +192,8 @@ int main(int argc, char **argv)
                 return 2;
             }
             out = argv[++i];
+        } else if (!strcmp(argv[i], "--static-head")) {
+            moving = 0;
         } else if (!strncmp(argv[i], "--out=", 6)) {
             out = argv[i] + 6;
         } else {
@@ -152,7 +206,7 @@ int main(int argc, char **argv)
         return 2;
     }
     if (!strcmp(out, "-")) {
-        write_trace(stdout);
+        write_trace(stdout, moving);
         if (fflush(stdout) != 0) {
             fprintf(stderr, "gen_trace: cannot write to stdout: %s\n", strerror(errno));
             return 1;
@@ -173,7 +227,7 @@ int main(int argc, char **argv)
     if (!f) {
         err = errno;
     } else {
-        write_trace(f);
+        write_trace(f, moving);
         if (ferror(f) || fflush(f) != 0)
             err = errno ? errno : EIO;
         if (fclose(f) != 0 && !err)
