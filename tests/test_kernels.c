@@ -10,7 +10,10 @@
 
 #include "testutil.h"
 
+#include "camera.h"
 #include "dsp.h"
+#include "pullpush.h"
+#include "reproject.h"
 
 #define CANARY 16 /* floats checked after (and 4 before) every output row */
 static const uint32_t canary_bits = 0x7fc0dead; /* a NaN no kernel computes */
@@ -269,6 +272,176 @@ static void test_push_row(void **state)
     printf("[ kernels  ] push_row: %d ISA version(s) tested\n", tested);
 }
 
+/* ------------------------------------------------------------------ reprojection */
+
+/* A history pyramid with random content on every level (borders included): colours in [0, 1],
+ * depths in [0.3, 30] m with some at the miss depth, weights per mode (0/1, random, all 0). */
+static void random_history(fv_pyramid *h, int w, int hgt, int wmode)
+{
+    assert_int_equal(fv_pyramid_init(h, w, hgt), 0);
+    for (int l = 0; l < h->levels; l++) {
+        fv_pyr_level *L = &h->lv[l];
+        for (int y = -1; y <= L->h; y++)
+            for (int x = -1; x <= L->w; x++) {
+                float *c = L->rgbd + 4 * ((ptrdiff_t)y * L->stride + x);
+                for (int k = 0; k < 3; k++)
+                    c[k] = rnd();
+                const float u = rnd();
+                /* mostly one surface near 3 m (so history agrees with the samples and the blend
+                 * and the fill really run), some texels elsewhere and some misses */
+                c[3] = u < 0.05f ? 1000.0f : u < 0.3f ? 0.3f + 30.0f * rnd() * rnd() : 3.0f * (1.0f + 0.04f * (rnd() - 0.5f));
+                const int border = x < 0 || y < 0 || x >= L->w || y >= L->h;
+                float wt = wmode == 0 ? (float)(fv_test_rand(&rng) & 1) : wmode == 1 ? (rnd() < 0.2f ? 0.0f : rnd()) : 0.0f;
+                L->wgt[(ptrdiff_t)y * L->stride + x] = border ? 0.0f : wt;
+            }
+    }
+}
+
+/* Cameras of the current and previous frame: equal (identity), a small head motion, or a large
+ * one that sends much of the image outside the previous frame. */
+static void random_cameras(fv_camera *cur, fv_camera *prev, int w, int h, int motion)
+{
+    fv_camera_desc d;
+    fv_camera_desc_default(&d);
+    d.width = w;
+    d.height = h;
+    fv_pose a = {{0.1f, 1.6f, 0.2f}, {0, 0, 0, 1}}, b = a;
+    const float amt = motion == 1 ? 0.02f : 0.4f;
+    if (motion) {
+        for (int k = 0; k < 3; k++)
+            b.pos[k] += amt * (rnd() - 0.5f);
+        b.quat[0] = amt * (rnd() - 0.5f);
+        b.quat[1] = amt * (rnd() - 0.5f);
+        b.quat[2] = 0.3f * amt * (rnd() - 0.5f);
+        fv_quat_normalize(b.quat);
+    }
+    assert_int_equal(fv_camera_setup(cur, &d, &a), 0);
+    assert_int_equal(fv_camera_setup(prev, &d, &b), 0);
+}
+
+/* A row of n current pixels: samples (weight 1) with depths, holes (weight 0), and pixels of
+ * other weights that both kernels must leave alone. */
+static void random_row(float *rgbd, float *wgt, int n)
+{
+    static const float depths[] = { 1000.0f, 1e-3f, 0.31f, 2.0f, 7.5f };
+    for (int i = 0; i < n; i++) {
+        const float u = rnd();
+        wgt[i] = u < 0.4f ? 1.0f : u < 0.9f ? 0.0f : rnd();
+        for (int k = 0; k < 3; k++)
+            rgbd[4 * i + k] = rnd();
+        const float v = rnd();
+        rgbd[4 * i + 3] = v < 0.1f ? depths[fv_test_rand(&rng) % 5] : v < 0.3f ? 0.3f + 30.0f * rnd() * rnd()
+                                                                          : 3.0f * (1.0f + 0.04f * (rnd() - 0.5f));
+    }
+}
+
+static const char *motion_name[3] = { "identity", "small", "large" };
+static long taa_blended, taa_quincunx, taa_filled; /* how often the paths really ran */
+
+static int run_taa(const fv_dsp *d, const char *isa, const fv_taa_frame *f, int n, int off, int motion)
+{
+    const int W = (int)f->prev_w, H = (int)f->prev_h;
+    const int x0 = n >= W ? 0 : (int)(fv_test_rand(&rng) % (unsigned)(W - n + 1)), y = (int)(fv_test_rand(&rng) % (unsigned)H);
+    /* footprints of one texel, of several levels, and wide enough for quincunx taps */
+    static const float widen[] = { 1.0f, 1.0f, 1.3f, 2.2360680f, 2.6f, 3.0f, 4.0f, 9.0f };
+    fv_taa_tile t = { widen[fv_test_rand(&rng) % 8], 0.05f + 0.95f * rnd(), 0, 0 };
+    /* fill flow: small, or far enough that rows / runs leave the previous image */
+    const int big = fv_test_rand(&rng) % 8 == 0;
+    t.flow_x = (int)(fv_test_rand(&rng) % 7) - 3 + (big ? (int)(fv_test_rand(&rng) % (unsigned)(2 * W)) - W : 0);
+    t.flow_y = (int)(fv_test_rand(&rng) % 7) - 3 + (big ? (int)(fv_test_rand(&rng) % (unsigned)(2 * H)) - H : 0);
+    buf rc = out_new(4 * (size_t)n, off), rw = out_new((size_t)n, off);
+    buf tc = out_new(4 * (size_t)n, off), tw = out_new((size_t)n, off);
+    random_row(rc.p, rw.p, n);
+    memcpy(tc.p, rc.p, 4 * (size_t)n * sizeof(float));
+    memcpy(tw.p, rw.p, (size_t)n * sizeof(float));
+    fv_taa_flow fr = { 0.5f, -0.25f, 3.0f }, ft = fr; /* sums continue from earlier rows */
+    float *before = malloc(4 * (size_t)n * sizeof(float));
+    assert_non_null(before);
+    memcpy(before, rc.p, 4 * (size_t)n * sizeof(float));
+    fv_taa_blend_row_c(f, &t, rc.p, rw.p, x0, y, n, &fr);
+    for (int i = 0; i < n; i++)
+        if (memcmp(before + 4 * i, rc.p + 4 * i, 3 * sizeof(float))) {
+            taa_blended++;
+            taa_quincunx += t.widen >= 2.6f;
+        }
+    d->taa_blend_row(f, &t, tc.p, tw.p, x0, y, n, &ft);
+    check_canaries(&tc, 4 * (size_t)n, isa, "taa_blend_row", n);
+    check_canaries(&tw, (size_t)n, isa, "taa_blend_row", n);
+    compare(rc.p, tc.p, 4 * (size_t)n, 4, isa, "taa_blend_row", motion_name[motion], n, off, 0);
+    compare(rw.p, tw.p, (size_t)n, 1, isa, "taa_blend_row", "weight", n, off, 0);
+    compare(&fr.dx, &ft.dx, 3, 3, isa, "taa_blend_row", "flow sums", n, off, 0);
+    assert_finite(rc.p, 4 * (size_t)n, "taa_blend_row", n);
+    float *wbefore = malloc((size_t)n * sizeof(float));
+    assert_non_null(wbefore);
+    memcpy(wbefore, rw.p, (size_t)n * sizeof(float));
+    fv_taa_fill_row_c(f, &t, rc.p, rw.p, x0, y, n);
+    for (int i = 0; i < n; i++)
+        if (wbefore[i] == 0.0f && rw.p[i] > 0.0f)
+            taa_filled++;
+        else if (wbefore[i] != rw.p[i]) /* only holes are filled */
+            fail_msg("c taa_fill_row changed the weight of pixel %d from %g", i, (double)wbefore[i]);
+    free(before);
+    free(wbefore);
+    d->taa_fill_row(f, &t, tc.p, tw.p, x0, y, n);
+    check_canaries(&tc, 4 * (size_t)n, isa, "taa_fill_row", n);
+    check_canaries(&tw, (size_t)n, isa, "taa_fill_row", n);
+    compare(rc.p, tc.p, 4 * (size_t)n, 4, isa, "taa_fill_row", motion_name[motion], n, off, 0);
+    compare(rw.p, tw.p, (size_t)n, 1, isa, "taa_fill_row", "weight", n, off, 0);
+    assert_finite(rc.p, 4 * (size_t)n, "taa_fill_row", n);
+    for (int i = 0; i < n; i++)
+        assert_true(rw.p[i] >= 0.0f && rw.p[i] <= 1.0f);
+    free(rc.base), free(rw.base), free(tc.base), free(tw.base);
+    return 1;
+}
+
+static void test_taa_rows(void **state)
+{
+    (void)state;
+    int tested = 0;
+    for (int k = 0; isa_list[k]; k++) {
+        const unsigned isa = isa_list[k];
+        if (!(fv_cpu_isas() & isa)) {
+            printf("[ kernels  ] taa rows: %-7s not on this CPU, skipped\n", fv_isa_name(isa));
+            continue;
+        }
+        fv_dsp d;
+        fv_dsp_init(&d, isa);
+        if (d.taa_blend_row == fv_taa_blend_row_c || d.taa_fill_row == fv_taa_fill_row_c) {
+            printf("[ kernels  ] taa rows: %-7s has no version of its own, skipped\n", fv_isa_name(isa));
+            continue;
+        }
+        int runs = 0;
+        static const int dims[][2] = { { 67, 53 }, { 160, 180 }, { 9, 7 }, { 1, 1 } };
+        for (int di = 0; di < 4; di++)
+            for (int wmode = 0; wmode < 3; wmode++)
+                for (int motion = 0; motion < 3; motion++) {
+                    const int W = dims[di][0], H = dims[di][1];
+                    fv_pyramid hist;
+                    random_history(&hist, W, H, wmode);
+                    fv_camera cur, prev;
+                    random_cameras(&cur, &prev, W, H, motion);
+                    fv_taa_frame f;
+                    fv_taa_frame_setup(&f, &cur, &prev, &hist, 0.03f);
+                    assert_int_equal(f.identity, motion == 0);
+                    for (int r = 0; r < 40; r++) {
+                        int n = 1 + (int)(fv_test_rand(&rng) % (unsigned)(W < 40 ? W : 40));
+                        if (r < NSIZES && sizes[r] <= W)
+                            n = sizes[r];
+                        runs += run_taa(&d, fv_isa_name(isa), &f, n, (int)(fv_test_rand(&rng) % 4), motion);
+                    }
+                    fv_pyramid_free(&hist);
+                }
+        printf("[ kernels  ] taa_blend_row, taa_fill_row: %-7s == c on %d rows (bit-exact); %ld samples blended "
+               "(%ld with wide footprints), %ld holes filled\n", fv_isa_name(isa), runs, taa_blended, taa_quincunx,
+               taa_filled);
+        /* the inputs must really exercise the blend, the quincunx taps and the fill */
+        assert_true(taa_blended > 1000 && taa_quincunx > 100 && taa_filled > 500);
+        taa_blended = taa_quincunx = taa_filled = 0;
+        tested++;
+    }
+    printf("[ kernels  ] taa rows: %d ISA version(s) tested\n", tested);
+}
+
 /* ------------------------------------------------------------------ dispatch */
 
 static void test_dispatch(void **state)
@@ -285,6 +458,8 @@ static void test_dispatch(void **state)
     assert_int_equal(d.isa, FV_ISA_C);
     assert_ptr_equal(d.pull_row, fv_pull_row_c);
     assert_ptr_equal(d.push_row, fv_push_row_c);
+    assert_ptr_equal(d.taa_blend_row, fv_taa_blend_row_c);
+    assert_ptr_equal(d.taa_fill_row, fv_taa_fill_row_c);
     fv_dsp_init(&d, ~0u); /* best: the highest ISA bit this CPU has */
     unsigned best = 0;
     for (unsigned b = 1; b <= FV_ISA_NEON; b <<= 1)
@@ -305,6 +480,7 @@ int main(void)
         cmocka_unit_test(test_dispatch),
         cmocka_unit_test(test_pull_row),
         cmocka_unit_test(test_push_row),
+        cmocka_unit_test(test_taa_rows),
     };
     return cmocka_run_group_tests_name("kernels", tests, NULL, NULL);
 }
