@@ -24,7 +24,10 @@ static void usage(FILE *f)
             "  --frames N         timed frames per mode (default 30)\n"
             "  --warmup N         untimed frames first (default 3)\n"
             "  --mode M           foveated, full or both (default both)\n"
-            "  --json FILE        write the results as JSON\n" FV_COMMON_HELP "  --help             this text\n");
+            "  --json FILE        write the results as JSON\n"
+            "  --yaw-rate DEG_S   turn the head about the vertical axis at this rate (degrees per\n"
+            "                     second at 90 Hz; default 0: a static head, as in Weier's table)\n"
+            FV_COMMON_HELP "  --help             this text\n");
 }
 
 typedef struct {
@@ -39,8 +42,21 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static int bench_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, const fv_pose *view, int warmup,
-                      int frames, run_result *r, char *err, size_t err_len)
+/* The head pose of frame f: the view turned by yaw_rate * f / 90 Hz about its vertical axis. */
+static fv_pose head_at(const fv_pose *view, float yaw_rate_dps, int f)
+{
+    const float a = yaw_rate_dps * (float)f / 90.0f * 3.14159265f / 180.0f;
+    const float q[4] = {0.0f, sinf(0.5f * a), 0.0f, cosf(0.5f * a)}, *v = view->quat;
+    fv_pose p = *view; /* view * yaw (about the head's own up axis) */
+    p.quat[0] = v[3] * q[0] + v[0] * q[3] + v[1] * q[2] - v[2] * q[1];
+    p.quat[1] = v[3] * q[1] - v[0] * q[2] + v[1] * q[3] + v[2] * q[0];
+    p.quat[2] = v[3] * q[2] + v[0] * q[1] - v[1] * q[0] + v[2] * q[3];
+    p.quat[3] = v[3] * q[3] - v[0] * q[0] - v[1] * q[1] - v[2] * q[2];
+    return p;
+}
+
+static int bench_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, const fv_pose *view, float yaw_rate,
+                      int warmup, int frames, run_result *r, char *err, size_t err_len)
 {
     cfg.samp.full = full;
     fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, err_len);
@@ -56,7 +72,8 @@ static int bench_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, c
     r->mode = full ? "full" : "foveated";
     fv_frame_stats st;
     for (int f = 0; f < warmup + frames; f++) {
-        fv_pipeline_render(pl, FV_EYE_CENTER, view, 0.5f, 0.5f, &st);
+        const fv_pose head = head_at(view, yaw_rate, f);
+        fv_pipeline_render(pl, FV_EYE_CENTER, &head, 0.5f, 0.5f, &st);
         if (f < warmup)
             continue;
         for (int s = 0; s < FV_STAGE_COUNT; s++)
@@ -95,11 +112,13 @@ int main(int argc, char **argv)
     fv_pipeline_config_default(&cfg);
     const char *scene_path = NULL, *json_path = NULL, *mode = "both";
     int frames = 30, warmup = 3;
-    enum { OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_HELP };
+    float yaw_rate = 0.0f;
+    enum { OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_YAW, OPT_HELP };
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, {"frames", required_argument, 0, OPT_FRAMES},
         {"warmup", required_argument, 0, OPT_WARMUP}, {"mode", required_argument, 0, OPT_MODE},
-        {"json", required_argument, 0, OPT_JSON}, {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS,
+        {"json", required_argument, 0, OPT_JSON}, {"yaw-rate", required_argument, 0, OPT_YAW},
+        {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS,
         {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -114,6 +133,7 @@ int main(int argc, char **argv)
             mode = optarg;
             break;
         case OPT_JSON: json_path = optarg; break;
+        case OPT_YAW: yaw_rate = fv_arg_float(prog, "--yaw-rate", optarg, -720.0f, 720.0f); break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
@@ -135,16 +155,19 @@ int main(int argc, char **argv)
     int threads = cfg.threads > 0 ? cfg.threads : fv_online_cpus();
     fv_dsp dsp;
     fv_dsp_init(&dsp, cfg.isa_mask);
-    printf("%s: %s, %zu triangles (loaded in %.0f ms), %dx%d, %d thread%s, kernels %s, %d+%d frames\n", prog,
-           scene_path, fv_scene_triangle_count(scene), load_ms, W, H, threads, threads == 1 ? "" : "s",
-           fv_isa_name(dsp.isa), warmup, frames);
+    printf("%s: %s, %zu triangles (loaded in %.0f ms), %dx%d, %d thread%s, kernels %s, %d+%d frames, head %s\n",
+           prog, scene_path, fv_scene_triangle_count(scene), load_ms, W, H, threads, threads == 1 ? "" : "s",
+           fv_isa_name(dsp.isa), warmup, frames, yaw_rate != 0.0f ? "turning" : "static");
+    if (yaw_rate != 0.0f)
+        printf("%s: head turning at %g deg/s (%.3f deg per 90 Hz frame)\n", prog, (double)yaw_rate,
+               (double)yaw_rate / 90.0);
 
     run_result res[2];
     int nres = 0;
     for (int full = 0; full < 2; full++) {
         if ((full && !strcmp(mode, "foveated")) || (!full && !strcmp(mode, "full")))
             continue;
-        if (bench_mode(scene, cfg, full, &view, warmup, frames, &res[nres], err, sizeof err)) {
+        if (bench_mode(scene, cfg, full, &view, yaw_rate, warmup, frames, &res[nres], err, sizeof err)) {
             fv_scene_free(scene);
             fv_fail(prog, FV_EXIT_FAIL, "%s", err);
         }
@@ -190,8 +213,9 @@ int main(int argc, char **argv)
             else
                 fputc(*c, f);
         fprintf(f, "\", \"width\": %d, \"height\": %d, \"threads\": %d, \"frames\": %d, \"warmup\": %d, "
-                   "\"isa\": \"%s\", \"triangles\": %zu, \"load_ms\": %.1f,\n \"runs\": [",
-                W, H, threads, frames, warmup, fv_isa_name(dsp.isa), fv_scene_triangle_count(scene), load_ms);
+                   "\"isa\": \"%s\", \"triangles\": %zu, \"load_ms\": %.1f, \"yaw_rate_dps\": %g,\n \"runs\": [",
+                W, H, threads, frames, warmup, fv_isa_name(dsp.isa), fv_scene_triangle_count(scene), load_ms,
+                (double)yaw_rate);
         for (int i = 0; i < nres; i++) {
             run_result *r = &res[i];
             fprintf(f, "%s\n  {\"mode\": \"%s\", \"samples_per_frame\": %ld, \"total_ms\": ", i ? "," : "", r->mode,

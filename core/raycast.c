@@ -125,6 +125,8 @@ static void trace_tile(void *ctx, int index, int thread_id)
     int tw = cam->width - x0 < FV_TILE ? cam->width - x0 : FV_TILE;
     int th = cam->height - y0 < FV_TILE ? cam->height - y0 : FV_TILE;
 
+    if (j->taa) /* early: the lines arrive while the rays are traced */
+        prefetch_history(j, x0, y0, tw, th);
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++) {
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
@@ -197,7 +199,6 @@ static void trace_tile(void *ctx, int index, int thread_id)
     }
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
-        prefetch_history(j, x0, y0, tw, th);
         reproject_tile(j, x0, y0, tw, th);
         atomic_fetch_add_explicit(&j->taa_ns, fv_time_ns() - t0, memory_order_relaxed);
     }

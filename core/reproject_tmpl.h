@@ -14,6 +14,7 @@
  *                    accw = accw + ((wt00 + wt01) + (wt10 + wt11))
  *   out_blend(px, acc, accw, alpha)   h = acc / accw; px.rgb = h + alpha (px.rgb - h)
  *   sample_mask(wgt, n)               bit i set where wgt[i] == 1 (n <= 64)
+ * (an ISA that defines TAA_OWN_BLEND needs none of these and writes its own blend).
  * The blend's per-sample arithmetic is scalar IEEE code here, identical for all ISAs; the fill
  * has a scalar form here (the reference, and the ISAs' row edges) that the ISA files vectorise
  * across pixels with the same operations per lane. */
@@ -36,6 +37,7 @@ static inline int taa_level(float f, int max_level)
 
 static inline float taa_clampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
 
+#ifndef TAA_OWN_BLEND /* an ISA may vectorise the blend across samples instead */
 static void TAA_FN(taa_blend_row)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
                                   const float *wgt, int x0, int y, int n, struct fv_taa_flow *flow)
 {
@@ -102,6 +104,7 @@ static void TAA_FN(taa_blend_row)(const struct fv_taa_frame *f, const struct fv_
     flow->dy = fdy;
     flow->n = fn;
 }
+#endif
 
 /* The fill for pixels i in [i0, i1) of the row (the whole row in the reference). hrow / hw point
  * at pixel 0 of history row y + flow_y of level 0; B = N0 + vc * NY for that row's centre vc. */
