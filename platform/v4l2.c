@@ -186,11 +186,24 @@ int64_t fv_v4l2_backoff_ns(int attempt)
 
 /* ---- device ------------------------------------------------------------------------------ */
 
-static int xioctl(int fd, unsigned long req, void *arg)
+/* The real system calls behind fv_v4l2_sys. */
+static int sys_open(void *u, const char *path, int flags) { (void)u; return open(path, flags); }
+static int sys_close(void *u, int fd) { (void)u; return close(fd); }
+static int sys_ioctl(void *u, int fd, unsigned long req, void *arg) { (void)u; return ioctl(fd, req, arg); }
+static int sys_poll(void *u, struct pollfd *pfd, int timeout_ms) { (void)u; return poll(pfd, 1, timeout_ms); }
+static void *sys_mmap(void *u, int fd, size_t length, int64_t offset)
+{
+    (void)u;
+    void *p = mmap(NULL, length, PROT_READ | PROT_WRITE, MAP_SHARED, fd, (off_t)offset);
+    return p == MAP_FAILED ? NULL : p;
+}
+static int sys_munmap(void *u, void *start, size_t length) { (void)u; return munmap(start, length); }
+
+static int xioctl(fv_v4l2 *cam, unsigned long req, void *arg)
 {
     int r;
     do
-        r = ioctl(fd, req, arg);
+        r = cam->sys.ioctl(cam->sys.user, cam->fd, req, arg);
     while (r == -1 && errno == EINTR);
     return r;
 }
@@ -206,13 +219,13 @@ static int call_err(const fv_v4l2 *cam, const char *call, int e, char *err, size
     return -1;
 }
 #define VIOCTL(cam, req, arg, err, err_len) \
-    (xioctl((cam)->fd, (req), (arg)) == 0 ? 0 : call_err((cam), #req, errno, (err), (err_len)))
+    (xioctl((cam), (req), (arg)) == 0 ? 0 : call_err((cam), #req, errno, (err), (err_len)))
 
 static void unmap_all(fv_v4l2 *cam)
 {
     for (int i = 0; i < FV_V4L2_MAX_BUFFERS; i++) {
         if (cam->bufs[i].start)
-            munmap(cam->bufs[i].start, cam->bufs[i].length);
+            cam->sys.munmap(cam->sys.user, cam->bufs[i].start, cam->bufs[i].length);
         cam->bufs[i].start = NULL;
         cam->bufs[i].length = 0;
     }
@@ -225,10 +238,10 @@ static void close_stream(fv_v4l2 *cam)
     if (cam->fd >= 0) {
         if (cam->streaming) {
             enum v4l2_buf_type t = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-            xioctl(cam->fd, VIDIOC_STREAMOFF, &t); /* fails harmlessly on a vanished device */
+            xioctl(cam, VIDIOC_STREAMOFF, &t); /* fails harmlessly on a vanished device */
         }
         unmap_all(cam);
-        close(cam->fd); /* closing also frees the driver's buffers */
+        cam->sys.close(cam->sys.user, cam->fd); /* closing also frees the driver's buffers */
     }
     cam->fd = -1;
     cam->streaming = 0;
@@ -275,7 +288,7 @@ static int find_ctrl(fv_v4l2 *cam, const char *want, struct v4l2_queryctrl *qc, 
         unsigned long id = strtoul(want, &end, 16);
         memset(qc, 0, sizeof *qc);
         qc->id = (uint32_t)id;
-        if (!*end && xioctl(cam->fd, VIDIOC_QUERYCTRL, qc) == 0)
+        if (!*end && xioctl(cam, VIDIOC_QUERYCTRL, qc) == 0)
             return 0;
         if (*end || errno == EINVAL)
             return fv_err(err, err_len, "%s: no control with id %s", cam->path, want);
@@ -286,7 +299,7 @@ static int find_ctrl(fv_v4l2 *cam, const char *want, struct v4l2_queryctrl *qc, 
     memset(qc, 0, sizeof *qc);
     qc->id = V4L2_CTRL_FLAG_NEXT_CTRL;
     int found = 0;
-    while (xioctl(cam->fd, VIDIOC_QUERYCTRL, qc) == 0) {
+    while (xioctl(cam, VIDIOC_QUERYCTRL, qc) == 0) {
         if (!(qc->flags & V4L2_CTRL_FLAG_DISABLED) && qc->type != V4L2_CTRL_TYPE_CTRL_CLASS) {
             char name[sizeof qc->name + 1];
             memcpy(name, qc->name, sizeof qc->name);
@@ -346,11 +359,11 @@ static int apply_ctrls(fv_v4l2 *cam, char *err, size_t err_len)
         cs.count = 1;
         cs.controls = &c;
         const char *call = "VIDIOC_S_EXT_CTRLS";
-        int r = xioctl(cam->fd, VIDIOC_S_EXT_CTRLS, &cs);
+        int r = xioctl(cam, VIDIOC_S_EXT_CTRLS, &cs);
         if (r < 0 && errno == ENOTTY && qc.type != V4L2_CTRL_TYPE_INTEGER64) { /* pre-extended-controls driver */
             struct v4l2_control c1 = {.id = qc.id, .value = (int32_t)v};
             call = "VIDIOC_S_CTRL";
-            r = xioctl(cam->fd, VIDIOC_S_CTRL, &c1);
+            r = xioctl(cam, VIDIOC_S_CTRL, &c1);
         }
         if (r < 0) {
             int e = errno;
@@ -375,7 +388,7 @@ static int choose_format(fv_v4l2 *cam, uint32_t *out, char *err, size_t err_len)
         memset(&d, 0, sizeof d);
         d.index = (uint32_t)n;
         d.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-        if (xioctl(cam->fd, VIDIOC_ENUM_FMT, &d) < 0) {
+        if (xioctl(cam, VIDIOC_ENUM_FMT, &d) < 0) {
             if (errno == EINVAL)
                 break; /* end of the list */
             return call_err(cam, "VIDIOC_ENUM_FMT", errno, err, err_len);
@@ -440,7 +453,7 @@ static int set_rate(fv_v4l2 *cam, char *err, size_t err_len)
     memset(&p, 0, sizeof p);
     p.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     cam->fps_num = cam->fps_den = 0;
-    if (xioctl(cam->fd, VIDIOC_G_PARM, &p) < 0) {
+    if (xioctl(cam, VIDIOC_G_PARM, &p) < 0) {
         if (cam->cfg.fps > 0 && errno != ENOTTY && errno != EINVAL)
             return call_err(cam, "VIDIOC_G_PARM", errno, err, err_len);
         return 0; /* the driver has no say about its rate: run at whatever it delivers */
@@ -482,8 +495,8 @@ static int map_buffers(fv_v4l2 *cam, char *err, size_t err_len)
         if (i == 0)
             cam->timestamps_monotonic =
                 (b.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
-        void *p = mmap(NULL, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, cam->fd, b.m.offset);
-        if (p == MAP_FAILED) {
+        void *p = cam->sys.mmap(cam->sys.user, cam->fd, b.length, b.m.offset);
+        if (!p) {
             fv_err(err, err_len, "mmap of buffer %u (%u bytes) on %s: %s", i, b.length, cam->path, strerror(errno));
             return -1;
         }
@@ -512,14 +525,14 @@ static int open_stream(fv_v4l2 *cam, int *e_out, char *err, size_t err_len)
 {
     *e_out = 0;
     /* Non-blocking: DQBUF must never stall the caller beyond its poll timeout. */
-    cam->fd = open(cam->path, O_RDWR | O_NONBLOCK | O_CLOEXEC);
+    cam->fd = cam->sys.open(cam->sys.user, cam->path, O_RDWR | O_NONBLOCK | O_CLOEXEC);
     if (cam->fd < 0) {
         *e_out = errno;
         return fv_err(err, err_len, "open on %s: %s", cam->path, strerror(errno));
     }
     struct v4l2_capability cap;
     memset(&cap, 0, sizeof cap);
-    if (xioctl(cam->fd, VIDIOC_QUERYCAP, &cap) < 0) {
+    if (xioctl(cam, VIDIOC_QUERYCAP, &cap) < 0) {
         *e_out = errno;
         call_err(cam, "VIDIOC_QUERYCAP", errno, err, err_len);
         if (*e_out == ENOTTY) {
@@ -583,6 +596,9 @@ int fv_v4l2_open(fv_v4l2 *cam, const fv_v4l2_config *cfg, char *err, size_t err_
         return -1;
     /* Own copies: the stream is renegotiated from them on every reopen. */
     cam->cfg = *cfg;
+    static const fv_v4l2_sys real = {NULL, sys_open, sys_close, sys_ioctl, sys_poll, sys_mmap, sys_munmap};
+    cam->sys = cfg->sys ? *cfg->sys : real;
+    cam->cfg.sys = NULL;
     snprintf(cam->path, sizeof cam->path, "%s", cfg->path);
     for (int i = 0; i < cfg->n_ctrls; i++)
         snprintf(cam->ctrl_text[i], sizeof cam->ctrl_text[i], "%s", cfg->ctrls[i]);
@@ -662,7 +678,7 @@ static int requeue(fv_v4l2 *cam, int index)
     b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     b.memory = V4L2_MEMORY_MMAP;
     b.index = (uint32_t)index;
-    return xioctl(cam->fd, VIDIOC_QBUF, &b);
+    return xioctl(cam, VIDIOC_QBUF, &b);
 }
 
 fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, char *err, size_t err_len)
@@ -689,7 +705,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
         int64_t now = mono_ns();
         int ms = deadline > now ? (int)((deadline - now + 999999) / 1000000) : 0;
         struct pollfd pfd = {.fd = cam->fd, .events = POLLIN};
-        int r = poll(&pfd, 1, ms);
+        int r = cam->sys.poll(cam->sys.user, &pfd, ms);
         if (r < 0) {
             if (errno == EINTR)
                 continue;
@@ -702,7 +718,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
         memset(&b, 0, sizeof b);
         b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
         b.memory = V4L2_MEMORY_MMAP;
-        if (xioctl(cam->fd, VIDIOC_DQBUF, &b) < 0) {
+        if (xioctl(cam, VIDIOC_DQBUF, &b) < 0) {
             int e = errno;
             if (e == EAGAIN && !(pfd.revents & (POLLERR | POLLHUP))) {
                 if (mono_ns() >= deadline)

@@ -25,6 +25,21 @@
 
 #include "pixfmt.h"
 
+struct pollfd;
+
+/* The system calls a camera makes. NULL in the config means the real ones; tests substitute a
+ * fake device. Each returns like the call it stands for (errno set on failure), except mmap,
+ * which returns NULL on failure. */
+typedef struct fv_v4l2_sys {
+    void *user;
+    int (*open)(void *user, const char *path, int flags);
+    int (*close)(void *user, int fd);
+    int (*ioctl)(void *user, int fd, unsigned long req, void *arg);
+    int (*poll)(void *user, struct pollfd *pfd, int timeout_ms); /* one descriptor */
+    void *(*mmap)(void *user, int fd, size_t length, int64_t offset);
+    int (*munmap)(void *user, void *start, size_t length);
+} fv_v4l2_sys;
+
 #define FV_V4L2_MAX_FORMATS 8
 #define FV_V4L2_MAX_CTRLS 16
 #define FV_V4L2_MAX_BUFFERS 32
@@ -41,6 +56,7 @@ typedef struct fv_v4l2_config {
     int n_ctrls;
     int wait_for_device;           /* 1: a missing device at open is not an error: the camera
                                     * starts FV_V4L2_GONE and next() keeps trying to open it */
+    const fv_v4l2_sys *sys;        /* NULL = the real system calls (copied by open) */
 } fv_v4l2_config;
 
 /* 640x480, driver's frame rate, the default formats, 4 buffers, no controls. */
@@ -93,6 +109,7 @@ typedef struct fv_v4l2 {
     int reopen_attempts;        /* failed reopen attempts since it went away */
     long reopens;               /* successful reopens since fv_v4l2_open */
     /* private */
+    fv_v4l2_sys sys;
     int fd;
     int streaming;
     int held;                   /* buffer lent to the caller as a zero-copy frame, or -1 */

@@ -4,6 +4,8 @@
  * the call and the path, not the errno text). */
 #define _DEFAULT_SOURCE
 #include <dirent.h>
+#include <poll.h>
+#include <linux/videodev2.h>
 #include <errno.h>
 #include <limits.h>
 #include <stdio.h>
@@ -371,6 +373,508 @@ static void test_config(void **st)
     assert_int_equal(cfg.n_ctrls, 0);
 }
 
+/* ---- a fake device behind fv_v4l2_sys: the streaming, control and reopen paths ------------ */
+
+#define FAKE_FD 42
+#define FAKE_MAX_BUFS 8
+typedef struct fake {
+    int absent, vanish;          /* open fails ENOENT / everything fails ENODEV (unplugged) */
+    int fd_open, opens, mapped;
+    uint32_t caps;
+    uint32_t formats[4];
+    int n_formats;
+    uint32_t pad;                /* bytes of padding per line */
+    uint32_t ts_flags;           /* V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC or _COPY */
+    int fail_sfmt, eintr_dqbuf, error_next;
+    uint32_t fourcc, bpl;
+    int w, h, streaming, n_bufs, next_buf, ready;
+    size_t len;
+    uint8_t *mem[FAKE_MAX_BUFS];
+    int queued[FAKE_MAX_BUFS];
+    uint32_t seq;
+    int64_t stamp_ns;
+    int32_t brightness, gain, exposure;
+    uint32_t fps_den;
+} fake;
+
+static uint8_t fake_luma(uint32_t seq, int x, int y) { return (uint8_t)(seq * 7 + (uint32_t)y * 16 + (uint32_t)x); }
+
+static const struct {
+    uint32_t id, type;
+    const char *name;
+    int32_t min, max;
+} fake_ctrls[] = {
+    {V4L2_CID_USER_CLASS, V4L2_CTRL_TYPE_CTRL_CLASS, "User Controls", 0, 0},
+    {V4L2_CID_BRIGHTNESS, V4L2_CTRL_TYPE_INTEGER, "Brightness", 0, 255},
+    {V4L2_CID_GAIN, V4L2_CTRL_TYPE_INTEGER, "Gain", 0, 100},
+    {V4L2_CID_CAMERA_CLASS, V4L2_CTRL_TYPE_CTRL_CLASS, "Camera Controls", 0, 0},
+    {V4L2_CID_EXPOSURE_ABSOLUTE, V4L2_CTRL_TYPE_INTEGER, "Exposure Time, Absolute", 1, 5000},
+};
+
+static int fake_open(void *u, const char *path, int flags)
+{
+    fake *f = u;
+    (void)path, (void)flags;
+    if (f->absent) {
+        errno = ENOENT;
+        return -1;
+    }
+    assert_false(f->fd_open); /* the camera never leaks a descriptor */
+    f->fd_open = 1;
+    f->opens++;
+    return FAKE_FD;
+}
+
+static int fake_close(void *u, int fd)
+{
+    fake *f = u;
+    assert_int_equal(fd, FAKE_FD);
+    assert_true(f->fd_open);
+    f->fd_open = 0;
+    f->streaming = 0;
+    for (int i = 0; i < f->n_bufs; i++)
+        free(f->mem[i]);
+    f->n_bufs = 0;
+    return 0;
+}
+
+static int fake_fail(int e)
+{
+    errno = e;
+    return -1;
+}
+
+static void fake_fill(fake *f, int i)
+{
+    uint8_t *m = f->mem[i];
+    memset(m, 0xEE, f->len);
+    for (int y = 0; y < f->h; y++)
+        for (int x = 0; x < f->w; x++) {
+            uint8_t l = fake_luma(f->seq, x, y);
+            uint8_t *row = m + (size_t)y * f->bpl;
+            if (f->fourcc == V4L2_PIX_FMT_GREY)
+                row[x] = l;
+            else if (f->fourcc == V4L2_PIX_FMT_Y10) { /* 10 bits: luma in the top 8, junk in the low 2 */
+                row[2 * x] = (uint8_t)((l << 2) | 3);
+                row[2 * x + 1] = (uint8_t)(l >> 6);
+            } else if (f->fourcc == V4L2_PIX_FMT_YUYV) {
+                row[2 * x] = l;
+                row[2 * x + 1] = 128;
+            }
+        }
+}
+
+static int fake_ioctl(void *u, int fd, unsigned long req, void *arg)
+{
+    fake *f = u;
+    assert_int_equal(fd, FAKE_FD);
+    if (f->vanish)
+        return fake_fail(ENODEV);
+    switch (req) {
+    case VIDIOC_QUERYCAP: {
+        struct v4l2_capability *c = arg;
+        memset(c, 0, sizeof *c);
+        strcpy((char *)c->driver, "fake");
+        strcpy((char *)c->card, "Fake IR eye camera");
+        strcpy((char *)c->bus_info, "platform:fake");
+        c->capabilities = f->caps | V4L2_CAP_DEVICE_CAPS;
+        c->device_caps = f->caps;
+        return 0;
+    }
+    case VIDIOC_ENUM_FMT: {
+        struct v4l2_fmtdesc *d = arg;
+        if (d->type != V4L2_BUF_TYPE_VIDEO_CAPTURE || d->index >= (uint32_t)f->n_formats)
+            return fake_fail(EINVAL);
+        d->pixelformat = f->formats[d->index];
+        return 0;
+    }
+    case VIDIOC_S_FMT: {
+        struct v4l2_format *fm = arg;
+        if (f->fail_sfmt)
+            return fake_fail(f->fail_sfmt);
+        f->fourcc = fm->fmt.pix.pixelformat;
+        f->w = (int)fm->fmt.pix.width;
+        f->h = (int)fm->fmt.pix.height;
+        f->bpl = (uint32_t)fv_pix_min_stride(f->fourcc, f->w) + f->pad;
+        fm->fmt.pix.bytesperline = f->bpl;
+        fm->fmt.pix.sizeimage = f->bpl * (uint32_t)f->h;
+        return 0;
+    }
+    case VIDIOC_G_PARM: case VIDIOC_S_PARM: {
+        struct v4l2_streamparm *p = arg;
+        if (req == VIDIOC_S_PARM)
+            f->fps_den = p->parm.capture.timeperframe.denominator;
+        p->parm.capture.capability = V4L2_CAP_TIMEPERFRAME;
+        p->parm.capture.timeperframe.numerator = 1;
+        p->parm.capture.timeperframe.denominator = f->fps_den;
+        return 0;
+    }
+    case VIDIOC_QUERYCTRL: {
+        struct v4l2_queryctrl *q = arg;
+        int next = !!(q->id & V4L2_CTRL_FLAG_NEXT_CTRL);
+        uint32_t id = q->id & ~(V4L2_CTRL_FLAG_NEXT_CTRL | V4L2_CTRL_FLAG_NEXT_COMPOUND);
+        for (size_t i = 0; i < sizeof fake_ctrls / sizeof *fake_ctrls; i++)
+            if (next ? fake_ctrls[i].id > id : fake_ctrls[i].id == id) {
+                memset(q, 0, sizeof *q);
+                q->id = fake_ctrls[i].id;
+                q->type = fake_ctrls[i].type;
+                snprintf((char *)q->name, sizeof q->name, "%s", fake_ctrls[i].name);
+                q->minimum = fake_ctrls[i].min;
+                q->maximum = fake_ctrls[i].max;
+                q->step = 1;
+                return 0;
+            }
+        return fake_fail(EINVAL);
+    }
+    case VIDIOC_S_EXT_CTRLS: {
+        struct v4l2_ext_controls *cs = arg;
+        assert_int_equal(cs->count, 1);
+        int32_t v = cs->controls[0].value;
+        switch (cs->controls[0].id) {
+        case V4L2_CID_BRIGHTNESS: f->brightness = v; break;
+        case V4L2_CID_GAIN: f->gain = v; break;
+        case V4L2_CID_EXPOSURE_ABSOLUTE: f->exposure = v; break;
+        default: return fake_fail(EINVAL);
+        }
+        return 0;
+    }
+    case VIDIOC_REQBUFS: {
+        struct v4l2_requestbuffers *rb = arg;
+        assert_int_equal(rb->memory, V4L2_MEMORY_MMAP);
+        if (rb->count > FAKE_MAX_BUFS)
+            rb->count = FAKE_MAX_BUFS;
+        f->n_bufs = (int)rb->count;
+        f->len = (size_t)f->bpl * (size_t)f->h;
+        for (int i = 0; i < f->n_bufs; i++) {
+            f->mem[i] = malloc(f->len);
+            f->queued[i] = 0;
+        }
+        f->next_buf = 0;
+        return 0;
+    }
+    case VIDIOC_QUERYBUF: case VIDIOC_QBUF: {
+        struct v4l2_buffer *b = arg;
+        if (b->index >= (uint32_t)f->n_bufs)
+            return fake_fail(EINVAL);
+        if (req == VIDIOC_QBUF) {
+            if (f->queued[b->index])
+                return fake_fail(EINVAL);
+            f->queued[b->index] = 1;
+            return 0;
+        }
+        b->length = (uint32_t)f->len;
+        b->m.offset = b->index * 0x10000u;
+        b->flags = f->ts_flags;
+        return 0;
+    }
+    case VIDIOC_STREAMON: f->streaming = 1; return 0;
+    case VIDIOC_STREAMOFF: f->streaming = 0; return 0;
+    case VIDIOC_DQBUF: {
+        if (f->eintr_dqbuf > 0) {
+            f->eintr_dqbuf--;
+            return fake_fail(EINTR);
+        }
+        int i = f->next_buf;
+        if (!f->streaming || !f->ready || !f->queued[i])
+            return fake_fail(EAGAIN);
+        struct v4l2_buffer *b = arg;
+        fake_fill(f, i);
+        f->queued[i] = 0;
+        f->next_buf = (i + 1) % f->n_bufs;
+        f->ready--;
+        b->index = (uint32_t)i;
+        b->bytesused = (uint32_t)f->len;
+        b->flags = f->ts_flags | (f->error_next ? V4L2_BUF_FLAG_ERROR : 0);
+        f->error_next = 0;
+        b->sequence = f->seq++;
+        b->timestamp.tv_sec = (time_t)(f->stamp_ns / 1000000000);
+        b->timestamp.tv_usec = (suseconds_t)(f->stamp_ns % 1000000000 / 1000);
+        return 0;
+    }
+    default:
+        return fake_fail(ENOTTY);
+    }
+}
+
+static int fake_poll(void *u, struct pollfd *pfd, int timeout_ms)
+{
+    fake *f = u;
+    (void)timeout_ms; /* no real time passes in the fake */
+    pfd->revents = 0;
+    if (f->vanish)
+        pfd->revents = POLLERR | POLLHUP;
+    else if (f->streaming && f->ready && f->queued[f->next_buf])
+        pfd->revents = POLLIN;
+    return pfd->revents ? 1 : 0;
+}
+
+static void *fake_mmap(void *u, int fd, size_t length, int64_t offset)
+{
+    fake *f = u;
+    assert_int_equal(fd, FAKE_FD);
+    int i = (int)(offset / 0x10000);
+    assert_true(i < f->n_bufs && length == f->len);
+    f->mapped++;
+    return f->mem[i];
+}
+
+static int fake_munmap(void *u, void *start, size_t length)
+{
+    fake *f = u;
+    (void)start, (void)length;
+    f->mapped--;
+    return 0;
+}
+
+static fv_v4l2_sys fake_sys(fake *f)
+{
+    fv_v4l2_sys s = {f, fake_open, fake_close, fake_ioctl, fake_poll, fake_mmap, fake_munmap};
+    return s;
+}
+
+static void fake_init(fake *f, uint32_t fourcc)
+{
+    memset(f, 0, sizeof *f);
+    f->caps = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_STREAMING;
+    f->formats[0] = V4L2_PIX_FMT_MJPEG;
+    f->formats[1] = fourcc;
+    f->n_formats = 2;
+    f->ts_flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
+    f->fps_den = 30;
+}
+
+static int fake_queued(const fake *f)
+{
+    int n = 0;
+    for (int i = 0; i < f->n_bufs; i++)
+        n += f->queued[i];
+    return n;
+}
+
+static void assert_frame(const fv_eye_frame *fr, uint32_t seq, int w, int h)
+{
+    assert_int_equal(fr->width, w);
+    assert_int_equal(fr->height, h);
+    assert_int_equal(fr->sequence, seq);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            if (fr->luma[(size_t)y * fr->stride + (size_t)x] != fake_luma(seq, x, y))
+                fail_msg("frame %u pixel (%d,%d) = %u, want %u", seq, x, y, fr->luma[(size_t)y * fr->stride + (size_t)x],
+                         fake_luma(seq, x, y));
+}
+
+static void test_fake_yuyv_stream(void **st)
+{
+    (void)st;
+    fake f;
+    fake_init(&f, V4L2_PIX_FMT_YUYV);
+    f.pad = 4;
+    fv_v4l2_sys sys = fake_sys(&f);
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, "/fake/video0");
+    cfg.sys = &sys;
+    cfg.width = 5; /* odd: 3 YUYV groups per row */
+    cfg.height = 3;
+    cfg.fps = 120;
+    cfg.buffers = 6;
+    char err[512] = "";
+    assert_int_equal(fv_v4l2_config_ctrl(&cfg, "exposure_time_absolute=100", err, sizeof err), 0);
+    assert_int_equal(fv_v4l2_config_ctrl(&cfg, "GAIN=7", err, sizeof err), 0);
+    fv_v4l2 cam;
+    if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
+        fail_msg("%s", err);
+    assert_int_equal(cam.fourcc, FV_PIX_YUYV); /* MJPG offered first, skipped */
+    assert_int_equal(cam.bytesperline, 16);
+    assert_int_equal(cam.n_buffers, 6);
+    assert_int_equal(f.mapped, 6);
+    assert_int_equal(fake_queued(&f), 6);
+    assert_int_equal(f.fps_den, 120);
+    assert_int_equal(f.exposure, 100);
+    assert_int_equal(f.gain, 7);
+    char d[512];
+    fv_v4l2_describe(&cam, d, sizeof d);
+    assert_contains(d, "YUYV 5x3");
+    assert_contains(d, "120.00 fps");
+    assert_contains(d, "driver monotonic");
+
+    fv_eye_frame fr;
+    for (uint32_t seq = 0; seq < 3; seq++) {
+        f.ready = 1;
+        f.stamp_ns = now_ns() - 2000000;
+        assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+        assert_frame(&fr, seq, 5, 3);
+        assert_int_equal(fr.stride, 5);
+        assert_int_equal(fr.fourcc, FV_PIX_YUYV);
+        assert_true(fr.t_from_driver);
+        assert_true(fr.t_ns == f.stamp_ns / 1000 * 1000);
+        assert_int_equal(fake_queued(&f), 6); /* converted frames go straight back */
+    }
+    assert_int_equal(fv_v4l2_next(&cam, 0, &fr, err, sizeof err), FV_V4L2_TIMEOUT);
+
+    /* EINTR is retried; a buffer the driver flags as bad is skipped */
+    f.ready = 2;
+    f.eintr_dqbuf = 2;
+    f.error_next = 1;
+    f.stamp_ns = now_ns() - 1000000;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_frame(&fr, 4, 5, 3);
+    fv_v4l2_close(&cam);
+    assert_false(f.fd_open);
+    assert_int_equal(f.mapped, 0);
+}
+
+static void test_fake_grey_zero_copy(void **st)
+{
+    (void)st;
+    fake f;
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    f.pad = 3;
+    f.ts_flags = V4L2_BUF_FLAG_TIMESTAMP_COPY; /* not monotonic: stamped at dequeue */
+    fv_v4l2_sys sys = fake_sys(&f);
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, "/fake/video0");
+    cfg.sys = &sys;
+    cfg.width = 4;
+    cfg.height = 2;
+    char err[512] = "";
+    fv_v4l2 cam;
+    if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
+        fail_msg("%s", err);
+    assert_false(cam.timestamps_monotonic);
+    fv_eye_frame fr;
+    f.ready = 1;
+    f.stamp_ns = 12345; /* garbage: must not be used */
+    int64_t t0 = now_ns();
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_frame(&fr, 0, 4, 2);
+    assert_int_equal(fr.stride, 7);
+    assert_ptr_equal(fr.luma, f.mem[0]); /* lent, not copied */
+    assert_int_equal(fake_queued(&f), 3);
+    assert_false(fr.t_from_driver);
+    assert_true(fr.t_ns >= t0 && fr.t_ns <= now_ns());
+    assert_int_equal(fv_v4l2_next(&cam, 0, &fr, err, sizeof err), FV_V4L2_TIMEOUT);
+    assert_int_equal(fake_queued(&f), 4); /* given back on the next call */
+    fv_v4l2_close(&cam);
+    assert_int_equal(f.mapped, 0);
+}
+
+static void test_fake_unplug_reopen(void **st)
+{
+    (void)st;
+    fake f;
+    fake_init(&f, V4L2_PIX_FMT_Y10);
+    fv_v4l2_sys sys = fake_sys(&f);
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, "/fake/video0");
+    cfg.sys = &sys;
+    cfg.width = 6;
+    cfg.height = 2;
+    cfg.ctrls[0] = "gain=9";
+    cfg.n_ctrls = 1;
+    char err[512] = "";
+    fv_v4l2 cam;
+    if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
+        fail_msg("%s", err);
+    fv_eye_frame fr;
+    f.ready = 1;
+    f.stamp_ns = now_ns() - 1000000;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_frame(&fr, 0, 6, 2);
+
+    f.vanish = 1; /* unplugged mid-stream */
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_GONE);
+    assert_contains(err, "VIDIOC_DQBUF on /fake/video0: ");
+    assert_contains(err, "device gone");
+    assert_true(cam.gone);
+    assert_false(f.fd_open); /* the dead descriptor and mappings are let go at once */
+    assert_int_equal(f.mapped, 0);
+
+    /* The node is gone: tries on the back-off schedule, never beyond the caller's timeout. */
+    f.vanish = 0;
+    f.absent = 1;
+    f.gain = 0;
+    int64_t t0 = now_ns();
+    assert_int_equal(fv_v4l2_next(&cam, 0, &fr, err, sizeof err), FV_V4L2_GONE);
+    assert_int_equal(cam.reopen_attempts, 0);
+    assert_int_equal(fv_v4l2_next(&cam, 120, &fr, err, sizeof err), FV_V4L2_GONE);
+    assert_true(now_ns() - t0 < 1000000000);
+    assert_true(cam.reopen_attempts >= 1);
+    assert_contains(err, "open on /fake/video0");
+
+    /* Plugged back in: reopened, renegotiated, controls applied again, frames flow. */
+    f.absent = 0;
+    f.ready = 1;
+    f.seq = 0;
+    f.stamp_ns = now_ns() + 500000000; /* from the future (a driver bug): not trusted */
+    fv_v4l2_status s = FV_V4L2_GONE;
+    for (int i = 0; i < 40 && s == FV_V4L2_GONE; i++)
+        s = fv_v4l2_next(&cam, 100, &fr, err, sizeof err);
+    if (s != FV_V4L2_FRAME)
+        fail_msg("no frame after replug: %d %s", s, err);
+    assert_false(cam.gone);
+    assert_int_equal(cam.reopens, 1);
+    assert_int_equal(f.opens, 2);
+    assert_int_equal(f.gain, 9);
+    assert_frame(&fr, 0, 6, 2);
+    assert_false(fr.t_from_driver);
+    fv_v4l2_close(&cam);
+    assert_false(f.fd_open);
+}
+
+static void expect_fake_fails(fake *f, const char *ctrl, const char *needle)
+{
+    fv_v4l2_sys sys = fake_sys(f);
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, "/fake/video0");
+    cfg.sys = &sys;
+    if (ctrl) {
+        cfg.ctrls[0] = ctrl;
+        cfg.n_ctrls = 1;
+    }
+    char err[512] = "";
+    fv_v4l2 cam;
+    assert_int_equal(fv_v4l2_open(&cam, &cfg, err, sizeof err), -1);
+    assert_contains(err, needle);
+    assert_false(f->fd_open);
+    assert_int_equal(f->mapped, 0);
+    fv_v4l2_close(&cam);
+}
+
+static void test_fake_errors(void **st)
+{
+    (void)st;
+    fake f;
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    f.fail_sfmt = EBUSY;
+    expect_fake_fails(&f, NULL, "VIDIOC_S_FMT on /fake/video0: Device or resource busy");
+    fake_init(&f, V4L2_PIX_FMT_H264);
+    expect_fake_fails(&f, NULL, "/fake/video0: no usable pixel format (device offers MJPG, H264; fovea wants GREY, Y16");
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    expect_fake_fails(&f, "focus_absolute=3",
+                      "/fake/video0: no control 'focus_absolute' (it has: brightness, gain, exposure_time_absolute)");
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    expect_fake_fails(&f, "gain=1000", "'Gain' = 1000 is outside 0..100");
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    f.caps = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING;
+    expect_fake_fails(&f, NULL, "/fake/video0 (fake): not a video capture device");
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    f.caps = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_READWRITE;
+    expect_fake_fails(&f, NULL, "no streaming I/O");
+    /* Device errors other than a vanished device are reported, not retried. */
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    fv_v4l2_sys sys = fake_sys(&f);
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, "/fake/video0");
+    cfg.sys = &sys;
+    cfg.wait_for_device = 1;
+    f.fail_sfmt = EINVAL;
+    char err[512];
+    fv_v4l2 cam;
+    assert_int_equal(fv_v4l2_open(&cam, &cfg, err, sizeof err), -1);
+    assert_contains(err, "VIDIOC_S_FMT on /fake/video0: ");
+    fv_v4l2_close(&cam);
+}
+
 /* ---- a real camera, when the machine has one --------------------------------------------- */
 
 static void test_real_device(void **st)
@@ -436,6 +940,10 @@ int main(void)
         cmocka_unit_test(test_backoff),
         cmocka_unit_test(test_ctrl_names),
         cmocka_unit_test(test_config),
+        cmocka_unit_test(test_fake_yuyv_stream),
+        cmocka_unit_test(test_fake_grey_zero_copy),
+        cmocka_unit_test(test_fake_unplug_reopen),
+        cmocka_unit_test(test_fake_errors),
         cmocka_unit_test(test_real_device),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
