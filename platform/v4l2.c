@@ -791,6 +791,8 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
     }
 }
 
+int fv_v4l2_fd(const fv_v4l2 *cam) { return cam->gone ? -1 : cam->fd; }
+
 void fv_v4l2_describe(const fv_v4l2 *cam, char *buf, size_t len)
 {
     if (cam->gone) {

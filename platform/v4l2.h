@@ -137,6 +137,10 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
  * on a camera never passed to fv_v4l2_open). The struct must not be copied while open. */
 void fv_v4l2_close(fv_v4l2 *cam);
 
+/* The descriptor to poll (POLLIN) beside others, e.g. a vsync GPIO line; -1 while gone. It
+ * changes on a reopen: fetch it again after every fv_v4l2_next. */
+int fv_v4l2_fd(const fv_v4l2 *cam);
+
 /* One line about the open stream: device, driver, format, size, rate, buffers, timestamp source. */
 void fv_v4l2_describe(const fv_v4l2 *cam, char *buf, size_t len);
 

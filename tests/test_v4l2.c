@@ -781,12 +781,14 @@ static void test_fake_unplug_reopen(void **st)
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_frame(&fr, 0, 6, 2);
 
+    assert_int_equal(fv_v4l2_fd(&cam), FAKE_FD);
     f.vanish = 1; /* unplugged mid-stream */
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_GONE);
     assert_contains(err, "VIDIOC_DQBUF on /fake/video0: ");
     assert_contains(err, "device gone");
     assert_true(cam.gone);
     assert_false(f.fd_open); /* the dead descriptor and mappings are let go at once */
+    assert_int_equal(fv_v4l2_fd(&cam), -1);
     assert_int_equal(f.mapped, 0);
 
     /* The node is gone: tries on the back-off schedule, never beyond the caller's timeout. */
