@@ -232,11 +232,19 @@ static void test_wait_for_device(void **st)
     assert_int_equal(fv_v4l2_open(&cam, &cfg, err, sizeof err), 0);
     assert_true(cam.gone);
     fv_eye_frame f;
-    int64_t t0 = now_ns();
-    assert_int_equal(fv_v4l2_next(&cam, 0, &f, err, sizeof err), FV_V4L2_GONE);
-    assert_true(now_ns() - t0 < 40000000); /* the first attempt is 50 ms away: no sleep */
-    assert_contains(err, path);
-    assert_int_equal(cam.reopen_attempts, 0);
+    /* timeout 0 never sleeps, though the next attempt is 50+ ms away (best of 3: a loaded
+     * machine may deschedule us once) */
+    int64_t best = INT64_MAX;
+    for (int i = 0; i < 3; i++) {
+        int64_t t0 = now_ns();
+        assert_int_equal(fv_v4l2_next(&cam, 0, &f, err, sizeof err), FV_V4L2_GONE);
+        int64_t dt = now_ns() - t0;
+        best = dt < best ? dt : best;
+        assert_contains(err, path);
+    }
+    assert_true(best < 40000000);
+    assert_true(cam.reopen_attempts <= 1);
+    int64_t t0;
 
     t0 = now_ns();
     assert_int_equal(fv_v4l2_next(&cam, 250, &f, err, sizeof err), FV_V4L2_GONE);
@@ -797,7 +805,7 @@ static void test_fake_unplug_reopen(void **st)
     f.gain = 0;
     int64_t t0 = now_ns();
     assert_int_equal(fv_v4l2_next(&cam, 0, &fr, err, sizeof err), FV_V4L2_GONE);
-    assert_int_equal(cam.reopen_attempts, 0);
+    assert_true(cam.reopen_attempts <= 1); /* 0 unless 50 ms passed since the loss */
     assert_int_equal(fv_v4l2_next(&cam, 120, &fr, err, sizeof err), FV_V4L2_GONE);
     assert_true(now_ns() - t0 < 1000000000);
     assert_true(cam.reopen_attempts >= 1);
