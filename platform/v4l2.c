@@ -628,13 +628,13 @@ void fv_v4l2_close(fv_v4l2 *cam)
 }
 
 /* The device vanished: drop the stream now, first reopen attempt after the first back-off. */
-static fv_v4l2_status go_gone(fv_v4l2 *cam, const char *call, int e, char *err, size_t err_len)
+static fv_v4l2_status go_gone(fv_v4l2 *cam, const char *call, const char *why, char *err, size_t err_len)
 {
     close_stream(cam);
     cam->gone = 1;
     cam->reopen_attempts = 0;
     cam->next_try_ns = mono_ns() + fv_v4l2_backoff_ns(0);
-    fv_err(cam->last_err, sizeof cam->last_err, "%s on %s: %s", call, cam->path, strerror(e));
+    fv_err(cam->last_err, sizeof cam->last_err, "%s on %s: %s", call, cam->path, why);
     fv_err(err, err_len, "%s (device gone; reopening)", cam->last_err);
     return FV_V4L2_GONE;
 }
@@ -690,7 +690,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
         if (requeue(cam, i) < 0) {
             int e = errno;
             if (errno_gone(e))
-                return go_gone(cam, "VIDIOC_QBUF", e, err, err_len);
+                return go_gone(cam, "VIDIOC_QBUF", strerror(e), err, err_len);
             call_err(cam, "VIDIOC_QBUF", e, err, err_len);
             return FV_V4L2_ERROR;
         }
@@ -725,8 +725,10 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
                     return FV_V4L2_TIMEOUT;
                 continue; /* woken without a buffer */
             }
-            if (e == EAGAIN || errno_gone(e)) /* POLLERR/POLLHUP with nothing to dequeue: gone too */
-                return go_gone(cam, e == EAGAIN ? "poll" : "VIDIOC_DQBUF", e == EAGAIN ? ENODEV : e, err, err_len);
+            if (e == EAGAIN) /* POLLERR/POLLHUP with nothing to dequeue: the queue is dead; reopen */
+                return go_gone(cam, "poll", "error condition with no buffer to dequeue", err, err_len);
+            if (errno_gone(e))
+                return go_gone(cam, "VIDIOC_DQBUF", strerror(e), err, err_len);
             call_err(cam, "VIDIOC_DQBUF", e, err, err_len);
             return FV_V4L2_ERROR;
         }
@@ -745,7 +747,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
             if (requeue(cam, (int)b.index) < 0) {
                 int e = errno;
                 if (errno_gone(e))
-                    return go_gone(cam, "VIDIOC_QBUF", e, err, err_len);
+                    return go_gone(cam, "VIDIOC_QBUF", strerror(e), err, err_len);
                 call_err(cam, "VIDIOC_QBUF", e, err, err_len);
                 return FV_V4L2_ERROR;
             }
@@ -760,8 +762,9 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
         out->fourcc = cam->fourcc;
         int mono = (b.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
         int64_t t = (int64_t)b.timestamp.tv_sec * 1000000000 + (int64_t)b.timestamp.tv_usec * 1000;
-        /* A monotonic stamp from the future or more than a second old is a driver bug: don't trust it. */
-        if (mono && t > 0 && t <= t_deq && t_deq - t < 1000000000) {
+        /* A monotonic stamp from the future is a driver bug: don't trust it. (An old one is not:
+         * the frame may have waited in the queue while the caller was busy.) */
+        if (mono && t > 0 && t <= t_deq) {
             out->t_ns = t;
             out->t_from_driver = 1;
         } else {
@@ -781,7 +784,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
         if (requeue(cam, (int)b.index) < 0) {
             int e = errno;
             if (errno_gone(e)) /* this frame is good; the next call reports the loss */
-                go_gone(cam, "VIDIOC_QBUF", e, err, err_len);
+                go_gone(cam, "VIDIOC_QBUF", strerror(e), err, err_len);
             else {
                 call_err(cam, "VIDIOC_QBUF", e, err, err_len);
                 return FV_V4L2_ERROR;

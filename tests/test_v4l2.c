@@ -393,7 +393,7 @@ typedef struct fake {
     int n_formats;
     uint32_t pad;                /* bytes of padding per line */
     uint32_t ts_flags;           /* V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC or _COPY */
-    int fail_sfmt, eintr_dqbuf, error_next;
+    int fail_sfmt, eintr_dqbuf, error_next, pollerr;
     uint32_t fourcc, bpl;
     int w, h, streaming, n_bufs, next_buf, ready;
     size_t len;
@@ -609,7 +609,7 @@ static int fake_poll(void *u, struct pollfd *pfd, int timeout_ms)
     fake *f = u;
     (void)timeout_ms; /* no real time passes in the fake */
     pfd->revents = 0;
-    if (f->vanish)
+    if (f->vanish || f->pollerr)
         pfd->revents = POLLERR | POLLHUP;
     else if (f->streaming && f->ready && f->queued[f->next_buf])
         pfd->revents = POLLIN;
@@ -726,6 +726,19 @@ static void test_fake_yuyv_stream(void **st)
     f.stamp_ns = now_ns() - 1000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_frame(&fr, 4, 5, 3);
+
+    /* A frame that waited in the queue keeps the driver's (old) stamp. */
+    f.ready = 1;
+    f.stamp_ns = now_ns() - 3000000000;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_true(fr.t_from_driver);
+    assert_true(fr.t_ns == f.stamp_ns / 1000 * 1000);
+
+    /* POLLERR with nothing to dequeue: a dead queue, treated as a lost device */
+    f.pollerr = 1;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_GONE);
+    assert_contains(err, "poll on /fake/video0: error condition");
+    assert_false(f.fd_open);
     fv_v4l2_close(&cam);
     assert_false(f.fd_open);
     assert_int_equal(f.mapped, 0);
