@@ -122,10 +122,10 @@ typedef struct fv_v4l2 {
     size_t luma_size;
 } fv_v4l2;
 
-/* Opens cfg->path, checks it is a streaming capture device, negotiates format, size and frame
- * rate, applies the controls, maps the buffers and starts streaming. On failure the camera is
- * left closed (fv_v4l2_close is harmless) and err names the call, the device and the reason,
- * e.g. "VIDIOC_QUERYCAP on /dev/null: Inappropriate ioctl for device (not a V4L2 device)". */
+/* Opens cfg->path (cam: fresh or closed), checks it is a streaming capture device, negotiates
+ * format, size and frame rate, applies the controls, maps the buffers and starts streaming. On
+ * failure the camera is left closed (fv_v4l2_close is harmless) and err names the call, the
+ * device and the reason, e.g. "VIDIOC_QUERYCAP on /dev/null: Inappropriate ioctl for device (not a V4L2 device)". */
 int fv_v4l2_open(fv_v4l2 *cam, const fv_v4l2_config *cfg, char *err, size_t err_len);
 
 /* Waits at most timeout_ms (0 = just look; negative counts as 0) for the next frame. While the
