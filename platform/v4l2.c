@@ -17,6 +17,7 @@
 #include <linux/videodev2.h>
 
 #include "err.h"
+#include "mjpeg.h"
 
 _Static_assert(FV_PIX_GREY == V4L2_PIX_FMT_GREY, "GREY fourcc");
 _Static_assert(FV_PIX_Y10 == V4L2_PIX_FMT_Y10, "Y10 fourcc");
@@ -25,8 +26,13 @@ _Static_assert(FV_PIX_Y16 == V4L2_PIX_FMT_Y16, "Y16 fourcc");
 _Static_assert(FV_PIX_YUYV == V4L2_PIX_FMT_YUYV, "YUYV fourcc");
 _Static_assert(FV_PIX_UYVY == V4L2_PIX_FMT_UYVY, "UYVY fourcc");
 
-/* Deeper formats first: they carry the most of the sensor's range before the reduction. */
-static const uint32_t default_formats[] = {FV_PIX_GREY, FV_PIX_Y16, FV_PIX_Y12, FV_PIX_Y10, FV_PIX_YUYV, FV_PIX_UYVY};
+/* Deeper formats first: they carry the most of the sensor's range before the reduction. MJPEG
+ * last: decoding costs CPU time and compression blurs the pupil edge. */
+static const uint32_t default_formats[] = {FV_PIX_GREY,  FV_PIX_Y16,  FV_PIX_Y12,  FV_PIX_Y10,
+                                           FV_PIX_YUYV, FV_PIX_UYVY, FV_PIX_MJPEG};
+#define READS "GREY, Y16, Y12, Y10, YUYV, UYVY, MJPG"
+
+static int readable(uint32_t fourcc) { return fv_pix_supported(fourcc) || fourcc == FV_PIX_MJPEG; }
 
 static int64_t mono_ns(void)
 {
@@ -110,9 +116,9 @@ int fv_v4l2_config_validate(const fv_v4l2_config *cfg, char *err, size_t err_len
         return fv_err(err, err_len, "%s: bad format count %d", cfg->path, cfg->n_formats);
     for (int i = 0; i < cfg->n_formats; i++) {
         char nm[5];
-        if (!fv_pix_supported(cfg->formats[i]))
-            return fv_err(err, err_len, "%s: pixel format '%s' is not one fovea reads (GREY, Y16, Y12, Y10, YUYV, UYVY)",
-                          cfg->path, fv_pix_name(cfg->formats[i], nm));
+        if (!readable(cfg->formats[i]))
+            return fv_err(err, err_len, "%s: pixel format '%s' is not one fovea reads (" READS ")", cfg->path,
+                          fv_pix_name(cfg->formats[i], nm));
         for (int j = 0; j < i; j++)
             if (cfg->formats[j] == cfg->formats[i])
                 return fv_err(err, err_len, "%s: pixel format '%s' listed twice", cfg->path, fv_pix_name(cfg->formats[i], nm));
@@ -142,9 +148,9 @@ int fv_v4l2_config_formats(fv_v4l2_config *cfg, const char *list, char *err, siz
         if (len == 0 || len > 4)
             return fv_err(err, err_len, "pixel formats '%s': expected a comma-separated list like GREY,YUYV", list);
         snprintf(name, sizeof name, "%.*s", (int)len, p);
-        uint32_t x = fv_pix_parse(name);
+        uint32_t x = strcasecmp(name, "MJPG") ? fv_pix_parse(name) : FV_PIX_MJPEG;
         if (!x)
-            return fv_err(err, err_len, "pixel format '%s' is not one fovea reads (GREY, Y16, Y12, Y10, YUYV, UYVY)", name);
+            return fv_err(err, err_len, "pixel format '%s' is not one fovea reads (" READS ")", name);
         for (int i = 0; i < n; i++)
             if (f[i] == x)
                 return fv_err(err, err_len, "pixel format '%s' listed twice", name);
@@ -379,6 +385,14 @@ static int apply_ctrls(fv_v4l2 *cam, char *err, size_t err_len)
     return 0;
 }
 
+/* Fewest bytes a good frame has (a JPEG's size varies: at least something). */
+static size_t frame_min_bytes(const fv_v4l2 *cam)
+{
+    if (cam->fourcc == FV_PIX_MJPEG)
+        return 1;
+    return fv_pix_min_size(cam->fourcc, cam->width, cam->height, cam->bytesperline);
+}
+
 static int choose_format(fv_v4l2 *cam, uint32_t *out, char *err, size_t err_len)
 {
     uint32_t have[64];
@@ -503,9 +517,9 @@ static int map_buffers(fv_v4l2 *cam, char *err, size_t err_len)
         cam->bufs[i].start = p;
         cam->bufs[i].length = b.length;
         cam->n_buffers = (int)i + 1;
-        if (b.length < fv_pix_min_size(cam->fourcc, cam->width, cam->height, cam->bytesperline))
+        if (b.length < frame_min_bytes(cam))
             return fv_err(err, err_len, "VIDIOC_QUERYBUF on %s: buffer %u holds %u bytes, a frame needs %zu", cam->path, i,
-                          b.length, fv_pix_min_size(cam->fourcc, cam->width, cam->height, cam->bytesperline));
+                          b.length, frame_min_bytes(cam));
     }
     for (int i = 0; i < cam->n_buffers; i++) {
         struct v4l2_buffer b;
@@ -741,9 +755,13 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
         if (used > cam->bufs[b.index].length)
             used = cam->bufs[b.index].length;
         const uint8_t *src = cam->bufs[b.index].start;
-        size_t need = fv_pix_min_size(cam->fourcc, cam->width, cam->height, cam->bytesperline);
-        if ((b.flags & V4L2_BUF_FLAG_ERROR) || used < need) {
+        int bad = (b.flags & V4L2_BUF_FLAG_ERROR) || used < frame_min_bytes(cam);
+        if (!bad && cam->fourcc == FV_PIX_MJPEG)
+            bad = fv_mjpeg_to_luma8(src, used, cam->width, cam->height, cam->luma, (size_t)cam->width, cam->last_err,
+                                    sizeof cam->last_err) != 0;
+        if (bad) {
             /* A corrupted or short frame (USB packet loss): hand it back and wait for the next. */
+            cam->skipped++;
             if (requeue(cam, (int)b.index) < 0) {
                 int e = errno;
                 if (errno_gone(e))
@@ -778,7 +796,9 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
             cam->held = (int)b.index;
             return FV_V4L2_FRAME;
         }
-        fv_pix_to_luma8(cam->fourcc, src, used, cam->bytesperline, cam->width, cam->height, cam->luma, (size_t)cam->width);
+        if (cam->fourcc != FV_PIX_MJPEG) /* (MJPEG was decoded above) */
+            fv_pix_to_luma8(cam->fourcc, src, used, cam->bytesperline, cam->width, cam->height, cam->luma,
+                            (size_t)cam->width);
         out->luma = cam->luma;
         out->stride = (size_t)cam->width;
         if (requeue(cam, (int)b.index) < 0) {

@@ -23,6 +23,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "mjpeg.h"
 #include "pixfmt.h"
 
 struct pollfd;
@@ -50,7 +51,7 @@ typedef struct fv_v4l2_config {
     int width, height;             /* requested size; the driver may pick the nearest it has */
     int fps;                       /* requested frame rate; 0 = leave the driver's */
     uint32_t formats[FV_V4L2_MAX_FORMATS]; /* preferred pixel formats, best first (FV_PIX_*) */
-    int n_formats;                 /* 0 = GREY, Y16, Y12, Y10, YUYV, UYVY */
+    int n_formats;                 /* 0 = GREY, Y16, Y12, Y10, YUYV, UYVY, MJPG */
     int buffers;                   /* mmap buffers to request, FV_V4L2_MIN_BUFFERS..MAX_BUFFERS */
     const char *ctrls[FV_V4L2_MAX_CTRLS]; /* "name=value", applied in order; copied by open */
     int n_ctrls;
@@ -108,6 +109,8 @@ typedef struct fv_v4l2 {
     int gone;                   /* 1 between a vanished device and its successful reopen */
     int reopen_attempts;        /* failed reopen attempts since it went away */
     long reopens;               /* successful reopens since fv_v4l2_open */
+    long skipped;               /* frames dropped as corrupt: flagged by the driver, short, or
+                                 * (MJPEG) undecodable; the reason of the last is in last_err */
     /* private */
     fv_v4l2_sys sys;
     int fd;

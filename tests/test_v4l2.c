@@ -14,7 +14,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <jpeglib.h>
+
 #include "testutil.h"
+#include "mjpeg.h"
 #include "pixfmt.h"
 #include "v4l2.h"
 
@@ -350,7 +353,7 @@ static void test_config(void **st)
     BAD(cfg.fps = -1, "frame rate");
     BAD(cfg.path = NULL, "path");
     BAD(cfg.path = "", "path");
-    BAD((cfg.formats[0] = FV_FOURCC('M', 'J', 'P', 'G'), cfg.n_formats = 1), "MJPG");
+    BAD((cfg.formats[0] = FV_FOURCC('H', '2', '6', '4'), cfg.n_formats = 1), "H264");
     BAD((cfg.formats[0] = FV_PIX_GREY, cfg.formats[1] = FV_PIX_GREY, cfg.n_formats = 2), "twice");
     BAD((cfg.ctrls[0] = "gain", cfg.n_ctrls = 1), "name=value");
     BAD((cfg.ctrls[0] = NULL, cfg.n_ctrls = 1), "missing");
@@ -362,7 +365,10 @@ static void test_config(void **st)
     assert_int_equal(cfg.formats[0], FV_PIX_GREY);
     assert_int_equal(cfg.formats[1], FV_PIX_YUYV);
     assert_int_equal(cfg.formats[2], FV_PIX_Y10);
-    const char *bad_lists[] = {"", "GREY,", ",GREY", "GREY,,YUYV", "MJPG", "GREY,GREY", "GREYS"};
+    assert_int_equal(fv_v4l2_config_formats(&cfg, "mjpg", err, sizeof err), 0);
+    assert_int_equal(cfg.formats[0], FV_PIX_MJPEG);
+    assert_int_equal(fv_v4l2_config_formats(&cfg, "GREY,yuyv,Y10", err, sizeof err), 0);
+    const char *bad_lists[] = {"", "GREY,", ",GREY", "GREY,,YUYV", "H264", "GREY,GREY", "GREYS", "mjpg,MJPG"};
     for (size_t i = 0; i < sizeof bad_lists / sizeof *bad_lists; i++) {
         err[0] = 0;
         assert_int_equal(fv_v4l2_config_formats(&cfg, bad_lists[i], err, sizeof err), -1);
@@ -402,6 +408,8 @@ typedef struct fake {
     uint32_t seq;
     int64_t stamp_ns;
     int32_t brightness, gain, exposure;
+    const uint8_t *jpeg;         /* the frame an MJPEG fake sends */
+    size_t jpeg_len, sizeimage;
     uint32_t fps_den;
 } fake;
 
@@ -456,6 +464,10 @@ static void fake_fill(fake *f, int i)
 {
     uint8_t *m = f->mem[i];
     memset(m, 0xEE, f->len);
+    if (f->fourcc == V4L2_PIX_FMT_MJPEG) {
+        memcpy(m, f->jpeg, f->jpeg_len);
+        return;
+    }
     for (int y = 0; y < f->h; y++)
         for (int x = 0; x < f->w; x++) {
             uint8_t l = fake_luma(f->seq, x, y);
@@ -506,6 +518,9 @@ static int fake_ioctl(void *u, int fd, unsigned long req, void *arg)
         f->bpl = (uint32_t)fv_pix_min_stride(f->fourcc, f->w) + f->pad;
         fm->fmt.pix.bytesperline = f->bpl;
         fm->fmt.pix.sizeimage = f->bpl * (uint32_t)f->h;
+        if (f->fourcc == V4L2_PIX_FMT_MJPEG)
+            fm->fmt.pix.sizeimage = (uint32_t)(f->w * f->h * 2);
+        f->sizeimage = fm->fmt.pix.sizeimage;
         return 0;
     }
     case VIDIOC_G_PARM: case VIDIOC_S_PARM: {
@@ -552,7 +567,7 @@ static int fake_ioctl(void *u, int fd, unsigned long req, void *arg)
         if (rb->count > FAKE_MAX_BUFS)
             rb->count = FAKE_MAX_BUFS;
         f->n_bufs = (int)rb->count;
-        f->len = (size_t)f->bpl * (size_t)f->h;
+        f->len = f->sizeimage;
         for (int i = 0; i < f->n_bufs; i++) {
             f->mem[i] = malloc(f->len);
             f->queued[i] = 0;
@@ -591,7 +606,7 @@ static int fake_ioctl(void *u, int fd, unsigned long req, void *arg)
         f->next_buf = (i + 1) % f->n_bufs;
         f->ready--;
         b->index = (uint32_t)i;
-        b->bytesused = (uint32_t)f->len;
+        b->bytesused = (uint32_t)(f->fourcc == V4L2_PIX_FMT_MJPEG ? f->jpeg_len : f->len);
         b->flags = f->ts_flags | (f->error_next ? V4L2_BUF_FLAG_ERROR : 0);
         f->error_next = 0;
         b->sequence = f->seq++;
@@ -871,7 +886,8 @@ static void test_fake_errors(void **st)
     f.fail_sfmt = EBUSY;
     expect_fake_fails(&f, NULL, "VIDIOC_S_FMT on /fake/video0: Device or resource busy");
     fake_init(&f, V4L2_PIX_FMT_H264);
-    expect_fake_fails(&f, NULL, "/fake/video0: no usable pixel format (device offers MJPG, H264; fovea wants GREY, Y16");
+    f.formats[0] = V4L2_PIX_FMT_RGB24;
+    expect_fake_fails(&f, NULL, "/fake/video0: no usable pixel format (device offers RGB3, H264; fovea wants GREY, Y16");
     fake_init(&f, V4L2_PIX_FMT_GREY);
     expect_fake_fails(&f, "focus_absolute=3",
                       "/fake/video0: no control 'focus_absolute' (it has: brightness, gain, exposure_time_absolute)");
@@ -896,6 +912,151 @@ static void test_fake_errors(void **st)
     assert_int_equal(fv_v4l2_open(&cam, &cfg, err, sizeof err), -1);
     assert_contains(err, "VIDIOC_S_FMT on /fake/video0: ");
     fv_v4l2_close(&cam);
+}
+
+/* ---- MJPEG ------------------------------------------------------------------------------- */
+
+/* A smooth grey gradient (JPEG keeps it within a few levels). */
+static uint8_t grad(int x, int y) { return (uint8_t)(40 + 3 * x + 5 * y); }
+
+/* JPEG of the gradient: 1 component, or YCbCr 4:2:2 as UVC cameras send it. Caller frees. */
+static unsigned char *make_jpeg(int w, int h, int ycc, unsigned long *len)
+{
+    struct jpeg_compress_struct c;
+    struct jpeg_error_mgr e;
+    c.err = jpeg_std_error(&e);
+    jpeg_create_compress(&c);
+    unsigned char *out = NULL;
+    *len = 0;
+    jpeg_mem_dest(&c, &out, len);
+    c.image_width = (JDIMENSION)w;
+    c.image_height = (JDIMENSION)h;
+    c.input_components = ycc ? 3 : 1;
+    c.in_color_space = ycc ? JCS_RGB : JCS_GRAYSCALE;
+    jpeg_set_defaults(&c);
+    jpeg_set_quality(&c, 95, TRUE);
+    if (ycc) {
+        c.comp_info[0].h_samp_factor = 2; /* 4:2:2 */
+        c.comp_info[0].v_samp_factor = 1;
+    }
+    jpeg_start_compress(&c, TRUE);
+    uint8_t row[3 * 64];
+    while (c.next_scanline < c.image_height) {
+        int y = (int)c.next_scanline;
+        for (int x = 0; x < w; x++)
+            for (int k = 0; k < c.input_components; k++)
+                row[x * c.input_components + k] = grad(x, y);
+        JSAMPROW r = row;
+        jpeg_write_scanlines(&c, &r, 1);
+    }
+    jpeg_finish_compress(&c);
+    jpeg_destroy_compress(&c);
+    return out;
+}
+
+/* Drops every DHT segment before the scan, as UVC cameras do to save bandwidth. */
+static size_t strip_dht(unsigned char *j, size_t n)
+{
+    size_t i = 2; /* after SOI */
+    while (i + 4 <= n && j[i] == 0xFF && j[i + 1] != 0xDA) {
+        size_t seg = 2 + ((size_t)j[i + 2] << 8 | j[i + 3]);
+        if (j[i + 1] == 0xC4) {
+            memmove(j + i, j + i + seg, n - i - seg);
+            n -= seg;
+        } else {
+            i += seg;
+        }
+    }
+    return n;
+}
+
+static void assert_near_grad(const uint8_t *l, size_t stride, int w, int h)
+{
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            int d = (int)l[(size_t)y * stride + (size_t)x] - grad(x, y);
+            if (d < -3 || d > 3)
+                fail_msg("pixel (%d,%d) = %u, want %u +- 3", x, y, l[(size_t)y * stride + (size_t)x], grad(x, y));
+        }
+}
+
+static void test_mjpeg_decode(void **st)
+{
+    (void)st;
+    const int w = 24, h = 16;
+    uint8_t dst[24 * 16 + 64];
+    char err[256];
+    for (int ycc = 0; ycc < 2; ycc++) {
+        unsigned long n;
+        unsigned char *j = make_jpeg(w, h, ycc, &n);
+        memset(dst, 0, sizeof dst);
+        if (fv_mjpeg_to_luma8(j, n, w, h, dst, w + 2, err, sizeof err))
+            fail_msg("%s", err);
+        assert_near_grad(dst, (size_t)w + 2, w, h);
+
+        /* Without Huffman tables (UVC): the standard ones are assumed. */
+        size_t m = strip_dht(j, n);
+        assert_true(m < n);
+        memset(dst, 0, sizeof dst);
+        if (fv_mjpeg_to_luma8(j, m, w, h, dst, w, err, sizeof err))
+            fail_msg("no DHT: %s", err);
+        assert_near_grad(dst, (size_t)w, w, h);
+
+        err[0] = 0; /* truncated: libjpeg only warns; the frame is refused */
+        assert_int_equal(fv_mjpeg_to_luma8(j, m / 2, w, h, dst, w, err, sizeof err), -1);
+        assert_contains(err, "MJPEG: ");
+        err[0] = 0;
+        assert_int_equal(fv_mjpeg_to_luma8(j, m, w + 8, h, dst, w + 8, err, sizeof err), -1);
+        assert_contains(err, "24x16");
+        free(j);
+    }
+    const uint8_t junk[] = "this is not a jpeg";
+    err[0] = 0;
+    assert_int_equal(fv_mjpeg_to_luma8(junk, sizeof junk, 4, 4, dst, 4, err, sizeof err), -1);
+    assert_contains(err, "MJPEG: ");
+    assert_int_equal(fv_mjpeg_to_luma8(junk, 0, 4, 4, dst, 4, err, sizeof err), -1);
+}
+
+static void test_fake_mjpeg_stream(void **st)
+{
+    (void)st;
+    fake f;
+    fake_init(&f, V4L2_PIX_FMT_H264); /* offers MJPG and H264: MJPG is taken */
+    unsigned long n;
+    unsigned char *j = make_jpeg(32, 8, 1, &n);
+    size_t m = strip_dht(j, n);
+    f.jpeg = j;
+    f.jpeg_len = m;
+    fv_v4l2_sys sys = fake_sys(&f);
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, "/fake/video0");
+    cfg.sys = &sys;
+    cfg.width = 32;
+    cfg.height = 8;
+    char err[512] = "";
+    fv_v4l2 cam;
+    if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
+        fail_msg("%s", err);
+    assert_int_equal(cam.fourcc, FV_PIX_MJPEG);
+    fv_eye_frame fr;
+    f.ready = 1;
+    f.stamp_ns = now_ns() - 1000000;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_int_equal(fr.fourcc, FV_PIX_MJPEG);
+    assert_int_equal(fr.stride, 32);
+    assert_near_grad(fr.luma, fr.stride, 32, 8);
+    /* a truncated JPEG is dropped (counted), the next good one delivered */
+    f.jpeg_len = m / 2;
+    f.ready = 1;
+    assert_int_equal(fv_v4l2_next(&cam, 0, &fr, err, sizeof err), FV_V4L2_TIMEOUT);
+    assert_int_equal(cam.skipped, 1);
+    f.jpeg_len = m;
+    f.ready = 1;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_int_equal(fr.sequence, 2);
+    assert_int_equal(fake_queued(&f), cam.n_buffers);
+    fv_v4l2_close(&cam);
+    free(j);
 }
 
 /* ---- a real camera, when the machine has one --------------------------------------------- */
@@ -967,6 +1128,8 @@ int main(void)
         cmocka_unit_test(test_fake_grey_zero_copy),
         cmocka_unit_test(test_fake_unplug_reopen),
         cmocka_unit_test(test_fake_errors),
+        cmocka_unit_test(test_mjpeg_decode),
+        cmocka_unit_test(test_fake_mjpeg_stream),
         cmocka_unit_test(test_real_device),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
