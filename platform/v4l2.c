@@ -577,7 +577,7 @@ static int open_stream(fv_v4l2 *cam, int *e_out, char *err, size_t err_len)
         *e_out = errno;
         goto fail;
     }
-    if (cam->fourcc != FV_PIX_GREY) {
+    if (cam->fourcc != FV_PIX_GREY || cam->cfg.copy_frames) {
         size_t need = (size_t)cam->width * (size_t)cam->height;
         if (need > cam->luma_size) {
             uint8_t *p = realloc(cam->luma, need);
@@ -695,6 +695,50 @@ static int requeue(fv_v4l2 *cam, int index)
     return xioctl(cam, VIDIOC_QBUF, &b);
 }
 
+static size_t buffer_used(const fv_v4l2 *cam, const struct v4l2_buffer *b)
+{
+    size_t len = cam->bufs[b->index].length;
+    size_t used = b->bytesused ? b->bytesused : len; /* 0 from old drivers means "all of it" */
+    return used < len ? used : len;
+}
+
+/* Not flagged bad by the driver and long enough (MJPEG is checked by decoding it). */
+static int buffer_ok(const fv_v4l2 *cam, const struct v4l2_buffer *b)
+{
+    return !(b->flags & V4L2_BUF_FLAG_ERROR) && buffer_used(cam, b) >= frame_min_bytes(cam);
+}
+
+/* latest_only: while more frames are already waiting, hand the older one back and take the newer,
+ * so the tracker sees the freshest eye image. Failures here are left for the next poll/DQBUF to
+ * report (a vanished device fails those too); *b stays a good buffer throughout. */
+static void drain_to_newest(fv_v4l2 *cam, struct v4l2_buffer *b)
+{
+    for (;;) {
+        struct pollfd pfd = {.fd = cam->fd, .events = POLLIN};
+        if (cam->sys.poll(cam->sys.user, &pfd, 0) <= 0 || !(pfd.revents & POLLIN))
+            return;
+        struct v4l2_buffer nb;
+        memset(&nb, 0, sizeof nb);
+        nb.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+        nb.memory = V4L2_MEMORY_MMAP;
+        if (xioctl(cam, VIDIOC_DQBUF, &nb) < 0 || nb.index >= (uint32_t)cam->n_buffers)
+            return;
+        if (!buffer_ok(cam, &nb)) {
+            cam->skipped++;
+            if (requeue(cam, (int)nb.index) < 0)
+                return;
+            continue;
+        }
+        if (requeue(cam, (int)b->index) < 0) {
+            /* keep the newer frame; the older buffer is lost to the queue until a reopen */
+            *b = nb;
+            return;
+        }
+        *b = nb;
+        cam->stale++;
+    }
+}
+
 fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, char *err, size_t err_len)
 {
     int64_t deadline = mono_ns() + (int64_t)(timeout_ms > 0 ? timeout_ms : 0) * 1000000;
@@ -746,16 +790,16 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
             call_err(cam, "VIDIOC_DQBUF", e, err, err_len);
             return FV_V4L2_ERROR;
         }
-        int64_t t_deq = mono_ns();
         if (b.index >= (uint32_t)cam->n_buffers) {
             fv_err(err, err_len, "VIDIOC_DQBUF on %s: buffer index %u out of range", cam->path, b.index);
             return FV_V4L2_ERROR;
         }
-        size_t used = b.bytesused ? b.bytesused : cam->bufs[b.index].length;
-        if (used > cam->bufs[b.index].length)
-            used = cam->bufs[b.index].length;
+        int bad = !buffer_ok(cam, &b);
+        if (!bad && cam->cfg.latest_only)
+            drain_to_newest(cam, &b);
+        int64_t t_deq = mono_ns();
+        size_t used = buffer_used(cam, &b);
         const uint8_t *src = cam->bufs[b.index].start;
-        int bad = (b.flags & V4L2_BUF_FLAG_ERROR) || used < frame_min_bytes(cam);
         if (!bad && cam->fourcc == FV_PIX_MJPEG)
             bad = fv_mjpeg_to_luma8(src, used, cam->width, cam->height, cam->luma, (size_t)cam->width, cam->last_err,
                                     sizeof cam->last_err) != 0;
@@ -789,7 +833,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
             out->t_ns = t_deq;
         }
         cam->timestamps_monotonic = mono;
-        if (cam->fourcc == FV_PIX_GREY) {
+        if (cam->fourcc == FV_PIX_GREY && !cam->cfg.copy_frames) {
             /* Zero-copy: the driver's buffer is lent until the next call. */
             out->luma = src;
             out->stride = cam->bytesperline;

@@ -57,6 +57,10 @@ typedef struct fv_v4l2_config {
     int n_ctrls;
     int wait_for_device;           /* 1: a missing device at open is not an error: the camera
                                     * starts FV_V4L2_GONE and next() keeps trying to open it */
+    int latest_only;               /* 1: when several frames are waiting, return the newest and
+                                    * hand the older back (lowest gaze latency; cam.stale counts) */
+    int copy_frames;               /* 1: copy GREY frames too instead of lending the driver's
+                                    * buffer (for drivers whose buffers are uncached: slow reads) */
     const fv_v4l2_sys *sys;        /* NULL = the real system calls (copied by open) */
 } fv_v4l2_config;
 
@@ -109,6 +113,7 @@ typedef struct fv_v4l2 {
     int gone;                   /* 1 between a vanished device and its successful reopen */
     int reopen_attempts;        /* failed reopen attempts since it went away */
     long reopens;               /* successful reopens since fv_v4l2_open */
+    long stale;                 /* frames passed over for a newer one (latest_only) */
     long skipped;               /* frames dropped as corrupt: flagged by the driver, short, or
                                  * (MJPEG) undecodable; the reason of the last is in last_err */
     /* private */

@@ -859,6 +859,45 @@ static void test_fake_unplug_reopen(void **st)
     assert_false(f.fd_open);
 }
 
+static void test_fake_latest_and_copy(void **st)
+{
+    (void)st;
+    fake f;
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    fv_v4l2_sys sys = fake_sys(&f);
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, "/fake/video0");
+    cfg.sys = &sys;
+    cfg.width = 8;
+    cfg.height = 4;
+    cfg.latest_only = 1;
+    cfg.copy_frames = 1;
+    char err[512] = "";
+    fv_v4l2 cam;
+    if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
+        fail_msg("%s", err);
+    fv_eye_frame fr;
+    /* three frames waiting: the newest is returned, the two older handed back */
+    f.ready = 3;
+    f.stamp_ns = now_ns() - 1000000;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_frame(&fr, 2, 8, 4);
+    assert_int_equal(cam.stale, 2);
+    assert_int_equal(fr.stride, 8);
+    for (int i = 0; i < f.n_bufs; i++) /* copied, not lent */
+        assert_true(fr.luma != f.mem[i]);
+    assert_int_equal(fake_queued(&f), cam.n_buffers);
+    /* a flagged frame first: skipped; of the two good ones the newer wins */
+    f.ready = 3;
+    f.error_next = 1;
+    assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
+    assert_frame(&fr, 5, 8, 4);
+    assert_int_equal(cam.skipped, 1);
+    assert_int_equal(cam.stale, 3);
+    assert_int_equal(fake_queued(&f), cam.n_buffers);
+    fv_v4l2_close(&cam);
+}
+
 static void expect_fake_fails(fake *f, const char *ctrl, const char *needle)
 {
     fv_v4l2_sys sys = fake_sys(f);
@@ -1127,6 +1166,7 @@ int main(void)
         cmocka_unit_test(test_fake_yuyv_stream),
         cmocka_unit_test(test_fake_grey_zero_copy),
         cmocka_unit_test(test_fake_unplug_reopen),
+        cmocka_unit_test(test_fake_latest_and_copy),
         cmocka_unit_test(test_fake_errors),
         cmocka_unit_test(test_mjpeg_decode),
         cmocka_unit_test(test_fake_mjpeg_stream),
