@@ -3,6 +3,7 @@
 #define _DEFAULT_SOURCE
 #include "v4l2.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -204,6 +205,7 @@ static void *sys_mmap(void *u, int fd, size_t length, int64_t offset)
     return p == MAP_FAILED ? NULL : p;
 }
 static int sys_munmap(void *u, void *start, size_t length) { (void)u; return munmap(start, length); }
+static const fv_v4l2_sys real_sys = {NULL, sys_open, sys_close, sys_ioctl, sys_poll, sys_mmap, sys_munmap};
 
 static int xioctl(fv_v4l2 *cam, unsigned long req, void *arg)
 {
@@ -610,8 +612,7 @@ int fv_v4l2_open(fv_v4l2 *cam, const fv_v4l2_config *cfg, char *err, size_t err_
         return -1;
     /* Own copies: the stream is renegotiated from them on every reopen. */
     cam->cfg = *cfg;
-    static const fv_v4l2_sys real = {NULL, sys_open, sys_close, sys_ioctl, sys_poll, sys_mmap, sys_munmap};
-    cam->sys = cfg->sys ? *cfg->sys : real;
+    cam->sys = cfg->sys ? *cfg->sys : real_sys;
     cam->cfg.sys = NULL;
     snprintf(cam->path, sizeof cam->path, "%s", cfg->path);
     for (int i = 0; i < cfg->n_ctrls; i++)
@@ -856,6 +857,59 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, cha
         }
         return FV_V4L2_FRAME;
     }
+}
+
+static int cmp_int(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+int fv_v4l2_list(const char *dir, const fv_v4l2_sys *sys, char *buf, size_t len)
+{
+    if (!dir)
+        dir = "/dev";
+    if (len)
+        buf[0] = 0;
+    int nums[256], n = 0;
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0;
+    struct dirent *e;
+    while ((e = readdir(d)) && n < (int)(sizeof nums / sizeof *nums)) {
+        const char *p = e->d_name;
+        if (strncmp(p, "video", 5) || p[5] < '0' || p[5] > '9' || strlen(p) > 9)
+            continue;
+        char *end;
+        long k = strtol(p + 5, &end, 10);
+        if (!*end)
+            nums[n++] = (int)k;
+    }
+    closedir(d);
+    qsort(nums, (size_t)n, sizeof *nums, cmp_int);
+    fv_v4l2 probe; /* only path, fd and sys are used (xioctl's EINTR retry) */
+    memset(&probe, 0, sizeof probe);
+    probe.sys = sys ? *sys : real_sys;
+    int found = 0;
+    for (int i = 0; i < n; i++) {
+        snprintf(probe.path, sizeof probe.path, "%s/video%d", dir, nums[i]);
+        probe.fd = probe.sys.open(probe.sys.user, probe.path, O_RDWR | O_NONBLOCK | O_CLOEXEC);
+        if (probe.fd < 0)
+            continue;
+        struct v4l2_capability cap;
+        memset(&cap, 0, sizeof cap);
+        int ok = xioctl(&probe, VIDIOC_QUERYCAP, &cap) == 0;
+        probe.sys.close(probe.sys.user, probe.fd);
+        uint32_t caps = (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
+        if (!ok || !(caps & V4L2_CAP_VIDEO_CAPTURE) || !(caps & V4L2_CAP_STREAMING))
+            continue; /* metadata and output nodes, codecs */
+        size_t used = strlen(buf);
+        if (used < len)
+            snprintf(buf + used, len - used, "%s%s (%.*s)", found ? ", " : "", probe.path,
+                     (int)strnlen((const char *)cap.card, sizeof cap.card), (const char *)cap.card);
+        found++;
+    }
+    return found;
 }
 
 int fv_v4l2_fd(const fv_v4l2 *cam) { return cam->gone ? -1 : cam->fd; }

@@ -149,6 +149,12 @@ void fv_v4l2_close(fv_v4l2 *cam);
  * changes on a reopen: fetch it again after every fv_v4l2_next. */
 int fv_v4l2_fd(const fv_v4l2 *cam);
 
+/* The capture devices (streaming, single-planar) among DIR/videoN (dir NULL = "/dev"), by number,
+ * as "/dev/video0 (card), /dev/video2 (card)" into buf (truncated to len), for messages such as
+ * "no camera at X; capture devices here: ...". Nodes that cannot be opened are passed over.
+ * sys as in the config (NULL = the real calls). Returns how many were found. */
+int fv_v4l2_list(const char *dir, const fv_v4l2_sys *sys, char *buf, size_t len);
+
 /* One line about the open stream: device, driver, format, size, rate, buffers, timestamp source. */
 void fv_v4l2_describe(const fv_v4l2 *cam, char *buf, size_t len);
 

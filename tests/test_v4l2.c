@@ -393,6 +393,7 @@ static void test_config(void **st)
 #define FAKE_MAX_BUFS 8
 typedef struct fake {
     int absent, vanish;          /* open fails ENOENT / everything fails ENODEV (unplugged) */
+    const char *deny;            /* open of a path ending so fails EACCES */
     int fd_open, opens, mapped;
     uint32_t caps;
     uint32_t formats[4];
@@ -430,7 +431,12 @@ static const struct {
 static int fake_open(void *u, const char *path, int flags)
 {
     fake *f = u;
-    (void)path, (void)flags;
+    (void)flags;
+    size_t n = strlen(path), d = f->deny ? strlen(f->deny) : 0;
+    if (d && n >= d && !strcmp(path + n - d, f->deny)) {
+        errno = EACCES;
+        return -1;
+    }
     if (f->absent) {
         errno = ENOENT;
         return -1;
@@ -953,6 +959,44 @@ static void test_fake_errors(void **st)
     fv_v4l2_close(&cam);
 }
 
+static void test_list_devices(void **st)
+{
+    (void)st;
+    char dir[] = "/tmp/fovea-v4l2-dev-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    const char *names[] = {"video10", "video0", "video2", "videoX", "video1a", "media0", "video"};
+    char p[128];
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+        snprintf(p, sizeof p, "%s/%s", dir, names[i]);
+        FILE *fp = fopen(p, "w");
+        assert_non_null(fp);
+        fclose(fp);
+    }
+    fake f;
+    fake_init(&f, V4L2_PIX_FMT_GREY);
+    f.deny = "/video2";
+    fv_v4l2_sys sys = fake_sys(&f);
+    char buf[512], want[512];
+    assert_int_equal(fv_v4l2_list(dir, &sys, buf, sizeof buf), 2);
+    snprintf(want, sizeof want, "%s/video0 (Fake IR eye camera), %s/video10 (Fake IR eye camera)", dir, dir);
+    assert_string_equal(buf, want);
+    assert_false(f.fd_open);
+    f.deny = NULL;
+    f.caps = V4L2_CAP_META_CAPTURE | V4L2_CAP_STREAMING; /* metadata nodes are not cameras */
+    assert_int_equal(fv_v4l2_list(dir, &sys, buf, sizeof buf), 0);
+    assert_string_equal(buf, "");
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+        snprintf(p, sizeof p, "%s/%s", dir, names[i]);
+        unlink(p);
+    }
+    rmdir(dir);
+    /* The real /dev: whatever is there, the count and the text agree. */
+    int n = fv_v4l2_list(NULL, NULL, buf, sizeof buf);
+    assert_true(n >= 0);
+    assert_int_equal(n == 0, buf[0] == 0);
+    assert_int_equal(fv_v4l2_list("/nonexistent-fovea", NULL, buf, sizeof buf), 0);
+}
+
 /* ---- MJPEG ------------------------------------------------------------------------------- */
 
 /* A smooth grey gradient (JPEG keeps it within a few levels). */
@@ -1168,6 +1212,7 @@ int main(void)
         cmocka_unit_test(test_fake_unplug_reopen),
         cmocka_unit_test(test_fake_latest_and_copy),
         cmocka_unit_test(test_fake_errors),
+        cmocka_unit_test(test_list_devices),
         cmocka_unit_test(test_mjpeg_decode),
         cmocka_unit_test(test_fake_mjpeg_stream),
         cmocka_unit_test(test_real_device),
