@@ -41,7 +41,7 @@ WARN := -Wall -Wextra -Werror
 # ISO C: no silent FMA contraction, so the plain-C references give the same bits everywhere.
 BASE_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) $(WARN) -ffp-contract=off -fno-math-errno -pthread -Icore -Iplatform $(SANFLAGS)
 BASE_CXXFLAGS := -std=c++17 $(OPT) $(WARN) -Wno-unused-parameter -pthread -Icore $(SANFLAGS) $(if $(filter asan,$(SAN)),-fno-sanitize=vptr)
-LIBS := -lembree3 -ltinygltf -lstb -lstdc++ -lm -lpthread
+LIBS := -lembree3 -ltinygltf -lstb -ljpeg -lstdc++ -lm -lpthread
 TEST_LIBS := -lcmocka
 
 ALL_CFLAGS = $(BASE_CFLAGS) $(CFLAGS)
