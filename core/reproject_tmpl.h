@@ -37,6 +37,10 @@ static inline int taa_level(float f, int max_level)
 
 static inline float taa_clampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
 
+/* 2^l and 2^-l: exact, without a division on the sample's dependency chain */
+static const float taa_pow2[8] = {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f, 128.0f};
+static const float taa_inv_pow2[8] = {1.0f, 0.5f, 0.25f, 0.125f, 0.0625f, 0.03125f, 0.015625f, 0.0078125f};
+
 #ifndef TAA_OWN_BLEND /* an ISA may vectorise the blend across samples instead */
 static void TAA_FN(taa_blend_row)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
                                   const float *wgt, int x0, int y, int n, struct fv_taa_flow *flow)
@@ -77,7 +81,7 @@ static void TAA_FN(taa_blend_row)(const struct fv_taa_frame *f, const struct fv_
             const float fp = (d * rz) * t->widen;
             const int l = taa_level(fp, f->max_level);
             const fv_pyr_level *L = &f->hist->lv[l];
-            const float ts = (float)(1 << l), inv_ts = 1.0f / ts;
+            const float ts = taa_pow2[l], inv_ts = taa_inv_pow2[l]; /* l <= max_level <= 5 */
             float o = (fp - ts) * 0.5f;
             o = o < 0.5f * ts ? o : 0.5f * ts;
             const float inv_tol = rz * f->inv_depth_tol;
@@ -96,7 +100,7 @@ static void TAA_FN(taa_blend_row)(const struct fv_taa_frame *f, const struct fv_
             }
             if (!(accw > 0.0f))
                 continue; /* no valid history: the sample stands alone */
-            const float a1 = 1.0f - accw / (float)taps;
+            const float a1 = 1.0f - (taps == 1 ? accw : accw / 5.0f); /* accw / 1 is accw */
             out_blend(px, acc, accw, a1 > t->alpha ? a1 : t->alpha);
         }
     }
