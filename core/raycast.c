@@ -62,43 +62,6 @@ static void prefetch_history(const rc_job *j, int x0, int y0, int tw, int th)
     }
 }
 
-/* Temporal reprojection of one tile (core/reproject.h): blend the samples with their history,
- * then fill the holes from history at the tile's mean sample flow. */
-static void reproject_tile(rc_job *j, int x0, int y0, int tw, int th)
-{
-    const fv_pyr_level *l0 = &j->pyr->lv[0];
-    fv_taa_tile tt;
-    const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
-    fv_taa_tile_setup(&tt, j->taa_prm, fv_sampler_probability(j->smp, cx - (float)j->gx, cy - (float)j->gy),
-                      j->smp->prm.p_min, j->smp->phases);
-    fv_taa_flow fl = {0.0f, 0.0f, 0.0f};
-    for (int y = y0; y < y0 + th; y++) {
-        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
-        j->dsp->taa_blend_row(j->taa, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw, &fl);
-    }
-    if (!j->taa_prm->fill)
-        return;
-    float fx = 0.0f, fy = 0.0f;
-    if (fl.n > 0.0f) {
-        fx = fl.dx / fl.n;
-        fy = fl.dy / fl.n;
-    } else if (!j->taa->identity) { /* no sample reached the previous image: assume far away */
-        float u, v;
-        if (fv_taa_project(j->taa, cx, cy, FV_DEPTH_MISS_M, &u, &v) > 0.0f) {
-            fx = u - cx;
-            fy = v - cy;
-        }
-    }
-    if (!(fabsf(fx) < 65536.0f && fabsf(fy) < 65536.0f))
-        return;
-    tt.flow_x = (int)floorf(fx + 0.5f);
-    tt.flow_y = (int)floorf(fy + 0.5f);
-    for (int y = y0; y < y0 + th; y++) {
-        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
-        j->dsp->taa_fill_row(j->taa, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw);
-    }
-}
-
 /* Pixels of a tile in 4x2 blocks, so a full packet of 8 is a compact 4x2 footprint and a
  * sparse tile's packets still gather nearby pixels (coherent rays). */
 static const unsigned char *tile_order(void)
@@ -199,7 +162,7 @@ static void trace_tile(void *ctx, int index, int thread_id)
     }
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
-        reproject_tile(j, x0, y0, tw, th);
+        fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], j->dsp, x0, y0, tw, th);
         atomic_fetch_add_explicit(&j->taa_ns, fv_time_ns() - t0, memory_order_relaxed);
     }
     /* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "dsp.h"
+#include "sampling.h"
 
 void fv_taa_params_default(fv_taa_params *p)
 {
@@ -104,6 +105,41 @@ float fv_taa_project(const fv_taa_frame *f, float px, float py, float d, float *
         *v = V / Z;
     }
     return Z;
+}
+
+void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
+                     const fv_pyr_level *l0, const struct fv_dsp *dsp, int x0, int y0, int tw, int th)
+{
+    fv_taa_tile tt;
+    const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
+    fv_taa_tile_setup(&tt, prm, fv_sampler_probability(smp, cx - (float)gx, cy - (float)gy), smp->prm.p_min,
+                      smp->phases);
+    fv_taa_flow fl = {0.0f, 0.0f, 0.0f};
+    for (int y = y0; y < y0 + th; y++) {
+        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
+        dsp->taa_blend_row(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw, &fl);
+    }
+    if (!prm->fill)
+        return;
+    float fx = 0.0f, fy = 0.0f;
+    if (fl.n > 0.0f) {
+        fx = fl.dx / fl.n;
+        fy = fl.dy / fl.n;
+    } else if (!f->identity) { /* no sample reached the previous image: assume far away */
+        float u, v;
+        if (fv_taa_project(f, cx, cy, 1000.0f /* FV_DEPTH_MISS_M */, &u, &v) > 0.0f) {
+            fx = u - cx;
+            fy = v - cy;
+        }
+    }
+    if (!(fabsf(fx) < 65536.0f && fabsf(fy) < 65536.0f))
+        return;
+    tt.flow_x = (int)floorf(fx + 0.5f);
+    tt.flow_y = (int)floorf(fy + 0.5f);
+    for (int y = y0; y < y0 + th; y++) {
+        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
+        dsp->taa_fill_row(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw);
+    }
 }
 
 /* ---------------------------------------------------------------- reference kernels */

@@ -74,6 +74,15 @@ void fv_taa_frame_setup(fv_taa_frame *f, const fv_camera *cur, const fv_camera *
  * holds min(1, K p) of the pixels; a static one samples the same pixels every frame. */
 void fv_taa_tile_setup(fv_taa_tile *t, const fv_taa_params *prm, float p, float p_min, int phases);
 
+/* Reprojects one tile [x0, x0+tw) x [y0, y0+th) of the current level 0 (samples written, holes
+ * at weight 0): tile constants from the acuity model at the tile centre (gaze at pixel gx, gy),
+ * the blend row by row, then the fill at the tile's mean sample flow (rounded; where no sample
+ * reached the previous image, the flow of a far point at the tile centre). */
+struct fv_sampler;
+struct fv_dsp;
+void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
+                     const fv_pyr_level *l0, const struct fv_dsp *dsp, int x0, int y0, int tw, int th);
+
 /* The mapping itself, for tests and tools: current pixel (px, py) at depth d -> previous pixel
  * (*u, *v); returns the previous view depth (<= 0: behind the previous eye). */
 float fv_taa_project(const fv_taa_frame *f, float px, float py, float d, float *u, float *v);
