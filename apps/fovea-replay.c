@@ -142,7 +142,9 @@ int main(int argc, char **argv)
 
     int status = FV_EXIT_FAIL;
     int outw = stereo ? 2 * W : W;
-    uint8_t *rgb = malloc((size_t)outw * H * 3), *prev = malloc((size_t)W * H * 3), *full = NULL;
+    /* cur / prev: the (left) eye's image of this and the last frame, W * 3 bytes a row */
+    uint8_t *rgb = malloc((size_t)outw * H * 3), *prev = malloc((size_t)W * H * 3), *cur = malloc((size_t)W * H * 3);
+    uint8_t *full = NULL;
     float *err_prev = NULL, *err_cur = NULL;
     if (vs_full) {
         full = malloc((size_t)W * H * 3);
@@ -155,7 +157,7 @@ int main(int argc, char **argv)
     fv_y4m_writer y4m = {0};
     int y4m_open = 0;
     char path[4200];
-    if (!rgb || !prev || (vs_full && (!full || !err_prev || !err_cur))) {
+    if (!rgb || !prev || !cur || (vs_full && (!full || !err_prev || !err_cur))) {
         fprintf(stderr, "%s: out of memory\n", prog);
         goto done;
     }
@@ -206,9 +208,11 @@ int main(int argc, char **argv)
         const float gpx = smp_gaze_px(smp.gaze_x, W), gpy = smp_gaze_px(smp.gaze_y, H);
         const fv_sampler *sm = fv_pipeline_sampler(pl);
         double dl = NAN, p_all = NAN, p_fov = NAN, p_per = NAN, fl = NAN;
+        for (int y = 0; y < H; y++)
+            memcpy(cur + (size_t)y * W * 3, rgb + (size_t)y * outw * 3, (size_t)W * 3);
         if (f > 0) {
             fv_region per = {gpx, gpy, sm->r1_px, prev_gx, prev_gy, 1};
-            dl = fv_luma_mad(prev, rgb, W, H, (ptrdiff_t)outw * 3, &per);
+            dl = fv_luma_mad(prev, cur, W, H, (ptrdiff_t)W * 3, &per);
         }
         if (vs_full) {
             fv_eye eye = stereo ? FV_EYE_LEFT : FV_EYE_CENTER;
@@ -216,14 +220,11 @@ int main(int argc, char **argv)
             fv_pipeline_render(ref, eye, &head, smp.gaze_x, smp.gaze_y, &rs);
             fv_pipeline_to_rgb8(ref, eye, full, (ptrdiff_t)W * 3);
             fv_region fov = fv_region_disc(gpx, gpy, sm->r0_px, 0), per = fv_region_disc(gpx, gpy, sm->r1_px, 1);
-            /* the foveated image in rgb has row stride outw * 3: compare row by row via a copy */
-            for (int y = 0; y < H; y++)
-                memcpy(prev + (size_t)y * W * 3, rgb + (size_t)y * outw * 3, (size_t)W * 3);
-            p_all = fv_luma_psnr(full, prev, W, H, (ptrdiff_t)W * 3, NULL);
-            p_fov = fv_luma_psnr(full, prev, W, H, (ptrdiff_t)W * 3, &fov);
-            p_per = fv_luma_psnr(full, prev, W, H, (ptrdiff_t)W * 3, &per);
+            p_all = fv_luma_psnr(full, cur, W, H, (ptrdiff_t)W * 3, NULL);
+            p_fov = fv_luma_psnr(full, cur, W, H, (ptrdiff_t)W * 3, &fov);
+            p_per = fv_luma_psnr(full, cur, W, H, (ptrdiff_t)W * 3, &per);
             /* flicker: how much the error against full sampling changes between frames */
-            fv_luma_error(full, prev, W, H, (ptrdiff_t)W * 3, err_cur);
+            fv_luma_error(full, cur, W, H, (ptrdiff_t)W * 3, err_cur);
             if (f > 0) {
                 fv_region both = {gpx, gpy, sm->r1_px, prev_gx, prev_gy, 1};
                 fl = fv_mean_abs_diff(err_prev, err_cur, W, H, &both);
@@ -231,10 +232,10 @@ int main(int argc, char **argv)
             float *t = err_prev;
             err_prev = err_cur;
             err_cur = t;
-        } else {
-            for (int y = 0; y < H; y++)
-                memcpy(prev + (size_t)y * W * 3, rgb + (size_t)y * outw * 3, (size_t)W * 3);
         }
+        uint8_t *t8 = prev;
+        prev = cur;
+        cur = t8;
         prev_gx = gpx;
         prev_gy = gpy;
         mean_add(&m_dl, dl);
@@ -287,6 +288,7 @@ done:
         fv_y4m_abort(&y4m);
     free(rgb);
     free(prev);
+    free(cur);
     free(full);
     free(err_prev);
     free(err_cur);
