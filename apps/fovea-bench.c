@@ -46,12 +46,9 @@ static int cmp_double(const void *a, const void *b)
 static fv_pose head_at(const fv_pose *view, float yaw_rate_dps, int f)
 {
     const float a = yaw_rate_dps * (float)f / 90.0f * 3.14159265f / 180.0f;
-    const float q[4] = {0.0f, sinf(0.5f * a), 0.0f, cosf(0.5f * a)}, *v = view->quat;
-    fv_pose p = *view; /* view * yaw (about the head's own up axis) */
-    p.quat[0] = v[3] * q[0] + v[0] * q[3] + v[1] * q[2] - v[2] * q[1];
-    p.quat[1] = v[3] * q[1] - v[0] * q[2] + v[1] * q[3] + v[2] * q[0];
-    p.quat[2] = v[3] * q[2] + v[0] * q[1] - v[1] * q[0] + v[2] * q[3];
-    p.quat[3] = v[3] * q[3] - v[0] * q[0] - v[1] * q[1] - v[2] * q[2];
+    const float q[4] = {0.0f, sinf(0.5f * a), 0.0f, cosf(0.5f * a)};
+    fv_pose p = *view;
+    fv_quat_mul(view->quat, q, p.quat); /* about the head's own up axis */
     return p;
 }
 

@@ -25,6 +25,18 @@ void fv_quat_rotate(const float q[4], const float v[3], float out[3])
     out[2] = v[2] + 2.0f * (w * cz + ccz);
 }
 
+void fv_quat_mul(const float a[4], const float b[4], float out[4])
+{
+    const float x = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
+    const float y = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
+    const float z = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
+    const float w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    out[0] = x;
+    out[1] = y;
+    out[2] = z;
+    out[3] = w;
+}
+
 void fv_quat_normalize(float q[4])
 {
     float n = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);

@@ -49,6 +49,8 @@ static inline void fv_camera_ray(const fv_camera *c, float px, float py, float d
 float fv_camera_project(const fv_camera *c, const float p[3], float *px, float *py);
 
 void fv_quat_rotate(const float q[4], const float v[3], float out[3]);
+/* out = a * b (Hamilton product, x, y, z, w): the rotation b, then a. out may alias a or b. */
+void fv_quat_mul(const float a[4], const float b[4], float out[4]);
 void fv_quat_normalize(float q[4]);
 void fv_quat_slerp(const float a[4], const float b[4], float t, float out[4]);
 

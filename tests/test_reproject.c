@@ -106,6 +106,32 @@ static const float *px_at(const fv_pipeline *p, int x, int y)
     return l0->rgbd + 4 * ((ptrdiff_t)y * l0->stride + x);
 }
 
+/* Quaternion product: composing rotations equals rotating twice; the identity is neutral. */
+static void test_quat_mul(void **st)
+{
+    (void)st;
+    const float a[4] = {0.1f, 0.7f, -0.2f, 0.5f}, b[4] = {-0.4f, 0.1f, 0.3f, 0.8f}, id[4] = {0, 0, 0, 1};
+    float qa[4], qb[4], ab[4], t[4];
+    memcpy(qa, a, sizeof qa);
+    memcpy(qb, b, sizeof qb);
+    fv_quat_normalize(qa);
+    fv_quat_normalize(qb);
+    fv_quat_mul(qa, qb, ab);
+    const float v[3] = {0.3f, -1.2f, 2.0f};
+    float r1[3], r2[3], r3[3];
+    fv_quat_rotate(ab, v, r1);
+    fv_quat_rotate(qb, v, r2);
+    fv_quat_rotate(qa, r2, r3);
+    for (int i = 0; i < 3; i++)
+        assert_float_equal(r1[i], r3[i], 1e-5);
+    fv_quat_mul(id, qa, t);
+    for (int i = 0; i < 4; i++)
+        assert_float_equal(t[i], qa[i], 0.0);
+    fv_quat_mul(qa, id, t);
+    for (int i = 0; i < 4; i++)
+        assert_float_equal(t[i], qa[i], 0.0);
+}
+
 /* The mapping against hand-computed pose changes: a sideways translation t shifts a point at
  * depth D by -t f / D pixels; a rotation moves points independently of their depth, to where
  * an independent projection (fv_camera_project) puts them. */
@@ -368,6 +394,7 @@ static void test_no_ghost_on_disocclusion(void **st)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_quat_mul),
         cmocka_unit_test(test_mapping),
         cmocka_unit_test(test_exact_plane_shift),
         cmocka_unit_test(test_static_convergence),

@@ -77,12 +77,9 @@ int main(int argc, char **argv)
     fv_pose view, turned;
     fv_scene_default_view(s, cfg.cam.fov_y_deg, (float)W / (float)H, view.pos, view.quat);
     turned = view;
-    const float a = yaw_deg * 3.14159265f / 180.0f; /* the view turned about world +Y */
-    const float q[4] = {0.0f, sinf(0.5f * a), 0.0f, cosf(0.5f * a)}, *v = view.quat;
-    turned.quat[0] = q[3] * v[0] + q[0] * v[3] + q[1] * v[2] - q[2] * v[1];
-    turned.quat[1] = q[3] * v[1] - q[0] * v[2] + q[1] * v[3] + q[2] * v[0];
-    turned.quat[2] = q[3] * v[2] + q[0] * v[1] - q[1] * v[0] + q[2] * v[3];
-    turned.quat[3] = q[3] * v[3] - q[0] * v[0] - q[1] * v[1] - q[2] * v[2];
+    const float a = yaw_deg * 3.14159265f / 180.0f; /* the view turned about its own up axis */
+    const float q[4] = {0.0f, sinf(0.5f * a), 0.0f, cosf(0.5f * a)};
+    fv_quat_mul(view.quat, q, turned.quat);
 
     /* history: a converged static view (one pattern cycle and one more frame) */
     fv_pipeline *hp = fv_pipeline_create(s, &cfg, err, sizeof err);
