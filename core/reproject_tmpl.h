@@ -147,6 +147,18 @@ static inline void taa_fill_px(const struct fv_taa_frame *f, const struct fv_taa
     }
 }
 
+/* The pixels [*ilo, *ihi) of a fill row whose history texels x0 + i + flow_x lie inside the
+ * previous row (contiguous runs the ISA versions load whole; the rest goes pixel by pixel). */
+static inline void taa_fill_span(const struct fv_taa_frame *f, const struct fv_taa_tile *t, int x0, int n, int *ilo,
+                                 int *ihi)
+{
+    const int sx0 = x0 + t->flow_x, W = (int)f->prev_w;
+    int lo = sx0 < 0 ? -sx0 : 0, hi = W - sx0 < n ? W - sx0 : n;
+    lo = lo > n ? n : lo;
+    *ilo = lo;
+    *ihi = hi < lo ? lo : hi;
+}
+
 /* Row set-up of the fill: NULL when the history row is outside the previous image. */
 static inline const float *taa_fill_setup(const struct fv_taa_frame *f, const struct fv_taa_tile *t, int y,
                                           const float **hw, float B[3])

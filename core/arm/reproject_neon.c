@@ -75,12 +75,9 @@ static void taa_fill_row_neon(const struct fv_taa_frame *f, const struct fv_taa_
     if (!(hrow = taa_fill_setup(f, t, y, &hw, B)))
         return;
     const float py = (float)y + 0.5f;
-    const int sx0 = x0 + t->flow_x, W = (int)f->prev_w;
-    int ilo = sx0 < 0 ? -sx0 : 0, ihi = W - sx0 < n ? W - sx0 : n;
-    if (ilo > n)
-        ilo = n;
-    if (ihi < ilo)
-        ihi = ilo;
+    const int sx0 = x0 + t->flow_x;
+    int ilo, ihi;
+    taa_fill_span(f, t, x0, n, &ilo, &ihi);
     taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
     const float32x4_t zero = vdupq_n_f32(0.0f), half = vdupq_n_f32(0.5f), mhalf = vdupq_n_f32(-0.5f);
     static const int32_t lanes[4] = {0, 1, 2, 3};

@@ -72,13 +72,9 @@ static void taa_fill_row_sse41(const struct fv_taa_frame *f, const struct fv_taa
     if (!(hrow = taa_fill_setup(f, t, y, &hw, B)))
         return;
     const float py = (float)y + 0.5f;
-    const int sx0 = x0 + t->flow_x, W = (int)f->prev_w;
-    /* vector lanes need their history texels inside the row: sx0 + i in [0, W) */
-    int ilo = sx0 < 0 ? -sx0 : 0, ihi = W - sx0 < n ? W - sx0 : n;
-    if (ilo > n)
-        ilo = n;
-    if (ihi < ilo)
-        ihi = ilo;
+    const int sx0 = x0 + t->flow_x;
+    int ilo, ihi;
+    taa_fill_span(f, t, x0, n, &ilo, &ihi);
     taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
     const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), mhalf = _mm_set1_ps(-0.5f);
     const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
