@@ -16,6 +16,8 @@
 #ifndef FOVEA_DSP_H
 #define FOVEA_DSP_H
 
+#include <stddef.h>
+
 enum {
     FV_ISA_C = 0,
     FV_ISA_SSE41 = 1 << 0,
@@ -53,29 +55,32 @@ typedef void (*fv_pull_row_fn)(float *restrict dst_rgbd, float *restrict dst_wgt
 typedef void (*fv_push_row_fn)(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
                                const float *coarse_far, int n);
 
-/* Temporal reprojection (core/reproject.h has the model). Rows of n pixels x0 .. x0+n-1 of
- * level-0 row y; rgbd / wgt point at pixel x0.
- * taa_blend_row: every pixel with weight 1 (a sample) is blended with its reprojected history;
- *   the sums of its flow to the previous frame are added to *flow. Other pixels untouched.
- * taa_fill_row: every pixel with weight 0 (a hole) takes valid history, if any: colour,
- *   depth in this frame's view, weight = the history's confidence in (0, 1]. Others untouched.
+/* Temporal reprojection (core/reproject.h has the model), on a block of level 0: pixels
+ * x0 .. x0+w-1 (w <= 64) of rows y0 .. y0+h-1; rgbd / wgt point at pixel (x0, y0), rows are
+ * stride pixels apart. One call per tile, so the per-call set-up is paid once.
+ * taa_blend: every pixel with weight 1 (a sample) is blended with its reprojected history; the
+ *   sums of its flow to the previous frame are added to *flow in row-major pixel order. Other
+ *   pixels untouched.
+ * taa_fill: every pixel with weight 0 (a hole) takes valid history, if any: colour, depth in
+ *   this frame's view, weight = the history's confidence in (0, 1]. Others untouched.
  * Both read the history pyramid only at texels [-1, w] x [-1, h] of a level (its border).
  * All arithmetic outside the 4-channel texel accumulation is scalar and shared
  * (core/reproject_tmpl.h), so every ISA version gives the reference's bits. */
 struct fv_taa_frame;
 struct fv_taa_tile;
 struct fv_taa_flow;
-typedef void (*fv_taa_blend_row_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
-                                    const float *wgt, int x0, int y, int n, struct fv_taa_flow *flow);
-typedef void (*fv_taa_fill_row_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
-                                   float *wgt, int x0, int y, int n);
+typedef void (*fv_taa_blend_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
+                                const float *wgt, ptrdiff_t stride, int x0, int y0, int w, int h,
+                                struct fv_taa_flow *flow);
+typedef void (*fv_taa_fill_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                               ptrdiff_t stride, int x0, int y0, int w, int h);
 
 typedef struct fv_dsp {
     unsigned isa; /* the ISA actually selected (one FV_ISA_* value) */
     fv_pull_row_fn pull_row;
     fv_push_row_fn push_row;
-    fv_taa_blend_row_fn taa_blend_row;
-    fv_taa_fill_row_fn taa_fill_row;
+    fv_taa_blend_fn taa_blend;
+    fv_taa_fill_fn taa_fill;
 } fv_dsp;
 
 unsigned fv_cpu_isas(void);            /* FV_ISA_* bits this CPU runs */
@@ -90,10 +95,10 @@ void fv_pull_row_c(float *restrict dst_rgbd, float *restrict dst_wgt, const floa
                    const float *src0_wgt, const float *src1_rgbd, const float *src1_wgt, int n);
 void fv_push_row_c(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
                    const float *coarse_far, int n);
-void fv_taa_blend_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
-                        int x0, int y, int n, struct fv_taa_flow *flow);
-void fv_taa_fill_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt, int x0,
-                       int y, int n);
+void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
+                    ptrdiff_t stride, int x0, int y0, int w, int h, struct fv_taa_flow *flow);
+void fv_taa_fill_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                   ptrdiff_t stride, int x0, int y0, int w, int h);
 
 void fv_pullpush_init_c(fv_dsp *d);
 void fv_reproject_init_c(fv_dsp *d);

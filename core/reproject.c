@@ -115,10 +115,8 @@ void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const stru
     fv_taa_tile_setup(&tt, prm, fv_sampler_probability(smp, cx - (float)gx, cy - (float)gy), smp->prm.p_min,
                       smp->phases);
     fv_taa_flow fl = {0.0f, 0.0f, 0.0f};
-    for (int y = y0; y < y0 + th; y++) {
-        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
-        dsp->taa_blend_row(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw, &fl);
-    }
+    const ptrdiff_t o = (ptrdiff_t)y0 * l0->stride + x0;
+    dsp->taa_blend(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th, &fl);
     if (!prm->fill)
         return;
     float fx = 0.0f, fy = 0.0f;
@@ -136,10 +134,7 @@ void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const stru
         return;
     tt.flow_x = (int)floorf(fx + 0.5f);
     tt.flow_y = (int)floorf(fy + 0.5f);
-    for (int y = y0; y < y0 + th; y++) {
-        const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x0;
-        dsp->taa_fill_row(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, x0, y, tw);
-    }
+    dsp->taa_fill(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
 }
 
 /* ---------------------------------------------------------------- reference kernels */
@@ -194,23 +189,30 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 #define TAA_FN(name) name##_c
 #include "reproject_tmpl.h"
 
-void fv_taa_blend_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
-                        int x0, int y, int n, struct fv_taa_flow *flow)
+void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
+                    ptrdiff_t stride, int x0, int y0, int w, int h, struct fv_taa_flow *flow)
 {
-    taa_blend_row_c(f, t, rgbd, wgt, x0, y, n, flow);
+    taa_blend_c(f, t, rgbd, wgt, stride, x0, y0, w, h, flow);
 }
 
-void fv_taa_fill_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt, int x0,
-                       int y, int n)
+static inline void fill_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                              int x0, int y, int n)
 {
     const float *hw, *hrow;
     float B[3];
     if ((hrow = taa_fill_setup(f, t, y, &hw, B)))
         taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, (float)y + 0.5f, 0, n);
 }
+TAA_FILL_BLOCK(fill_c, fill_row_c)
+
+void fv_taa_fill_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                   ptrdiff_t stride, int x0, int y0, int w, int h)
+{
+    fill_c(f, t, rgbd, wgt, stride, x0, y0, w, h);
+}
 
 void fv_reproject_init_c(fv_dsp *d)
 {
-    d->taa_blend_row = fv_taa_blend_row_c;
-    d->taa_fill_row = fv_taa_fill_row_c;
+    d->taa_blend = fv_taa_blend_c;
+    d->taa_fill = fv_taa_fill_c;
 }

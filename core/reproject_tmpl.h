@@ -42,18 +42,21 @@ static const float taa_pow2[8] = {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f, 1
 static const float taa_inv_pow2[8] = {1.0f, 0.5f, 0.25f, 0.125f, 0.0625f, 0.03125f, 0.015625f, 0.0078125f};
 
 #ifndef TAA_OWN_BLEND /* an ISA may vectorise the blend across samples instead */
-static void TAA_FN(taa_blend_row)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
-                                  const float *wgt, int x0, int y, int n, struct fv_taa_flow *flow)
+static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                              const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
+                              struct fv_taa_flow *flow)
 {
-    const float py = (float)y + 0.5f;
-    const float b0 = f->M0[0] + py * f->MY[0], b1 = f->M0[1] + py * f->MY[1], b2 = f->M0[2] + py * f->MY[2];
     const float umax = f->prev_w - 0.015625f, vmax = f->prev_h - 0.015625f; /* taps stay inside */
     float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
-    for (int x = 0; x < n; x += 64) {
+    for (int r = 0; r < h; r++) {
+        const int y = y0 + r;
+        float *rgbd = rgbd_blk + 4 * r * stride;
+        const float py = (float)y + 0.5f;
+        const float b0 = f->M0[0] + py * f->MY[0], b1 = f->M0[1] + py * f->MY[1], b2 = f->M0[2] + py * f->MY[2];
         /* iterate over the samples' bits: no branch on the (dithered) pattern per pixel */
-        uint64_t m = sample_mask(wgt + x, n - x < 64 ? n - x : 64);
+        uint64_t m = sample_mask(wgt_blk + r * stride, w);
         while (m) {
-            const int i = x + __builtin_ctzll(m);
+            const int i = __builtin_ctzll(m);
             m &= m - 1;
             float *px = rgbd + 4 * i;
             const float d = px[3], pxc = (float)(x0 + i) + 0.5f;
@@ -158,6 +161,15 @@ static inline void taa_fill_span(const struct fv_taa_frame *f, const struct fv_t
     *ilo = lo;
     *ihi = hi < lo ? lo : hi;
 }
+
+/* The block form of a fill row function (each ISA's vector row, the reference's scalar one). */
+#define TAA_FILL_BLOCK(name, row)                                                                         \
+    static void name(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,  \
+                     ptrdiff_t stride, int x0, int y0, int w, int h)                                     \
+    {                                                                                                     \
+        for (int r = 0; r < h; r++)                                                                       \
+            row(f, t, rgbd + 4 * r * stride, wgt + r * stride, x0, y0 + r, w);                             \
+    }
 
 /* Row set-up of the fill: NULL when the history row is outside the previous image. */
 static inline const float *taa_fill_setup(const struct fv_taa_frame *f, const struct fv_taa_tile *t, int y,

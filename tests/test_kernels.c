@@ -338,10 +338,14 @@ static void random_row(float *rgbd, float *wgt, int n)
 static const char *motion_name[3] = { "identity", "small", "large" };
 static long taa_blended, taa_quincunx, taa_filled; /* how often the paths really ran */
 
-static int run_taa(const fv_dsp *d, const char *isa, const fv_taa_frame *f, int n, int off, int motion)
+/* One block of w pixels by h rows (rows stride pixels apart; the padding between rows is part of
+ * the buffer and must come back untouched) at a random place of the image. */
+static int run_taa(const fv_dsp *d, const char *isa, const fv_taa_frame *f, int w, int h, int pad, int off, int motion)
 {
     const int W = (int)f->prev_w, H = (int)f->prev_h;
-    const int x0 = n >= W ? 0 : (int)(fv_test_rand(&rng) % (unsigned)(W - n + 1)), y = (int)(fv_test_rand(&rng) % (unsigned)H);
+    const int x0 = (int)(fv_test_rand(&rng) % (unsigned)(W - w + 1)), y0 = (int)(fv_test_rand(&rng) % (unsigned)(H - h + 1));
+    const ptrdiff_t stride = w + pad;
+    const size_t n = (size_t)(h - 1) * (size_t)stride + (size_t)w; /* pixels in the buffer */
     /* footprints of one texel, of several levels, and wide enough for quincunx taps */
     static const float widen[] = { 1.0f, 1.0f, 1.3f, 2.2360680f, 2.6f, 3.0f, 4.0f, 9.0f };
     fv_taa_tile t = { widen[fv_test_rand(&rng) % 8], 0.05f + 0.95f * rnd(), 0, 0 };
@@ -349,65 +353,69 @@ static int run_taa(const fv_dsp *d, const char *isa, const fv_taa_frame *f, int 
     const int big = fv_test_rand(&rng) % 8 == 0;
     t.flow_x = (int)(fv_test_rand(&rng) % 7) - 3 + (big ? (int)(fv_test_rand(&rng) % (unsigned)(2 * W)) - W : 0);
     t.flow_y = (int)(fv_test_rand(&rng) % 7) - 3 + (big ? (int)(fv_test_rand(&rng) % (unsigned)(2 * H)) - H : 0);
-    buf rc = out_new(4 * (size_t)n, off), rw = out_new((size_t)n, off);
-    buf tc = out_new(4 * (size_t)n, off), tw = out_new((size_t)n, off);
-    random_row(rc.p, rw.p, n);
-    memcpy(tc.p, rc.p, 4 * (size_t)n * sizeof(float));
-    memcpy(tw.p, rw.p, (size_t)n * sizeof(float));
-    fv_taa_flow fr = { 0.5f, -0.25f, 3.0f }, ft = fr; /* sums continue from earlier rows */
-    float *before = malloc(4 * (size_t)n * sizeof(float));
+    buf rc = out_new(4 * n, off), rw = out_new(n, off);
+    buf tc = out_new(4 * n, off), tw = out_new(n, off);
+    random_row(rc.p, rw.p, (int)n);
+    memcpy(tc.p, rc.p, 4 * n * sizeof(float));
+    memcpy(tw.p, rw.p, n * sizeof(float));
+    fv_taa_flow fr = { 0.5f, -0.25f, 3.0f }, ft = fr; /* sums continue from earlier calls */
+    float *before = malloc(4 * n * sizeof(float)), *wbefore = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, rc.p, 4 * (size_t)n * sizeof(float));
-    fv_taa_blend_row_c(f, &t, rc.p, rw.p, x0, y, n, &fr);
-    for (int i = 0; i < n; i++)
+    assert_non_null(wbefore);
+    memcpy(before, rc.p, 4 * n * sizeof(float));
+    fv_taa_blend_c(f, &t, rc.p, rw.p, stride, x0, y0, w, h, &fr);
+    for (size_t i = 0; i < n; i++)
         if (memcmp(before + 4 * i, rc.p + 4 * i, 3 * sizeof(float))) {
+            if ((ptrdiff_t)(i % (size_t)stride) >= w)
+                fail_msg("c taa_blend wrote into the padding between rows (pixel %zu)", i);
             taa_blended++;
             taa_quincunx += t.widen >= 2.6f;
         }
-    d->taa_blend_row(f, &t, tc.p, tw.p, x0, y, n, &ft);
-    check_canaries(&tc, 4 * (size_t)n, isa, "taa_blend_row", n);
-    check_canaries(&tw, (size_t)n, isa, "taa_blend_row", n);
-    compare(rc.p, tc.p, 4 * (size_t)n, 4, isa, "taa_blend_row", motion_name[motion], n, off, 0);
-    compare(rw.p, tw.p, (size_t)n, 1, isa, "taa_blend_row", "weight", n, off, 0);
-    compare(&fr.dx, &ft.dx, 3, 3, isa, "taa_blend_row", "flow sums", n, off, 0);
-    assert_finite(rc.p, 4 * (size_t)n, "taa_blend_row", n);
-    float *wbefore = malloc((size_t)n * sizeof(float));
-    assert_non_null(wbefore);
-    memcpy(wbefore, rw.p, (size_t)n * sizeof(float));
-    fv_taa_fill_row_c(f, &t, rc.p, rw.p, x0, y, n);
-    for (int i = 0; i < n; i++)
-        if (wbefore[i] == 0.0f && rw.p[i] > 0.0f)
+    d->taa_blend(f, &t, tc.p, tw.p, stride, x0, y0, w, h, &ft);
+    check_canaries(&tc, 4 * n, isa, "taa_blend", w);
+    check_canaries(&tw, n, isa, "taa_blend", w);
+    compare(rc.p, tc.p, 4 * n, 4, isa, "taa_blend", motion_name[motion], w, off, 0);
+    compare(rw.p, tw.p, n, 1, isa, "taa_blend", "weight", w, off, 0);
+    compare(&fr.dx, &ft.dx, 3, 3, isa, "taa_blend", "flow sums", w, off, 0);
+    assert_finite(rc.p, 4 * n, "taa_blend", w);
+    memcpy(wbefore, rw.p, n * sizeof(float));
+    fv_taa_fill_c(f, &t, rc.p, rw.p, stride, x0, y0, w, h);
+    for (size_t i = 0; i < n; i++)
+        if (wbefore[i] == 0.0f && rw.p[i] > 0.0f) {
+            if ((ptrdiff_t)(i % (size_t)stride) >= w)
+                fail_msg("c taa_fill wrote into the padding between rows (pixel %zu)", i);
             taa_filled++;
-        else if (wbefore[i] != rw.p[i]) /* only holes are filled */
-            fail_msg("c taa_fill_row changed the weight of pixel %d from %g", i, (double)wbefore[i]);
+        } else if (wbefore[i] != rw.p[i]) { /* only holes are filled */
+            fail_msg("c taa_fill changed the weight of pixel %zu from %g", i, (double)wbefore[i]);
+        }
     free(before);
     free(wbefore);
-    d->taa_fill_row(f, &t, tc.p, tw.p, x0, y, n);
-    check_canaries(&tc, 4 * (size_t)n, isa, "taa_fill_row", n);
-    check_canaries(&tw, (size_t)n, isa, "taa_fill_row", n);
-    compare(rc.p, tc.p, 4 * (size_t)n, 4, isa, "taa_fill_row", motion_name[motion], n, off, 0);
-    compare(rw.p, tw.p, (size_t)n, 1, isa, "taa_fill_row", "weight", n, off, 0);
-    assert_finite(rc.p, 4 * (size_t)n, "taa_fill_row", n);
-    for (int i = 0; i < n; i++)
+    d->taa_fill(f, &t, tc.p, tw.p, stride, x0, y0, w, h);
+    check_canaries(&tc, 4 * n, isa, "taa_fill", w);
+    check_canaries(&tw, n, isa, "taa_fill", w);
+    compare(rc.p, tc.p, 4 * n, 4, isa, "taa_fill", motion_name[motion], w, off, 0);
+    compare(rw.p, tw.p, n, 1, isa, "taa_fill", "weight", w, off, 0);
+    assert_finite(rc.p, 4 * n, "taa_fill", w);
+    for (size_t i = 0; i < n; i++)
         assert_true(rw.p[i] >= 0.0f && rw.p[i] <= 1.0f);
     free(rc.base), free(rw.base), free(tc.base), free(tw.base);
     return 1;
 }
 
-static void test_taa_rows(void **state)
+static void test_taa_blocks(void **state)
 {
     (void)state;
     int tested = 0;
     for (int k = 0; isa_list[k]; k++) {
         const unsigned isa = isa_list[k];
         if (!(fv_cpu_isas() & isa)) {
-            printf("[ kernels  ] taa rows: %-7s not on this CPU, skipped\n", fv_isa_name(isa));
+            printf("[ kernels  ] taa: %-7s not on this CPU, skipped\n", fv_isa_name(isa));
             continue;
         }
         fv_dsp d;
         fv_dsp_init(&d, isa);
-        if (d.taa_blend_row == fv_taa_blend_row_c || d.taa_fill_row == fv_taa_fill_row_c) {
-            printf("[ kernels  ] taa rows: %-7s has no version of its own, skipped\n", fv_isa_name(isa));
+        if (d.taa_blend == fv_taa_blend_c || d.taa_fill == fv_taa_fill_c) {
+            printf("[ kernels  ] taa: %-7s has no version of its own, skipped\n", fv_isa_name(isa));
             continue;
         }
         int runs = 0;
@@ -423,15 +431,19 @@ static void test_taa_rows(void **state)
                     fv_taa_frame f;
                     fv_taa_frame_setup(&f, &cur, &prev, &hist, 0.03f);
                     assert_int_equal(f.identity, motion == 0);
+                    const int wmax = W < 64 ? W : 64;
                     for (int r = 0; r < 40; r++) {
-                        int n = 1 + (int)(fv_test_rand(&rng) % (unsigned)(W < 40 ? W : 40));
-                        if (r < NSIZES && sizes[r] <= W)
-                            n = sizes[r];
-                        runs += run_taa(&d, fv_isa_name(isa), &f, n, (int)(fv_test_rand(&rng) % 4), motion);
+                        /* single rows of the edge-case widths first, then random blocks up to 64x16 */
+                        int w = 1 + (int)(fv_test_rand(&rng) % (unsigned)wmax);
+                        int h = r < 20 ? 1 : 1 + (int)(fv_test_rand(&rng) % (unsigned)(H < 16 ? H : 16));
+                        if (r < NSIZES && sizes[r] <= wmax)
+                            w = sizes[r];
+                        runs += run_taa(&d, fv_isa_name(isa), &f, w, h, (int)(fv_test_rand(&rng) % 6),
+                                        (int)(fv_test_rand(&rng) % 4), motion);
                     }
                     fv_pyramid_free(&hist);
                 }
-        printf("[ kernels  ] taa_blend_row, taa_fill_row: %-7s == c on %d rows (bit-exact); %ld samples blended "
+        printf("[ kernels  ] taa_blend, taa_fill: %-7s == c on %d blocks (bit-exact); %ld samples blended "
                "(%ld with wide footprints), %ld holes filled\n", fv_isa_name(isa), runs, taa_blended, taa_quincunx,
                taa_filled);
         /* the inputs must really exercise the blend, the quincunx taps and the fill */
@@ -439,7 +451,7 @@ static void test_taa_rows(void **state)
         taa_blended = taa_quincunx = taa_filled = 0;
         tested++;
     }
-    printf("[ kernels  ] taa rows: %d ISA version(s) tested\n", tested);
+    printf("[ kernels  ] taa: %d ISA version(s) tested\n", tested);
 }
 
 /* ------------------------------------------------------------------ dispatch */
@@ -458,8 +470,8 @@ static void test_dispatch(void **state)
     assert_int_equal(d.isa, FV_ISA_C);
     assert_ptr_equal(d.pull_row, fv_pull_row_c);
     assert_ptr_equal(d.push_row, fv_push_row_c);
-    assert_ptr_equal(d.taa_blend_row, fv_taa_blend_row_c);
-    assert_ptr_equal(d.taa_fill_row, fv_taa_fill_row_c);
+    assert_ptr_equal(d.taa_blend, fv_taa_blend_c);
+    assert_ptr_equal(d.taa_fill, fv_taa_fill_c);
     fv_dsp_init(&d, ~0u); /* best: the highest ISA bit this CPU has */
     unsigned best = 0;
     for (unsigned b = 1; b <= FV_ISA_NEON; b <<= 1)
@@ -480,7 +492,7 @@ int main(void)
         cmocka_unit_test(test_dispatch),
         cmocka_unit_test(test_pull_row),
         cmocka_unit_test(test_push_row),
-        cmocka_unit_test(test_taa_rows),
+        cmocka_unit_test(test_taa_blocks),
     };
     return cmocka_run_group_tests_name("kernels", tests, NULL, NULL);
 }

@@ -67,7 +67,7 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 
 /* The fill, four pixels at a time (vld4 / vst4 de-interleave r, g, b, depth): each lane does the
  * reference's operations (taa_fill_px). */
-static void taa_fill_row_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+static inline void taa_fill_row_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                               int x0, int y, int n)
 {
     const float *hw, *hrow;
@@ -119,8 +119,10 @@ static void taa_fill_row_neon(const struct fv_taa_frame *f, const struct fv_taa_
     taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
 }
 
+TAA_FILL_BLOCK(taa_fill_neon, taa_fill_row_neon)
+
 void fv_reproject_init_neon(fv_dsp *d)
 {
-    d->taa_blend_row = taa_blend_row_neon;
-    d->taa_fill_row = taa_fill_row_neon;
+    d->taa_blend = taa_blend_neon;
+    d->taa_fill = taa_fill_neon;
 }

@@ -71,7 +71,7 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1); }
 
 /* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). */
-static void taa_fill_row_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+static inline void taa_fill_row_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                               int x0, int y, int n)
 {
     const float *hw, *hrow;
@@ -135,8 +135,10 @@ static void taa_fill_row_avx2(const struct fv_taa_frame *f, const struct fv_taa_
     taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
 }
 
+TAA_FILL_BLOCK(taa_fill_avx2, taa_fill_row_avx2)
+
 void fv_reproject_init_avx2(fv_dsp *d)
 {
-    d->taa_blend_row = taa_blend_row_avx2;
-    d->taa_fill_row = taa_fill_row_avx2;
+    d->taa_blend = taa_blend_avx2;
+    d->taa_fill = taa_fill_avx2;
 }

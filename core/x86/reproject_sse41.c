@@ -64,7 +64,7 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 #include "reproject_tmpl.h"
 
 /* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px). */
-static void taa_fill_row_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+static inline void taa_fill_row_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                                int x0, int y, int n)
 {
     const float *hw, *hrow;
@@ -120,8 +120,10 @@ static void taa_fill_row_sse41(const struct fv_taa_frame *f, const struct fv_taa
     taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
 }
 
+TAA_FILL_BLOCK(taa_fill_sse41, taa_fill_row_sse41)
+
 void fv_reproject_init_sse41(fv_dsp *d)
 {
-    d->taa_blend_row = taa_blend_row_sse41;
-    d->taa_fill_row = taa_fill_row_sse41;
+    d->taa_blend = taa_blend_sse41;
+    d->taa_fill = taa_fill_sse41;
 }
