@@ -154,6 +154,7 @@ bench: deps
 	@$(MAKE) --no-print-directory all $(RANGE)
 	@mkdir -p out/bench
 	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 30 --json out/bench/range.json
+	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 30 --yaw-rate 30 --json out/bench/range-turning.json
 
 PREFIX ?= /usr/local
 install: all
