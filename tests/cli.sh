@@ -65,6 +65,7 @@ expect_usage "replay empty trace" 'empty.csv: no samples' $R --scene $SCENE --ou
 expect_usage "replay reference not built" '--reference: .*not built yet' $R --scene $SCENE --out "$T/o2" --reference 16
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
 expect_usage "bench bad mode" '--mode: .fast. is not one of' $B/fovea-bench --scene $SCENE --mode fast
+expect_usage "bench bad yaw rate" '--yaw-rate: 1000 is out of range' $B/fovea-bench --scene $SCENE --yaw-rate 1000
 
 # A good run: frames and stats with the documented columns
 if $R --scene $SCENE --trace "$T/good.csv" --frames 3 --size 96x108 --out "$T/run" --quiet 2>"$T/err"; then
@@ -131,6 +132,14 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
         grep -q "$k" "$T/b.json" && ok || bad "bench JSON lacks $k"
     done
     grep -q 'Ray Tracing' "$T/out" && ok || bad "bench table header missing"
+    # a turning head: the reprojection column is measured, and the JSON says the rate
+    if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --mode foveated --yaw-rate 30 \
+        --json "$T/t.json" >/dev/null 2>"$T/err"; then
+        grep -q '"yaw_rate_dps": 30' "$T/t.json" && grep -q '"reproject": [0-9]' "$T/t.json" && ok ||
+            bad "turning bench JSON: $(cat "$T/t.json")"
+    else
+        bad "turning bench failed: $(cat "$T/err")"
+    fi
 else
     bad "bench failed: $(cat "$T/err")"
 fi
