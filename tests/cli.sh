@@ -62,7 +62,11 @@ expect_usage "replay truncated trace" 'truncated.csv:3: 2 fields, expected 3' $R
 expect_usage "replay non-numeric trace" 'nan.csv:2: field 3 .*abc.* is not a finite number' $R --scene $SCENE --out "$T/o2" --trace "$T/nan.csv"
 expect_usage "replay wrong header" 'header.csv:1: header must start with t_ms,gaze_x,gaze_y' $R --scene $SCENE --out "$T/o2" --trace "$T/header.csv"
 expect_usage "replay empty trace" 'empty.csv: no samples' $R --scene $SCENE --out "$T/o2" --trace "$T/empty.csv"
-expect_usage "replay reference not built" '--reference: .*not built yet' $R --scene $SCENE --out "$T/o2" --reference 16
+expect_usage "replay reference spp 0" '--reference: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 0
+expect_usage "replay focus without reference" '--focus-m only applies to --reference' $R --scene $SCENE --out "$T/o2" --focus-m 2
+expect_usage "replay bad focus" '--focus-m: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --focus-m 0
+expect_usage "replay bad pupil" '--pupil-mm: 20 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --pupil-mm 20
+expect_usage "replay reference vs-full" '--vs-full and --reference exclude each other' $R --scene $SCENE --out "$T/o2" --reference 4 --vs-full
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
 expect_usage "bench bad mode" '--mode: .fast. is not one of' $B/fovea-bench --scene $SCENE --mode fast
 
@@ -108,6 +112,25 @@ for f in frame_00000.png frame_00001.png frame_00002.png; do
         if cmp -s "$T/d1/$f" "$T/$d/$f"; then ok; else bad "$f differs between d1 and $d"; fi
     done
 done
+# --reference: same files and header; the stage columns are empty, total_ms is the render time,
+# samples = (SPP + 1 depth ray) per pixel; a zero pupil at SPP 1 is the full pinhole render;
+# same bytes for 1 and 2 threads
+if $R --scene $SCENE --frames 2 --size 48x54 --reference 4 --out "$T/ref" --quiet 2>"$T/err"; then
+    [ "$(head -n 1 "$T/ref/stats.csv")" = "$(head -n 1 "$T/run/stats.csv")" ] && ok || bad "reference stats header differs"
+    awk -F, 'NR == 2 && $5 == 48 * 54 * 5 && $6 == "" && $11 == "" && $12 > 0 {ok = 1} END {exit !ok}' "$T/ref/stats.csv" \
+        && ok || bad "reference stats row: $(sed -n 2p "$T/ref/stats.csv")"
+    [ -e "$T/ref/frame_00001.png" ] && ok || bad "reference frames missing"
+else
+    bad "replay --reference failed: $(cat "$T/err")"
+fi
+$R --scene $SCENE --frames 1 --size 64x72 --full --out "$T/pin" --quiet 2>/dev/null
+$R --scene $SCENE --frames 1 --size 64x72 --reference 1 --pupil-mm 0 --out "$T/ref0" --quiet 2>/dev/null
+cmp -s "$T/pin/frame_00000.png" "$T/ref0/frame_00000.png" && ok || bad "reference with a zero pupil differs from --full"
+for th in 1 2; do
+    $R --scene $SCENE --frames 1 --size 64x72 --reference 6 --focus-m 1.5 --threads $th --out "$T/rt$th" --quiet 2>/dev/null
+done
+cmp -s "$T/rt1/frame_00000.png" "$T/rt2/frame_00000.png" && ok || bad "reference differs between 1 and 2 threads"
+cmp -s "$T/pin/frame_00000.png" "$T/rt1/frame_00000.png" && bad "reference with a pupil is not blurred" || ok
 $R --scene $SCENE --frames 1 --size 160x180 --stereo --out "$T/st" --quiet 2>"$T/err" && ok || bad "stereo: $(cat "$T/err")"
 # Y4M: header, then per frame "FRAME\n" + a 4:2:0 picture (w*h*3/2 bytes); stereo is side by side
 if $R --scene $SCENE --frames 2 --size 64x72 --stereo --y4m "$T/v.y4m" --out "$T/y" --quiet 2>"$T/err"; then
