@@ -208,6 +208,12 @@ static void test_defocused_edge_width(void **st)
                (double)pupils[i], got, want, coc_px);
         assert_true(fabs(got - want) < 0.02 * want);
     }
+    /* the near side: focus 4 m, the plane at 0.25 m has the same |1/g - 1/focus| = 3.75 D and
+     * so the same 9.44 px width (8 mm pupil) */
+    const double near = edge_width_px(0.25f, 4.0f, 8.0f, &cam, 256);
+    printf("    near field (plane 0.25 m, focus 4 m): measured %.3f px, thin lens %.3f px\n", near,
+           DISC_ESF_10_90 * 0.008 * 3.75 * cam.focal_px);
+    assert_true(fabs(near - DISC_ESF_10_90 * 0.008 * 3.75 * cam.focal_px) < 0.02 * near);
     /* in focus the edge is a one-pixel step (the crossings lie between two pixel centres) */
     assert_true(edge_width_px(4.0f, 4.0f, 8.0f, &cam, 16) < 1.0);
 }
