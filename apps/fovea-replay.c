@@ -247,9 +247,11 @@ int main(int argc, char **argv)
                 fv_camera cam;
                 cd.eye = eye;
                 fv_camera_setup(&cam, &cd, &head); /* the size and FOV passed fv_pipeline_create */
-                if (e == 0 && !focus_given) /* the first eye's depth at the point of regard, for both */
+                if (e == 0 && !focus_given) { /* the first eye's depth at the point of regard, for both */
                     refp.focus_m = fv_reference_depth_at(scene, &cam, smp_gaze_px(smp.gaze_x, W),
                                                          smp_gaze_px(smp.gaze_y, H));
+                    refp.focus_m = refp.focus_m > 0.05f ? refp.focus_m : 0.05f; /* as --focus-m's minimum */
+                }
                 render_reference(scene, &cam, &refp, fv_pipeline_pool(pl), refbuf, rgb + (size_t)e * W * 3,
                                  (ptrdiff_t)outw * 3, &rprog, &st[e]);
             } else {
