@@ -100,29 +100,25 @@ static void ref_tile(void *ctx, int index, int thread_id)
         if (r < n) {
             const int p = (int)(r / (spp + 1)), s = (int)(r % (spp + 1)) - 1;
             const int x = x0 + p % tw, y = y0 + p / tw;
-            float d[3], lx = 0.0f, ly = 0.0f;
+            float d[3], o[3] = {cam->eye_pos[0], cam->eye_pos[1], cam->eye_pos[2]};
             fv_camera_ray(cam, (float)x + 0.5f, (float)y + 0.5f, d);
-            if (s >= 0 && j->lens_r_m > 0.0f)
+            if (s >= 0 && j->lens_r_m > 0.0f) {
+                /* from the lens point a through the pixel's point on the focus plane, eye + d *
+                 * focus; the pinhole ray (else) stays bit for bit the pipeline's */
+                float lx, ly;
                 lens_point(j, x, y, s, &lx, &ly);
-            float a[3] = {0.0f, 0.0f, 0.0f};
-            if (s >= 0 && j->lens_r_m > 0.0f) /* else the pinhole ray, bit for bit (no -0 terms) */
-                for (int c = 0; c < 3; c++)
-                    a[c] = lx * cam->right[c] + ly * cam->up[c];
-            /* from the lens point through the pixel's point on the focus plane */
-            rh.ray.org_x[k] = cam->eye_pos[0] + a[0];
-            rh.ray.org_y[k] = cam->eye_pos[1] + a[1];
-            rh.ray.org_z[k] = cam->eye_pos[2] + a[2];
-            rh.ray.dir_x[k] = d[0] - a[0] * inv_focus;
-            rh.ray.dir_y[k] = d[1] - a[1] * inv_focus;
-            rh.ray.dir_z[k] = d[2] - a[2] * inv_focus;
-            if (a[0] == 0.0f && a[1] == 0.0f && a[2] == 0.0f) {
-                rh.ray.org_x[k] = cam->eye_pos[0];
-                rh.ray.org_y[k] = cam->eye_pos[1];
-                rh.ray.org_z[k] = cam->eye_pos[2];
-                rh.ray.dir_x[k] = d[0];
-                rh.ray.dir_y[k] = d[1];
-                rh.ray.dir_z[k] = d[2];
+                for (int c = 0; c < 3; c++) {
+                    const float a = lx * cam->right[c] + ly * cam->up[c];
+                    o[c] += a;
+                    d[c] -= a * inv_focus;
+                }
             }
+            rh.ray.org_x[k] = o[0];
+            rh.ray.org_y[k] = o[1];
+            rh.ray.org_z[k] = o[2];
+            rh.ray.dir_x[k] = d[0];
+            rh.ray.dir_y[k] = d[1];
+            rh.ray.dir_z[k] = d[2];
             rh.ray.tnear[k] = 0.0f;
             rh.ray.tfar[k] = INFINITY;
             rh.ray.time[k] = 0.0f;
