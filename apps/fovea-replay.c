@@ -10,6 +10,7 @@
 #include "metrics.h"
 #include "output.h"
 #include "pipeline.h"
+#include "reference.h"
 #include "scene.h"
 #include "trace.h"
 
@@ -35,13 +36,45 @@ static void usage(FILE *f)
             "  --y4m FILE         also write the frames as a YUV4MPEG2 video\n"
             "  --vs-full          also render every frame with full sampling and report the luma\n"
             "                     PSNR against it (whole image, fovea < r0, periphery > r1)\n"
-            "  --reference SPP    ground-truth depth of field (not built yet)\n"
+            "  --reference SPP    render ground-truth depth of field instead: SPP thin-lens rays\n"
+            "                     per pixel (every pixel; stage columns empty, total_ms its time)\n"
+            "  --focus-m D        --reference focus distance in metres (default: the view depth\n"
+            "                     at the point of regard)\n"
+            "  --pupil-mm P       --reference pupil (lens aperture) diameter (default 4.49)\n"
             "  --window           show frames in a window (not built yet)\n"
             "  --quiet            no progress output\n" FV_COMMON_HELP "  --help             this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_TRACE, OPT_FRAMES, OPT_OUT, OPT_FULL, OPT_STEREO, OPT_Y4M, OPT_REF, OPT_WINDOW, OPT_HZ,
-       OPT_QUIET, OPT_VS_FULL, OPT_HELP };
+       OPT_QUIET, OPT_VS_FULL, OPT_FOCUS, OPT_PUPIL, OPT_HELP };
+
+/* --reference: the thin-lens ground truth (core/reference.h) of one eye into rgb8. The focus is
+ * fixed by the caller for both eyes (they accommodate together). Progress counts tiles. */
+typedef struct {
+    fv_progress *bar;
+    long base;
+    int quiet;
+} ref_progress;
+static void on_ref_progress(void *ctx, long done, long total)
+{
+    (void)total;
+    ref_progress *r = ctx;
+    if (!r->quiet)
+        fv_progress_update(r->bar, r->base + done);
+}
+static long ref_tiles(int w, int h) { return (long)((w + 15) / 16) * ((h + 15) / 16); }
+static void render_reference(const fv_scene *scene, const fv_camera *cam, const fv_reference_params *prm,
+                             fv_pool *pool, float *rgbd, uint8_t *rgb8, ptrdiff_t stride, ref_progress *rp,
+                             fv_frame_stats *st)
+{
+    const int64_t t0 = fv_time_ns();
+    st->samples = fv_reference_render(scene, cam, prm, pool, rgbd, on_ref_progress, rp);
+    fv_reference_to_rgb8(rgbd, cam->width, cam->height, rgb8, stride);
+    for (int s = 0; s < FV_STAGE_COUNT; s++)
+        st->stage_ms[s] = NAN; /* none of the pipeline's stages ran */
+    st->total_ms = (double)(fv_time_ns() - t0) * 1e-6;
+    rp->base += ref_tiles(cam->width, cam->height);
+}
 
 /* Mean of the finite values of a column (NAN when there are none). */
 typedef struct {
@@ -72,6 +105,8 @@ int main(int argc, char **argv)
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL;
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0;
+    fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
+    int focus_given = 0, pupil_given = 0;
     float hz = 90.0f;
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, {"trace", required_argument, 0, OPT_TRACE},
@@ -80,6 +115,7 @@ int main(int argc, char **argv)
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
         {"window", no_argument, 0, OPT_WINDOW}, {"hz", required_argument, 0, OPT_HZ},
         {"quiet", no_argument, 0, OPT_QUIET}, {"vs-full", no_argument, 0, OPT_VS_FULL},
+        {"focus-m", required_argument, 0, OPT_FOCUS}, {"pupil-mm", required_argument, 0, OPT_PUPIL},
         {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -95,9 +131,9 @@ int main(int argc, char **argv)
         case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
         case OPT_QUIET: quiet = 1; break;
         case OPT_VS_FULL: vs_full = 1; break;
-        case OPT_REF:
-            fv_arg_long(prog, "--reference", optarg, 1, 65536);
-            fv_usage_error(prog, "--reference: the ground-truth depth-of-field renderer is not built yet");
+        case OPT_REF: refp.spp = (int)fv_arg_long(prog, "--reference", optarg, 1, 65536); break;
+        case OPT_FOCUS: refp.focus_m = fv_arg_float(prog, "--focus-m", optarg, 0.05f, 1000.0f), focus_given = 1; break;
+        case OPT_PUPIL: refp.pupil_mm = fv_arg_float(prog, "--pupil-mm", optarg, 0.0f, 12.0f), pupil_given = 1; break;
         case OPT_WINDOW: fv_usage_error(prog, "--window: the window display is not built yet; use --out / --y4m");
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
@@ -109,6 +145,10 @@ int main(int argc, char **argv)
     fv_common_validate(prog, argc, argv, scene_path, &cfg);
     if (!out_dir)
         fv_usage_error(prog, "--out DIR is required (see --help)");
+    if ((focus_given || pupil_given) && !refp.spp)
+        fv_usage_error(prog, "%s only applies to --reference SPP", focus_given ? "--focus-m" : "--pupil-mm");
+    if (refp.spp && vs_full)
+        fv_usage_error(prog, "--vs-full and --reference exclude each other");
     if (y4m_path && ((cfg.cam.width & 1) || (cfg.cam.height & 1)))
         fv_usage_error(prog, "--y4m: 4:2:0 video needs even frame sizes, got %dx%d", cfg.cam.width, cfg.cam.height);
 
@@ -145,6 +185,7 @@ int main(int argc, char **argv)
     /* cur / prev: the (left) eye's image of this and the last frame, W * 3 bytes a row */
     uint8_t *rgb = malloc((size_t)outw * H * 3), *prev = malloc((size_t)W * H * 3), *cur = malloc((size_t)W * H * 3);
     uint8_t *full = NULL;
+    float *refbuf = refp.spp ? malloc(sizeof(float) * 4 * (size_t)W * H) : NULL;
     float *err_prev = NULL, *err_cur = NULL;
     if (vs_full) {
         full = malloc((size_t)W * H * 3);
@@ -157,7 +198,7 @@ int main(int argc, char **argv)
     fv_y4m_writer y4m = {0};
     int y4m_open = 0;
     char path[4200];
-    if (!rgb || !prev || !cur || (vs_full && (!full || !err_prev || !err_cur))) {
+    if (!rgb || !prev || !cur || (refp.spp && !refbuf) || (vs_full && (!full || !err_prev || !err_cur))) {
         fprintf(stderr, "%s: out of memory\n", prog);
         goto done;
     }
@@ -185,7 +226,12 @@ int main(int argc, char **argv)
     fprintf(csv.f, ",total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph\n");
 
     fv_progress prog_bar;
-    fv_progress_begin(&prog_bar, "rendering frame", frames);
+    const int neyes = stereo ? 2 : 1;
+    if (refp.spp)
+        fv_progress_begin(&prog_bar, "reference: tile", frames * neyes * ref_tiles(W, H));
+    else
+        fv_progress_begin(&prog_bar, "rendering frame", frames);
+    ref_progress rprog = {&prog_bar, 0, quiet};
     double t_first = trace_path ? tr.s[0].t_ms : 0.0;
     for (long f = 0; f < frames; f++) {
         fv_trace_sample smp;
@@ -194,11 +240,24 @@ int main(int argc, char **argv)
         fv_pose head = tr.has_head ? smp.head : view;
         fv_frame_stats st[2], sum;
         memset(&sum, 0, sizeof sum);
-        int neyes = stereo ? 2 : 1;
         for (int e = 0; e < neyes; e++) {
             fv_eye eye = stereo ? (e == 0 ? FV_EYE_LEFT : FV_EYE_RIGHT) : FV_EYE_CENTER;
-            fv_pipeline_render(pl, eye, &head, smp.gaze_x, smp.gaze_y, &st[e]);
-            fv_pipeline_to_rgb8(pl, eye, rgb + (size_t)e * W * 3, (ptrdiff_t)outw * 3);
+            if (refp.spp) {
+                fv_camera_desc cd = cfg.cam;
+                fv_camera cam;
+                cd.eye = eye;
+                fv_camera_setup(&cam, &cd, &head); /* the size and FOV passed fv_pipeline_create */
+                if (e == 0 && !focus_given) { /* the first eye's depth at the point of regard, for both */
+                    refp.focus_m = fv_reference_depth_at(scene, &cam, smp_gaze_px(smp.gaze_x, W),
+                                                         smp_gaze_px(smp.gaze_y, H));
+                    refp.focus_m = refp.focus_m > 0.05f ? refp.focus_m : 0.05f; /* as --focus-m's minimum */
+                }
+                render_reference(scene, &cam, &refp, fv_pipeline_pool(pl), refbuf, rgb + (size_t)e * W * 3,
+                                 (ptrdiff_t)outw * 3, &rprog, &st[e]);
+            } else {
+                fv_pipeline_render(pl, eye, &head, smp.gaze_x, smp.gaze_y, &st[e]);
+                fv_pipeline_to_rgb8(pl, eye, rgb + (size_t)e * W * 3, (ptrdiff_t)outw * 3);
+            }
             for (int s = 0; s < FV_STAGE_COUNT; s++)
                 sum.stage_ms[s] = e ? sum.stage_ms[s] + st[e].stage_ms[s] : st[e].stage_ms[s];
             sum.total_ms += st[e].total_ms;
@@ -263,7 +322,7 @@ int main(int argc, char **argv)
         csv_num(csv.f, p_per, "%.3f");
         csv_num(csv.f, fl, "%.4f");
         fputc('\n', csv.f);
-        if (!quiet)
+        if (!quiet && !refp.spp)
             fv_progress_update(&prog_bar, f + 1);
     }
     fv_progress_end(&prog_bar);
@@ -292,6 +351,7 @@ done:
     free(full);
     free(err_prev);
     free(err_cur);
+    free(refbuf);
     fv_pipeline_destroy(ref);
     fv_pipeline_destroy(pl);
     fv_scene_free(scene);

@@ -62,7 +62,11 @@ expect_usage "replay truncated trace" 'truncated.csv:3: 2 fields, expected 3' $R
 expect_usage "replay non-numeric trace" 'nan.csv:2: field 3 .*abc.* is not a finite number' $R --scene $SCENE --out "$T/o2" --trace "$T/nan.csv"
 expect_usage "replay wrong header" 'header.csv:1: header must start with t_ms,gaze_x,gaze_y' $R --scene $SCENE --out "$T/o2" --trace "$T/header.csv"
 expect_usage "replay empty trace" 'empty.csv: no samples' $R --scene $SCENE --out "$T/o2" --trace "$T/empty.csv"
-expect_usage "replay reference not built" '--reference: .*not built yet' $R --scene $SCENE --out "$T/o2" --reference 16
+expect_usage "replay reference spp 0" '--reference: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 0
+expect_usage "replay focus without reference" '--focus-m only applies to --reference' $R --scene $SCENE --out "$T/o2" --focus-m 2
+expect_usage "replay bad focus" '--focus-m: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --focus-m 0
+expect_usage "replay bad pupil" '--pupil-mm: 20 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --pupil-mm 20
+expect_usage "replay reference vs-full" '--vs-full and --reference exclude each other' $R --scene $SCENE --out "$T/o2" --reference 4 --vs-full
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
 expect_usage "bench bad mode" '--mode: .fast. is not one of' $B/fovea-bench --scene $SCENE --mode fast
 expect_usage "bench bad yaw rate" '--yaw-rate: 1000 is out of range' $B/fovea-bench --scene $SCENE --yaw-rate 1000
@@ -109,6 +113,52 @@ for f in frame_00000.png frame_00001.png frame_00002.png; do
         if cmp -s "$T/d1/$f" "$T/$d/$f"; then ok; else bad "$f differs between d1 and $d"; fi
     done
 done
+# --reference: same files and header; the stage columns are empty, total_ms is the render time,
+# samples = (SPP + 1 depth ray) per pixel; a zero pupil at SPP 1 is the full pinhole render;
+# same bytes for 1 and 2 threads
+if $R --scene $SCENE --frames 2 --size 48x54 --reference 4 --out "$T/ref" --quiet 2>"$T/err"; then
+    [ "$(head -n 1 "$T/ref/stats.csv")" = "$(head -n 1 "$T/run/stats.csv")" ] && ok || bad "reference stats header differs"
+    awk -F, 'NR == 2 && $5 == 48 * 54 * 5 && $6 == "" && $11 == "" && $12 > 0 {ok = 1} END {exit !ok}' "$T/ref/stats.csv" \
+        && ok || bad "reference stats row: $(sed -n 2p "$T/ref/stats.csv")"
+    [ -e "$T/ref/frame_00001.png" ] && ok || bad "reference frames missing"
+else
+    bad "replay --reference failed: $(cat "$T/err")"
+fi
+$R --scene $SCENE --frames 1 --size 64x72 --full --out "$T/pin" --quiet 2>/dev/null
+$R --scene $SCENE --frames 1 --size 64x72 --reference 1 --pupil-mm 0 --out "$T/ref0" --quiet 2>/dev/null
+cmp -s "$T/pin/frame_00000.png" "$T/ref0/frame_00000.png" && ok || bad "reference with a zero pupil differs from --full"
+for th in 1 2; do
+    $R --scene $SCENE --frames 1 --size 64x72 --reference 6 --focus-m 1.5 --threads $th --out "$T/rt$th" --quiet 2>/dev/null
+done
+cmp -s "$T/rt1/frame_00000.png" "$T/rt2/frame_00000.png" && ok || bad "reference differs between 1 and 2 threads"
+cmp -s "$T/pin/frame_00000.png" "$T/rt1/frame_00000.png" && bad "reference with a pupil is not blurred" || ok
+# fovea-compare: PSNR and SSIM of two PNGs (the frames above)
+C=$B/fovea-compare
+P1="$T/pin/frame_00000.png" P2="$T/rt1/frame_00000.png"
+head -c 100 "$P1" >"$T/trunc.png"
+expect_usage "compare missing file" 'nope.png: No such file' $C "$T/nope.png" "$P1"
+expect_usage "compare not png" 'bad.glb: not a PNG file' $C "$P1" "$T/bad.glb"
+expect_usage "compare corrupt png" 'trunc.png: corrupt PNG' $C "$T/trunc.png" "$P1"
+expect_usage "compare size mismatch" 'is 64x72 but .* is 96x108: sizes must match' $C "$P1" "$T/run/frame_00000.png"
+expect_usage "compare malformed region" '--fovea: .1,2. is not CX,CY,R' $C "$P1" "$P2" --fovea 1,2
+expect_usage "compare region text" '--periphery: .a,b,c. is not CX,CY,R' $C "$P1" "$P2" --periphery a,b,c
+expect_usage "compare bad radius" '--fovea: radius -3 must be positive' $C "$P1" "$P2" --fovea 10,10,-3
+expect_usage "compare two regions" 'give one of --fovea, --periphery' $C "$P1" "$P2" --fovea 1,2,3 --periphery 1,2,3
+expect_usage "compare empty region" '--fovea 500,500,3: the region holds no pixel' $C "$P1" "$P2" --fovea 500,500,3
+expect_usage "compare one file" 'expected two PNG files' $C "$P1"
+expect_usage "compare unknown flag" '--bogus: unknown option' $C "$P1" "$P2" --bogus
+$C --help | grep -q -- --periphery && ok || bad "compare --help"
+out=$($C "$P1" "$T/ref0/frame_00000.png" 2>&1)
+[ "$out" = "$(printf 'psnr_db inf\nssim 1.000000')" ] && ok || bad "compare identical: $out"
+# the blurred reference against the pinhole frame: finite PSNR, SSIM below 1; the periphery of
+# a small disc is nearly the whole image, the fovea a part of it
+if $C "$P1" "$P2" >"$T/c_all" && $C "$P1" "$P2" --fovea 32,36,12 >"$T/c_fov" && $C "$P1" "$P2" --periphery 32,36,12 >"$T/c_per"; then
+    awk '$1 == "psnr_db" && $2 > 5 && $2 < 80 {p = 1} $1 == "ssim" && $2 > 0 && $2 < 0.999 {s = 1} END {exit !(p && s)}' "$T/c_all" \
+        && ok || bad "compare values: $(cat "$T/c_all")"
+    cmp -s "$T/c_fov" "$T/c_per" && bad "fovea and periphery give the same numbers" || ok
+else
+    bad "compare good runs failed"
+fi
 $R --scene $SCENE --frames 1 --size 160x180 --stereo --out "$T/st" --quiet 2>"$T/err" && ok || bad "stereo: $(cat "$T/err")"
 # Y4M: header, then per frame "FRAME\n" + a 4:2:0 picture (w*h*3/2 bytes); stereo is side by side
 if $R --scene $SCENE --frames 2 --size 64x72 --stereo --y4m "$T/v.y4m" --out "$T/y" --quiet 2>"$T/err"; then

@@ -1,0 +1,13 @@
+/* fovea platform: reading images back (the compare tool and tests). */
+#ifndef FOVEA_IMAGE_H
+#define FOVEA_IMAGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Loads a PNG as 8-bit RGB (w * h * 3 bytes, rows packed; free() it). Grey, grey+alpha and
+ * RGBA are converted (alpha dropped). NULL with a one-line reason naming the file in err: it
+ * cannot be opened, is not a PNG (signature), or does not decode (corrupt or truncated). */
+uint8_t *fv_read_png(const char *path, int *w, int *h, char *err, size_t err_len);
+
+#endif
