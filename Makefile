@@ -160,7 +160,7 @@ PREFIX ?= /usr/local
 install: all
 	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/fovea $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig
 	install -m 644 $(LIB) $(PLIB) $(DESTDIR)$(PREFIX)/lib/
-	install -m 644 core/*.h platform/*.h $(DESTDIR)$(PREFIX)/include/fovea/
+	install -m 644 core/*.h core/dof/*.h platform/*.h $(DESTDIR)$(PREFIX)/include/fovea/
 	install -m 755 $(APPS) $(DESTDIR)$(PREFIX)/bin/
 	sed -e 's|@PREFIX@|$(PREFIX)|g' tools/fovea.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/fovea.pc
 
