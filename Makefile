@@ -48,7 +48,7 @@ ALL_CFLAGS = $(BASE_CFLAGS) $(CFLAGS)
 ALL_CXXFLAGS = $(BASE_CXXFLAGS) $(CXXFLAGS)
 ALL_LDFLAGS = $(SANFLAGS) -pthread $(LDFLAGS)
 
-CORE_C := $(wildcard core/*.c)
+CORE_C := $(wildcard core/*.c core/eyetrack/*.c)
 CORE_CXX := $(wildcard core/*.cpp)
 ifeq ($(ARCH),x86_64)
 CORE_ISA := $(wildcard core/x86/*.c)

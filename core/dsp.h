@@ -16,6 +16,8 @@
 #ifndef FOVEA_DSP_H
 #define FOVEA_DSP_H
 
+#include <stdint.h>
+
 enum {
     FV_ISA_C = 0,
     FV_ISA_SSE41 = 1 << 0,
@@ -53,10 +55,24 @@ typedef void (*fv_pull_row_fn)(float *restrict dst_rgbd, float *restrict dst_wgt
 typedef void (*fv_push_row_fn)(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
                                const float *coarse_far, int n);
 
+/* ---- eye tracker kernels (core/eyetrack/kernels.c; integer, so every ISA is exact) ----
+ * et_down2_row: dst[x] = (a[2x] + a[2x+1] + b[2x] + b[2x+1] + 2) >> 2 for x in [0, n)
+ *   (reads 2n pixels of each source row).
+ * et_integral_row: dst[x] = above[x] + (src[0] + ... + src[x]) (uint32, wraps mod 2^32; the
+ *   tracker's images are far too small to wrap), for x in [0, n).
+ * et_thresh_row: dst[x] = src[x] >= t ? 255 : 0 (t in [0, 256]); returns the count of 255s. */
+typedef void (*fv_et_down2_row_fn)(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n);
+typedef void (*fv_et_integral_row_fn)(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
+typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, int n, int t);
+
 typedef struct fv_dsp {
     unsigned isa; /* the ISA actually selected (one FV_ISA_* value) */
     fv_pull_row_fn pull_row;
     fv_push_row_fn push_row;
+    /* eye tracker */
+    fv_et_down2_row_fn et_down2_row;
+    fv_et_integral_row_fn et_integral_row;
+    fv_et_thresh_row_fn et_thresh_row;
 } fv_dsp;
 
 unsigned fv_cpu_isas(void);            /* FV_ISA_* bits this CPU runs */
@@ -78,6 +94,18 @@ void fv_pullpush_init_sse41(fv_dsp *d);
 void fv_pullpush_init_avx2(fv_dsp *d);
 #elif defined(__aarch64__)
 void fv_pullpush_init_neon(fv_dsp *d);
+#endif
+
+/* eye tracker */
+void fv_et_down2_row_c(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n);
+void fv_et_integral_row_c(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
+int fv_et_thresh_row_c(uint8_t *restrict dst, const uint8_t *src, int n, int t);
+void fv_eyetrack_init_c(fv_dsp *d);
+#if defined(__x86_64__)
+void fv_eyetrack_init_sse41(fv_dsp *d);
+void fv_eyetrack_init_avx2(fv_dsp *d);
+#elif defined(__aarch64__)
+void fv_eyetrack_init_neon(fv_dsp *d);
 #endif
 
 #endif

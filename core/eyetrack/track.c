@@ -1,0 +1,566 @@
+/* fovea eye tracker: dark-pupil detection, sub-pixel centre, glints, confidence, blinks.
+ *
+ * 1. Coarse search on a small copy (halved with dsp->et_down2_row until min(w, h) <= 72):
+ *    reflections (bright blobs, dsp->et_thresh_row) are masked, grown by one pixel and
+ *    inpainted from their surroundings so a glint inside the pupil does not make it look bright.
+ *    Over an integral image (dsp->et_integral_row) every centre and a range of radii k is
+ *    scored by contrast = mean(ring k..2k) - mean(box k): the darkest compact blob wins. A
+ *    contrast score, not darkness alone, is what rejects eyebrows, lashes and shadows (dark
+ *    regions that are as dark around as inside).
+ * 2. Refinement at full resolution in a window around the candidate (reflections inpainted
+ *    again): threshold half way between the blob and its surround, then an iterated weighted
+ *    centroid of the dark pixels (robust for the ~10 px pupils of remote cameras); then rays
+ *    from that centre give sub-pixel edge points for a direct ellipse fit with outlier
+ *    rejection, whose centre is used when the pupil is big enough and the fit agrees.
+ * 3. Glints: small bright blobs of the raw image close to the pupil.
+ * 4. Confidence from the contrast and the fit; blinks from contrast / size drops against the
+ *    tracker's running reference. */
+#include <math.h>
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#include <stdlib.h>
+#include <string.h>
+
+#include "dsp.h"
+#include "eyetrack/eyetrack.h"
+
+#define SEARCH_MAX_SIDE 128 /* coarse search image: min side at most this */
+#define NRAYS 48
+#define SMALL_BLOB_PX 8.0f /* search radius (full-res px) below which the box centre is kept */
+
+struct fv_eye_tracker {
+    fv_eye_params p;
+    fv_dsp dsp;
+    uint8_t *mem;
+    size_t cap;
+    /* history for blink detection (fv_track_frame only) */
+    int nref;
+    float ref_contrast, ref_radius;
+};
+
+void fv_eye_default_params(fv_eye_params *p)
+{
+    p->isa_mask = ~0u;
+    p->min_radius_frac = 0.035f;
+    p->max_radius_frac = 0.17f;
+    p->max_glints = FV_EYE_MAX_GLINTS;
+}
+
+fv_eye_tracker *fv_eye_create(const fv_eye_params *p)
+{
+    fv_eye_tracker *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    if (p)
+        t->p = *p;
+    else
+        fv_eye_default_params(&t->p);
+    if (t->p.max_glints < 0 || t->p.max_glints > FV_EYE_MAX_GLINTS)
+        t->p.max_glints = FV_EYE_MAX_GLINTS;
+    fv_dsp_init(&t->dsp, t->p.isa_mask);
+    return t;
+}
+
+void fv_eye_destroy(fv_eye_tracker *t)
+{
+    if (!t)
+        return;
+    free(t->mem);
+    free(t);
+}
+
+void fv_eye_reset(fv_eye_tracker *t)
+{
+    t->nref = 0;
+    t->ref_contrast = t->ref_radius = 0;
+}
+
+static void *scratch(fv_eye_tracker *t, size_t bytes)
+{
+    if (bytes > t->cap) {
+        void *m = realloc(t->mem, bytes);
+        if (!m)
+            return NULL;
+        t->mem = m;
+        t->cap = bytes;
+    }
+    return t->mem;
+}
+
+/* ---------------------------------------------------------------- helpers */
+
+/* Grey level below which a fraction q of the pixels lie. */
+static int percentile(const uint32_t hist[256], uint32_t total, double q)
+{
+    const uint32_t want = (uint32_t)(q * total);
+    uint32_t acc = 0;
+    for (int v = 0; v < 256; v++) {
+        acc += hist[v];
+        if (acc > want)
+            return v;
+    }
+    return 255;
+}
+
+static void histogram(const uint8_t *img, int w, int h, ptrdiff_t stride, uint32_t hist[256])
+{
+    /* four sub-histograms break the store-to-load dependency on runs of equal pixels */
+    uint32_t hs[4][256];
+    memset(hs, 0, sizeof hs);
+    for (int y = 0; y < h; y++) {
+        const uint8_t *r = img + y * stride;
+        int x = 0;
+        for (; x + 4 <= w; x += 4) {
+            hs[0][r[x]]++, hs[1][r[x + 1]]++, hs[2][r[x + 2]]++, hs[3][r[x + 3]]++;
+        }
+        for (; x < w; x++)
+            hs[0][r[x]]++;
+    }
+    for (int v = 0; v < 256; v++)
+        hist[v] = hs[0][v] + hs[1][v] + hs[2][v] + hs[3][v];
+}
+
+/* Reflections: pixels >= thr, grown by one pixel, replaced by the mean of their unmasked
+ * 4-neighbours, ring by ring from the outside in. mask is w*h scratch. */
+static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, uint8_t *mask, uint8_t fallback)
+{
+    int any = 0;
+    for (int y = 0; y < h; y++)
+        any += dsp->et_thresh_row(mask + y * w, img + y * w, w, thr);
+    if (!any)
+        return;
+    /* grow by one pixel (the halo of a glint is brighter than its background) */
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            uint8_t *m = mask + y * w + x;
+            if (*m == 255) {
+                if (x > 0 && !m[-1]) m[-1] = 1;
+                if (x + 1 < w && !m[1]) m[1] = 1;
+                if (y > 0 && !m[-w]) m[-w] = 1;
+                if (y + 1 < h && !m[w]) m[w] = 1;
+            }
+        }
+    for (int pass = 0; pass < 12 && any; pass++) {
+        any = 0;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                const int i = y * w + x;
+                if (!mask[i])
+                    continue;
+                int s = 0, c = 0;
+                if (x > 0 && !mask[i - 1]) s += img[i - 1], c++;
+                if (x + 1 < w && !mask[i + 1]) s += img[i + 1], c++;
+                if (y > 0 && !mask[i - w]) s += img[i - w], c++;
+                if (y + 1 < h && !mask[i + w]) s += img[i + w], c++;
+                if (c) {
+                    img[i] = (uint8_t)((s + c / 2) / c);
+                    mask[i] = 2; /* filled this pass: not a source until the next */
+                } else {
+                    any = 1;
+                }
+            }
+        for (int i = 0; i < w * h; i++)
+            if (mask[i] == 2)
+                mask[i] = 0;
+    }
+    for (int i = 0; i < w * h; i++)
+        if (mask[i])
+            img[i] = fallback;
+}
+
+static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x1, int y1)
+{
+    /* sum over [x0, x1) x [y0, y1); ii has a zero first row and column, row length iw */
+    return ii[y1 * iw + x1] - ii[y0 * iw + x1] - ii[y1 * iw + x0] + ii[y0 * iw + x0];
+}
+
+static inline int imin(int a, int b) { return a < b ? a : b; }
+static inline int imax(int a, int b) { return a > b ? a : b; }
+static inline float fclampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
+
+/* Bilinear sample, pixel centres at +0.5 (clamped to the image). */
+static inline float sample(const uint8_t *img, int w, int h, float x, float y)
+{
+    x -= 0.5f, y -= 0.5f;
+    x = fclampf(x, 0.0f, (float)w - 1.001f);
+    y = fclampf(y, 0.0f, (float)h - 1.001f);
+    const int ix = (int)x, iy = (int)y;
+    const float fx = x - ix, fy = y - iy;
+    const uint8_t *r = img + iy * w + ix;
+    const int x1 = ix + 1 < w ? 1 : 0, y1 = iy + 1 < h ? w : 0;
+    const float a = r[0] + fx * (r[x1] - r[0]), b = r[y1] + fx * (r[y1 + x1] - r[y1]);
+    return a + fy * (b - a);
+}
+
+/* ---------------------------------------------------------------- coarse search */
+
+typedef struct {
+    float x, y, r; /* full-resolution pixels (corner origin) */
+    float inner, ring;
+    int ok;
+} candidate;
+
+static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride,
+                               uint8_t *work, uint8_t *mask, uint32_t *ii)
+{
+    candidate c = { 0 };
+    const fv_dsp *d = &t->dsp;
+    /* level 0 copy, then halve, ping-ponging between work and mask (both w*h) */
+    int sw = w, sh = h, scale = 1;
+    for (int y = 0; y < h; y++)
+        memcpy(work + (size_t)y * w, luma + y * stride, (size_t)w);
+    while (imin(sw, sh) > SEARCH_MAX_SIDE) {
+        const int nw = sw / 2, nh = sh / 2;
+        for (int y = 0; y < nh; y++)
+            d->et_down2_row(mask + (size_t)y * nw, work + (size_t)(2 * y) * sw, work + (size_t)(2 * y + 1) * sw, nw);
+        uint8_t *tmp = work;
+        work = mask, mask = tmp;
+        sw = nw, sh = nh, scale *= 2;
+    }
+    uint32_t hist[256];
+    histogram(work, sw, sh, sw, hist);
+    const int med = percentile(hist, (uint32_t)(sw * sh), 0.5);
+    const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
+    const int thr = imax(med + 40, med + (255 - med) / 2);
+    if (hi >= thr)
+        inpaint_bright(d, work, sw, sh, thr, mask, (uint8_t)med);
+    /* integral image with a zero first row and column */
+    const int iw = sw + 1;
+    memset(ii, 0, (size_t)iw * sizeof *ii);
+    for (int y = 0; y < sh; y++) {
+        ii[(size_t)(y + 1) * iw] = 0;
+        d->et_integral_row(ii + (size_t)(y + 1) * iw + 1, ii + (size_t)y * iw + 1, work + (size_t)y * sw, sw);
+    }
+    const float side = (float)imin(sw, sh);
+    const int kmin = imax(1, (int)lrintf(t->p.min_radius_frac * side));
+    const int kmax = imax(kmin, (int)lrintf(t->p.max_radius_frac * side));
+    float best = -1e30f;
+    for (int k = kmin; k <= kmax; k += (k < 4 ? 1 : k / 4)) {
+        for (int y = 0; y < sh; y++) {
+            const int iy0 = imax(0, y - k), iy1 = imin(sh, y + k + 1);
+            const int oy0 = imax(0, y - 2 * k), oy1 = imin(sh, y + 2 * k + 1);
+            for (int x = 0; x < sw; x++) {
+                const int ix0 = imax(0, x - k), ix1 = imin(sw, x + k + 1);
+                const int ox0 = imax(0, x - 2 * k), ox1 = imin(sw, x + 2 * k + 1);
+                const int na = (ix1 - ix0) * (iy1 - iy0), no = (ox1 - ox0) * (oy1 - oy0);
+                if (na * 2 < (2 * k + 1) * (2 * k + 1) || no == na)
+                    continue; /* mostly outside the image */
+                const uint32_t si = box_sum(ii, iw, ix0, iy0, ix1, iy1);
+                const uint32_t so = box_sum(ii, iw, ox0, oy0, ox1, oy1) - si;
+                const float mi = (float)si / na, mo = (float)so / (no - na);
+                const float score = mo - mi;
+                if (score > best) {
+                    best = score;
+                    c.x = (x + 0.5f) * scale;
+                    c.y = (y + 0.5f) * scale;
+                    c.r = (k + 0.5f) * scale;
+                    c.inner = mi;
+                    c.ring = mo;
+                    c.ok = 1;
+                }
+            }
+        }
+    }
+    if (!c.ok)
+        return c;
+    return c;
+}
+
+/* ---------------------------------------------------------------- refinement */
+
+typedef struct {
+    float x, y, r;
+    float inner, ring;
+    int fit;
+    fv_ellipse e;
+    float inliers; /* fraction of rays giving inlier edge points */
+} pupil;
+
+static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
+                  uint8_t *win, uint8_t *mask, pupil *out)
+{
+    /* window around the candidate, reflections inpainted */
+    const int half = (int)ceilf(3.0f * c->r) + 2;
+    const int x0 = imax(0, (int)c->x - half), y0 = imax(0, (int)c->y - half);
+    const int x1 = imin(w, (int)c->x + half), y1 = imin(h, (int)c->y + half);
+    const int ww = x1 - x0, wh = y1 - y0;
+    if (ww < 4 || wh < 4)
+        return -1;
+    for (int y = 0; y < wh; y++)
+        memcpy(win + (size_t)y * ww, luma + (y + y0) * stride + x0, (size_t)ww);
+    uint32_t hist[256];
+    histogram(win, ww, wh, ww, hist);
+    const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
+    const int thr = imax(med + 40, med + (255 - med) / 2);
+    if (percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
+        inpaint_bright(&t->dsp, win, ww, wh, thr, mask, (uint8_t)med);
+
+    float cx = c->x - x0, cy = c->y - y0, r = c->r;
+    float inner = c->inner, ring = c->ring;
+    for (int it = 0; it < 4; it++) {
+        /* blob and surround levels around the current estimate */
+        double si = 0, so = 0;
+        int ni = 0, no = 0;
+        const float ri = 0.7f * r, ro0 = 1.6f * r, ro1 = 2.4f * r;
+        const int bx0 = imax(0, (int)(cx - ro1)), bx1 = imin(ww, (int)(cx + ro1) + 1);
+        const int by0 = imax(0, (int)(cy - ro1)), by1 = imin(wh, (int)(cy + ro1) + 1);
+        for (int y = by0; y < by1; y++)
+            for (int x = bx0; x < bx1; x++) {
+                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy, d2 = dx * dx + dy * dy;
+                const int v = win[y * ww + x];
+                if (d2 <= ri * ri)
+                    si += v, ni++;
+                else if (d2 >= ro0 * ro0 && d2 <= ro1 * ro1)
+                    so += v, no++;
+            }
+        if (ni)
+            inner = (float)(si / ni);
+        if (no)
+            ring = (float)(so / no);
+        if (!(ring > inner))
+            return -1;
+        const float th = 0.5f * (inner + ring);
+        /* weighted centroid of the dark pixels near the estimate */
+        const float rr = 1.5f * r;
+        double sw = 0, sx = 0, sy = 0;
+        int area = 0;
+        const int ax0 = imax(0, (int)(cx - rr)), ax1 = imin(ww, (int)(cx + rr) + 1);
+        const int ay0 = imax(0, (int)(cy - rr)), ay1 = imin(wh, (int)(cy + rr) + 1);
+        for (int y = ay0; y < ay1; y++)
+            for (int x = ax0; x < ax1; x++) {
+                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy;
+                if (dx * dx + dy * dy > rr * rr)
+                    continue;
+                const float v = win[y * ww + x];
+                if (v < th) {
+                    const double wt = th - v;
+                    sw += wt, sx += wt * (x + 0.5f), sy += wt * (y + 0.5f);
+                    area++;
+                }
+            }
+        if (sw <= 0)
+            return -1;
+        cx = (float)(sx / sw);
+        cy = (float)(sy / sw);
+        r = fclampf(sqrtf(area / (float)M_PI), 0.5f * c->r, 1.5f * c->r);
+    }
+    out->x = cx + x0;
+    out->y = cy + y0;
+    out->r = r;
+    out->inner = inner;
+    out->ring = ring;
+    out->fit = 0;
+    out->inliers = 0;
+
+    /* edge points along rays: first outward crossing of the mid level */
+    const float th = 0.5f * (inner + ring);
+    float ex[NRAYS], ey[NRAYS];
+    int ne = 0;
+    const float step = fmaxf(0.25f, r / 24.0f);
+    for (int k = 0; k < NRAYS; k++) {
+        const float a = (float)(2.0 * M_PI * k / NRAYS), dx = cosf(a), dy = sinf(a);
+        float prev = sample(win, ww, wh, cx, cy), pd = 0;
+        for (float dist = step; dist < 2.2f * r; dist += step) {
+            const float px = cx + dist * dx, py = cy + dist * dy;
+            if (px < 0.5f || py < 0.5f || px > ww - 0.5f || py > wh - 0.5f)
+                break;
+            const float v = sample(win, ww, wh, px, py);
+            if (v >= th && prev < th) {
+                const float f = (th - prev) / (v - prev);
+                const float de = pd + f * (dist - pd);
+                ex[ne] = cx + de * dx + x0;
+                ey[ne] = cy + de * dy + y0;
+                ne++;
+                break;
+            }
+            prev = v, pd = dist;
+        }
+    }
+    if (ne < 8)
+        return 0;
+    fv_ellipse e;
+    int n = ne;
+    for (int round = 0; round < 3; round++) {
+        if (fv_ellipse_fit(ex, ey, n, &e))
+            return 0;
+        /* drop points far from the fit (lashes, lids, leftover reflections), refit */
+        const double tol = fmax(0.75, 0.08 * e.a);
+        int m = 0;
+        for (int i = 0; i < n; i++)
+            if (fv_ellipse_distance(&e, ex[i], ey[i]) <= tol)
+                ex[m] = ex[i], ey[m] = ey[i], m++;
+        if (m == n)
+            break;
+        if (m < 6)
+            return 0;
+        n = m;
+    }
+    if (fv_ellipse_fit(ex, ey, n, &e))
+        return 0;
+    const double dc = hypot(e.cx - out->x, e.cy - out->y);
+    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < 0.3 * e.a || dc > 0.6 * r)
+        return 0;
+    out->fit = 1;
+    out->e = e;
+    out->inliers = (float)n / NRAYS;
+    return 0;
+}
+
+/* ---------------------------------------------------------------- glints */
+
+static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const pupil *pp,
+                       uint8_t *lab, int *stack, fv_eye_glint *g)
+{
+    const float rad = fmaxf(3.5f * pp->r, 6.0f);
+    const int x0 = imax(0, (int)(pp->x - rad)), x1 = imin(w, (int)(pp->x + rad) + 1);
+    const int y0 = imax(0, (int)(pp->y - rad)), y1 = imin(h, (int)(pp->y + rad) + 1);
+    const int ww = x1 - x0, wh = y1 - y0;
+    if (ww < 1 || wh < 1)
+        return 0;
+    const int thr = imax((int)pp->ring + 40, (int)(pp->ring + 0.5f * (255.0f - pp->ring)));
+    const float max_area = fmaxf(4.0f, 0.8f * pp->r * pp->r);
+    memset(lab, 0, (size_t)ww * wh);
+    int n = 0;
+    for (int y = 0; y < wh; y++)
+        for (int x = 0; x < ww; x++) {
+            if (lab[y * ww + x] || luma[(y + y0) * stride + x + x0] < thr)
+                continue;
+            /* flood fill one 4-connected blob */
+            int sp = 0, area = 0, touches = 0;
+            double sw = 0, sx = 0, sy = 0;
+            stack[sp++] = y * ww + x;
+            lab[y * ww + x] = 1;
+            while (sp) {
+                const int i = stack[--sp], px = i % ww, py = i / ww;
+                const int v = luma[(py + y0) * stride + px + x0];
+                const double wt = v - thr + 1;
+                sw += wt, sx += wt * (px + 0.5), sy += wt * (py + 0.5);
+                area++;
+                if (px == 0 || py == 0 || px == ww - 1 || py == wh - 1)
+                    touches = 1;
+                const int nb[4] = { px > 0 ? i - 1 : -1, px + 1 < ww ? i + 1 : -1, py > 0 ? i - ww : -1,
+                                    py + 1 < wh ? i + ww : -1 };
+                for (int k = 0; k < 4; k++)
+                    if (nb[k] >= 0 && !lab[nb[k]] &&
+                        luma[(nb[k] / ww + y0) * stride + nb[k] % ww + x0] >= thr) {
+                        lab[nb[k]] = 1;
+                        stack[sp++] = nb[k];
+                    }
+            }
+            if (touches || area > max_area || n == FV_EYE_MAX_GLINTS * 2)
+                continue;
+            fv_eye_glint gl = { (float)(sx / sw) + x0, (float)(sy / sw) + y0, (float)area };
+            const float dd = hypotf(gl.x - pp->x, gl.y - pp->y);
+            if (dd > rad)
+                continue;
+            /* insertion by distance to the pupil centre */
+            int j = n < FV_EYE_MAX_GLINTS * 2 ? n++ : n - 1;
+            while (j > 0 && hypotf(g[j - 1].x - pp->x, g[j - 1].y - pp->y) > dd) {
+                g[j] = g[j - 1];
+                j--;
+            }
+            g[j] = gl;
+        }
+    return imin(n, t->p.max_glints);
+}
+
+/* ---------------------------------------------------------------- frame */
+
+static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, fv_eye_result *r,
+                 int history)
+{
+    if (!t || !luma || !r || w < 8 || h < 8 || w > 8192 || h > 8192 || stride < w)
+        return -1;
+    memset(r, 0, sizeof *r);
+    r->status = FV_EYE_LOST;
+    const size_t px = (size_t)w * h;
+    const size_t ii_bytes = ((size_t)(w + 1) * (h + 1)) * sizeof(uint32_t);
+    uint8_t *m = scratch(t, 2 * px + ii_bytes + px * sizeof(int) + 64 + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
+    if (!m)
+        return -1;
+    uint32_t *ii = (uint32_t *)m;
+    int *stack = (int *)(m + ii_bytes);
+    fv_eye_glint *gl = (fv_eye_glint *)(m + ii_bytes + px * sizeof(int));
+    uint8_t *work = m + ii_bytes + px * sizeof(int) + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint), *mask = work + px;
+
+    const candidate c = coarse_search(t, luma, w, h, stride, work, mask, ii);
+    if (!c.ok)
+        return 0;
+    pupil p;
+    if (refine(t, luma, w, h, stride, &c, work, mask, &p)) {
+        /* no dark region stands out in the window: keep the search's answer, flagged low */
+        p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
+    }
+    /* Small dark blobs (remote cameras, ~10 px pupils inside an equally dark iris): the centre of
+     * the best contrast box beat the refined centroid on the MRL images (lids and lashes pull
+     * it). Headset-sized pupils: the ellipse centre, else the dark-region centroid. */
+    if (c.r < SMALL_BLOB_PX) {
+        r->pupil_x = c.x;
+        r->pupil_y = c.y;
+    } else if (p.fit) {
+        r->pupil_x = (float)p.e.cx;
+        r->pupil_y = (float)p.e.cy;
+        r->ellipse_fit = 1;
+    } else {
+        r->pupil_x = p.x;
+        r->pupil_y = p.y;
+    }
+    if (p.fit) {
+        r->pupil_a_px = (float)p.e.a;
+        r->pupil_b_px = (float)p.e.b;
+        r->pupil_angle_rad = (float)p.e.angle;
+    } else {
+        r->pupil_a_px = r->pupil_b_px = p.r;
+    }
+    r->contrast = p.ring - p.inner;
+    r->found = 1;
+    r->status = FV_EYE_OK;
+
+    r->n_glints = find_glints(t, luma, w, h, stride, &p, work, stack, gl);
+    memcpy(r->glints, gl, (size_t)r->n_glints * sizeof *gl);
+    if (r->n_glints) {
+        float gx = 0, gy = 0;
+        for (int i = 0; i < r->n_glints; i++)
+            gx += r->glints[i].x, gy += r->glints[i].y;
+        r->has_pg = 1;
+        r->pg_x = r->pupil_x - gx / r->n_glints;
+        r->pg_y = r->pupil_y - gy / r->n_glints;
+    }
+
+    /* confidence: contrast (grey levels) and how much of the outline the fit explains */
+    const float cc = fclampf((r->contrast - 4.0f) / 24.0f, 0.0f, 1.0f);
+    const float fit = p.fit ? fclampf(p.inliers / 0.6f, 0.0f, 1.0f) : 0.5f;
+    r->confidence = cc * (0.4f + 0.6f * fit);
+
+    if (r->contrast < 6.0f) {
+        r->status = FV_EYE_LOST;
+        r->found = 0;
+    }
+    if (history && r->status == FV_EYE_OK) {
+        /* a blink: the dark blob loses most of its contrast or shrinks to a sliver */
+        const float flat = p.fit ? (float)(p.e.b / p.e.a) : 1.0f;
+        if (t->nref >= 3 && (r->contrast < 0.45f * t->ref_contrast || p.r < 0.45f * t->ref_radius || flat < 0.3f)) {
+            r->status = FV_EYE_BLINK;
+            r->confidence *= 0.25f;
+        } else {
+            const float a = t->nref < 10 ? 1.0f / (t->nref + 1) : 0.1f;
+            t->ref_contrast += a * (r->contrast - t->ref_contrast);
+            t->ref_radius += a * (p.r - t->ref_radius);
+            t->nref++;
+        }
+    } else if (history && r->status == FV_EYE_LOST && t->nref >= 3) {
+        r->status = FV_EYE_BLINK;
+    }
+    return 0;
+}
+
+int fv_track_frame(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, fv_eye_result *r)
+{
+    return track(t, luma, w, h, stride, r, 1);
+}
+
+int fv_track_image(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, fv_eye_result *r)
+{
+    return track(t, luma, w, h, stride, r, 0);
+}
