@@ -27,7 +27,7 @@
 
 #define SEARCH_MAX_SIDE 128 /* coarse search image: min side at most this */
 #define NRAYS 48
-#define SMALL_BLOB_PX 8.0f /* search radius (full-res px) below which the box centre is kept */
+#define SMALL_BLOB_PX 16.0f /* search radius (full-res px) below which the box centre is kept */
 
 struct fv_eye_tracker {
     fv_eye_params p;
@@ -533,7 +533,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     const float fit = p.fit ? fclampf(p.inliers / 0.6f, 0.0f, 1.0f) : 0.5f;
     r->confidence = cc * (0.4f + 0.6f * fit);
 
-    if (r->contrast < 6.0f) {
+    if (r->contrast < 3.0f) {
         r->status = FV_EYE_LOST;
         r->found = 0;
     }
