@@ -27,7 +27,6 @@
 
 #define SEARCH_MAX_SIDE 128 /* coarse search image: min side at most this */
 #define NRAYS 48
-#define SMALL_BLOB_PX 16.0f /* search radius (full-res px) below which the box centre is kept */
 
 struct fv_eye_tracker {
     fv_eye_params p;
@@ -36,7 +35,7 @@ struct fv_eye_tracker {
     size_t cap;
     /* history for blink detection (fv_track_frame only) */
     int nref;
-    float ref_contrast, ref_radius;
+    float ref_contrast, ref_radius, ref_inner, ref_ring;
 };
 
 void fv_eye_default_params(fv_eye_params *p)
@@ -73,7 +72,7 @@ void fv_eye_destroy(fv_eye_tracker *t)
 void fv_eye_reset(fv_eye_tracker *t)
 {
     t->nref = 0;
-    t->ref_contrast = t->ref_radius = 0;
+    t->ref_contrast = t->ref_radius = t->ref_inner = t->ref_ring = 0;
 }
 
 static void *scratch(fv_eye_tracker *t, size_t bytes)
@@ -123,24 +122,28 @@ static void histogram(const uint8_t *img, int w, int h, ptrdiff_t stride, uint32
 
 /* Reflections: pixels >= thr, grown by one pixel, replaced by the mean of their unmasked
  * 4-neighbours, ring by ring from the outside in. mask is w*h scratch. */
-static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, uint8_t *mask, uint8_t fallback)
+static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask,
+                           uint8_t fallback)
 {
     int any = 0;
     for (int y = 0; y < h; y++)
         any += dsp->et_thresh_row(mask + y * w, img + y * w, w, thr);
     if (!any)
         return;
-    /* grow by one pixel (the halo of a glint is brighter than its background) */
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            uint8_t *m = mask + y * w + x;
-            if (*m == 255) {
-                if (x > 0 && !m[-1]) m[-1] = 1;
-                if (x + 1 < w && !m[1]) m[1] = 1;
-                if (y > 0 && !m[-w]) m[-w] = 1;
-                if (y + 1 < h && !m[w]) m[w] = 1;
+    /* grow by `grow` pixels (the halo of a glint is brighter than its background) */
+    for (int gpass = 0; gpass < grow; gpass++) {
+        const uint8_t src = gpass ? 254 - gpass + 1 : 255, dst = 254 - gpass;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                uint8_t *m = mask + y * w + x;
+                if (*m == src) {
+                    if (x > 0 && !m[-1]) m[-1] = dst;
+                    if (x + 1 < w && !m[1]) m[1] = dst;
+                    if (y > 0 && !m[-w]) m[-w] = dst;
+                    if (y + 1 < h && !m[w]) m[w] = dst;
+                }
             }
-        }
+    }
     for (int pass = 0; pass < 12 && any; pass++) {
         any = 0;
         for (int y = 0; y < h; y++)
@@ -193,11 +196,27 @@ static inline float sample(const uint8_t *img, int w, int h, float x, float y)
     return a + fy * (b - a);
 }
 
+/* The ray stays at or above th for len pixels past dist (a pupil edge, not a glint's halo or
+ * a stray bright pixel inside the pupil). */
+static int sustained(const uint8_t *win, int ww, int wh, float cx, float cy, float dx, float dy, float dist, float len,
+                     float th)
+{
+    for (float d = dist + 0.5f; d <= dist + len; d += 0.5f) {
+        const float px = cx + d * dx, py = cy + d * dy;
+        if (px < 0.5f || py < 0.5f || px > ww - 0.5f || py > wh - 0.5f)
+            return 1;
+        if (sample(win, ww, wh, px, py) < th)
+            return 0;
+    }
+    return 1;
+}
+
 /* ---------------------------------------------------------------- coarse search */
 
 typedef struct {
     float x, y, r; /* full-resolution pixels (corner origin) */
     float inner, ring;
+    int scale; /* of the search image */
     int ok;
 } candidate;
 
@@ -224,7 +243,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
     const int thr = imax(med + 40, med + (255 - med) / 2);
     if (hi >= thr)
-        inpaint_bright(d, work, sw, sh, thr, mask, (uint8_t)med);
+        inpaint_bright(d, work, sw, sh, thr, 1, mask, (uint8_t)med);
     /* integral image with a zero first row and column */
     const int iw = sw + 1;
     memset(ii, 0, (size_t)iw * sizeof *ii);
@@ -236,6 +255,8 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     const int kmin = imax(1, (int)lrintf(t->p.min_radius_frac * side));
     const int kmax = imax(kmin, (int)lrintf(t->p.max_radius_frac * side));
     float best = -1e30f;
+    const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
+    const float lambda = 1.0f; /* prefer the darker of two contrasting blobs: the pupil in the iris */
     for (int k = kmin; k <= kmax; k += (k < 4 ? 1 : k / 4)) {
         for (int y = 0; y < sh; y++) {
             const int iy0 = imax(0, y - k), iy1 = imin(sh, y + k + 1);
@@ -249,7 +270,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
                 const uint32_t si = box_sum(ii, iw, ix0, iy0, ix1, iy1);
                 const uint32_t so = box_sum(ii, iw, ox0, oy0, ox1, oy1) - si;
                 const float mi = (float)si / na, mo = (float)so / (no - na);
-                const float score = mo - mi;
+                const float score = mo - mi - lambda * (mi - dark);
                 if (score > best) {
                     best = score;
                     c.x = (x + 0.5f) * scale;
@@ -258,6 +279,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
                     c.inner = mi;
                     c.ring = mo;
                     c.ok = 1;
+                    c.scale = scale;
                 }
             }
         }
@@ -294,15 +316,15 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
     const int thr = imax(med + 40, med + (255 - med) / 2);
     if (percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
-        inpaint_bright(&t->dsp, win, ww, wh, thr, mask, (uint8_t)med);
+        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, (uint8_t)med);
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
     float inner = c->inner, ring = c->ring;
-    for (int it = 0; it < 4; it++) {
+    for (int it = 0; it < 6; it++) {
         /* blob and surround levels around the current estimate */
         double si = 0, so = 0;
         int ni = 0, no = 0;
-        const float ri = 0.7f * r, ro0 = 1.6f * r, ro1 = 2.4f * r;
+        const float ri = 0.7f * r, ro0 = 1.2f * r, ro1 = 1.7f * r;
         const int bx0 = imax(0, (int)(cx - ro1)), bx1 = imin(ww, (int)(cx + ro1) + 1);
         const int by0 = imax(0, (int)(cy - ro1)), by1 = imin(wh, (int)(cy + ro1) + 1);
         for (int y = by0; y < by1; y++)
@@ -343,7 +365,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             return -1;
         cx = (float)(sx / sw);
         cy = (float)(sy / sw);
-        r = fclampf(sqrtf(area / (float)M_PI), 0.5f * c->r, 1.5f * c->r);
+        r = fclampf(sqrtf(area / (float)M_PI), 0.6f * r, 1.4f * r);
     }
     out->x = cx + x0;
     out->y = cy + y0;
@@ -366,7 +388,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             if (px < 0.5f || py < 0.5f || px > ww - 0.5f || py > wh - 0.5f)
                 break;
             const float v = sample(win, ww, wh, px, py);
-            if (v >= th && prev < th) {
+            if (v >= th && prev < th && sustained(win, ww, wh, cx, cy, dx, dy, dist, fmaxf(1.5f, 0.2f * r), th)) {
                 const float f = (th - prev) / (v - prev);
                 const float de = pd + f * (dist - pd);
                 ex[ne] = cx + de * dx + x0;
@@ -379,8 +401,25 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     }
     if (ne < 8)
         return 0;
+    /* first cut: points much nearer or farther than the median radius (glints, lids, lashes) */
+    float rad[NRAYS];
+    for (int i = 0; i < ne; i++)
+        rad[i] = hypotf(ex[i] - (cx + x0), ey[i] - (cy + y0));
+    float sorted[NRAYS];
+    memcpy(sorted, rad, sizeof(float) * (size_t)ne);
+    for (int i = 1; i < ne; i++) /* insertion sort: 48 values */
+        for (int j = i; j > 0 && sorted[j - 1] > sorted[j]; j--) {
+            const float tmp = sorted[j];
+            sorted[j] = sorted[j - 1], sorted[j - 1] = tmp;
+        }
+    const float rmed = sorted[ne / 2];
+    int n = 0;
+    for (int i = 0; i < ne; i++)
+        if (fabsf(rad[i] - rmed) <= fmaxf(1.5f, 0.25f * rmed))
+            ex[n] = ex[i], ey[n] = ey[i], n++;
+    if (n < 8)
+        return 0;
     fv_ellipse e;
-    int n = ne;
     for (int round = 0; round < 3; round++) {
         if (fv_ellipse_fit(ex, ey, n, &e))
             return 0;
@@ -412,7 +451,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
 static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const pupil *pp,
                        uint8_t *lab, int *stack, fv_eye_glint *g)
 {
-    const float rad = fmaxf(3.5f * pp->r, 6.0f);
+    const float rad = fmaxf(2.2f * pp->r, 6.0f);
     const int x0 = imax(0, (int)(pp->x - rad)), x1 = imin(w, (int)(pp->x + rad) + 1);
     const int y0 = imax(0, (int)(pp->y - rad)), y1 = imin(h, (int)(pp->y + rad) + 1);
     const int ww = x1 - x0, wh = y1 - y0;
@@ -427,7 +466,7 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
             if (lab[y * ww + x] || luma[(y + y0) * stride + x + x0] < thr)
                 continue;
             /* flood fill one 4-connected blob */
-            int sp = 0, area = 0, touches = 0;
+            int sp = 0, area = 0, touches = 0, peak = 0;
             double sw = 0, sx = 0, sy = 0;
             stack[sp++] = y * ww + x;
             lab[y * ww + x] = 1;
@@ -435,6 +474,7 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
                 const int i = stack[--sp], px = i % ww, py = i / ww;
                 const int v = luma[(py + y0) * stride + px + x0];
                 const double wt = v - thr + 1;
+                peak = imax(peak, v);
                 sw += wt, sx += wt * (px + 0.5), sy += wt * (py + 0.5);
                 area++;
                 if (px == 0 || py == 0 || px == ww - 1 || py == wh - 1)
@@ -448,14 +488,28 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
                         stack[sp++] = nb[k];
                     }
             }
-            if (touches || area > max_area || n == FV_EYE_MAX_GLINTS * 2)
+            if (touches || area > max_area)
                 continue;
             fv_eye_glint gl = { (float)(sx / sw) + x0, (float)(sy / sw) + y0, (float)area };
+            /* a reflection is a small spot much brighter than what is right around it (bright
+             * skin or sclera above the threshold is not) */
+            const float rb = sqrtf(area / (float)M_PI) + 2.5f;
+            float bg = 0;
+            for (int k = 0; k < 8; k++) {
+                const int bx = imin(w - 1, imax(0, (int)floorf(gl.x + rb * cosf(k * (float)M_PI / 4)))),
+                          by = imin(h - 1, imax(0, (int)floorf(gl.y + rb * sinf(k * (float)M_PI / 4))));
+                bg += luma[by * stride + bx];
+            }
+            if (peak - bg / 8 < 50)
+                continue;
             const float dd = hypotf(gl.x - pp->x, gl.y - pp->y);
             if (dd > rad)
                 continue;
             /* insertion by distance to the pupil centre */
-            int j = n < FV_EYE_MAX_GLINTS * 2 ? n++ : n - 1;
+            int j = n < FV_EYE_MAX_GLINTS ? n++ : n - 1;
+            if (j == FV_EYE_MAX_GLINTS - 1 && n == FV_EYE_MAX_GLINTS &&
+                hypotf(g[j].x - pp->x, g[j].y - pp->y) <= dd && j > 0)
+                continue; /* full, and farther than all kept */
             while (j > 0 && hypotf(g[j - 1].x - pp->x, g[j - 1].y - pp->y) > dd) {
                 g[j] = g[j - 1];
                 j--;
@@ -495,7 +549,12 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     /* Small dark blobs (remote cameras, ~10 px pupils inside an equally dark iris): the centre of
      * the best contrast box beat the refined centroid on the MRL images (lids and lashes pull
      * it). Headset-sized pupils: the ellipse centre, else the dark-region centroid. */
-    if (c.r < SMALL_BLOB_PX) {
+    /* Small images (min side <= SEARCH_MAX_SIDE: remote-camera crops, ~10 px pupils inside an
+     * often equally dark iris): the best contrast box's centre beat the refined centroid and the
+     * ellipse on the MRL images (lids, lashes and iris pull them). Headset-sized eyes: the ellipse
+     * centre, else the dark-region centroid. */
+    const int small = c.scale == 1;
+    if (small) {
         r->pupil_x = c.x;
         r->pupil_y = c.y;
     } else if (p.fit) {
@@ -538,15 +597,20 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
         r->found = 0;
     }
     if (history && r->status == FV_EYE_OK) {
-        /* a blink: the dark blob loses most of its contrast or shrinks to a sliver */
+        /* a blink: what is found is not the pupil the tracker has been seeing: much less dark
+         * (lashes, lid crease), much less contrast, much smaller, or a sliver */
         const float flat = p.fit ? (float)(p.e.b / p.e.a) : 1.0f;
-        if (t->nref >= 3 && (r->contrast < 0.45f * t->ref_contrast || p.r < 0.45f * t->ref_radius || flat < 0.3f)) {
+        const float span = t->ref_ring - t->ref_inner;
+        if (t->nref >= 3 && (p.inner > t->ref_inner + 0.4f * span || r->contrast < 0.45f * t->ref_contrast ||
+                             p.r < 0.45f * t->ref_radius || flat < 0.3f)) {
             r->status = FV_EYE_BLINK;
             r->confidence *= 0.25f;
         } else {
             const float a = t->nref < 10 ? 1.0f / (t->nref + 1) : 0.1f;
             t->ref_contrast += a * (r->contrast - t->ref_contrast);
             t->ref_radius += a * (p.r - t->ref_radius);
+            t->ref_inner += a * (p.inner - t->ref_inner);
+            t->ref_ring += a * (p.ring - t->ref_ring);
             t->nref++;
         }
     } else if (history && r->status == FV_EYE_LOST && t->nref >= 3) {
