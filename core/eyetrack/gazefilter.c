@@ -8,13 +8,14 @@
 
 void fv_gaze_filter_default_params(fv_gaze_filter_params *p)
 {
-    p->saccade_deg_s = 30.0f;
+    p->saccade_deg_s = 50.0f;
     p->outlier_deg_s = 1000.0f;
     p->confirm_samples = 2;
     p->min_cutoff_hz = 1.0f;
     p->beta = 0.02f;
     p->d_cutoff_hz = 1.0f;
     p->hold_ms = 300.0f;
+    p->velocity_window_ms = 30.0f;
 }
 
 void fv_gaze_filter_init(fv_gaze_filter *f, const fv_gaze_filter_params *p)
@@ -39,6 +40,31 @@ float fv_fovea_radius_scale(float confidence)
     if (confidence >= 0.8f)
         return 1.0f;
     return 1.0f + (0.8f - confidence) / 0.6f;
+}
+
+static void push_hist(fv_gaze_filter *f, double t, float x, float y)
+{
+    if (f->nhist == 8) {
+        memmove(f->hist_t, f->hist_t + 1, 7 * sizeof *f->hist_t);
+        memmove(f->hist_x, f->hist_x + 1, 7 * sizeof *f->hist_x);
+        memmove(f->hist_y, f->hist_y + 1, 7 * sizeof *f->hist_y);
+        f->nhist = 7;
+    }
+    f->hist_t[f->nhist] = t, f->hist_x[f->nhist] = x, f->hist_y[f->nhist] = y;
+    f->nhist++;
+}
+
+/* Angular velocity from the newest kept sample at least velocity_window_ms older than t (or the
+ * oldest one). */
+static float window_velocity(const fv_gaze_filter *f, double t, float x, float y)
+{
+    if (!f->nhist)
+        return 0;
+    int k = f->nhist - 1;
+    while (k > 0 && t - f->hist_t[k] < f->p.velocity_window_ms)
+        k--;
+    const double dt_s = fmax(1e-4, (t - f->hist_t[k]) / 1000.0);
+    return (float)(fv_gaze_angle_deg(f->hist_x[k], f->hist_y[k], x, y) / dt_s);
 }
 
 static void hold(fv_gaze_filter *f, double t_ms, fv_gaze_out *out)
@@ -74,6 +100,8 @@ void fv_gaze_filter_update(fv_gaze_filter *f, double t_ms, int valid, float yaw,
         f->dfx = f->dfy = 0;
         f->last_good_ms = t_ms;
         f->last_conf = conf;
+        f->nhist = 0;
+        push_hist(f, t_ms, yaw, pitch);
         *out = (fv_gaze_out){ yaw, pitch, conf, 0, FV_GAZE_FIXATION };
         f->out = *out;
         return;
@@ -98,14 +126,18 @@ void fv_gaze_filter_update(fv_gaze_filter *f, double t_ms, int valid, float yaw,
         f->dfx = f->dfy = 0;
         f->last_good_ms = t_ms;
         f->last_conf = conf;
+        f->nhist = 0;
+        push_hist(f, t_ms, yaw, pitch);
         *out = (fv_gaze_out){ yaw, pitch, conf, vel, FV_GAZE_SACCADE };
         f->out = *out;
         return;
     }
     f->pending = 0;
     const float dt_s = (float)fmax(1e-4, dt_ms / 1000.0);
+    const float wvel = window_velocity(f, t_ms, yaw, pitch);
+    push_hist(f, t_ms, yaw, pitch);
     int state;
-    if (vel > f->p.saccade_deg_s) {
+    if (wvel > f->p.saccade_deg_s) {
         state = FV_GAZE_SACCADE; /* follow the raw signal; reset the smoother onto it */
         f->dfx = (yaw - f->fx) / dt_s;
         f->dfy = (pitch - f->fy) / dt_s;
@@ -124,6 +156,6 @@ void fv_gaze_filter_update(fv_gaze_filter *f, double t_ms, int valid, float yaw,
     f->raw_x = yaw, f->raw_y = pitch;
     f->last_good_ms = t_ms;
     f->last_conf = conf;
-    *out = (fv_gaze_out){ f->fx, f->fy, conf, vel, state };
+    *out = (fv_gaze_out){ f->fx, f->fy, conf, wvel, state };
     f->out = *out;
 }

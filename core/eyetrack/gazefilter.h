@@ -1,7 +1,9 @@
 /* fovea eye tracker: gaze filter between the calibrated tracker and the renderer.
  *  - outlier rejection: a sample implying an angular velocity above outlier_deg_s is dropped,
  *    unless the next confirm_samples samples agree with it (then the eye really went there);
- *  - classification by angular velocity: saccade above saccade_deg_s, fixation below;
+ *  - classification by angular velocity: saccade above saccade_deg_s, fixation below; the
+ *    velocity is taken over at least velocity_window_ms (tracker jitter between consecutive
+ *    frames would otherwise look like a saccade at 120 Hz);
  *  - smoothing during fixations with a 1-euro filter (Casiez et al. 2012); saccades pass
  *    through unsmoothed (lag there costs more than jitter);
  *  - blinks / lost frames: hold the last good gaze for up to hold_ms with a confidence that
@@ -13,13 +15,14 @@
 enum { FV_GAZE_NONE = 0, FV_GAZE_FIXATION, FV_GAZE_SACCADE, FV_GAZE_HOLD, FV_GAZE_LOST };
 
 typedef struct fv_gaze_filter_params {
-    float saccade_deg_s;  /* 30 */
+    float saccade_deg_s;  /* 50 */
     float outlier_deg_s;  /* 1000: above any saccade's peak velocity */
     int confirm_samples;  /* 2 */
     float min_cutoff_hz;  /* 1-euro: 1.0 */
     float beta;           /* 1-euro: 0.02 (per deg/s) */
     float d_cutoff_hz;    /* 1-euro: 1.0 */
     float hold_ms;        /* 300 */
+    float velocity_window_ms; /* 30 */
 } fv_gaze_filter_params;
 
 typedef struct fv_gaze_out {
@@ -38,6 +41,9 @@ typedef struct fv_gaze_filter {
     float last_conf;
     int pending;                    /* outlier candidates agreeing so far */
     float cand_x, cand_y;
+    double hist_t[8];               /* recent accepted samples, for the velocity */
+    float hist_x[8], hist_y[8];
+    int nhist;
     fv_gaze_out out;
 } fv_gaze_filter;
 
