@@ -25,7 +25,7 @@
 #include "dsp.h"
 #include "eyetrack/eyetrack.h"
 
-#define SEARCH_MAX_SIDE 128 /* coarse search image: min side at most this */
+#define SEARCH_MAX_SIDE 128 /* search image F: min side at most this (C: half that) */
 #define NRAYS 48
 
 struct fv_eye_tracker {
@@ -220,50 +220,39 @@ typedef struct {
     int ok;
 } candidate;
 
-static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride,
-                               uint8_t *work, uint8_t *mask, uint32_t *ii)
+static void integral(const fv_dsp *d, const uint8_t *img, int w, int h, uint32_t *ii)
 {
-    candidate c = { 0 };
-    const fv_dsp *d = &t->dsp;
-    /* level 0 copy, then halve, ping-ponging between work and mask (both w*h) */
-    int sw = w, sh = h, scale = 1;
-    for (int y = 0; y < h; y++)
-        memcpy(work + (size_t)y * w, luma + y * stride, (size_t)w);
-    while (imin(sw, sh) > SEARCH_MAX_SIDE) {
-        const int nw = sw / 2, nh = sh / 2;
-        for (int y = 0; y < nh; y++)
-            d->et_down2_row(mask + (size_t)y * nw, work + (size_t)(2 * y) * sw, work + (size_t)(2 * y + 1) * sw, nw);
-        uint8_t *tmp = work;
-        work = mask, mask = tmp;
-        sw = nw, sh = nh, scale *= 2;
-    }
-    uint32_t hist[256];
-    histogram(work, sw, sh, sw, hist);
-    const int med = percentile(hist, (uint32_t)(sw * sh), 0.5);
-    const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
-    const int thr = imax(med + 40, med + (255 - med) / 2);
-    if (hi >= thr)
-        inpaint_bright(d, work, sw, sh, thr, 1, mask, (uint8_t)med);
-    /* integral image with a zero first row and column */
-    const int iw = sw + 1;
+    /* zero first row and column */
+    const int iw = w + 1;
     memset(ii, 0, (size_t)iw * sizeof *ii);
-    for (int y = 0; y < sh; y++) {
+    for (int y = 0; y < h; y++) {
         ii[(size_t)(y + 1) * iw] = 0;
-        d->et_integral_row(ii + (size_t)(y + 1) * iw + 1, ii + (size_t)y * iw + 1, work + (size_t)y * sw, sw);
+        d->et_integral_row(ii + (size_t)(y + 1) * iw + 1, ii + (size_t)y * iw + 1, img + (size_t)y * w, w);
     }
-    const float side = (float)imin(sw, sh);
-    const int kmin = imax(1, (int)lrintf(t->p.min_radius_frac * side));
-    const int kmax = imax(kmin, (int)lrintf(t->p.max_radius_frac * side));
-    float best = -1e30f;
-    const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
-    const float lambda = 1.0f; /* prefer the darker of two contrasting blobs: the pupil in the iris */
-    for (int k = kmin; k <= kmax; k += (k < 4 ? 1 : k / 4)) {
-        for (int y = 0; y < sh; y++) {
+}
+
+typedef struct {
+    float score, inner, ring;
+    int x, y, k;
+} box_hit;
+
+/* Best contrast box over centres [x0, x1) x [y0, y1) and half-sizes k in [kmin, kmax]
+ * (every k when step1, else a geometric-ish ladder). Score = mean(ring k..1.5k) - mean(box k)
+ * - lambda * (mean(box) - dark): lambda prefers the darker of two contrasting blobs (the pupil
+ * in the iris); a 1.5k ring beat 2k and 3k on the MRL images (less lid and brow in it). */
+static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0, int x1, int y0, int y1,
+                       float dark, box_hit *best)
+{
+    const float lambda = 1.0f, rf = 1.5f;
+    const int iw = sw + 1;
+    for (int k = kmin; k <= kmax; k += (step1 || k < 4 ? 1 : k / 4)) {
+        const int ko = (int)lrintf(rf * k);
+        for (int y = imax(0, y0); y < imin(sh, y1); y++) {
             const int iy0 = imax(0, y - k), iy1 = imin(sh, y + k + 1);
-            const int oy0 = imax(0, y - 2 * k), oy1 = imin(sh, y + 2 * k + 1);
-            for (int x = 0; x < sw; x++) {
+            const int oy0 = imax(0, y - ko), oy1 = imin(sh, y + ko + 1);
+            for (int x = imax(0, x0); x < imin(sw, x1); x++) {
                 const int ix0 = imax(0, x - k), ix1 = imin(sw, x + k + 1);
-                const int ox0 = imax(0, x - 2 * k), ox1 = imin(sw, x + 2 * k + 1);
+                const int ox0 = imax(0, x - ko), ox1 = imin(sw, x + ko + 1);
                 const int na = (ix1 - ix0) * (iy1 - iy0), no = (ox1 - ox0) * (oy1 - oy0);
                 if (na * 2 < (2 * k + 1) * (2 * k + 1) || no == na)
                     continue; /* mostly outside the image */
@@ -271,21 +260,79 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
                 const uint32_t so = box_sum(ii, iw, ox0, oy0, ox1, oy1) - si;
                 const float mi = (float)si / na, mo = (float)so / (no - na);
                 const float score = mo - mi - lambda * (mi - dark);
-                if (score > best) {
-                    best = score;
-                    c.x = (x + 0.5f) * scale;
-                    c.y = (y + 0.5f) * scale;
-                    c.r = (k + 0.5f) * scale;
-                    c.inner = mi;
-                    c.ring = mo;
-                    c.ok = 1;
-                    c.scale = scale;
-                }
+                if (score > best->score)
+                    *best = (box_hit){ score, mi, mo, x, y, k };
             }
         }
     }
-    if (!c.ok)
+}
+
+/* Two levels: F (halved until min side <= SEARCH_MAX_SIDE; reflections inpainted there) and C
+ * (F halved again until min side <= SEARCH_MAX_SIDE / 2). The exhaustive search runs on C;
+ * F only refines position and size around C's answer, which costs ~25x less than searching F. */
+static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride,
+                               uint8_t *work, uint8_t *mask, uint8_t *small, uint32_t *ii)
+{
+    candidate c = { 0 };
+    const fv_dsp *d = &t->dsp;
+    int sw = w, sh = h, scale = 1;
+    const uint8_t *src = luma;
+    ptrdiff_t sst = stride;
+    while (imin(sw, sh) > SEARCH_MAX_SIDE) { /* halve straight from the input, then in place-free ping-pong */
+        const int nw = sw / 2, nh = sh / 2;
+        uint8_t *dst = src == work ? mask : work;
+        for (int y = 0; y < nh; y++)
+            d->et_down2_row(dst + (size_t)y * nw, src + (2 * y) * sst, src + (2 * y + 1) * sst, nw);
+        src = dst, sst = nw;
+        sw = nw, sh = nh, scale *= 2;
+    }
+    if (src != work)
+        for (int y = 0; y < sh; y++)
+            memcpy(work + (size_t)y * sw, src + y * sst, (size_t)sw);
+    uint32_t hist[256];
+    histogram(work, sw, sh, sw, hist);
+    const int med = percentile(hist, (uint32_t)(sw * sh), 0.5);
+    const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
+    const int thr = imax(med + 40, med + (255 - med) / 2);
+    if (hi >= thr)
+        inpaint_bright(d, work, sw, sh, thr, 1, mask, (uint8_t)med);
+    const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
+    /* level C */
+    int cw = sw, ch = sh, f = 1;
+    const uint8_t *cs = work;
+    while (imin(cw, ch) > SEARCH_MAX_SIDE / 2) {
+        const int nw = cw / 2, nh = ch / 2;
+        uint8_t *dst = cs == small ? mask : small;
+        for (int y = 0; y < nh; y++)
+            d->et_down2_row(dst + (size_t)y * nw, cs + (size_t)(2 * y) * cw, cs + (size_t)(2 * y + 1) * cw, nw);
+        cs = dst;
+        cw = nw, ch = nh, f *= 2;
+    }
+    const float side = (float)imin(cw, ch);
+    const int kmin = imax(1, (int)lrintf(t->p.min_radius_frac * side));
+    const int kmax = imax(kmin, (int)lrintf(t->p.max_radius_frac * side));
+    box_hit b = { -1e30f, 0, 0, 0, 0, 0 };
+    integral(d, cs, cw, ch, ii);
+    box_search(ii, cw, ch, kmin, kmax, 0, 0, cw, 0, ch, dark, &b);
+    if (b.score <= -1e30f)
         return c;
+    if (f > 1) { /* refine on F around C's answer */
+        const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
+        box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
+        integral(d, work, sw, sh, ii);
+        box_search(ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, &bf);
+        if (bf.score > -1e30f)
+            b = bf;
+        else
+            b.x = fx, b.y = fy, b.k = fk;
+    }
+    c.x = (b.x + 0.5f) * scale;
+    c.y = (b.y + 0.5f) * scale;
+    c.r = (b.k + 0.5f) * scale;
+    c.inner = b.inner;
+    c.ring = b.ring;
+    c.ok = 1;
+    c.scale = scale;
     return c;
 }
 
@@ -530,15 +577,16 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     r->status = FV_EYE_LOST;
     const size_t px = (size_t)w * h;
     const size_t ii_bytes = ((size_t)(w + 1) * (h + 1)) * sizeof(uint32_t);
-    uint8_t *m = scratch(t, 2 * px + ii_bytes + px * sizeof(int) + 64 + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
+    uint8_t *m = scratch(t, 3 * px + ii_bytes + px * sizeof(int) + 64 + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
     if (!m)
         return -1;
     uint32_t *ii = (uint32_t *)m;
     int *stack = (int *)(m + ii_bytes);
     fv_eye_glint *gl = (fv_eye_glint *)(m + ii_bytes + px * sizeof(int));
-    uint8_t *work = m + ii_bytes + px * sizeof(int) + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint), *mask = work + px;
+    uint8_t *work = m + ii_bytes + px * sizeof(int) + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint), *mask = work + px,
+            *lowres = mask + px;
 
-    const candidate c = coarse_search(t, luma, w, h, stride, work, mask, ii);
+    const candidate c = coarse_search(t, luma, w, h, stride, work, mask, lowres, ii);
     if (!c.ok)
         return 0;
     pupil p;
