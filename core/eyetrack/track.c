@@ -120,56 +120,60 @@ static void histogram(const uint8_t *img, int w, int h, ptrdiff_t stride, uint32
         hist[v] = hs[0][v] + hs[1][v] + hs[2][v] + hs[3][v];
 }
 
-/* Reflections: pixels >= thr, grown by one pixel, replaced by the mean of their unmasked
- * 4-neighbours, ring by ring from the outside in. mask is w*h scratch. */
-static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask,
+/* Reflections: pixels >= thr, grown by `grow` pixels (a glint's halo is brighter than its
+ * background too), replaced by the mean of their unmasked 4-neighbours, ring by ring from the
+ * outside in. mask is w*h bytes of scratch, idx w*h ints; the work is proportional to the
+ * masked area, not the image. */
+static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
                            uint8_t fallback)
 {
-    int any = 0;
+    int n = 0;
     for (int y = 0; y < h; y++)
-        any += dsp->et_thresh_row(mask + y * w, img + y * w, w, thr);
-    if (!any)
+        if (dsp->et_thresh_row(mask + y * w, img + y * w, w, thr))
+            for (int x = 0; x < w; x++)
+                if (mask[y * w + x])
+                    idx[n++] = y * w + x;
+    if (!n)
         return;
-    /* grow by `grow` pixels (the halo of a glint is brighter than its background) */
-    for (int gpass = 0; gpass < grow; gpass++) {
-        const uint8_t src = gpass ? 254 - gpass + 1 : 255, dst = 254 - gpass;
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) {
-                uint8_t *m = mask + y * w + x;
-                if (*m == src) {
-                    if (x > 0 && !m[-1]) m[-1] = dst;
-                    if (x + 1 < w && !m[1]) m[1] = dst;
-                    if (y > 0 && !m[-w]) m[-w] = dst;
-                    if (y + 1 < h && !m[w]) m[w] = dst;
+    for (int i = 0; i < n; i++)
+        mask[idx[i]] = 1;
+    for (int g = 0, from = 0; g < grow; g++) {
+        const int to = n;
+        for (int j = from; j < to; j++) {
+            const int i = idx[j], x = i % w, y = i / w;
+            const int nb[4] = { x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1, y + 1 < h ? i + w : -1 };
+            for (int k = 0; k < 4; k++)
+                if (nb[k] >= 0 && !mask[nb[k]]) {
+                    mask[nb[k]] = 1;
+                    idx[n++] = nb[k];
                 }
-            }
+        }
+        from = to;
     }
-    for (int pass = 0; pass < 12 && any; pass++) {
-        any = 0;
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) {
-                const int i = y * w + x;
-                if (!mask[i])
-                    continue;
-                int s = 0, c = 0;
-                if (x > 0 && !mask[i - 1]) s += img[i - 1], c++;
-                if (x + 1 < w && !mask[i + 1]) s += img[i + 1], c++;
-                if (y > 0 && !mask[i - w]) s += img[i - w], c++;
-                if (y + 1 < h && !mask[i + w]) s += img[i + w], c++;
-                if (c) {
-                    img[i] = (uint8_t)((s + c / 2) / c);
-                    mask[i] = 2; /* filled this pass: not a source until the next */
-                } else {
-                    any = 1;
-                }
+    /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on) */
+    for (int pass = 0; pass < 12 && n; pass++) {
+        const uint8_t lim = (uint8_t)(2 + pass);
+#define SRC(j) (mask[j] == 0 || (mask[j] >= 2 && mask[j] < lim))
+        int left = 0;
+        for (int j = 0; j < n; j++) {
+            const int i = idx[j], x = i % w, y = i / w;
+            int s = 0, c = 0;
+            if (x > 0 && SRC(i - 1)) s += img[i - 1], c++;
+            if (x + 1 < w && SRC(i + 1)) s += img[i + 1], c++;
+            if (y > 0 && SRC(i - w)) s += img[i - w], c++;
+            if (y + 1 < h && SRC(i + w)) s += img[i + w], c++;
+            if (c) {
+                img[i] = (uint8_t)((s + c / 2) / c);
+                mask[i] = lim;
+            } else {
+                idx[left++] = i;
             }
-        for (int i = 0; i < w * h; i++)
-            if (mask[i] == 2)
-                mask[i] = 0;
+        }
+#undef SRC
+        n = left;
     }
-    for (int i = 0; i < w * h; i++)
-        if (mask[i])
-            img[i] = fallback;
+    for (int j = 0; j < n; j++)
+        img[idx[j]] = fallback;
 }
 
 static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x1, int y1)
@@ -247,6 +251,8 @@ static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, i
     const int iw = sw + 1;
     for (int k = kmin; k <= kmax; k += (step1 || k < 4 ? 1 : k / 4)) {
         const int ko = (int)lrintf(rf * k);
+        const int na_full = (2 * k + 1) * (2 * k + 1), no_full = (2 * ko + 1) * (2 * ko + 1);
+        const float inv_a = 1.0f / (float)na_full, inv_r = 1.0f / (float)(no_full - na_full);
         for (int y = imax(0, y0); y < imin(sh, y1); y++) {
             const int iy0 = imax(0, y - k), iy1 = imin(sh, y + k + 1);
             const int oy0 = imax(0, y - ko), oy1 = imin(sh, y + ko + 1);
@@ -254,11 +260,16 @@ static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, i
                 const int ix0 = imax(0, x - k), ix1 = imin(sw, x + k + 1);
                 const int ox0 = imax(0, x - ko), ox1 = imin(sw, x + ko + 1);
                 const int na = (ix1 - ix0) * (iy1 - iy0), no = (ox1 - ox0) * (oy1 - oy0);
-                if (na * 2 < (2 * k + 1) * (2 * k + 1) || no == na)
-                    continue; /* mostly outside the image */
                 const uint32_t si = box_sum(ii, iw, ix0, iy0, ix1, iy1);
                 const uint32_t so = box_sum(ii, iw, ox0, oy0, ox1, oy1) - si;
-                const float mi = (float)si / na, mo = (float)so / (no - na);
+                float mi, mo;
+                if (na == na_full && no == no_full) { /* inside: no divisions */
+                    mi = (float)si * inv_a, mo = (float)so * inv_r;
+                } else {
+                    if (na * 2 < na_full || no == na)
+                        continue; /* mostly outside the image */
+                    mi = (float)si / na, mo = (float)so / (no - na);
+                }
                 const float score = mo - mi - lambda * (mi - dark);
                 if (score > best->score)
                     *best = (box_hit){ score, mi, mo, x, y, k };
@@ -271,7 +282,7 @@ static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, i
  * (F halved again until min side <= SEARCH_MAX_SIDE / 2). The exhaustive search runs on C;
  * F only refines position and size around C's answer, which costs ~25x less than searching F. */
 static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride,
-                               uint8_t *work, uint8_t *mask, uint8_t *small, uint32_t *ii)
+                               uint8_t *work, uint8_t *mask, uint8_t *small, uint32_t *ii, int *idx)
 {
     candidate c = { 0 };
     const fv_dsp *d = &t->dsp;
@@ -295,7 +306,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
     const int thr = imax(med + 40, med + (255 - med) / 2);
     if (hi >= thr)
-        inpaint_bright(d, work, sw, sh, thr, 1, mask, (uint8_t)med);
+        inpaint_bright(d, work, sw, sh, thr, 1, mask, idx, (uint8_t)med);
     const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
     /* level C */
     int cw = sw, ch = sh, f = 1;
@@ -347,7 +358,7 @@ typedef struct {
 } pupil;
 
 static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
-                  uint8_t *win, uint8_t *mask, pupil *out)
+                  uint8_t *win, uint8_t *mask, int *idx, pupil *out)
 {
     /* window around the candidate, reflections inpainted */
     const int half = (int)ceilf(3.0f * c->r) + 2;
@@ -363,7 +374,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
     const int thr = imax(med + 40, med + (255 - med) / 2);
     if (percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
-        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, (uint8_t)med);
+        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, (uint8_t)med);
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
     float inner = c->inner, ring = c->ring;
@@ -410,9 +421,12 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             }
         if (sw <= 0)
             return -1;
-        cx = (float)(sx / sw);
-        cy = (float)(sy / sw);
-        r = fclampf(sqrtf(area / (float)M_PI), 0.6f * r, 1.4f * r);
+        const float nx = (float)(sx / sw), ny = (float)(sy / sw);
+        const float nr = fclampf(sqrtf(area / (float)M_PI), 0.6f * r, 1.4f * r);
+        const int settled = fabsf(nx - cx) < 0.02f * r && fabsf(ny - cy) < 0.02f * r && fabsf(nr - r) < 0.02f * r;
+        cx = nx, cy = ny, r = nr;
+        if (settled)
+            break;
     }
     out->x = cx + x0;
     out->y = cy + y0;
@@ -586,11 +600,11 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     uint8_t *work = m + ii_bytes + px * sizeof(int) + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint), *mask = work + px,
             *lowres = mask + px;
 
-    const candidate c = coarse_search(t, luma, w, h, stride, work, mask, lowres, ii);
+    const candidate c = coarse_search(t, luma, w, h, stride, work, mask, lowres, ii, stack);
     if (!c.ok)
         return 0;
     pupil p;
-    if (refine(t, luma, w, h, stride, &c, work, mask, &p)) {
+    if (refine(t, luma, w, h, stride, &c, work, mask, stack, &p)) {
         /* no dark region stands out in the window: keep the search's answer, flagged low */
         p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
     }
