@@ -11,6 +11,7 @@
 #include "testutil.h"
 
 #include "calibfile.h"
+#include "eyesrc.h"
 #include "eyetrack/calib.h"
 #include "eyetrack/eyetrack.h"
 #include "eyetrack/gazefilter.h"
@@ -462,6 +463,85 @@ static void test_gaze_filter(void **state)
     assert_true(fv_fovea_radius_scale(0.6f) < fv_fovea_radius_scale(0.4f));
 }
 
+/* ------------------------------------------------------------------ the bundled video */
+
+/* assets/eye_synth.y4m (made at build time by tools/gen_eye from the bundled gaze trace) through
+ * the Y4M reader and the tracker with history, against assets/eye_synth.csv. */
+static void test_bundled_video(void **state)
+{
+    (void)state;
+    char err[512];
+    fv_eyesrc *src;
+    if (fv_eyesrc_open_y4m(&src, "assets/eye_synth.y4m", err, sizeof err))
+        fail_msg("%s (run from the repository root after make)", err);
+    FILE *f = fopen("assets/eye_synth.csv", "r");
+    assert_non_null(f);
+    char line[2048];
+    assert_non_null(fgets(line, sizeof line, f)); /* header */
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    float err_px[512];
+    int n_open = 0, vis = 0, matched = 0, closed = 0, closed_flagged = 0, open_ok = 0, frames = 0;
+    fv_eye_frame fr;
+    int rc;
+    while ((rc = fv_eyesrc_next(src, &fr, err, sizeof err)) == 1) {
+        assert_non_null(fgets(line, sizeof line, f));
+        /* frame,t_ms,yaw,pitch,open,blink,pupil_x,pupil_y,pupil_r_px,pupil_visible,n_glints,g0_x,g0_y,... */
+        float v[11], gx[6], gy[6];
+        int gv[6];
+        char *p = line;
+        for (int k = 0; k < 11; k++) {
+            v[k] = strtof(p, &p);
+            assert_true(*p == ',');
+            p++;
+        }
+        for (int k = 0; k < 6; k++) {
+            gv[k] = *p != ',';
+            gx[k] = gv[k] ? strtof(p, &p) : 0;
+            p++;
+            gy[k] = gv[k] ? strtof(p, &p) : 0;
+            if (*p == ',')
+                p++;
+        }
+        fv_eye_result r;
+        assert_int_equal(fv_track_frame(t, fr.luma, fr.w, fr.h, fr.stride, &r), 0);
+        frames++;
+        if (v[9] >= 0.99f) { /* pupil fully visible */
+            open_ok += r.status == FV_EYE_OK;
+            err_px[n_open++] = r.found ? hypotf(r.pupil_x - v[6], r.pupil_y - v[7]) : INFINITY;
+            for (int k = 0; k < 6; k++) {
+                if (!gv[k])
+                    continue;
+                vis++;
+                for (int j = 0; j < r.n_glints; j++)
+                    if (hypotf(r.glints[j].x - gx[k], r.glints[j].y - gy[k]) < 1.0f) {
+                        matched++;
+                        break;
+                    }
+            }
+        }
+        if (v[9] == 0.0f) { /* pupil completely covered */
+            closed++;
+            closed_flagged += r.status != FV_EYE_OK;
+        }
+    }
+    assert_int_equal(rc, 0);
+    fclose(f);
+    float sorted[512];
+    memcpy(sorted, err_px, (size_t)n_open * sizeof *sorted);
+    const float med = median(sorted, n_open), worst = sorted[n_open - 1];
+    printf("[ eyetrack ] bundled video: %d frames; pupil fully visible in %d: median error %.3f px, max %.3f px, "
+           "status OK in %d; glints found %d of %d visible (within 1 px); pupil covered in %d: %d flagged blink/lost\n",
+           frames, n_open, (double)med, (double)worst, open_ok, matched, vis, closed, closed_flagged);
+    assert_true(frames >= 60 && n_open >= 40 && closed >= 2);
+    assert_true(med < 0.5f);
+    assert_true(worst < 2.0f);
+    assert_true(matched * 10 >= vis * 9);
+    assert_int_equal(closed_flagged, closed);
+    assert_true(open_ok * 10 >= n_open * 9);
+    fv_eye_destroy(t);
+    fv_eyesrc_close(src);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -474,6 +554,7 @@ int main(void)
         cmocka_unit_test(test_calib_file),
         cmocka_unit_test(test_end_to_end),
         cmocka_unit_test(test_gaze_filter),
+        cmocka_unit_test(test_bundled_video),
     };
     return cmocka_run_group_tests_name("eyetrack", tests, NULL, NULL);
 }
