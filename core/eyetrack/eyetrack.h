@@ -40,6 +40,8 @@ typedef struct fv_eye_params {
     unsigned isa_mask;       /* kernels allowed (FV_ISA_* bits; ~0u = best) */
     float min_radius_frac;   /* pupil search radii as fractions of min(w, h) */
     float max_radius_frac;
+    float border_frac;       /* no pupil centre nearer the image border than this fraction of
+                                min(w, h) (vignetted corners are dark) */
     int max_glints;          /* <= FV_EYE_MAX_GLINTS */
 } fv_eye_params;
 

@@ -43,6 +43,7 @@ void fv_eye_default_params(fv_eye_params *p)
     p->isa_mask = ~0u;
     p->min_radius_frac = 0.035f;
     p->max_radius_frac = 0.17f;
+    p->border_frac = 0.1f;
     p->max_glints = FV_EYE_MAX_GLINTS;
 }
 
@@ -266,8 +267,10 @@ static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, i
                 if (na == na_full && no == no_full) { /* inside: no divisions */
                     mi = (float)si * inv_a, mo = (float)so * inv_r;
                 } else {
-                    if (na * 2 < na_full || no == na)
-                        continue; /* mostly outside the image */
+                    /* the box inside the image, most of the ring too: vignetted corners and
+                     * image edges are dark and half a ring is no surround */
+                    if (na != na_full || 10 * (no - na) < 6 * (no_full - na_full))
+                        continue;
                     mi = (float)si / na, mo = (float)so / (no - na);
                 }
                 const float score = mo - mi - lambda * (mi - dark);
@@ -324,7 +327,10 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     const int kmax = imax(kmin, (int)lrintf(t->p.max_radius_frac * side));
     box_hit b = { -1e30f, 0, 0, 0, 0, 0 };
     integral(d, cs, cw, ch, ii);
-    box_search(ii, cw, ch, kmin, kmax, 0, 0, cw, 0, ch, dark, &b);
+    /* centres no nearer the border than margin_frac of the side: vignetted corners and image
+     * edges are dark, and a pupil there is cut anyway */
+    const int mx = (int)lrintf(t->p.border_frac * side);
+    box_search(ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, &b);
     if (b.score <= -1e30f)
         return c;
     if (f > 1) { /* refine on F around C's answer */
