@@ -42,6 +42,8 @@ typedef struct fv_eye_params {
     float max_radius_frac;
     float border_frac;       /* no pupil centre nearer the image border than this fraction of
                                 min(w, h) (vignetted corners are dark) */
+    float centre_prior;      /* search score penalty, grey levels per min(w, h) of distance
+                                from the image centre (the eye is roughly centred) */
     int max_glints;          /* <= FV_EYE_MAX_GLINTS */
 } fv_eye_params;
 

@@ -44,6 +44,7 @@ void fv_eye_default_params(fv_eye_params *p)
     p->min_radius_frac = 0.035f;
     p->max_radius_frac = 0.17f;
     p->border_frac = 0.1f;
+    p->centre_prior = 20.0f;
     p->max_glints = FV_EYE_MAX_GLINTS;
 }
 
@@ -243,12 +244,16 @@ typedef struct {
 
 /* Best contrast box over centres [x0, x1) x [y0, y1) and half-sizes k in [kmin, kmax]
  * (every k when step1, else a geometric-ish ladder). Score = mean(ring k..1.5k) - mean(box k)
- * - lambda * (mean(box) - dark): lambda prefers the darker of two contrasting blobs (the pupil
- * in the iris); a 1.5k ring beat 2k and 3k on the MRL images (less lid and brow in it). */
+ * - lambda * (mean(box) - dark) - mu * (distance from the image centre) / min side: lambda
+ * prefers the darker of two contrasting blobs (the pupil in the iris); a 1.5k ring beat 2k and
+ * 3k on the MRL images (less lid and brow in it); mu (grey levels per image side) is a weak
+ * prior for the eye being roughly centred in its camera, which keeps dark brows, hair and
+ * vignetted corners from winning in dim images. */
 static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0, int x1, int y0, int y1,
-                       float dark, box_hit *best)
+                       float dark, float mu, box_hit *best)
 {
     const float lambda = 1.0f, rf = 1.5f;
+    const float cxm = 0.5f * (sw - 1), cym = 0.5f * (sh - 1), prior = mu / (float)(sw < sh ? sw : sh);
     const int iw = sw + 1;
     for (int k = kmin; k <= kmax; k += (step1 || k < 4 ? 1 : k / 4)) {
         const int ko = (int)lrintf(rf * k);
@@ -273,7 +278,8 @@ static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, i
                         continue;
                     mi = (float)si / na, mo = (float)so / (no - na);
                 }
-                const float score = mo - mi - lambda * (mi - dark);
+                const float ddx = (float)x - cxm, ddy = (float)y - cym;
+                const float score = mo - mi - lambda * (mi - dark) - prior * sqrtf(ddx * ddx + ddy * ddy);
                 if (score > best->score)
                     *best = (box_hit){ score, mi, mo, x, y, k };
             }
@@ -330,14 +336,14 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     /* centres no nearer the border than margin_frac of the side: vignetted corners and image
      * edges are dark, and a pupil there is cut anyway */
     const int mx = (int)lrintf(t->p.border_frac * side);
-    box_search(ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, &b);
+    box_search(ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, t->p.centre_prior, &b);
     if (b.score <= -1e30f)
         return c;
     if (f > 1) { /* refine on F around C's answer */
         const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
         box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
         integral(d, work, sw, sh, ii);
-        box_search(ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, &bf);
+        box_search(ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
         if (bf.score > -1e30f)
             b = bf;
         else
