@@ -278,8 +278,13 @@ static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, i
                         continue;
                     mi = (float)si / na, mo = (float)so / (no - na);
                 }
-                const float ddx = (float)x - cxm, ddy = (float)y - cym;
-                const float score = mo - mi - lambda * (mi - dark) - prior * sqrtf(ddx * ddx + ddy * ddy);
+                float score = mo - mi - lambda * (mi - dark);
+                if (score <= best->score) /* the prior only lowers it */
+                    continue;
+                if (prior > 0) {
+                    const float ddx = (float)x - cxm, ddy = (float)y - cym;
+                    score -= prior * sqrtf(ddx * ddx + ddy * ddy);
+                }
                 if (score > best->score)
                     *best = (box_hit){ score, mi, mo, x, y, k };
             }
@@ -370,7 +375,7 @@ typedef struct {
 } pupil;
 
 static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
-                  uint8_t *win, uint8_t *mask, int *idx, pupil *out)
+                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, pupil *out)
 {
     /* window around the candidate, reflections inpainted */
     const int half = (int)ceilf(3.0f * c->r) + 2;
@@ -385,7 +390,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     histogram(win, ww, wh, ww, hist);
     const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
     const int thr = imax(med + 40, med + (255 - med) / 2);
-    if (percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
+    if (!inpainted && percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
         inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, (uint8_t)med);
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
@@ -616,7 +621,10 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     if (!c.ok)
         return 0;
     pupil p;
-    if (refine(t, luma, w, h, stride, &c, work, mask, stack, &p)) {
+    /* small images: the search image is the full-resolution frame, already inpainted; refine
+     * from it (into another buffer) rather than inpainting the window again */
+    const int reuse = c.scale == 1;
+    if (refine(t, reuse ? work : luma, w, h, reuse ? w : stride, &c, reuse, reuse ? lowres : work, mask, stack, &p)) {
         /* no dark region stands out in the window: keep the search's answer, flagged low */
         p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
     }
