@@ -395,7 +395,9 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
     float inner = c->inner, ring = c->ring;
-    for (int it = 0; it < 6; it++) {
+    /* small frames only need the levels and size from this (their centre is the search's) */
+    const int iters = inpainted ? 2 : 6;
+    for (int it = 0; it < iters; it++) {
         /* blob and surround levels around the current estimate */
         double si = 0, so = 0;
         int ni = 0, no = 0;
@@ -458,8 +460,9 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     float ex[NRAYS], ey[NRAYS];
     int ne = 0;
     const float step = fmaxf(0.25f, r / 24.0f);
-    for (int k = 0; k < NRAYS; k++) {
-        const float a = (float)(2.0 * M_PI * k / NRAYS), dx = cosf(a), dy = sinf(a);
+    const int nrays = r < 12.0f ? NRAYS / 2 : NRAYS; /* small pupils: fewer edge pixels anyway */
+    for (int k = 0; k < nrays; k++) {
+        const float a = (float)(2.0 * M_PI * k / nrays), dx = cosf(a), dy = sinf(a);
         float prev = sample(win, ww, wh, cx, cy), pd = 0;
         for (float dist = step; dist < 2.2f * r; dist += step) {
             const float px = cx + dist * dx, py = cy + dist * dy;
@@ -520,7 +523,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         return 0;
     out->fit = 1;
     out->e = e;
-    out->inliers = (float)n / NRAYS;
+    out->inliers = (float)n / nrays;
     return 0;
 }
 
