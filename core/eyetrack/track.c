@@ -153,7 +153,7 @@ static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int th
         from = to;
     }
     /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on) */
-    for (int pass = 0; pass < 12 && n; pass++) {
+    for (int pass = 0; pass < 3 + 2 * grow && n; pass++) { /* enough for a grown glint; big bright areas get the fallback */
         const uint8_t lim = (uint8_t)(2 + pass);
 #define SRC(j) (mask[j] == 0 || (mask[j] >= 2 && mask[j] < lim))
         int left = 0;
