@@ -99,10 +99,8 @@ int fv_eyesrc_open_y4m(fv_eyesrc **out, const char *path, char *err, size_t err_
     if (!what) {
         if (!strcmp(cs, "mono"))
             s->frame_bytes = luma;
-        else if (!strncmp(cs, "420", 3) && !strchr(cs, 'p'))
-            s->frame_bytes = luma + 2 * cw * ch;
-        else if (!strcmp(cs, "420paldv"))
-            s->frame_bytes = luma + 2 * cw * ch;
+        else if (!strcmp(cs, "420") || !strcmp(cs, "420jpeg") || !strcmp(cs, "420paldv") || !strcmp(cs, "420mpeg2"))
+            s->frame_bytes = luma + 2 * cw * ch; /* the 8-bit 4:2:0 sitings; not 420p10 etc. */
         else if (!strcmp(cs, "422"))
             s->frame_bytes = luma + 2 * cw * (size_t)s->h;
         else if (!strcmp(cs, "444"))

@@ -171,6 +171,12 @@ if $K --video $V --out "$T/track.csv" --quiet >"$T/out" 2>"$T/err"; then
 else
     bad "track good run failed: $(cat "$T/err")"
 fi
+# fovea-replay's own Y4M (C420jpeg, 128x72, 2 frames) reads back
+if [ -s "$T/v.y4m" ] && $K --video "$T/v.y4m" --out "$T/v.csv" --quiet >"$T/out" 2>"$T/err"; then
+    [ "$(wc -l <"$T/v.csv")" -eq 2 ] && ok || bad "track on the replay's C420jpeg video: $(cat "$T/v.csv")"
+else
+    bad "track on the replay's C420jpeg video failed: $(cat "$T/err")"
+fi
 # With labels: the detection rates within 1, 2, 3 and 5 px (labels here: the ground truth)
 awk -F, 'NR > 1 && NR <= 6 { printf "f%d.pgm %s %s\n", NR - 2, $7, $8 }' assets/eye_synth.csv >"$T/lab.txt"
 i=0
