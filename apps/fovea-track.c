@@ -181,7 +181,7 @@ int main(int argc, char **argv)
     long frames = 0, found = 0, with_glints = 0, blinks = 0;
     double conf_sum = 0;
     fv_eye_frame fr;
-    int rc;
+    int rc = 0;
     while ((max_frames < 0 || frames < max_frames) && (rc = fv_eyesrc_next(src, &fr, err, sizeof err)) == 1) {
         /* run 0 gives the result (with blink history for videos); extra --bench runs only time */
         fv_eye_result r, scratch_r;

@@ -1,20 +1,20 @@
-/* fovea eye tracker: dark-pupil detection, sub-pixel centre, glints, confidence, blinks.
+/* fovea eye tracker: dark-pupil detection, sub-pixel centre, glints, confidence, blinks
+ * (docs/eyetrack.md has the measurements behind the choices).
  *
- * 1. Coarse search on a small copy (halved with dsp->et_down2_row until min(w, h) <= 72):
- *    reflections (bright blobs, dsp->et_thresh_row) are masked, grown by one pixel and
- *    inpainted from their surroundings so a glint inside the pupil does not make it look bright.
- *    Over an integral image (dsp->et_integral_row) every centre and a range of radii k is
- *    scored by contrast = mean(ring k..2k) - mean(box k): the darkest compact blob wins. A
- *    contrast score, not darkness alone, is what rejects eyebrows, lashes and shadows (dark
- *    regions that are as dark around as inside).
- * 2. Refinement at full resolution in a window around the candidate (reflections inpainted
- *    again): threshold half way between the blob and its surround, then an iterated weighted
- *    centroid of the dark pixels (robust for the ~10 px pupils of remote cameras); then rays
- *    from that centre give sub-pixel edge points for a direct ellipse fit with outlier
- *    rejection, whose centre is used when the pupil is big enough and the fit agrees.
+ * 1. Search (coarse_search): the frame is halved (dsp->et_down2_row) until min(w, h) <= 128
+ *    (F), reflections on F (dsp->et_thresh_row) are masked and inpainted from their
+ *    surroundings so a glint inside the pupil does not make it look bright; F is halved again
+ *    to <= 64 (C). Over integral images (dsp->et_integral_row) every centre and box size of C
+ *    is scored by contrast with its ring, darkness and a weak centre prior (box_search); the
+ *    best is refined in position and size on F. Contrast, not darkness alone, rejects brows,
+ *    lashes and shadows (as dark around as inside).
+ * 2. Refinement at full resolution in a window around it: threshold half way between the blob
+ *    and its surround, iterated weighted centroid of the darker pixels, then rays from there
+ *    give sub-pixel edge points for a direct ellipse fit with outlier rejection. Headset-sized
+ *    frames report the ellipse centre; small remote-camera crops report the search's box centre.
  * 3. Glints: small bright blobs of the raw image close to the pupil.
- * 4. Confidence from the contrast and the fit; blinks from contrast / size drops against the
- *    tracker's running reference. */
+ * 4. Confidence from the contrast and the fit; blinks from darkness / contrast / size drops
+ *    against the tracker's running reference. */
 #include <math.h>
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
