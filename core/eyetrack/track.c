@@ -1,7 +1,7 @@
 /* fovea eye tracker: dark-pupil detection, sub-pixel centre, glints, confidence, blinks
  * (docs/eyetrack.md has the measurements behind the choices).
  *
- * 1. Search (coarse_search): the frame is halved (dsp->et_down2_row) until min(w, h) <= 128
+ * 1. Search (coarse_search): the frame is halved (dsp->et_down2_row) until min(w, h) <= 160
  *    (F), reflections on F (dsp->et_thresh_row) are masked and inpainted from their
  *    surroundings so a glint inside the pupil does not make it look bright; F is halved again
  *    to <= 64 (C). Over integral images (dsp->et_integral_row) every centre and box size of C
@@ -25,7 +25,8 @@
 #include "dsp.h"
 #include "eyetrack/eyetrack.h"
 
-#define SEARCH_MAX_SIDE 128 /* search image F: min side at most this (C: half that) */
+#define SEARCH_MAX_SIDE 160 /* search image F: min side at most this */
+#define SEARCH_C_SIDE 64    /* exhaustive search image C: min side at most this */
 #define NRAYS 48
 
 struct fv_eye_tracker {
@@ -293,7 +294,7 @@ static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, i
 }
 
 /* Two levels: F (halved until min side <= SEARCH_MAX_SIDE; reflections inpainted there) and C
- * (F halved again until min side <= SEARCH_MAX_SIDE / 2). The exhaustive search runs on C;
+ * (F halved again until min side <= SEARCH_C_SIDE). The exhaustive search runs on C;
  * F only refines position and size around C's answer, which costs ~25x less than searching F. */
 static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride,
                                uint8_t *work, uint8_t *mask, uint8_t *small, uint32_t *ii, int *idx)
@@ -325,7 +326,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     /* level C */
     int cw = sw, ch = sh, f = 1;
     const uint8_t *cs = work;
-    while (imin(cw, ch) > SEARCH_MAX_SIDE / 2) {
+    while (imin(cw, ch) > SEARCH_C_SIDE) {
         const int nw = cw / 2, nh = ch / 2;
         uint8_t *dst = cs == small ? mask : small;
         for (int y = 0; y < nh; y++)
@@ -631,9 +632,6 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
         /* no dark region stands out in the window: keep the search's answer, flagged low */
         p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
     }
-    /* Small dark blobs (remote cameras, ~10 px pupils inside an equally dark iris): the centre of
-     * the best contrast box beat the refined centroid on the MRL images (lids and lashes pull
-     * it). Headset-sized pupils: the ellipse centre, else the dark-region centroid. */
     /* Small images (min side <= SEARCH_MAX_SIDE: remote-camera crops, ~10 px pupils inside an
      * often equally dark iris): the best contrast box's centre beat the refined centroid and the
      * ellipse on the MRL images (lids, lashes and iris pull them). Headset-sized eyes: the ellipse
