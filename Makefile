@@ -122,8 +122,9 @@ $(RANGE): tools/gen_range.c
 	$(MAKE) --no-print-directory $(BUILD)/tools/gen_range
 	$(BUILD)/tools/gen_range --out $@
 
-$(EYE_SYNTH): tools/gen_eye.c core/eyetrack/synth.c core/eyetrack/synth.h assets/gaze_sweep.csv
-	$(MAKE) --no-print-directory $(BUILD)/tools/gen_eye
+# (order-only on the tool: built by this make, not a recursive one racing it under -j; the asset
+# is remade when its sources change, not whenever some build folder's tool is newer)
+$(EYE_SYNTH): tools/gen_eye.c core/eyetrack/synth.c core/eyetrack/synth.h assets/gaze_sweep.csv | $(BUILD)/tools/gen_eye
 	$(BUILD)/tools/gen_eye --trace assets/gaze_sweep.csv --out $@ --truth $(EYE_SYNTH_TRUTH)
 $(EYE_SYNTH_TRUTH): $(EYE_SYNTH)
 
