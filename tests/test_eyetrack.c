@@ -3,6 +3,7 @@
  * against a known polynomial; the whole chain gaze -> synthetic frames -> tracker ->
  * calibration -> gaze in degrees; the gaze filter; calibration files. Deterministic. Frames are
  * 320x240 with 2x2 supersampling and few in number, to stay quick under ASan and qemu. */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -542,6 +543,62 @@ static void test_bundled_video(void **state)
     fv_eyesrc_close(src);
 }
 
+/* ------------------------------------------------------------------ real infrared crops */
+
+/* Every 15th labelled MRL image (~300, both sensors) through the list reader and the tracker:
+ * a regression guard on the figures docs/eyetrack.md reports for all 4,485 (79.8% within 5 px,
+ * 54.2% within 3 px there). Skipped when ../shared is not there. */
+static void test_mrl_subset(void **state)
+{
+    (void)state;
+    char rel[1024], dirp[4096], list[4200], line[2048], err[512];
+    snprintf(rel, sizeof rel, "%s/assets/eyes/mrl-dev", fv_test_shared());
+    FILE *in = NULL;
+    if (realpath(rel, dirp)) { /* the subset list lives elsewhere: absolute paths */
+        snprintf(list, sizeof list, "%s/pupil.txt", dirp);
+        in = fopen(list, "r");
+    }
+    if (!in) {
+        printf("[ eyetrack ] %s/pupil.txt not found: MRL subset skipped\n", rel);
+        skip();
+    }
+    char sub[] = "/tmp/fovea_mrl_XXXXXX";
+    const int fd = mkstemp(sub);
+    assert_true(fd >= 0);
+    FILE *out = fdopen(fd, "w");
+    int i = 0;
+    while (fgets(line, sizeof line, in))
+        if (i++ % 15 == 0)
+            fprintf(out, "%s/%s", dirp, line);
+    fclose(in);
+    fclose(out);
+    fv_eyesrc *src;
+    const int orc = fv_eyesrc_open_list(&src, sub, err, sizeof err);
+    unlink(sub); /* read in full by the open */
+    if (orc)
+        fail_msg("%s", err);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    int n = 0, w3 = 0, w5 = 0, found = 0;
+    fv_eye_frame fr;
+    int rc;
+    while ((rc = fv_eyesrc_next(src, &fr, err, sizeof err)) == 1) {
+        fv_eye_result r;
+        assert_true(fr.has_label);
+        assert_int_equal(fv_track_image(t, fr.luma, fr.w, fr.h, fr.stride, &r), 0);
+        const float e = r.found ? hypotf(r.pupil_x - fr.label_x, r.pupil_y - fr.label_y) : INFINITY;
+        n++, found += r.found, w3 += e <= 3.0f, w5 += e <= 5.0f;
+    }
+    if (rc < 0)
+        fail_msg("%s", err);
+    fv_eyesrc_close(src);
+    fv_eye_destroy(t);
+    printf("[ eyetrack ] MRL subset: %d images, found %d, within 3 px %.1f%%, within 5 px %.1f%% (bounds 48%%, 74%%)\n",
+           n, found, 100.0 * w3 / n, 100.0 * w5 / n);
+    assert_true(n >= 250);
+    assert_true(w3 >= 0.48 * n);
+    assert_true(w5 >= 0.74 * n);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -555,6 +612,7 @@ int main(void)
         cmocka_unit_test(test_end_to_end),
         cmocka_unit_test(test_gaze_filter),
         cmocka_unit_test(test_bundled_video),
+        cmocka_unit_test(test_mrl_subset),
     };
     return cmocka_run_group_tests_name("eyetrack", tests, NULL, NULL);
 }
