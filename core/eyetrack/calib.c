@@ -47,9 +47,6 @@ double fv_gaze_angle_deg(double yaw1, double pitch1, double yaw2, double pitch2)
 /* Solve the 6x6 system m x = r (Gaussian elimination, partial pivoting). */
 static int solve6(double m[6][6], double r[2][6], double x[2][6])
 {
-    int piv[6];
-    for (int i = 0; i < 6; i++)
-        piv[i] = i;
     double scale = 0;
     for (int i = 0; i < 6; i++)
         scale = fmax(scale, fabs(m[i][i]));
@@ -85,7 +82,6 @@ static int solve6(double m[6][6], double r[2][6], double x[2][6])
                 s -= m[i][j] * x[k][j];
             x[k][i] = s / m[i][i];
         }
-    (void)piv;
     return 0;
 }
 
