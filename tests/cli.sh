@@ -166,7 +166,7 @@ if $K --video $V --out "$T/track.csv" --quiet >"$T/out" 2>"$T/err"; then
     frames=$(( ($(wc -c <$V) - hl) / (6 + w * h) ))
     rows=$(wc -l <"$T/track.csv")
     [ "$rows" -eq "$frames" ] && ok || bad "track.csv has $rows lines for $frames frames"
-    grep -Eqv '^[0-9]+,([0-9.]+,[0-9.]+)?,[0-9.]+$' "$T/track.csv" && bad "track.csv line format: $(grep -Ev '^[0-9]+,([0-9.]+,[0-9.]+)?,[0-9.]+$' "$T/track.csv" | head -1)" || ok
+    grep -Eqv '^[0-9]+,([0-9.]+,[0-9.]+|,),[0-9.]+$' "$T/track.csv" && bad "track.csv line format: $(grep -Ev '^[0-9]+,([0-9.]+,[0-9.]+|,),[0-9.]+$' "$T/track.csv" | head -1)" || ok
     grep -q 'frames, pupil found in' "$T/out" && ok || bad "track summary: $(cat "$T/out")"
 else
     bad "track good run failed: $(cat "$T/err")"

@@ -24,7 +24,7 @@ enum { FV_EYE_OK = 0, FV_EYE_BLINK = 1, FV_EYE_LOST = 2 };
 
 typedef struct fv_eye_result {
     int status;             /* FV_EYE_OK, FV_EYE_BLINK (eye closed / pupil covered), FV_EYE_LOST */
-    int found;              /* a pupil position is given (status OK; also some low-confidence frames) */
+    int found;              /* a pupil position is given (status OK, possibly with low confidence) */
     float pupil_x, pupil_y; /* sub-pixel pupil centre */
     float pupil_a_px, pupil_b_px, pupil_angle_rad; /* ellipse semi-axes and angle (a >= b) */
     int ellipse_fit;        /* 1: centre from the ellipse fit; 0: from the dark-region centroid */

@@ -686,7 +686,9 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
         const float span = t->ref_ring - t->ref_inner;
         if (t->nref >= 3 && (p.inner > t->ref_inner + 0.4f * span || r->contrast < 0.45f * t->ref_contrast ||
                              p.r < 0.45f * t->ref_radius || flat < 0.3f)) {
-            r->status = FV_EYE_BLINK;
+            r->status = FV_EYE_BLINK; /* what was found is not a pupil: no position */
+            r->found = 0;
+            r->has_pg = 0;
             r->confidence *= 0.25f;
         } else {
             const float a = t->nref < 10 ? 1.0f / (t->nref + 1) : 0.1f;
