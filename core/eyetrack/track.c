@@ -367,6 +367,20 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
 
 /* ---------------------------------------------------------------- refinement */
 
+/* Points within tol of e (fv_ellipse_distance with the rotation computed once). */
+static int count_near(const fv_ellipse *e, const float *x, const float *y, int n, double tol)
+{
+    const double c = cos(e->angle), s = sin(e->angle), ia = 1.0 / e->a, ib = 1.0 / e->b;
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        const double u = (x[i] - e->cx) * c + (y[i] - e->cy) * s, v = -(x[i] - e->cx) * s + (y[i] - e->cy) * c;
+        const double rho = sqrt((u * ia) * (u * ia) + (v * ib) * (v * ib));
+        const double d = rho < 1e-12 ? e->b : fabs(rho - 1.0) * sqrt(u * u + v * v) / rho;
+        k += d <= tol;
+    }
+    return k;
+}
+
 typedef struct {
     float x, y, r;
     float inner, ring;
@@ -379,7 +393,9 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
                   int inpainted, uint8_t *win, uint8_t *mask, int *idx, pupil *out)
 {
     /* window around the candidate, reflections inpainted */
-    const int half = (int)ceilf(3.0f * c->r) + 2;
+    /* headset-sized frames: the search's box can be much smaller than the pupil (the darkest
+     * part of it), and rays must reach the pupil's far edge inside the window */
+    const int half = imax((int)ceilf(3.0f * c->r), inpainted ? 0 : imin(w, h) / 4) + 2;
     const int x0 = imax(0, (int)c->x - half), y0 = imax(0, (int)c->y - half);
     const int x1 = imin(w, (int)c->x + half), y1 = imin(h, (int)c->y + half);
     const int ww = x1 - x0, wh = y1 - y0;
@@ -473,9 +489,15 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             if (v >= th && prev < th && sustained(win, ww, wh, cx, cy, dx, dy, dist, fmaxf(1.5f, 0.2f * r), th)) {
                 const float f = (th - prev) / (v - prev);
                 const float de = pd + f * (dist - pd);
-                ex[ne] = cx + de * dx + x0;
-                ey[ne] = cy + de * dy + y0;
-                ne++;
+                /* beyond a pupil edge lies iris; beyond a lid edge, much brighter skin: a ray
+                 * that meets the lid gives no point (it would drag the fit) */
+                const float po = de + fmaxf(2.0f, 0.15f * r);
+                const float vo = sample(win, ww, wh, cx + po * dx, cy + po * dy);
+                if (vo <= ring + 0.6f * (ring - inner)) {
+                    ex[ne] = cx + de * dx + x0;
+                    ey[ne] = cy + de * dy + y0;
+                    ne++;
+                }
                 break;
             }
             prev = v, pd = dist;
@@ -483,6 +505,45 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     }
     if (ne < 8)
         return 0;
+    int n = 0;
+    if (!inpainted) {
+        /* Headset-sized pupils: RANSAC over 6-point fits (a lid can hide a third of the outline
+         * and put its own edge in the middle of the points, which moves a least-squares fit),
+         * then the least-squares refit below on the consensus. Deterministic sampling. */
+        uint64_t st = 0x5eedu;
+        int best = 0;
+        fv_ellipse be;
+        for (int it = 0; it < 64; it++) {
+            float sx[6], sy[6];
+            int pick[6], k = 0;
+            while (k < 6) {
+                st += 0x9e3779b97f4a7c15ull;
+                uint64_t z = st;
+                z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+                z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+                const int j = (int)((z ^ (z >> 31)) % (uint64_t)ne);
+                int dup = 0;
+                for (int q = 0; q < k; q++)
+                    dup |= pick[q] == j;
+                if (!dup)
+                    pick[k] = j, sx[k] = ex[j], sy[k] = ey[j], k++;
+            }
+            fv_ellipse e;
+            if (fv_ellipse_fit(sx, sy, 6, &e) || e.a < 0.5 * r || e.a > 2.5 * r || e.b < 0.3 * e.a ||
+                hypot(e.cx - (cx + x0), e.cy - (cy + y0)) > r)
+                continue;
+            const int cnt = count_near(&e, ex, ey, ne, fmax(1.0, 0.06 * e.a));
+            if (cnt > best)
+                best = cnt, be = e;
+        }
+        if (best >= 8) {
+            const double tol = fmax(1.0, 0.06 * be.a);
+            for (int i = 0; i < ne; i++)
+                if (fv_ellipse_distance(&be, ex[i], ey[i]) <= tol)
+                    ex[n] = ex[i], ey[n] = ey[i], n++;
+        }
+    }
+    if (n < 8) {
     /* first cut: points much nearer or farther than the median radius (glints, lids, lashes) */
     float rad[NRAYS];
     for (int i = 0; i < ne; i++)
@@ -495,10 +556,11 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             sorted[j] = sorted[j - 1], sorted[j - 1] = tmp;
         }
     const float rmed = sorted[ne / 2];
-    int n = 0;
+    n = 0;
     for (int i = 0; i < ne; i++)
         if (fabsf(rad[i] - rmed) <= fmaxf(1.5f, 0.25f * rmed))
             ex[n] = ex[i], ey[n] = ey[i], n++;
+    }
     if (n < 8)
         return 0;
     fv_ellipse e;
