@@ -478,6 +478,8 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     int ne = 0;
     const float step = fmaxf(0.25f, r / 24.0f);
     const int nrays = r < 12.0f ? NRAYS / 2 : NRAYS; /* small pupils: fewer edge pixels anyway */
+    float evo[NRAYS];
+    const float lidf = 0.35f;
     for (int k = 0; k < nrays; k++) {
         const float a = (float)(2.0 * M_PI * k / nrays), dx = cosf(a), dy = sinf(a);
         float prev = sample(win, ww, wh, cx, cy), pd = 0;
@@ -496,6 +498,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
                 if (vo <= ring + 0.6f * (ring - inner)) {
                     ex[ne] = cx + de * dx + x0;
                     ey[ne] = cy + de * dy + y0;
+                    evo[ne] = vo;
                     ne++;
                 }
                 break;
@@ -503,8 +506,29 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             prev = v, pd = dist;
         }
     }
+    if (!inpainted && ne >= 8) {
+        /* What lies just outside most edge points is iris; points with something clearly
+         * brighter beyond them (the lid margin, skin) are dropped. The median is the iris level
+         * as long as the lid hides less than half of the outline. */
+        float srt[NRAYS];
+        memcpy(srt, evo, sizeof(float) * (size_t)ne);
+        for (int i = 1; i < ne; i++)
+            for (int j = i; j > 0 && srt[j - 1] > srt[j]; j--) {
+                const float tmp = srt[j];
+                srt[j] = srt[j - 1], srt[j - 1] = tmp;
+            }
+        const float iris = srt[ne / 2], lim = iris + lidf * (iris - inner);
+        int m = 0;
+        for (int i = 0; i < ne; i++)
+            if (evo[i] <= lim)
+                ex[m] = ex[i], ey[m] = ey[i], evo[m] = evo[i], m++;
+        ne = m;
+    }
     if (ne < 8)
         return 0;
+    /* headset-sized pupils: aspect b/a >= 0.6 (gaze up to ~50 deg off the camera axis); flatter
+     * fits are lid-line consensus */
+    const double minab = 0.6;
     int n = 0;
     if (!inpainted) {
         /* Headset-sized pupils: RANSAC over 6-point fits (a lid can hide a third of the outline
@@ -529,7 +553,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
                     pick[k] = j, sx[k] = ex[j], sy[k] = ey[j], k++;
             }
             fv_ellipse e;
-            if (fv_ellipse_fit(sx, sy, 6, &e) || e.a < 0.5 * r || e.a > 2.5 * r || e.b < 0.3 * e.a ||
+            if (fv_ellipse_fit(sx, sy, 6, &e) || e.a < 0.5 * r || e.a > 2.5 * r || e.b < minab * e.a ||
                 hypot(e.cx - (cx + x0), e.cy - (cy + y0)) > r)
                 continue;
             const int cnt = count_near(&e, ex, ey, ne, fmax(1.0, 0.06 * e.a));
@@ -582,7 +606,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     if (fv_ellipse_fit(ex, ey, n, &e))
         return 0;
     const double dc = hypot(e.cx - out->x, e.cy - out->y);
-    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < 0.3 * e.a || dc > 0.6 * r)
+    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < (inpainted ? 0.3 : minab) * e.a || dc > 0.6 * r)
         return 0;
     out->fit = 1;
     out->e = e;
