@@ -48,7 +48,7 @@ ALL_CFLAGS = $(BASE_CFLAGS) $(CFLAGS)
 ALL_CXXFLAGS = $(BASE_CXXFLAGS) $(CXXFLAGS)
 ALL_LDFLAGS = $(SANFLAGS) -pthread $(LDFLAGS)
 
-CORE_C := $(wildcard core/*.c core/dof/*.c)
+CORE_C := $(wildcard core/*.c core/dof/*.c core/eyetrack/*.c)
 CORE_CXX := $(wildcard core/*.cpp)
 ifeq ($(ARCH),x86_64)
 CORE_ISA := $(wildcard core/x86/*.c)
@@ -67,6 +67,10 @@ PLIB := $(BUILD)/libfovea-platform.a
 
 # The bundled "space shooting range" scene is generated (deterministically) at build time.
 RANGE := assets/range.glb
+# The bundled synthetic eye video (tools/gen_eye.c, driven by the bundled gaze trace) and its
+# ground truth; deterministic, about 1.5 s to make.
+EYE_SYNTH := assets/eye_synth.y4m
+EYE_SYNTH_TRUTH := assets/eye_synth.csv
 # Where the shared assets live (scenes, eye images); tests read them from here.
 SHARED ?= ../shared
 
@@ -118,10 +122,16 @@ $(RANGE): tools/gen_range.c
 	$(MAKE) --no-print-directory $(BUILD)/tools/gen_range
 	$(BUILD)/tools/gen_range --out $@
 
+# (order-only on the tool: built by this make, not a recursive one racing it under -j; the asset
+# is remade when its sources change, not whenever some build folder's tool is newer)
+$(EYE_SYNTH): tools/gen_eye.c core/eyetrack/synth.c core/eyetrack/synth.h assets/gaze_sweep.csv | $(BUILD)/tools/gen_eye
+	$(BUILD)/tools/gen_eye --trace assets/gaze_sweep.csv --out $@ --truth $(EYE_SYNTH_TRUTH)
+$(EYE_SYNTH_TRUTH): $(EYE_SYNTH)
+
 deps:
 	@tools/deps.sh $(if $(CROSS),--cross)
 
-test-bin: $(LIB) $(PLIB) $(APPS) $(TOOLS) $(TESTS) $(RANGE)
+test-bin: $(LIB) $(PLIB) $(APPS) $(TOOLS) $(TESTS) $(RANGE) $(EYE_SYNTH)
 
 # The suite: unit + kernel tests (cmocka) and the command-line tests; one summary line at the end.
 test: deps
@@ -160,11 +170,11 @@ PREFIX ?= /usr/local
 install: all
 	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/fovea $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig
 	install -m 644 $(LIB) $(PLIB) $(DESTDIR)$(PREFIX)/lib/
-	install -m 644 core/*.h core/dof/*.h platform/*.h $(DESTDIR)$(PREFIX)/include/fovea/
+	install -m 644 core/*.h core/dof/*.h core/eyetrack/*.h platform/*.h $(DESTDIR)$(PREFIX)/include/fovea/
 	install -m 755 $(APPS) $(DESTDIR)$(PREFIX)/bin/
 	sed -e 's|@PREFIX@|$(PREFIX)|g' tools/fovea.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/fovea.pc
 
 clean:
-	rm -rf build build-asan build-tsan build-aarch64 out $(RANGE)
+	rm -rf build build-asan build-tsan build-aarch64 out $(RANGE) $(EYE_SYNTH) $(EYE_SYNTH_TRUTH)
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

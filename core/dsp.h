@@ -17,6 +17,7 @@
 #define FOVEA_DSP_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 enum {
     FV_ISA_C = 0,
@@ -74,6 +75,15 @@ typedef void (*fv_taa_blend_fn)(const struct fv_taa_frame *f, const struct fv_ta
                                 struct fv_taa_flow *flow);
 typedef void (*fv_taa_fill_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                                ptrdiff_t stride, int x0, int y0, int w, int h);
+/* ---- eye tracker kernels (core/eyetrack/kernels.c; integer, so every ISA is exact) ----
+ * et_down2_row: dst[x] = (a[2x] + a[2x+1] + b[2x] + b[2x+1] + 2) >> 2 for x in [0, n)
+ *   (reads 2n pixels of each source row).
+ * et_integral_row: dst[x] = above[x] + (src[0] + ... + src[x]) (uint32, wraps mod 2^32; the
+ *   tracker's images are far too small to wrap), for x in [0, n).
+ * et_thresh_row: dst[x] = src[x] >= t ? 255 : 0 (t in [0, 256]); returns the count of 255s. */
+typedef void (*fv_et_down2_row_fn)(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n);
+typedef void (*fv_et_integral_row_fn)(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
+typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, int n, int t);
 
 typedef struct fv_dsp {
     unsigned isa; /* the ISA actually selected (one FV_ISA_* value) */
@@ -81,6 +91,10 @@ typedef struct fv_dsp {
     fv_push_row_fn push_row;
     fv_taa_blend_fn taa_blend;
     fv_taa_fill_fn taa_fill;
+    /* eye tracker */
+    fv_et_down2_row_fn et_down2_row;
+    fv_et_integral_row_fn et_integral_row;
+    fv_et_thresh_row_fn et_thresh_row;
 } fv_dsp;
 
 unsigned fv_cpu_isas(void);            /* FV_ISA_* bits this CPU runs */
@@ -110,6 +124,18 @@ void fv_reproject_init_avx2(fv_dsp *d);
 #elif defined(__aarch64__)
 void fv_pullpush_init_neon(fv_dsp *d);
 void fv_reproject_init_neon(fv_dsp *d);
+#endif
+
+/* eye tracker */
+void fv_et_down2_row_c(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n);
+void fv_et_integral_row_c(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
+int fv_et_thresh_row_c(uint8_t *restrict dst, const uint8_t *src, int n, int t);
+void fv_eyetrack_init_c(fv_dsp *d);
+#if defined(__x86_64__)
+void fv_eyetrack_init_sse41(fv_dsp *d);
+void fv_eyetrack_init_avx2(fv_dsp *d);
+#elif defined(__aarch64__)
+void fv_eyetrack_init_neon(fv_dsp *d);
 #endif
 
 #endif

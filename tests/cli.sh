@@ -1,5 +1,5 @@
 #!/bin/sh
-# Command-line contract tests for fovea-replay and fovea-bench: bad input gets a one-line reason
+# Command-line contract tests for fovea-replay, fovea-bench and fovea-track: bad input gets a one-line reason
 # and exit 2 with no output left behind as if complete; good runs write what DESIGN.md promises;
 # frames are byte-identical for 1, 2 and 5 threads and across runs.
 set -u
@@ -192,6 +192,80 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
     fi
 else
     bad "bench failed: $(cat "$T/err")"
+fi
+# fovea-track: bad eye input gets one line naming the problem, exit 2, and no CSV left behind
+K=$B/fovea-track
+V=assets/eye_synth.y4m
+printf 'YUV4MPEG2 W8 H8 F30:1 Cmono\nFRAME\n' >"$T/trunc.y4m"
+head -c 40 /dev/zero >>"$T/trunc.y4m"
+printf 'YUV4MPEG2 W16 H16 F30:1 Cmono\nFRAME\n' >"$T/trunc2.y4m"
+head -c 256 /dev/zero >>"$T/trunc2.y4m"
+printf 'FRAME\n' >>"$T/trunc2.y4m"
+head -c 100 /dev/zero >>"$T/trunc2.y4m"
+printf 'YUV4MPEG2 W16 H16 F30:1 Cmono\nFRAMX\n' >"$T/corrupt.y4m"
+printf 'RIFF garbage\n' >"$T/notyuv.y4m"
+printf 'YUV4MPEG2 H16 F30:1\n' >"$T/now.y4m"
+printf 'YUV4MPEG2 W16 H16 C420p10\n' >"$T/p10.y4m"
+printf 'a.png 1 2 3\n' >"$T/fields.txt"
+printf 'a.png 1 x\n' >"$T/label.txt"
+printf '# only a comment\n\n' >"$T/empty.txt"
+printf 'missing.png 3 4\n' >"$T/missing.txt"
+printf 'not a png' >"$T/bad.png"
+printf 'bad.png\n' >"$T/badimg.txt"
+expect_usage "track no source" 'one of --images LIST, --video FILE or --device DEV is required' $K
+expect_usage "track two sources" 'only one of' $K --video $V --images "$T/fields.txt"
+expect_usage "track device" 'V4L2 capture is not wired yet' $K --device /dev/video0
+expect_usage "track unknown flag" '--bogus: unknown option' $K --video $V --bogus
+expect_usage "track bad bench" '--bench: 0 is out of range' $K --video $V --bench 0
+expect_usage "track missing video" 'nope.y4m: No such file' $K --video "$T/nope.y4m" --out "$T/k1.csv"
+expect_usage "track truncated y4m" 'trunc.y4m: frame 0 is truncated \(40 of 64 bytes\)' $K --video "$T/trunc.y4m" --out "$T/k1.csv"
+expect_usage "track truncated later frame" 'trunc2.y4m: frame 1 is truncated \(100 of 256 bytes\)' $K --video "$T/trunc2.y4m" --out "$T/k1.csv"
+expect_usage "track corrupt y4m" 'corrupt.y4m: frame 0: corrupt data \(no FRAME marker\)' $K --video "$T/corrupt.y4m" --out "$T/k1.csv"
+expect_usage "track not y4m" 'notyuv.y4m: not a YUV4MPEG2 file' $K --video "$T/notyuv.y4m" --out "$T/k1.csv"
+expect_usage "track y4m without W" 'now.y4m: the header lacks W or H' $K --video "$T/now.y4m" --out "$T/k1.csv"
+expect_usage "track y4m 10 bit" 'p10.y4m: colour space C420p10 is not supported' $K --video "$T/p10.y4m" --out "$T/k1.csv"
+expect_usage "track list fields" 'fields.txt:1: 4 fields, expected PATH \[X Y\]' $K --images "$T/fields.txt" --out "$T/k1.csv"
+expect_usage "track list label" 'label.txt:1: label .1 x. is not two numbers' $K --images "$T/label.txt" --out "$T/k1.csv"
+expect_usage "track empty list" 'empty.txt: no images listed' $K --images "$T/empty.txt" --out "$T/k1.csv"
+expect_usage "track missing image" 'missing.txt:1: missing.png: No such file' $K --images "$T/missing.txt" --out "$T/k1.csv"
+expect_usage "track corrupt image" 'badimg.txt:1: bad.png: ' $K --images "$T/badimg.txt" --out "$T/k1.csv"
+expect_usage "track list is a directory" '(directory|read error)' $K --images "$T" --out "$T/k1.csv"
+[ ! -e "$T/k1.csv" ] && [ ! -e "$T/k1.csv.tmp" ] && ok || bad "fovea-track bad input left $T/k1.csv behind"
+if $K --help >"$T/help" 2>&1 && grep -q -- --images "$T/help"; then ok; else bad "fovea-track --help"; fi
+
+# A good run on the bundled synthetic video: one line per frame, PATH_OR_FRAME,X,Y,CONF
+if $K --video $V --out "$T/track.csv" --quiet >"$T/out" 2>"$T/err"; then
+    hl=$(head -n 1 $V | wc -c)
+    w=$(head -n 1 $V | sed 's/.* W\([0-9]*\) .*/\1/'); h=$(head -n 1 $V | sed 's/.* H\([0-9]*\) .*/\1/')
+    frames=$(( ($(wc -c <$V) - hl) / (6 + w * h) ))
+    rows=$(wc -l <"$T/track.csv")
+    [ "$rows" -eq "$frames" ] && ok || bad "track.csv has $rows lines for $frames frames"
+    grep -Eqv '^[0-9]+,([0-9.]+,[0-9.]+|,),[0-9.]+$' "$T/track.csv" && bad "track.csv line format: $(grep -Ev '^[0-9]+,([0-9.]+,[0-9.]+|,),[0-9.]+$' "$T/track.csv" | head -1)" || ok
+    grep -q 'frames, pupil found in' "$T/out" && ok || bad "track summary: $(cat "$T/out")"
+else
+    bad "track good run failed: $(cat "$T/err")"
+fi
+# fovea-replay's own Y4M (C420jpeg, 128x72, 2 frames) reads back
+if [ -s "$T/v.y4m" ] && $K --video "$T/v.y4m" --out "$T/v.csv" --quiet >"$T/out" 2>"$T/err"; then
+    [ "$(wc -l <"$T/v.csv")" -eq 2 ] && ok || bad "track on the replay's C420jpeg video: $(cat "$T/v.csv")"
+else
+    bad "track on the replay's C420jpeg video failed: $(cat "$T/err")"
+fi
+# With labels: the detection rates within 1, 2, 3 and 5 px (labels here: the ground truth)
+awk -F, 'NR > 1 && NR <= 6 { printf "f%d.pgm %s %s\n", NR - 2, $7, $8 }' assets/eye_synth.csv >"$T/lab.txt"
+i=0
+while [ $i -lt 5 ]; do
+    # frame i of the Cmono video as a PGM: the header, then the luma bytes
+    w=$(head -n 1 $V | sed 's/.* W\([0-9]*\) .*/\1/'); h=$(head -n 1 $V | sed 's/.* H\([0-9]*\) .*/\1/')
+    hl=$(head -n 1 $V | wc -c)
+    { printf 'P5 %s %s 255\n' "$w" "$h"; tail -c +$((hl + 1 + i * (6 + w * h) + 6)) $V | head -c $((w * h)); } >"$T/f$i.pgm"
+    i=$((i + 1))
+done
+if $K --images "$T/lab.txt" --quiet >"$T/out" 2>"$T/err"; then
+    grep -Eq 'all +5 labelled: +<=1px +100\.0% +<=2px +100\.0% +<=3px +100\.0% +<=5px +100\.0%' "$T/out" && ok \
+        || bad "track rates on labelled synthetic frames: $(cat "$T/out")"
+else
+    bad "track labelled run failed: $(cat "$T/err")"
 fi
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -1,0 +1,267 @@
+/* fovea-track: runs the eye tracker over an image list or a Y4M eye video; writes one CSV line
+ * per image / frame (PATH_OR_FRAME,X,Y,CONF; X,Y empty when no pupil) and prints a summary,
+ * with detection rates when the list carries pupil labels. */
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cli.h"
+#include "dsp.h"
+#include "eyesrc.h"
+#include "eyetrack/eyetrack.h"
+#include "output.h"
+
+static const char *prog = "fovea-track";
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: fovea-track (--images LIST | --video FILE.y4m | --device /dev/videoN) [--out FILE.csv]\n"
+            "Tracks the pupil (and glints) in every image or frame; writes PATH_OR_FRAME,X,Y,CONF lines\n"
+            "(X,Y in pixels of that image, origin at the image's top-left corner, so pixel (i,j) has its\n"
+            "centre at (i+0.5, j+0.5); empty when no pupil) and prints a summary. With labels in LIST\n"
+            "(lines PATH X Y) it prints detection rates within 1, 2, 3 and 5 px and the median error.\n"
+            "  --images LIST      image list: lines PATH [X Y], PATH relative to the list's folder\n"
+            "  --video FILE       YUV4MPEG2 video (C420*, C422, C444, Cmono; luma is used)\n"
+            "  --device DEV       V4L2 camera (not wired yet)\n"
+            "  --out FILE         CSV output (written atomically)\n"
+            "  --frames N         stop after N images / frames\n"
+            "  --bench N          track each frame N times and report the median time per frame\n"
+            "  --isa c|sse41|avx2|neon  cap the SIMD kernels (default: best available)\n"
+            "  --quiet            no progress output\n"
+            "  --help             this text\n");
+}
+
+enum { OPT_IMAGES = 1, OPT_VIDEO, OPT_DEVICE, OPT_OUT, OPT_FRAMES, OPT_BENCH, OPT_ISA, OPT_QUIET, OPT_HELP };
+
+static int64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Label statistics for one group (all images, or one MRL sensor). */
+typedef struct {
+    char name[16];
+    long n, within[4];
+    double *err;
+} group;
+static const double radii[4] = { 1, 2, 3, 5 };
+
+static group *find_group(group *g, int *ng, const char *name, long cap)
+{
+    for (int i = 0; i < *ng; i++)
+        if (!strcmp(g[i].name, name))
+            return &g[i];
+    if (*ng == 8)
+        return NULL;
+    group *n = &g[(*ng)++];
+    memset(n, 0, sizeof *n);
+    snprintf(n->name, sizeof n->name, "%s", name);
+    n->err = malloc((size_t)cap * sizeof(double));
+    if (!n->err)
+        fv_fail(prog, FV_EXIT_FAIL, "out of memory");
+    return n;
+}
+
+/* The MRL file-name field for the sensor (subject_image_gender_glasses_eye_refl_light_SENSOR.png). */
+static int mrl_sensor(const char *path, char out[16])
+{
+    const char *b = strrchr(path, '/');
+    b = b ? b + 1 : path;
+    int us = 0;
+    const char *last = NULL;
+    for (const char *p = b; *p; p++)
+        if (*p == '_')
+            us++, last = p + 1;
+    if (us != 7 || !last)
+        return 0;
+    const char *dot = strchr(last, '.');
+    const int len = dot ? (int)(dot - last) : (int)strlen(last);
+    if (len < 1 || len > 8)
+        return 0;
+    snprintf(out, 16, "%.*s", len, last);
+    return 1;
+}
+
+static void print_group(const group *g)
+{
+    if (!g->n)
+        return;
+    qsort(g->err, (size_t)g->n, sizeof(double), cmp_double);
+    const double med = g->n % 2 ? g->err[g->n / 2] : 0.5 * (g->err[g->n / 2 - 1] + g->err[g->n / 2]);
+    printf("  %-10s %6ld labelled:", g->name, g->n);
+    for (int k = 0; k < 4; k++)
+        printf("  <=%gpx %5.1f%%", radii[k], 100.0 * g->within[k] / g->n);
+    if (isfinite(med))
+        printf("  median error %.2f px\n", med);
+    else
+        printf("  median error n/a (most not found)\n");
+}
+
+int main(int argc, char **argv)
+{
+    const char *images = NULL, *video = NULL, *device = NULL, *out_path = NULL;
+    long max_frames = -1, bench = 1;
+    unsigned isa_mask = ~0u;
+    int quiet = 0;
+    static const struct option opts[] = {
+        {"images", required_argument, 0, OPT_IMAGES}, {"video", required_argument, 0, OPT_VIDEO},
+        {"device", required_argument, 0, OPT_DEVICE}, {"out", required_argument, 0, OPT_OUT},
+        {"frames", required_argument, 0, OPT_FRAMES}, {"bench", required_argument, 0, OPT_BENCH},
+        {"isa", required_argument, 0, OPT_ISA}, {"quiet", no_argument, 0, OPT_QUIET},
+        {"help", no_argument, 0, OPT_HELP}, {0, 0, 0, 0}};
+    opterr = 0;
+    int o;
+    while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        switch (o) {
+        case OPT_IMAGES: images = optarg; break;
+        case OPT_VIDEO: video = optarg; break;
+        case OPT_DEVICE: device = optarg; break;
+        case OPT_OUT: out_path = optarg; break;
+        case OPT_FRAMES: max_frames = fv_arg_long(prog, "--frames", optarg, 1, 100000000); break;
+        case OPT_BENCH: bench = fv_arg_long(prog, "--bench", optarg, 1, 1000); break;
+        case OPT_ISA:
+            if (!strcmp(optarg, "c")) isa_mask = FV_ISA_C;
+            else if (!strcmp(optarg, "sse41")) isa_mask = FV_ISA_SSE41;
+            else if (!strcmp(optarg, "avx2")) isa_mask = FV_ISA_SSE41 | FV_ISA_AVX2;
+            else if (!strcmp(optarg, "neon")) isa_mask = FV_ISA_NEON;
+            else fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", optarg);
+            break;
+        case OPT_QUIET: quiet = 1; break;
+        case OPT_HELP: usage(stdout); return FV_EXIT_OK;
+        default: fv_bad_option(prog, argv);
+        }
+    }
+    if (optind < argc)
+        fv_usage_error(prog, "unexpected argument '%s' (see --help)", argv[optind]);
+    const int nsrc = !!images + !!video + !!device;
+    if (nsrc == 0)
+        fv_usage_error(prog, "one of --images LIST, --video FILE or --device DEV is required");
+    if (nsrc > 1)
+        fv_usage_error(prog, "give only one of --images, --video and --device");
+    if (device)
+        fv_usage_error(prog, "--device %s: V4L2 capture is not wired yet (use --video or --images)", device);
+
+    char err[512];
+    fv_eyesrc *src = NULL;
+    if ((images ? fv_eyesrc_open_list(&src, images, err, sizeof err) : fv_eyesrc_open_y4m(&src, video, err, sizeof err)))
+        fv_usage_error(prog, "%s", err);
+    fv_eye_params par;
+    fv_eye_default_params(&par);
+    par.isa_mask = isa_mask;
+    fv_eye_tracker *trk = fv_eye_create(&par);
+    if (!trk)
+        fv_fail(prog, FV_EXIT_FAIL, "out of memory");
+    fv_afile out;
+    if (out_path && fv_afile_open(&out, out_path, err, sizeof err))
+        fv_fail(prog, FV_EXIT_FAIL, "%s", err);
+
+    const long count = fv_eyesrc_count(src);
+    const long cap = count > 0 ? count : 1;
+    group groups[8];
+    int ngroups = 0;
+    group *all = fv_eyesrc_has_labels(src) ? find_group(groups, &ngroups, "all", cap) : NULL;
+    double *run_ns = calloc((size_t)bench, sizeof(double));
+    if (!run_ns)
+        fv_fail(prog, FV_EXIT_FAIL, "out of memory");
+    fv_progress prog_bar;
+    if (!quiet)
+        fv_progress_begin(&prog_bar, "tracking", count > 0 ? count : 0);
+    long frames = 0, found = 0, with_glints = 0, blinks = 0;
+    double conf_sum = 0;
+    fv_eye_frame fr;
+    int rc = 0;
+    while ((max_frames < 0 || frames < max_frames) && (rc = fv_eyesrc_next(src, &fr, err, sizeof err)) == 1) {
+        /* run 0 gives the result (with blink history for videos); extra --bench runs only time */
+        fv_eye_result r, scratch_r;
+        for (long k = 0; k < bench; k++) {
+            fv_eye_result *rr = k ? &scratch_r : &r;
+            const int64_t t0 = now_ns();
+            const int st = (images || k) ? fv_track_image(trk, fr.luma, fr.w, fr.h, fr.stride, rr)
+                                         : fv_track_frame(trk, fr.luma, fr.w, fr.h, fr.stride, rr);
+            run_ns[k] += (double)(now_ns() - t0);
+            if (st)
+                fv_fail(prog, FV_EXIT_FAIL, "frame %ld (%dx%d): the tracker failed", fr.index, fr.w, fr.h);
+        }
+        frames++;
+        found += r.found;
+        with_glints += r.n_glints > 0;
+        blinks += r.status == FV_EYE_BLINK;
+        conf_sum += r.confidence;
+        if (out_path) {
+            if (fr.name)
+                fprintf(out.f, "%s,", fr.name);
+            else
+                fprintf(out.f, "%ld,", fr.index);
+            if (r.found)
+                fprintf(out.f, "%.3f,%.3f,%.3f\n", (double)r.pupil_x, (double)r.pupil_y, (double)r.confidence);
+            else
+                fprintf(out.f, ",,%.3f\n", (double)r.confidence);
+        }
+        if (all && fr.has_label) {
+            const double e = r.found ? hypot(r.pupil_x - fr.label_x, r.pupil_y - fr.label_y) : INFINITY;
+            char sensor[16];
+            group *gs[2] = { all, NULL };
+            if (mrl_sensor(fr.name, sensor)) {
+                char gname[16];
+                snprintf(gname, sizeof gname, "sensor %.6s", sensor);
+                gs[1] = find_group(groups, &ngroups, gname, cap);
+            }
+            for (int i = 0; i < 2; i++)
+                if (gs[i]) {
+                    gs[i]->err[gs[i]->n++] = e;
+                    for (int k = 0; k < 4; k++)
+                        gs[i]->within[k] += e <= radii[k];
+                }
+        }
+        if (!quiet)
+            fv_progress_update(&prog_bar, frames);
+    }
+    if (!quiet)
+        fv_progress_end(&prog_bar);
+    if (!(max_frames >= 0 && frames >= max_frames) && rc < 0) {
+        if (out_path)
+            fv_afile_abort(&out);
+        fv_usage_error(prog, "%s", err);
+    }
+    if (frames == 0) {
+        if (out_path)
+            fv_afile_abort(&out);
+        fv_usage_error(prog, "%s: no frames", images ? images : video);
+    }
+    if (out_path && fv_afile_commit(&out, err, sizeof err))
+        fv_fail(prog, FV_EXIT_FAIL, "%s", err);
+
+    printf("%s: %ld %s, pupil found in %ld (%.1f%%), glints in %ld (%.1f%%), blinks %ld, mean confidence %.3f\n",
+           prog, frames, images ? "images" : "frames", found, 100.0 * found / frames, with_glints,
+           100.0 * with_glints / frames, blinks, conf_sum / frames);
+    if (ngroups) {
+        printf("detection rate (error = distance to the label, not found = miss):\n");
+        for (int i = 0; i < ngroups; i++)
+            print_group(&groups[i]);
+    }
+    for (long k = 0; k < bench; k++)
+        run_ns[k] /= (double)frames;
+    qsort(run_ns, (size_t)bench, sizeof(double), cmp_double);
+    fv_dsp d;
+    fv_dsp_init(&d, isa_mask);
+    printf("time per frame: %.4f ms (median of %ld run%s, one thread, kernels %s)\n", run_ns[bench / 2] * 1e-6, bench,
+           bench > 1 ? "s" : "", fv_isa_name(d.isa));
+    for (int i = 0; i < ngroups; i++)
+        free(groups[i].err);
+    free(run_ns);
+    fv_eye_destroy(trk);
+    fv_eyesrc_close(src);
+    return FV_EXIT_OK;
+}

@@ -1,0 +1,64 @@
+/* fovea eye tracker kernels, AArch64 Advanced SIMD. Exact: integer arithmetic, same results as
+ * the C references in core/eyetrack/kernels.c for every input. */
+#include <arm_neon.h>
+
+#include "dsp.h"
+
+static void down2_row_neon(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n)
+{
+    int x = 0;
+    for (; x + 16 <= n; x += 16) {
+        /* pairwise widening adds of both rows, then (s + 2) >> 2 narrowed */
+        const uint16x8_t s0 = vpadalq_u8(vpaddlq_u8(vld1q_u8(a + 2 * x)), vld1q_u8(b + 2 * x));
+        const uint16x8_t s1 = vpadalq_u8(vpaddlq_u8(vld1q_u8(a + 2 * x + 16)), vld1q_u8(b + 2 * x + 16));
+        vst1q_u8(dst + x, vcombine_u8(vrshrn_n_u16(s0, 2), vrshrn_n_u16(s1, 2)));
+    }
+    if (x < n)
+        fv_et_down2_row_c(dst + x, a + 2 * x, b + 2 * x, n - x);
+}
+
+static void integral_row_neon(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n)
+{
+    const uint16x8_t z = vdupq_n_u16(0);
+    uint32x4_t run = vdupq_n_u32(0);
+    int x = 0;
+    for (; x + 8 <= n; x += 8) {
+        uint16x8_t v = vmovl_u8(vld1_u8(src + x));
+        v = vaddq_u16(v, vextq_u16(z, v, 7)); /* + v shifted up one lane */
+        v = vaddq_u16(v, vextq_u16(z, v, 6));
+        v = vaddq_u16(v, vextq_u16(z, v, 4));
+        const uint32x4_t lo = vaddq_u32(vmovl_u16(vget_low_u16(v)), run);
+        const uint32x4_t hi = vaddq_u32(vmovl_u16(vget_high_u16(v)), run);
+        run = vdupq_laneq_u32(hi, 3);
+        vst1q_u32(dst + x, vaddq_u32(lo, vld1q_u32(above + x)));
+        vst1q_u32(dst + x + 4, vaddq_u32(hi, vld1q_u32(above + x + 4)));
+    }
+    uint32_t r = vgetq_lane_u32(run, 0);
+    for (; x < n; x++) {
+        r += src[x];
+        dst[x] = above[x] + r;
+    }
+}
+
+static int thresh_row_neon(uint8_t *restrict dst, const uint8_t *src, int n, int t)
+{
+    if (t > 255 || t <= 0)
+        return fv_et_thresh_row_c(dst, src, n, t);
+    const uint8x16_t tv = vdupq_n_u8((uint8_t)t);
+    int x = 0, count = 0;
+    for (; x + 16 <= n; x += 16) {
+        const uint8x16_t m = vcgeq_u8(vld1q_u8(src + x), tv);
+        vst1q_u8(dst + x, m);
+        count += vaddlvq_u8(vshrq_n_u8(m, 7));
+    }
+    if (x < n)
+        count += fv_et_thresh_row_c(dst + x, src + x, n - x, t);
+    return count;
+}
+
+void fv_eyetrack_init_neon(fv_dsp *d)
+{
+    d->et_down2_row = down2_row_neon;
+    d->et_integral_row = integral_row_neon;
+    d->et_thresh_row = thresh_row_neon;
+}

@@ -1,0 +1,242 @@
+/* fovea eye tracker: synthetic infrared eye renderer (see synth.h for the model). Deterministic:
+ * the same parameters, state and seeds give the same bytes on every machine (only float
+ * arithmetic with -ffp-contract=off and libm sin/cos/sqrt/atan2/exp, which glibc rounds the same
+ * on x86-64 and AArch64 for these calls; the bundled video is regenerated, not compared). */
+#include "eyetrack/synth.h"
+
+#include <math.h>
+#include <string.h>
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#define EYE_R 12.0f
+#define CORNEA_R 7.8f
+#define CORNEA_OFF 5.6f
+#define IRIS_R 6.0f
+#define IRIS_D 10.4f /* sqrt(12^2 - 6^2) */
+
+void fv_synth_default_params(fv_synth_params *p, int w, int h)
+{
+    memset(p, 0, sizeof *p);
+    p->w = w;
+    p->h = h;
+    p->px_per_mm = (float)w / 34.0f; /* the image spans 34 mm: the eye aperture and some skin */
+    p->n_leds = 4;
+    p->led_ring_mm = 14.0f;
+    p->led_dist_mm = 35.0f;
+    p->noise_sigma = 2.0f;
+    p->brightness = 1.0f;
+    p->supersample = 3;
+    p->seed = 0x5eed;
+}
+
+static uint64_t mix(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+static float hashf(uint64_t seed, int64_t a, int64_t b) /* [0,1) */
+{
+    return (float)(mix(seed ^ mix((uint64_t)a * 0x100000001b3ull + (uint64_t)b)) >> 40) * (1.0f / 16777216.0f);
+}
+/* Smooth value noise in [0,1) on an integer lattice. */
+static float vnoise(uint64_t seed, float x, float y)
+{
+    const float fx = floorf(x), fy = floorf(y);
+    const int64_t ix = (int64_t)fx, iy = (int64_t)fy;
+    float tx = x - fx, ty = y - fy;
+    tx = tx * tx * (3 - 2 * tx), ty = ty * ty * (3 - 2 * ty);
+    const float a = hashf(seed, ix, iy), b = hashf(seed, ix + 1, iy);
+    const float c = hashf(seed, ix, iy + 1), d = hashf(seed, ix + 1, iy + 1);
+    return (a + tx * (b - a)) + ty * ((c + tx * (d - c)) - (a + tx * (b - a)));
+}
+
+typedef struct {
+    float gx, gy, gz; /* gaze unit vector */
+    float ix, iy;     /* iris / pupil centre (mm, image plane) */
+    float lid_up0, lid_lo0;
+    float gl_x[FV_SYNTH_MAX_LEDS], gl_y[FV_SYNTH_MAX_LEDS];
+    int gl_vis[FV_SYNTH_MAX_LEDS];
+} geom;
+
+/* Lid aperture: upper and lower lid heights (mm) at image-plane x (mm). */
+static float lid_upper(const geom *g, float x)
+{
+    const float u = x / 15.0f;
+    return g->lid_up0 * (1.0f - u * u) + 0.6f * u;
+}
+static float lid_lower(const geom *g, float x)
+{
+    const float u = x / 15.0f;
+    return g->lid_lo0 * (1.0f - u * u) + 0.6f * u;
+}
+static int in_aperture(const geom *g, float x, float y)
+{
+    return fabsf(x) < 15.0f && y < lid_upper(g, x) && y > lid_lower(g, x);
+}
+
+static void setup(const fv_synth_params *p, const fv_synth_state *s, geom *g)
+{
+    const float yaw = s->yaw_deg * (float)(M_PI / 180.0), pit = s->pitch_deg * (float)(M_PI / 180.0);
+    g->gx = sinf(yaw) * cosf(pit);
+    g->gy = sinf(pit);
+    g->gz = cosf(yaw) * cosf(pit);
+    g->ix = IRIS_D * g->gx;
+    g->iy = IRIS_D * g->gy;
+    /* closed: both lids meet at -3 mm */
+    const float open = s->open < 0 ? 0 : s->open > 1 ? 1 : s->open;
+    g->lid_lo0 = -6.5f + 3.5f * (1.0f - open);
+    g->lid_up0 = -3.0f + 10.5f * open + 0.25f * s->pitch_deg * open * 0.2f;
+    /* glints: mirror points on the cornea sphere for LEDs on a ring around the (orthographic,
+     * direction +Z) camera */
+    const float cx = CORNEA_OFF * g->gx, cy = CORNEA_OFF * g->gy, cz = CORNEA_OFF * g->gz;
+    for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
+        const float a = (float)(2.0 * M_PI * (k + 0.5) / p->n_leds) + 0.3f;
+        const float lx = p->led_ring_mm * cosf(a), ly = p->led_ring_mm * sinf(a) * 0.6f, lz = p->led_dist_mm;
+        float dx = lx - cx, dy = ly - cy, dz = lz - cz;
+        const float dl = sqrtf(dx * dx + dy * dy + dz * dz);
+        float nx = dx / dl, ny = dy / dl, nz = dz / dl + 1.0f;
+        const float nn = sqrtf(nx * nx + ny * ny + nz * nz);
+        nx /= nn, ny /= nn, nz /= nn;
+        g->gl_x[k] = cx + CORNEA_R * nx;
+        g->gl_y[k] = cy + CORNEA_R * ny;
+        /* on the corneal cap (within ~45 deg of the gaze) and not under a lid */
+        const float cosang = nx * g->gx + ny * g->gy + nz * g->gz;
+        g->gl_vis[k] = cosang > 0.72f && in_aperture(g, g->gl_x[k], g->gl_y[k]);
+    }
+}
+
+static void truth(const fv_synth_params *p, const fv_synth_state *s, const geom *g, fv_synth_truth *t)
+{
+    memset(t, 0, sizeof *t);
+    const float sc = p->px_per_mm;
+    t->pupil_x = g->ix * sc + 0.5f * p->w;
+    t->pupil_y = -g->iy * sc + 0.5f * p->h;
+    t->pupil_r_px = s->pupil_mm * sc;
+    int in = 0, tot = 0;
+    for (int i = 0; i < 16; i++) /* visible fraction of the pupil disc, by sampling its image */
+        for (int j = 0; j < 16; j++) {
+            const float u = (i + 0.5f) / 8.0f - 1.0f, v = (j + 0.5f) / 8.0f - 1.0f;
+            if (u * u + v * v > 1.0f)
+                continue;
+            tot++;
+            /* the disc's image: ellipse with minor axis along the gaze's image direction */
+            const float gl = sqrtf(g->gx * g->gx + g->gy * g->gy);
+            const float ex = gl > 1e-6f ? g->gx / gl : 1.0f, ey = gl > 1e-6f ? g->gy / gl : 0.0f;
+            const float x = g->ix + s->pupil_mm * (u * g->gz * ex - v * ey);
+            const float y = g->iy + s->pupil_mm * (u * g->gz * ey + v * ex);
+            in += in_aperture(g, x, y);
+        }
+    t->pupil_visible = tot ? (float)in / tot : 0.0f;
+    t->n_glints = p->n_leds;
+    for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
+        t->glint_x[k] = g->gl_x[k] * sc + 0.5f * p->w;
+        t->glint_y[k] = -g->gl_y[k] * sc + 0.5f * p->h;
+        t->glint_visible[k] = g->gl_vis[k];
+    }
+}
+
+void fv_synth_truth_of(const fv_synth_params *p, const fv_synth_state *s, fv_synth_truth *t)
+{
+    geom g;
+    setup(p, s, &g);
+    truth(p, s, &g, t);
+}
+
+/* Radiance (grey level, before noise and glints) at image-plane point (x, y) mm. */
+static float shade(const fv_synth_params *p, const fv_synth_state *s, const geom *g, float x, float y)
+{
+    const float br = p->brightness;
+    if (!in_aperture(g, x, y)) {
+        /* skin: bright in IR, soft texture, darker crease above the upper lid */
+        float v = 165.0f + 25.0f * vnoise(p->seed + 7, x * 0.8f, y * 0.8f);
+        const float up = lid_upper(g, x);
+        if (y >= up) {
+            const float d = y - up;
+            v -= 45.0f * expf(-d * 1.2f); /* lid margin shadow */
+            /* lashes: dark curved strands rooted on the upper lid, 0 .. 2.5 mm long */
+            if (d < 2.5f) {
+                const float root = x - 0.35f * d * d * (x > 0 ? 1.0f : -1.0f) * 0.5f;
+                const float cell = root * 2.2f, fc = cell - floorf(cell);
+                const float len = 1.0f + 1.5f * hashf(p->seed + 11, (int64_t)floorf(cell), 0);
+                if (fabsf(fc - 0.5f) < 0.16f && d < len)
+                    v *= 0.35f;
+            }
+        } else {
+            v -= 30.0f * expf(-(lid_lower(g, x) - y) * 1.5f);
+        }
+        return v * br;
+    }
+    /* eyeball: ray (x, y, z) down -Z; the iris plane: P . g = IRIS_D */
+    const float z = (IRIS_D - x * g->gx - y * g->gy) / g->gz;
+    const float qx = x - g->ix, qy = y - g->iy, qz = z - IRIS_D * g->gz;
+    const float rho = sqrtf(qx * qx + qy * qy + qz * qz);
+    float v;
+    if (rho < s->pupil_mm) {
+        v = 22.0f;
+    } else if (rho < IRIS_R) {
+        /* iris: in-plane angle from a basis of the plane */
+        float ux = g->gz, uy = 0, uz = -g->gx; /* perpendicular to g, near +x */
+        const float un = sqrtf(ux * ux + uz * uz);
+        ux /= un, uz /= un;
+        const float vx = g->gy * uz - g->gz * uy, vy = g->gz * ux - g->gx * uz, vz = g->gx * uy - g->gy * ux;
+        const float ang = atan2f(qx * vx + qy * vy + qz * vz, qx * ux + qy * uy + qz * uz);
+        const float fib = vnoise(p->seed + 3, (ang + (float)M_PI) * 18.0f, rho * 1.5f);
+        const float t = (rho - s->pupil_mm) / (IRIS_R - s->pupil_mm);
+        v = 70.0f + 40.0f * fib + 25.0f * expf(-(t - 0.35f) * (t - 0.35f) * 40.0f) - 20.0f * t * t;
+        v *= br;
+    } else {
+        /* sclera, darkening towards the eyeball's limb */
+        const float r2 = (x * x + y * y) / (EYE_R * EYE_R);
+        v = (200.0f - 60.0f * r2) * br + 10.0f * vnoise(p->seed + 5, x * 1.5f, y * 1.5f);
+    }
+    /* shadow of the upper lid on the eye */
+    const float du = lid_upper(g, x) - y;
+    v *= 1.0f - 0.45f * expf(-du * 1.3f);
+    return v;
+}
+
+static float gauss(uint64_t *st)
+{
+    /* Box-Muller on splitmix64 */
+    const float u1 = ((float)(mix((*st)++) >> 40) + 0.5f) * (1.0f / 16777216.0f);
+    const float u2 = (float)(mix((*st)++) >> 40) * (1.0f / 16777216.0f);
+    return sqrtf(-2.0f * logf(u1)) * cosf((float)(2.0 * M_PI) * u2);
+}
+
+void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t noise_seed, uint8_t *img,
+                     ptrdiff_t stride, fv_synth_truth *t)
+{
+    geom g;
+    setup(p, s, &g);
+    truth(p, s, &g, t);
+    const float sc = p->px_per_mm, inv = 1.0f / sc;
+    const int ss = p->supersample < 1 ? 1 : p->supersample;
+    uint64_t st = mix(noise_seed ^ 0xabcdef);
+    const float gsig = 0.35f * sc > 0.8f ? 0.35f * sc * 0.5f : 0.8f; /* glint spot: ~0.35 mm wide */
+    for (int j = 0; j < p->h; j++) {
+        uint8_t *row = img + j * stride;
+        for (int i = 0; i < p->w; i++) {
+            float acc = 0;
+            for (int a = 0; a < ss; a++)
+                for (int b = 0; b < ss; b++) {
+                    const float px = i + (b + 0.5f) / ss, py = j + (a + 0.5f) / ss;
+                    acc += shade(p, s, &g, (px - 0.5f * p->w) * inv, -(py - 0.5f * p->h) * inv);
+                }
+            float v = acc / (float)(ss * ss);
+            for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
+                if (!t->glint_visible[k])
+                    continue;
+                const float dx = i + 0.5f - t->glint_x[k], dy = j + 0.5f - t->glint_y[k];
+                const float d2 = dx * dx + dy * dy;
+                if (d2 < 25.0f * gsig * gsig)
+                    v += 400.0f * expf(-d2 / (2.0f * gsig * gsig));
+            }
+            v += p->noise_sigma * gauss(&st);
+            row[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : lrintf(v));
+        }
+    }
+}

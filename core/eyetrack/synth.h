@@ -1,0 +1,54 @@
+/* fovea eye tracker: synthetic infrared eye images from a 3D eye model, with ground truth.
+ * Used by tools/gen_eye (the bundled video) and by the tests (no I/O here).
+ *
+ * Model (millimetres; eyeball centre at the origin, +Z towards the camera, +Y up): eyeball
+ * sphere R = 12; cornea sphere R = 7.8 centred 5.6 along the gaze; iris disc (radius 6) in the
+ * plane 10.4 along the gaze, textured with radial fibres and a collarette; pupil disc of
+ * variable radius in that plane; IR LEDs on a ring around the camera giving corneal
+ * reflections (the mirror point on the cornea sphere); an almond eyelid aperture that closes
+ * for blinks, with lashes along the upper lid; skin shading; Gaussian sensor noise.
+ * Camera: scaled orthographic (telecentric) looking down -Z, so the projected pupil centre is
+ * exactly the centre of the pupil ellipse; corneal refraction of the pupil is not modelled. */
+#ifndef FOVEA_EYETRACK_SYNTH_H
+#define FOVEA_EYETRACK_SYNTH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define FV_SYNTH_MAX_LEDS 6
+
+typedef struct fv_synth_params {
+    int w, h;
+    float px_per_mm;     /* image scale */
+    int n_leds;          /* 2 .. 6 */
+    float led_ring_mm;   /* LED ring radius around the camera axis */
+    float led_dist_mm;   /* LED plane distance from the eyeball centre */
+    float noise_sigma;   /* grey levels */
+    float brightness;    /* skin / sclera level scale (1 = nominal) */
+    int supersample;     /* n x n samples per pixel */
+    uint64_t seed;       /* iris texture and lash pattern (the subject) */
+} fv_synth_params;
+
+typedef struct fv_synth_state {
+    float yaw_deg, pitch_deg; /* gaze: + yaw = towards +x of the image, + pitch = up */
+    float pupil_mm;           /* pupil radius */
+    float open;               /* eyelid opening: 1 open, 0 closed */
+} fv_synth_state;
+
+typedef struct fv_synth_truth {
+    float pupil_x, pupil_y;  /* pixels, corner origin (pixel centres at +0.5) */
+    float pupil_r_px;        /* pupil radius in pixels (major semi-axis of its image) */
+    float pupil_visible;     /* fraction of the pupil disc inside the lid aperture */
+    int n_glints;            /* = n_leds */
+    float glint_x[FV_SYNTH_MAX_LEDS], glint_y[FV_SYNTH_MAX_LEDS];
+    int glint_visible[FV_SYNTH_MAX_LEDS];
+} fv_synth_truth;
+
+void fv_synth_default_params(fv_synth_params *p, int w, int h);
+/* Ground truth only (cheap). */
+void fv_synth_truth_of(const fv_synth_params *p, const fv_synth_state *s, fv_synth_truth *t);
+/* Renders one frame into img (w x h, stride bytes per row); noise_seed varies per frame. */
+void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t noise_seed, uint8_t *img,
+                     ptrdiff_t stride, fv_synth_truth *t);
+
+#endif

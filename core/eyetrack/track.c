@@ -1,0 +1,801 @@
+/* fovea eye tracker: dark-pupil detection, sub-pixel centre, glints, confidence, blinks
+ * (docs/eyetrack.md has the measurements behind the choices).
+ *
+ * 1. Search (coarse_search): the frame is halved (dsp->et_down2_row) until min(w, h) <= 160
+ *    (F), reflections on F (dsp->et_thresh_row) are masked and inpainted from their
+ *    surroundings so a glint inside the pupil does not make it look bright; F is halved again
+ *    to <= 64 (C). Over integral images (dsp->et_integral_row) every centre and box size of C
+ *    is scored by contrast with its ring, darkness and a weak centre prior (box_search); the
+ *    best is refined in position and size on F. Contrast, not darkness alone, rejects brows,
+ *    lashes and shadows (as dark around as inside).
+ * 2. Refinement at full resolution in a window around it: threshold half way between the blob
+ *    and its surround, iterated weighted centroid of the darker pixels, then rays from there
+ *    give sub-pixel edge points for a direct ellipse fit with outlier rejection. Headset-sized
+ *    frames report the ellipse centre; small remote-camera crops report the search's box centre.
+ * 3. Glints: small bright blobs of the raw image close to the pupil.
+ * 4. Confidence from the contrast and the fit; blinks from darkness / contrast / size drops
+ *    against the tracker's running reference. */
+#include <math.h>
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#include <stdlib.h>
+#include <string.h>
+
+#include "dsp.h"
+#include "eyetrack/eyetrack.h"
+
+#define SEARCH_MAX_SIDE 160 /* search image F: min side at most this */
+#define SEARCH_C_SIDE 64    /* exhaustive search image C: min side at most this */
+#define NRAYS 48
+
+struct fv_eye_tracker {
+    fv_eye_params p;
+    fv_dsp dsp;
+    uint8_t *mem;
+    size_t cap;
+    /* history for blink detection (fv_track_frame only) */
+    int nref;
+    float ref_contrast, ref_radius, ref_inner, ref_ring;
+};
+
+void fv_eye_default_params(fv_eye_params *p)
+{
+    p->isa_mask = ~0u;
+    p->min_radius_frac = 0.035f;
+    p->max_radius_frac = 0.17f;
+    p->border_frac = 0.1f;
+    p->centre_prior = 20.0f;
+    p->max_glints = FV_EYE_MAX_GLINTS;
+}
+
+fv_eye_tracker *fv_eye_create(const fv_eye_params *p)
+{
+    fv_eye_tracker *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    if (p)
+        t->p = *p;
+    else
+        fv_eye_default_params(&t->p);
+    if (t->p.max_glints < 0 || t->p.max_glints > FV_EYE_MAX_GLINTS)
+        t->p.max_glints = FV_EYE_MAX_GLINTS;
+    fv_dsp_init(&t->dsp, t->p.isa_mask);
+    return t;
+}
+
+void fv_eye_destroy(fv_eye_tracker *t)
+{
+    if (!t)
+        return;
+    free(t->mem);
+    free(t);
+}
+
+void fv_eye_reset(fv_eye_tracker *t)
+{
+    t->nref = 0;
+    t->ref_contrast = t->ref_radius = t->ref_inner = t->ref_ring = 0;
+}
+
+static void *scratch(fv_eye_tracker *t, size_t bytes)
+{
+    if (bytes > t->cap) {
+        void *m = realloc(t->mem, bytes);
+        if (!m)
+            return NULL;
+        t->mem = m;
+        t->cap = bytes;
+    }
+    return t->mem;
+}
+
+/* ---------------------------------------------------------------- helpers */
+
+/* Grey level below which a fraction q of the pixels lie. */
+static int percentile(const uint32_t hist[256], uint32_t total, double q)
+{
+    const uint32_t want = (uint32_t)(q * total);
+    uint32_t acc = 0;
+    for (int v = 0; v < 256; v++) {
+        acc += hist[v];
+        if (acc > want)
+            return v;
+    }
+    return 255;
+}
+
+static void histogram(const uint8_t *img, int w, int h, ptrdiff_t stride, uint32_t hist[256])
+{
+    /* four sub-histograms break the store-to-load dependency on runs of equal pixels */
+    uint32_t hs[4][256];
+    memset(hs, 0, sizeof hs);
+    for (int y = 0; y < h; y++) {
+        const uint8_t *r = img + y * stride;
+        int x = 0;
+        for (; x + 4 <= w; x += 4) {
+            hs[0][r[x]]++, hs[1][r[x + 1]]++, hs[2][r[x + 2]]++, hs[3][r[x + 3]]++;
+        }
+        for (; x < w; x++)
+            hs[0][r[x]]++;
+    }
+    for (int v = 0; v < 256; v++)
+        hist[v] = hs[0][v] + hs[1][v] + hs[2][v] + hs[3][v];
+}
+
+/* Reflections: pixels >= thr, grown by `grow` pixels (a glint's halo is brighter than its
+ * background too), replaced by the mean of their unmasked 4-neighbours, ring by ring from the
+ * outside in. mask is w*h bytes of scratch, idx w*h ints; the work is proportional to the
+ * masked area, not the image. */
+static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
+                           uint8_t fallback)
+{
+    int n = 0;
+    for (int y = 0; y < h; y++)
+        if (dsp->et_thresh_row(mask + y * w, img + y * w, w, thr))
+            for (int x = 0; x < w; x++)
+                if (mask[y * w + x])
+                    idx[n++] = y * w + x;
+    if (!n)
+        return;
+    for (int i = 0; i < n; i++)
+        mask[idx[i]] = 1;
+    for (int g = 0, from = 0; g < grow; g++) {
+        const int to = n;
+        for (int j = from; j < to; j++) {
+            const int i = idx[j], x = i % w, y = i / w;
+            const int nb[4] = { x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1, y + 1 < h ? i + w : -1 };
+            for (int k = 0; k < 4; k++)
+                if (nb[k] >= 0 && !mask[nb[k]]) {
+                    mask[nb[k]] = 1;
+                    idx[n++] = nb[k];
+                }
+        }
+        from = to;
+    }
+    /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on) */
+    for (int pass = 0; pass < 3 + 2 * grow && n; pass++) { /* enough for a grown glint; big bright areas get the fallback */
+        const uint8_t lim = (uint8_t)(2 + pass);
+#define SRC(j) (mask[j] == 0 || (mask[j] >= 2 && mask[j] < lim))
+        int left = 0;
+        for (int j = 0; j < n; j++) {
+            const int i = idx[j], x = i % w, y = i / w;
+            int s = 0, c = 0;
+            if (x > 0 && SRC(i - 1)) s += img[i - 1], c++;
+            if (x + 1 < w && SRC(i + 1)) s += img[i + 1], c++;
+            if (y > 0 && SRC(i - w)) s += img[i - w], c++;
+            if (y + 1 < h && SRC(i + w)) s += img[i + w], c++;
+            if (c) {
+                img[i] = (uint8_t)((s + c / 2) / c);
+                mask[i] = lim;
+            } else {
+                idx[left++] = i;
+            }
+        }
+#undef SRC
+        n = left;
+    }
+    for (int j = 0; j < n; j++)
+        img[idx[j]] = fallback;
+}
+
+static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x1, int y1)
+{
+    /* sum over [x0, x1) x [y0, y1); ii has a zero first row and column, row length iw */
+    return ii[y1 * iw + x1] - ii[y0 * iw + x1] - ii[y1 * iw + x0] + ii[y0 * iw + x0];
+}
+
+static inline int imin(int a, int b) { return a < b ? a : b; }
+static inline int imax(int a, int b) { return a > b ? a : b; }
+static inline float fclampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
+
+/* Bilinear sample, pixel centres at +0.5 (clamped to the image). */
+static inline float sample(const uint8_t *img, int w, int h, float x, float y)
+{
+    x -= 0.5f, y -= 0.5f;
+    x = fclampf(x, 0.0f, (float)w - 1.001f);
+    y = fclampf(y, 0.0f, (float)h - 1.001f);
+    const int ix = (int)x, iy = (int)y;
+    const float fx = x - ix, fy = y - iy;
+    const uint8_t *r = img + iy * w + ix;
+    const int x1 = ix + 1 < w ? 1 : 0, y1 = iy + 1 < h ? w : 0;
+    const float a = r[0] + fx * (r[x1] - r[0]), b = r[y1] + fx * (r[y1 + x1] - r[y1]);
+    return a + fy * (b - a);
+}
+
+/* The ray stays at or above th for len pixels past dist (a pupil edge, not a glint's halo or
+ * a stray bright pixel inside the pupil). */
+static int sustained(const uint8_t *win, int ww, int wh, float cx, float cy, float dx, float dy, float dist, float len,
+                     float th)
+{
+    for (float d = dist + 0.5f; d <= dist + len; d += 0.5f) {
+        const float px = cx + d * dx, py = cy + d * dy;
+        if (px < 0.5f || py < 0.5f || px > ww - 0.5f || py > wh - 0.5f)
+            return 1;
+        if (sample(win, ww, wh, px, py) < th)
+            return 0;
+    }
+    return 1;
+}
+
+/* ---------------------------------------------------------------- coarse search */
+
+typedef struct {
+    float x, y, r; /* full-resolution pixels (corner origin) */
+    float inner, ring;
+    int scale; /* of the search image */
+    int ok;
+} candidate;
+
+static void integral(const fv_dsp *d, const uint8_t *img, int w, int h, uint32_t *ii)
+{
+    /* zero first row and column */
+    const int iw = w + 1;
+    memset(ii, 0, (size_t)iw * sizeof *ii);
+    for (int y = 0; y < h; y++) {
+        ii[(size_t)(y + 1) * iw] = 0;
+        d->et_integral_row(ii + (size_t)(y + 1) * iw + 1, ii + (size_t)y * iw + 1, img + (size_t)y * w, w);
+    }
+}
+
+typedef struct {
+    float score, inner, ring;
+    int x, y, k;
+} box_hit;
+
+/* Best contrast box over centres [x0, x1) x [y0, y1) and half-sizes k in [kmin, kmax]
+ * (every k when step1, else a geometric-ish ladder). Score = mean(ring k..1.5k) - mean(box k)
+ * - lambda * (mean(box) - dark) - mu * (distance from the image centre) / min side: lambda
+ * prefers the darker of two contrasting blobs (the pupil in the iris); a 1.5k ring beat 2k and
+ * 3k on the MRL images (less lid and brow in it); mu (grey levels per image side) is a weak
+ * prior for the eye being roughly centred in its camera, which keeps dark brows, hair and
+ * vignetted corners from winning in dim images. */
+static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0, int x1, int y0, int y1,
+                       float dark, float mu, box_hit *best)
+{
+    const float lambda = 1.0f, rf = 1.5f;
+    const float cxm = 0.5f * (sw - 1), cym = 0.5f * (sh - 1), prior = mu / (float)(sw < sh ? sw : sh);
+    const int iw = sw + 1;
+    for (int k = kmin; k <= kmax; k += (step1 || k < 4 ? 1 : k / 4)) {
+        const int ko = (int)lrintf(rf * k);
+        const int na_full = (2 * k + 1) * (2 * k + 1), no_full = (2 * ko + 1) * (2 * ko + 1);
+        const float inv_a = 1.0f / (float)na_full, inv_r = 1.0f / (float)(no_full - na_full);
+        for (int y = imax(0, y0); y < imin(sh, y1); y++) {
+            const int iy0 = imax(0, y - k), iy1 = imin(sh, y + k + 1);
+            const int oy0 = imax(0, y - ko), oy1 = imin(sh, y + ko + 1);
+            for (int x = imax(0, x0); x < imin(sw, x1); x++) {
+                const int ix0 = imax(0, x - k), ix1 = imin(sw, x + k + 1);
+                const int ox0 = imax(0, x - ko), ox1 = imin(sw, x + ko + 1);
+                const int na = (ix1 - ix0) * (iy1 - iy0), no = (ox1 - ox0) * (oy1 - oy0);
+                const uint32_t si = box_sum(ii, iw, ix0, iy0, ix1, iy1);
+                const uint32_t so = box_sum(ii, iw, ox0, oy0, ox1, oy1) - si;
+                float mi, mo;
+                if (na == na_full && no == no_full) { /* inside: no divisions */
+                    mi = (float)si * inv_a, mo = (float)so * inv_r;
+                } else {
+                    /* the box inside the image, most of the ring too: vignetted corners and
+                     * image edges are dark and half a ring is no surround */
+                    if (na != na_full || 10 * (no - na) < 6 * (no_full - na_full))
+                        continue;
+                    mi = (float)si / na, mo = (float)so / (no - na);
+                }
+                float score = mo - mi - lambda * (mi - dark);
+                if (score <= best->score) /* the prior only lowers it */
+                    continue;
+                if (prior > 0) {
+                    const float ddx = (float)x - cxm, ddy = (float)y - cym;
+                    score -= prior * sqrtf(ddx * ddx + ddy * ddy);
+                }
+                if (score > best->score)
+                    *best = (box_hit){ score, mi, mo, x, y, k };
+            }
+        }
+    }
+}
+
+/* Two levels: F (halved until min side <= SEARCH_MAX_SIDE; reflections inpainted there) and C
+ * (F halved again until min side <= SEARCH_C_SIDE). The exhaustive search runs on C;
+ * F only refines position and size around C's answer, which costs ~25x less than searching F. */
+static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride,
+                               uint8_t *work, uint8_t *mask, uint8_t *small, uint32_t *ii, int *idx)
+{
+    candidate c = { 0 };
+    const fv_dsp *d = &t->dsp;
+    int sw = w, sh = h, scale = 1;
+    const uint8_t *src = luma;
+    ptrdiff_t sst = stride;
+    while (imin(sw, sh) > SEARCH_MAX_SIDE) { /* halve straight from the input, then in place-free ping-pong */
+        const int nw = sw / 2, nh = sh / 2;
+        uint8_t *dst = src == work ? mask : work;
+        for (int y = 0; y < nh; y++)
+            d->et_down2_row(dst + (size_t)y * nw, src + (2 * y) * sst, src + (2 * y + 1) * sst, nw);
+        src = dst, sst = nw;
+        sw = nw, sh = nh, scale *= 2;
+    }
+    if (src != work)
+        for (int y = 0; y < sh; y++)
+            memcpy(work + (size_t)y * sw, src + y * sst, (size_t)sw);
+    uint32_t hist[256];
+    histogram(work, sw, sh, sw, hist);
+    const int med = percentile(hist, (uint32_t)(sw * sh), 0.5);
+    const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
+    const int thr = imax(med + 40, med + (255 - med) / 2);
+    if (hi >= thr)
+        inpaint_bright(d, work, sw, sh, thr, 1, mask, idx, (uint8_t)med);
+    const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
+    /* level C */
+    int cw = sw, ch = sh, f = 1;
+    const uint8_t *cs = work;
+    while (imin(cw, ch) > SEARCH_C_SIDE) {
+        const int nw = cw / 2, nh = ch / 2;
+        uint8_t *dst = cs == small ? mask : small;
+        for (int y = 0; y < nh; y++)
+            d->et_down2_row(dst + (size_t)y * nw, cs + (size_t)(2 * y) * cw, cs + (size_t)(2 * y + 1) * cw, nw);
+        cs = dst;
+        cw = nw, ch = nh, f *= 2;
+    }
+    const float side = (float)imin(cw, ch);
+    const int kmin = imax(1, (int)lrintf(t->p.min_radius_frac * side));
+    const int kmax = imax(kmin, (int)lrintf(t->p.max_radius_frac * side));
+    box_hit b = { -1e30f, 0, 0, 0, 0, 0 };
+    integral(d, cs, cw, ch, ii);
+    /* centres no nearer the border than margin_frac of the side: vignetted corners and image
+     * edges are dark, and a pupil there is cut anyway */
+    const int mx = (int)lrintf(t->p.border_frac * side);
+    box_search(ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, t->p.centre_prior, &b);
+    if (b.score <= -1e30f)
+        return c;
+    if (f > 1) { /* refine on F around C's answer */
+        const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
+        box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
+        integral(d, work, sw, sh, ii);
+        box_search(ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
+        if (bf.score > -1e30f)
+            b = bf;
+        else
+            b.x = fx, b.y = fy, b.k = fk;
+    }
+    c.x = (b.x + 0.5f) * scale;
+    c.y = (b.y + 0.5f) * scale;
+    c.r = (b.k + 0.5f) * scale;
+    c.inner = b.inner;
+    c.ring = b.ring;
+    c.ok = 1;
+    c.scale = scale;
+    return c;
+}
+
+/* ---------------------------------------------------------------- refinement */
+
+/* Points within tol of e (fv_ellipse_distance with the rotation computed once). */
+static int count_near(const fv_ellipse *e, const float *x, const float *y, int n, double tol)
+{
+    const double c = cos(e->angle), s = sin(e->angle), ia = 1.0 / e->a, ib = 1.0 / e->b;
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        const double u = (x[i] - e->cx) * c + (y[i] - e->cy) * s, v = -(x[i] - e->cx) * s + (y[i] - e->cy) * c;
+        const double rho = sqrt((u * ia) * (u * ia) + (v * ib) * (v * ib));
+        const double d = rho < 1e-12 ? e->b : fabs(rho - 1.0) * sqrt(u * u + v * v) / rho;
+        k += d <= tol;
+    }
+    return k;
+}
+
+typedef struct {
+    float x, y, r;
+    float inner, ring;
+    int fit;
+    fv_ellipse e;
+    float inliers; /* fraction of rays giving inlier edge points */
+} pupil;
+
+static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
+                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, pupil *out)
+{
+    /* window around the candidate, reflections inpainted */
+    /* headset-sized frames: the search's box can be much smaller than the pupil (the darkest
+     * part of it), and rays must reach the pupil's far edge inside the window */
+    const int half = imax((int)ceilf(3.0f * c->r), inpainted ? 0 : imin(w, h) / 4) + 2;
+    const int x0 = imax(0, (int)c->x - half), y0 = imax(0, (int)c->y - half);
+    const int x1 = imin(w, (int)c->x + half), y1 = imin(h, (int)c->y + half);
+    const int ww = x1 - x0, wh = y1 - y0;
+    if (ww < 4 || wh < 4)
+        return -1;
+    for (int y = 0; y < wh; y++)
+        memcpy(win + (size_t)y * ww, luma + (y + y0) * stride + x0, (size_t)ww);
+    uint32_t hist[256];
+    histogram(win, ww, wh, ww, hist);
+    const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
+    const int thr = imax(med + 40, med + (255 - med) / 2);
+    if (!inpainted && percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
+        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, (uint8_t)med);
+
+    float cx = c->x - x0, cy = c->y - y0, r = c->r;
+    float inner = c->inner, ring = c->ring;
+    /* small frames only need the levels and size from this (their centre is the search's) */
+    const int iters = inpainted ? 2 : 6;
+    for (int it = 0; it < iters; it++) {
+        /* blob and surround levels around the current estimate */
+        double si = 0, so = 0;
+        int ni = 0, no = 0;
+        const float ri = 0.7f * r, ro0 = 1.2f * r, ro1 = 1.7f * r;
+        const int bx0 = imax(0, (int)(cx - ro1)), bx1 = imin(ww, (int)(cx + ro1) + 1);
+        const int by0 = imax(0, (int)(cy - ro1)), by1 = imin(wh, (int)(cy + ro1) + 1);
+        for (int y = by0; y < by1; y++)
+            for (int x = bx0; x < bx1; x++) {
+                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy, d2 = dx * dx + dy * dy;
+                const int v = win[y * ww + x];
+                if (d2 <= ri * ri)
+                    si += v, ni++;
+                else if (d2 >= ro0 * ro0 && d2 <= ro1 * ro1)
+                    so += v, no++;
+            }
+        if (ni)
+            inner = (float)(si / ni);
+        if (no)
+            ring = (float)(so / no);
+        if (!(ring > inner))
+            return -1;
+        const float th = 0.5f * (inner + ring);
+        /* weighted centroid of the dark pixels near the estimate */
+        const float rr = 1.5f * r;
+        double sw = 0, sx = 0, sy = 0;
+        int area = 0;
+        const int ax0 = imax(0, (int)(cx - rr)), ax1 = imin(ww, (int)(cx + rr) + 1);
+        const int ay0 = imax(0, (int)(cy - rr)), ay1 = imin(wh, (int)(cy + rr) + 1);
+        for (int y = ay0; y < ay1; y++)
+            for (int x = ax0; x < ax1; x++) {
+                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy;
+                if (dx * dx + dy * dy > rr * rr)
+                    continue;
+                const float v = win[y * ww + x];
+                if (v < th) {
+                    const double wt = th - v;
+                    sw += wt, sx += wt * (x + 0.5f), sy += wt * (y + 0.5f);
+                    area++;
+                }
+            }
+        if (sw <= 0)
+            return -1;
+        const float nx = (float)(sx / sw), ny = (float)(sy / sw);
+        const float nr = fclampf(sqrtf(area / (float)M_PI), 0.6f * r, 1.4f * r);
+        const int settled = fabsf(nx - cx) < 0.02f * r && fabsf(ny - cy) < 0.02f * r && fabsf(nr - r) < 0.02f * r;
+        cx = nx, cy = ny, r = nr;
+        if (settled)
+            break;
+    }
+    out->x = cx + x0;
+    out->y = cy + y0;
+    out->r = r;
+    out->inner = inner;
+    out->ring = ring;
+    out->fit = 0;
+    out->inliers = 0;
+
+    /* edge points along rays: first outward crossing of the mid level */
+    const float th = 0.5f * (inner + ring);
+    float ex[NRAYS], ey[NRAYS];
+    int ne = 0;
+    const float step = fmaxf(0.25f, r / 24.0f);
+    const int nrays = r < 12.0f ? NRAYS / 2 : NRAYS; /* small pupils: fewer edge pixels anyway */
+    float evo[NRAYS];
+    const float lidf = 0.35f;
+    for (int k = 0; k < nrays; k++) {
+        const float a = (float)(2.0 * M_PI * k / nrays), dx = cosf(a), dy = sinf(a);
+        float prev = sample(win, ww, wh, cx, cy), pd = 0;
+        for (float dist = step; dist < 2.2f * r; dist += step) {
+            const float px = cx + dist * dx, py = cy + dist * dy;
+            if (px < 0.5f || py < 0.5f || px > ww - 0.5f || py > wh - 0.5f)
+                break;
+            const float v = sample(win, ww, wh, px, py);
+            if (v >= th && prev < th && sustained(win, ww, wh, cx, cy, dx, dy, dist, fmaxf(1.5f, 0.2f * r), th)) {
+                const float f = (th - prev) / (v - prev);
+                const float de = pd + f * (dist - pd);
+                /* beyond a pupil edge lies iris; beyond a lid edge, much brighter skin: a ray
+                 * that meets the lid gives no point (it would drag the fit) */
+                const float po = de + fmaxf(2.0f, 0.15f * r);
+                const float vo = sample(win, ww, wh, cx + po * dx, cy + po * dy);
+                if (vo <= ring + 0.6f * (ring - inner)) {
+                    ex[ne] = cx + de * dx + x0;
+                    ey[ne] = cy + de * dy + y0;
+                    evo[ne] = vo;
+                    ne++;
+                }
+                break;
+            }
+            prev = v, pd = dist;
+        }
+    }
+    if (!inpainted && ne >= 8) {
+        /* What lies just outside most edge points is iris; points with something clearly
+         * brighter beyond them (the lid margin, skin) are dropped. The median is the iris level
+         * as long as the lid hides less than half of the outline. */
+        float srt[NRAYS];
+        memcpy(srt, evo, sizeof(float) * (size_t)ne);
+        for (int i = 1; i < ne; i++)
+            for (int j = i; j > 0 && srt[j - 1] > srt[j]; j--) {
+                const float tmp = srt[j];
+                srt[j] = srt[j - 1], srt[j - 1] = tmp;
+            }
+        const float iris = srt[ne / 2], lim = iris + lidf * (iris - inner);
+        int m = 0;
+        for (int i = 0; i < ne; i++)
+            if (evo[i] <= lim)
+                ex[m] = ex[i], ey[m] = ey[i], evo[m] = evo[i], m++;
+        ne = m;
+    }
+    if (ne < 8)
+        return 0;
+    /* headset-sized pupils: aspect b/a >= 0.6 (gaze up to ~50 deg off the camera axis); flatter
+     * fits are lid-line consensus */
+    const double minab = 0.6;
+    int n = 0;
+    if (!inpainted) {
+        /* Headset-sized pupils: RANSAC over 6-point fits (a lid can hide a third of the outline
+         * and put its own edge in the middle of the points, which moves a least-squares fit),
+         * then the least-squares refit below on the consensus. Deterministic sampling. */
+        uint64_t st = 0x5eedu;
+        int best = 0;
+        fv_ellipse be;
+        for (int it = 0; it < 64; it++) {
+            float sx[6], sy[6];
+            int pick[6], k = 0;
+            while (k < 6) {
+                st += 0x9e3779b97f4a7c15ull;
+                uint64_t z = st;
+                z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+                z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+                const int j = (int)((z ^ (z >> 31)) % (uint64_t)ne);
+                int dup = 0;
+                for (int q = 0; q < k; q++)
+                    dup |= pick[q] == j;
+                if (!dup)
+                    pick[k] = j, sx[k] = ex[j], sy[k] = ey[j], k++;
+            }
+            fv_ellipse e;
+            if (fv_ellipse_fit(sx, sy, 6, &e) || e.a < 0.5 * r || e.a > 2.5 * r || e.b < minab * e.a ||
+                hypot(e.cx - (cx + x0), e.cy - (cy + y0)) > r)
+                continue;
+            const int cnt = count_near(&e, ex, ey, ne, fmax(1.0, 0.06 * e.a));
+            if (cnt > best)
+                best = cnt, be = e;
+        }
+        if (best >= 8) {
+            const double tol = fmax(1.0, 0.06 * be.a);
+            for (int i = 0; i < ne; i++)
+                if (fv_ellipse_distance(&be, ex[i], ey[i]) <= tol)
+                    ex[n] = ex[i], ey[n] = ey[i], n++;
+        }
+    }
+    if (n < 8) {
+    /* first cut: points much nearer or farther than the median radius (glints, lids, lashes) */
+    float rad[NRAYS];
+    for (int i = 0; i < ne; i++)
+        rad[i] = hypotf(ex[i] - (cx + x0), ey[i] - (cy + y0));
+    float sorted[NRAYS];
+    memcpy(sorted, rad, sizeof(float) * (size_t)ne);
+    for (int i = 1; i < ne; i++) /* insertion sort: 48 values */
+        for (int j = i; j > 0 && sorted[j - 1] > sorted[j]; j--) {
+            const float tmp = sorted[j];
+            sorted[j] = sorted[j - 1], sorted[j - 1] = tmp;
+        }
+    const float rmed = sorted[ne / 2];
+    n = 0;
+    for (int i = 0; i < ne; i++)
+        if (fabsf(rad[i] - rmed) <= fmaxf(1.5f, 0.25f * rmed))
+            ex[n] = ex[i], ey[n] = ey[i], n++;
+    }
+    if (n < 8)
+        return 0;
+    fv_ellipse e;
+    for (int round = 0; round < 3; round++) {
+        if (fv_ellipse_fit(ex, ey, n, &e))
+            return 0;
+        /* drop points far from the fit (lashes, lids, leftover reflections), refit */
+        const double tol = fmax(0.75, 0.08 * e.a);
+        int m = 0;
+        for (int i = 0; i < n; i++)
+            if (fv_ellipse_distance(&e, ex[i], ey[i]) <= tol)
+                ex[m] = ex[i], ey[m] = ey[i], m++;
+        if (m == n)
+            break;
+        if (m < 6)
+            return 0;
+        n = m;
+    }
+    if (fv_ellipse_fit(ex, ey, n, &e))
+        return 0;
+    const double dc = hypot(e.cx - out->x, e.cy - out->y);
+    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < (inpainted ? 0.3 : minab) * e.a || dc > 0.6 * r)
+        return 0;
+    out->fit = 1;
+    out->e = e;
+    out->inliers = (float)n / nrays;
+    return 0;
+}
+
+/* ---------------------------------------------------------------- glints */
+
+static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const pupil *pp,
+                       uint8_t *lab, int *stack, fv_eye_glint *g)
+{
+    const float rad = fmaxf(2.2f * pp->r, 6.0f);
+    const int x0 = imax(0, (int)(pp->x - rad)), x1 = imin(w, (int)(pp->x + rad) + 1);
+    const int y0 = imax(0, (int)(pp->y - rad)), y1 = imin(h, (int)(pp->y + rad) + 1);
+    const int ww = x1 - x0, wh = y1 - y0;
+    if (ww < 1 || wh < 1)
+        return 0;
+    const int thr = imax((int)pp->ring + 40, (int)(pp->ring + 0.5f * (255.0f - pp->ring)));
+    const float max_area = fmaxf(4.0f, 0.8f * pp->r * pp->r);
+    memset(lab, 0, (size_t)ww * wh);
+    int n = 0;
+    for (int y = 0; y < wh; y++)
+        for (int x = 0; x < ww; x++) {
+            if (lab[y * ww + x] || luma[(y + y0) * stride + x + x0] < thr)
+                continue;
+            /* flood fill one 4-connected blob */
+            int sp = 0, area = 0, touches = 0, peak = 0;
+            double sw = 0, sx = 0, sy = 0;
+            stack[sp++] = y * ww + x;
+            lab[y * ww + x] = 1;
+            while (sp) {
+                const int i = stack[--sp], px = i % ww, py = i / ww;
+                const int v = luma[(py + y0) * stride + px + x0];
+                const double wt = v - thr + 1;
+                peak = imax(peak, v);
+                sw += wt, sx += wt * (px + 0.5), sy += wt * (py + 0.5);
+                area++;
+                if (px == 0 || py == 0 || px == ww - 1 || py == wh - 1)
+                    touches = 1;
+                const int nb[4] = { px > 0 ? i - 1 : -1, px + 1 < ww ? i + 1 : -1, py > 0 ? i - ww : -1,
+                                    py + 1 < wh ? i + ww : -1 };
+                for (int k = 0; k < 4; k++)
+                    if (nb[k] >= 0 && !lab[nb[k]] &&
+                        luma[(nb[k] / ww + y0) * stride + nb[k] % ww + x0] >= thr) {
+                        lab[nb[k]] = 1;
+                        stack[sp++] = nb[k];
+                    }
+            }
+            if (touches || area > max_area)
+                continue;
+            fv_eye_glint gl = { (float)(sx / sw) + x0, (float)(sy / sw) + y0, (float)area };
+            /* a reflection is a small spot much brighter than what is right around it (bright
+             * skin or sclera above the threshold is not) */
+            const float rb = sqrtf(area / (float)M_PI) + 2.5f;
+            float bg = 0;
+            for (int k = 0; k < 8; k++) {
+                const int bx = imin(w - 1, imax(0, (int)floorf(gl.x + rb * cosf(k * (float)M_PI / 4)))),
+                          by = imin(h - 1, imax(0, (int)floorf(gl.y + rb * sinf(k * (float)M_PI / 4))));
+                bg += luma[by * stride + bx];
+            }
+            if (peak - bg / 8 < 50)
+                continue;
+            const float dd = hypotf(gl.x - pp->x, gl.y - pp->y);
+            if (dd > rad)
+                continue;
+            /* insertion by distance to the pupil centre */
+            int j = n < FV_EYE_MAX_GLINTS ? n++ : n - 1;
+            if (j == FV_EYE_MAX_GLINTS - 1 && n == FV_EYE_MAX_GLINTS &&
+                hypotf(g[j].x - pp->x, g[j].y - pp->y) <= dd && j > 0)
+                continue; /* full, and farther than all kept */
+            while (j > 0 && hypotf(g[j - 1].x - pp->x, g[j - 1].y - pp->y) > dd) {
+                g[j] = g[j - 1];
+                j--;
+            }
+            g[j] = gl;
+        }
+    return imin(n, t->p.max_glints);
+}
+
+/* ---------------------------------------------------------------- frame */
+
+static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, fv_eye_result *r,
+                 int history)
+{
+    if (!t || !luma || !r || w < 8 || h < 8 || w > 8192 || h > 8192 || stride < w)
+        return -1;
+    memset(r, 0, sizeof *r);
+    r->status = FV_EYE_LOST;
+    const size_t px = (size_t)w * h;
+    const size_t ii_bytes = ((size_t)(w + 1) * (h + 1)) * sizeof(uint32_t);
+    uint8_t *m = scratch(t, 3 * px + ii_bytes + px * sizeof(int) + 64 + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
+    if (!m)
+        return -1;
+    uint32_t *ii = (uint32_t *)m;
+    int *stack = (int *)(m + ii_bytes);
+    fv_eye_glint *gl = (fv_eye_glint *)(m + ii_bytes + px * sizeof(int));
+    uint8_t *work = m + ii_bytes + px * sizeof(int) + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint), *mask = work + px,
+            *lowres = mask + px;
+
+    const candidate c = coarse_search(t, luma, w, h, stride, work, mask, lowres, ii, stack);
+    if (!c.ok)
+        return 0;
+    pupil p;
+    /* small images: the search image is the full-resolution frame, already inpainted; refine
+     * from it (into another buffer) rather than inpainting the window again */
+    const int reuse = c.scale == 1;
+    if (refine(t, reuse ? work : luma, w, h, reuse ? w : stride, &c, reuse, reuse ? lowres : work, mask, stack, &p)) {
+        /* no dark region stands out in the window: keep the search's answer, flagged low */
+        p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
+    }
+    /* Small images (min side <= SEARCH_MAX_SIDE: remote-camera crops, ~10 px pupils inside an
+     * often equally dark iris): the best contrast box's centre beat the refined centroid and the
+     * ellipse on the MRL images (lids, lashes and iris pull them). Headset-sized eyes: the ellipse
+     * centre, else the dark-region centroid. */
+    const int small = c.scale == 1;
+    if (small) {
+        r->pupil_x = c.x;
+        r->pupil_y = c.y;
+    } else if (p.fit) {
+        r->pupil_x = (float)p.e.cx;
+        r->pupil_y = (float)p.e.cy;
+        r->ellipse_fit = 1;
+    } else {
+        r->pupil_x = p.x;
+        r->pupil_y = p.y;
+    }
+    if (p.fit) {
+        r->pupil_a_px = (float)p.e.a;
+        r->pupil_b_px = (float)p.e.b;
+        r->pupil_angle_rad = (float)p.e.angle;
+    } else {
+        r->pupil_a_px = r->pupil_b_px = p.r;
+    }
+    r->contrast = p.ring - p.inner;
+    r->found = 1;
+    r->status = FV_EYE_OK;
+
+    r->n_glints = find_glints(t, luma, w, h, stride, &p, work, stack, gl);
+    memcpy(r->glints, gl, (size_t)r->n_glints * sizeof *gl);
+    if (r->n_glints) {
+        float gx = 0, gy = 0;
+        for (int i = 0; i < r->n_glints; i++)
+            gx += r->glints[i].x, gy += r->glints[i].y;
+        r->has_pg = 1;
+        r->pg_x = r->pupil_x - gx / r->n_glints;
+        r->pg_y = r->pupil_y - gy / r->n_glints;
+    }
+
+    /* confidence: contrast (grey levels) and how much of the outline the fit explains */
+    const float cc = fclampf((r->contrast - 4.0f) / 24.0f, 0.0f, 1.0f);
+    const float fit = p.fit ? fclampf(p.inliers / 0.6f, 0.0f, 1.0f) : 0.5f;
+    r->confidence = cc * (0.4f + 0.6f * fit);
+
+    if (r->contrast < 3.0f) {
+        r->status = FV_EYE_LOST;
+        r->found = 0;
+    }
+    if (history && r->status == FV_EYE_OK) {
+        /* a blink: what is found is not the pupil the tracker has been seeing: much less dark
+         * (lashes, lid crease), much less contrast, much smaller, or a sliver */
+        const float flat = p.fit ? (float)(p.e.b / p.e.a) : 1.0f;
+        const float span = t->ref_ring - t->ref_inner;
+        if (t->nref >= 3 && (p.inner > t->ref_inner + 0.4f * span || r->contrast < 0.45f * t->ref_contrast ||
+                             p.r < 0.45f * t->ref_radius || flat < 0.3f)) {
+            r->status = FV_EYE_BLINK; /* what was found is not a pupil: no position */
+            r->found = 0;
+            r->has_pg = 0;
+            r->confidence *= 0.25f;
+        } else {
+            const float a = t->nref < 10 ? 1.0f / (t->nref + 1) : 0.1f;
+            t->ref_contrast += a * (r->contrast - t->ref_contrast);
+            t->ref_radius += a * (p.r - t->ref_radius);
+            t->ref_inner += a * (p.inner - t->ref_inner);
+            t->ref_ring += a * (p.ring - t->ref_ring);
+            t->nref++;
+        }
+    } else if (history && r->status == FV_EYE_LOST && t->nref >= 3) {
+        r->status = FV_EYE_BLINK;
+    }
+    return 0;
+}
+
+int fv_track_frame(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, fv_eye_result *r)
+{
+    return track(t, luma, w, h, stride, r, 1);
+}
+
+int fv_track_image(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, fv_eye_result *r)
+{
+    return track(t, luma, w, h, stride, r, 0);
+}

@@ -1,0 +1,70 @@
+/* fovea eye tracker kernels, AVX2. Exact: integer arithmetic, same results as the C references
+ * in core/eyetrack/kernels.c for every input. */
+#include <immintrin.h>
+
+#include "dsp.h"
+
+static void down2_row_avx2(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n)
+{
+    const __m256i ones = _mm256_set1_epi8(1), two = _mm256_set1_epi16(2);
+    int x = 0;
+    for (; x + 32 <= n; x += 32) {
+        const __m256i a0 = _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(a + 2 * x)), ones);
+        const __m256i a1 = _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(a + 2 * x + 32)), ones);
+        const __m256i b0 = _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(b + 2 * x)), ones);
+        const __m256i b1 = _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(b + 2 * x + 32)), ones);
+        const __m256i s0 = _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(a0, b0), two), 2);
+        const __m256i s1 = _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(a1, b1), two), 2);
+        /* packus works per 128-bit lane: put the four quarters back in order */
+        const __m256i p = _mm256_permute4x64_epi64(_mm256_packus_epi16(s0, s1), _MM_SHUFFLE(3, 1, 2, 0));
+        _mm256_storeu_si256((__m256i *)(dst + x), p);
+    }
+    if (x < n)
+        fv_et_down2_row_c(dst + x, a + 2 * x, b + 2 * x, n - x);
+}
+
+static void integral_row_avx2(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n)
+{
+    __m256i run = _mm256_setzero_si256();
+    const __m256i last = _mm256_set1_epi32(7);
+    int x = 0;
+    for (; x + 8 <= n; x += 8) {
+        __m256i v = _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(src + x)));
+        /* prefix within each 128-bit lane, then carry the low lane's total into the high lane */
+        v = _mm256_add_epi32(v, _mm256_slli_si256(v, 4));
+        v = _mm256_add_epi32(v, _mm256_slli_si256(v, 8));
+        const __m256i carry = _mm256_shuffle_epi32(_mm256_permute2x128_si256(v, v, 0x08), 0xff);
+        v = _mm256_add_epi32(_mm256_add_epi32(v, carry), run);
+        run = _mm256_permutevar8x32_epi32(v, last);
+        _mm256_storeu_si256((__m256i *)(dst + x), _mm256_add_epi32(v, _mm256_loadu_si256((const __m256i *)(above + x))));
+    }
+    uint32_t r = (uint32_t)_mm256_cvtsi256_si32(run);
+    for (; x < n; x++) {
+        r += src[x];
+        dst[x] = above[x] + r;
+    }
+}
+
+static int thresh_row_avx2(uint8_t *restrict dst, const uint8_t *src, int n, int t)
+{
+    if (t > 255 || t <= 0)
+        return fv_et_thresh_row_c(dst, src, n, t);
+    const __m256i tv = _mm256_set1_epi8((char)t);
+    int x = 0, count = 0;
+    for (; x + 32 <= n; x += 32) {
+        const __m256i s = _mm256_loadu_si256((const __m256i *)(src + x));
+        const __m256i m = _mm256_cmpeq_epi8(_mm256_max_epu8(s, tv), s);
+        _mm256_storeu_si256((__m256i *)(dst + x), m);
+        count += __builtin_popcount((unsigned)_mm256_movemask_epi8(m));
+    }
+    if (x < n)
+        count += fv_et_thresh_row_c(dst + x, src + x, n - x, t);
+    return count;
+}
+
+void fv_eyetrack_init_avx2(fv_dsp *d)
+{
+    d->et_down2_row = down2_row_avx2;
+    d->et_integral_row = integral_row_avx2;
+    d->et_thresh_row = thresh_row_avx2;
+}

@@ -1,0 +1,70 @@
+/* fovea eye tracker kernels, SSE4.1 (+SSSE3). Exact: integer arithmetic, same results as the C
+ * references in core/eyetrack/kernels.c for every input. */
+#include <smmintrin.h>
+
+#include "dsp.h"
+
+static void down2_row_sse41(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n)
+{
+    const __m128i ones = _mm_set1_epi8(1), two = _mm_set1_epi16(2);
+    int x = 0;
+    for (; x + 16 <= n; x += 16) {
+        /* maddubs(u8, 1): the sum of each horizontal pair as 16 bits */
+        const __m128i a0 = _mm_maddubs_epi16(_mm_loadu_si128((const __m128i *)(a + 2 * x)), ones);
+        const __m128i a1 = _mm_maddubs_epi16(_mm_loadu_si128((const __m128i *)(a + 2 * x + 16)), ones);
+        const __m128i b0 = _mm_maddubs_epi16(_mm_loadu_si128((const __m128i *)(b + 2 * x)), ones);
+        const __m128i b1 = _mm_maddubs_epi16(_mm_loadu_si128((const __m128i *)(b + 2 * x + 16)), ones);
+        const __m128i s0 = _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(a0, b0), two), 2);
+        const __m128i s1 = _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(a1, b1), two), 2);
+        _mm_storeu_si128((__m128i *)(dst + x), _mm_packus_epi16(s0, s1));
+    }
+    if (x < n)
+        fv_et_down2_row_c(dst + x, a + 2 * x, b + 2 * x, n - x);
+}
+
+static void integral_row_sse41(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n)
+{
+    __m128i run = _mm_setzero_si128(); /* prefix so far, broadcast */
+    int x = 0;
+    for (; x + 8 <= n; x += 8) {
+        __m128i v = _mm_cvtepu8_epi16(_mm_loadl_epi64((const __m128i *)(src + x)));
+        /* inclusive prefix sum of 8 x 16 bits (at most 8 * 255) */
+        v = _mm_add_epi16(v, _mm_slli_si128(v, 2));
+        v = _mm_add_epi16(v, _mm_slli_si128(v, 4));
+        v = _mm_add_epi16(v, _mm_slli_si128(v, 8));
+        const __m128i lo = _mm_add_epi32(_mm_cvtepu16_epi32(v), run);
+        const __m128i hi = _mm_add_epi32(_mm_cvtepu16_epi32(_mm_srli_si128(v, 8)), run);
+        run = _mm_shuffle_epi32(hi, 0xff);
+        _mm_storeu_si128((__m128i *)(dst + x), _mm_add_epi32(lo, _mm_loadu_si128((const __m128i *)(above + x))));
+        _mm_storeu_si128((__m128i *)(dst + x + 4), _mm_add_epi32(hi, _mm_loadu_si128((const __m128i *)(above + x + 4))));
+    }
+    uint32_t r = (uint32_t)_mm_cvtsi128_si32(run);
+    for (; x < n; x++) {
+        r += src[x];
+        dst[x] = above[x] + r;
+    }
+}
+
+static int thresh_row_sse41(uint8_t *restrict dst, const uint8_t *src, int n, int t)
+{
+    if (t > 255 || t <= 0) /* nothing / everything passes: no 8-bit compare for these */
+        return fv_et_thresh_row_c(dst, src, n, t);
+    const __m128i tv = _mm_set1_epi8((char)t);
+    int x = 0, count = 0;
+    for (; x + 16 <= n; x += 16) {
+        const __m128i s = _mm_loadu_si128((const __m128i *)(src + x));
+        const __m128i m = _mm_cmpeq_epi8(_mm_max_epu8(s, tv), s); /* s >= t, unsigned */
+        _mm_storeu_si128((__m128i *)(dst + x), m);
+        count += __builtin_popcount((unsigned)_mm_movemask_epi8(m));
+    }
+    if (x < n)
+        count += fv_et_thresh_row_c(dst + x, src + x, n - x, t);
+    return count;
+}
+
+void fv_eyetrack_init_sse41(fv_dsp *d)
+{
+    d->et_down2_row = down2_row_sse41;
+    d->et_integral_row = integral_row_sse41;
+    d->et_thresh_row = thresh_row_sse41;
+}

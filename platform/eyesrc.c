@@ -1,0 +1,301 @@
+/* fovea platform: Y4M and image-list eye sources (see eyesrc.h). */
+#include "eyesrc.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb/stb_image.h>
+
+#include "err.h"
+
+typedef struct {
+    char *path; /* as written */
+    int line;
+    int has_label;
+    float x, y;
+} list_entry;
+
+struct fv_eyesrc {
+    int is_list;
+    char path[4096];
+    /* y4m */
+    FILE *f;
+    int w, h;
+    size_t frame_bytes;
+    uint8_t *frame;
+    /* list */
+    char dir[4096];
+    list_entry *e;
+    long n, next;
+    int labels;
+    uint8_t *img;
+};
+
+static fv_eyesrc *alloc_src(const char *path)
+{
+    fv_eyesrc *s = calloc(1, sizeof *s);
+    if (s)
+        snprintf(s->path, sizeof s->path, "%s", path);
+    return s;
+}
+
+/* ---------------------------------------------------------------- Y4M */
+
+static int parse_int(const char *tok, int *v)
+{
+    char *end;
+    errno = 0;
+    long x = strtol(tok, &end, 10);
+    if (end == tok || errno || x < 1 || x > 16384)
+        return -1;
+    *v = (int)x;
+    return 0;
+}
+
+int fv_eyesrc_open_y4m(fv_eyesrc **out, const char *path, char *err, size_t err_len)
+{
+    *out = NULL;
+    fv_eyesrc *s = alloc_src(path);
+    if (!s)
+        return fv_err(err, err_len, "out of memory");
+    s->f = fopen(path, "rb");
+    if (!s->f) {
+        fv_err(err, err_len, "%s: %s", path, strerror(errno));
+        free(s);
+        return -1;
+    }
+    char hdr[1024];
+    size_t n = 0;
+    int c;
+    while ((c = fgetc(s->f)) != EOF && c != '\n' && n + 1 < sizeof hdr)
+        hdr[n++] = (char)c;
+    hdr[n] = '\0';
+    const char *what = NULL;
+    if (c == EOF && ferror(s->f))
+        what = "read error (a directory?)";
+    else if (strncmp(hdr, "YUV4MPEG2", 9) || (hdr[9] != ' ' && hdr[9] != '\0'))
+        what = "not a YUV4MPEG2 file (no 'YUV4MPEG2 ' signature)";
+    else if (c != '\n')
+        what = "truncated or overlong YUV4MPEG2 header";
+    const char *cs = "420jpeg";
+    char csbuf[32] = "";
+    s->w = s->h = 0;
+    if (!what) {
+        for (char *tok = strtok(hdr + 9, " "); tok && !what; tok = strtok(NULL, " ")) {
+            switch (tok[0]) {
+            case 'W': if (parse_int(tok + 1, &s->w)) what = "bad width (W) in the header"; break;
+            case 'H': if (parse_int(tok + 1, &s->h)) what = "bad height (H) in the header"; break;
+            case 'C': snprintf(csbuf, sizeof csbuf, "%s", tok + 1); cs = csbuf; break;
+            default: break; /* F, I, A, X: not needed to read luma */
+            }
+        }
+    }
+    if (!what && (!s->w || !s->h))
+        what = "the header lacks W or H";
+    size_t luma = (size_t)s->w * s->h, cw = (size_t)(s->w + 1) / 2, ch = (size_t)(s->h + 1) / 2;
+    if (!what) {
+        if (!strcmp(cs, "mono"))
+            s->frame_bytes = luma;
+        else if (!strcmp(cs, "420") || !strcmp(cs, "420jpeg") || !strcmp(cs, "420paldv") || !strcmp(cs, "420mpeg2"))
+            s->frame_bytes = luma + 2 * cw * ch; /* the 8-bit 4:2:0 sitings; not 420p10 etc. */
+        else if (!strcmp(cs, "422"))
+            s->frame_bytes = luma + 2 * cw * (size_t)s->h;
+        else if (!strcmp(cs, "444"))
+            s->frame_bytes = 3 * luma;
+        else {
+            fv_err(err, err_len, "%s: colour space C%s is not supported (C420*, C422, C444, Cmono, 8 bit)", path, cs);
+            fv_eyesrc_close(s);
+            return -1;
+        }
+    }
+    if (what) {
+        fv_err(err, err_len, "%s: %s", path, what);
+        fv_eyesrc_close(s);
+        return -1;
+    }
+    s->frame = malloc(s->frame_bytes);
+    if (!s->frame) {
+        fv_eyesrc_close(s);
+        return fv_err(err, err_len, "out of memory");
+    }
+    *out = s;
+    return 0;
+}
+
+static int next_y4m(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
+{
+    char tag[256];
+    size_t n = 0;
+    int c;
+    while ((c = fgetc(s->f)) != EOF && c != '\n' && n + 1 < sizeof tag)
+        tag[n++] = (char)c;
+    tag[n] = '\0';
+    if (c == EOF && n == 0)
+        return ferror(s->f) ? fv_err(err, err_len, "%s: read error", s->path) : 0;
+    if (strncmp(tag, "FRAME", 5) || (tag[5] != ' ' && tag[5] != '\0') || c != '\n')
+        return fv_err(err, err_len, "%s: frame %ld: corrupt data (no FRAME marker)", s->path, s->next);
+    const size_t got = fread(s->frame, 1, s->frame_bytes, s->f);
+    if (got != s->frame_bytes)
+        return fv_err(err, err_len, "%s: frame %ld is truncated (%zu of %zu bytes)", s->path, s->next, got,
+                      s->frame_bytes);
+    f->luma = s->frame;
+    f->w = s->w;
+    f->h = s->h;
+    f->stride = s->w;
+    f->index = s->next++;
+    f->name = NULL;
+    f->has_label = 0;
+    return 1;
+}
+
+/* ---------------------------------------------------------------- image list */
+
+static int parse_float(const char *t, float *v)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(t, &end);
+    if (end == t || *end || errno || !isfinite(d))
+        return -1;
+    *v = (float)d;
+    return 0;
+}
+
+int fv_eyesrc_open_list(fv_eyesrc **out, const char *path, char *err, size_t err_len)
+{
+    *out = NULL;
+    fv_eyesrc *s = alloc_src(path);
+    if (!s)
+        return fv_err(err, err_len, "out of memory");
+    s->is_list = 1;
+    const char *slash = strrchr(path, '/');
+    if (slash)
+        snprintf(s->dir, sizeof s->dir, "%.*s", (int)(slash - path), path);
+    else
+        snprintf(s->dir, sizeof s->dir, ".");
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fv_err(err, err_len, "%s: %s", path, strerror(errno));
+        free(s);
+        return -1;
+    }
+    char line[8192];
+    long cap = 0;
+    int ln = 0, labelled = 0, unlabelled = 0, rc = 0;
+    while (fgets(line, sizeof line, f)) {
+        ln++;
+        if (!strchr(line, '\n') && !feof(f)) {
+            rc = fv_err(err, err_len, "%s:%d: line too long", path, ln);
+            break;
+        }
+        char *tok[4];
+        int nt = 0;
+        for (char *t = strtok(line, " \t\r\n"); t; t = strtok(NULL, " \t\r\n")) {
+            if (nt == 0 && t[0] == '#')
+                break;
+            if (nt < 4)
+                tok[nt] = t;
+            nt++;
+        }
+        if (nt == 0)
+            continue;
+        if (nt != 1 && nt != 3) {
+            rc = fv_err(err, err_len, "%s:%d: %d fields, expected PATH [X Y]", path, ln, nt);
+            break;
+        }
+        list_entry e = { 0 };
+        e.line = ln;
+        if (nt == 3) {
+            if (parse_float(tok[1], &e.x) || parse_float(tok[2], &e.y)) {
+                rc = fv_err(err, err_len, "%s:%d: label '%s %s' is not two numbers", path, ln, tok[1], tok[2]);
+                break;
+            }
+            e.has_label = 1;
+            labelled++;
+        } else {
+            unlabelled++;
+        }
+        e.path = strdup(tok[0]);
+        if (s->n == cap) {
+            cap = cap ? 2 * cap : 256;
+            list_entry *ne = realloc(s->e, (size_t)cap * sizeof *ne);
+            if (!ne || !e.path) {
+                free(e.path);
+                rc = fv_err(err, err_len, "out of memory");
+                break;
+            }
+            s->e = ne;
+        }
+        s->e[s->n++] = e;
+    }
+    if (!rc && ferror(f))
+        rc = fv_err(err, err_len, "%s: read error (a directory?)", path);
+    fclose(f);
+    if (!rc && s->n == 0)
+        rc = fv_err(err, err_len, "%s: no images listed", path);
+    if (rc) {
+        fv_eyesrc_close(s);
+        return -1;
+    }
+    s->labels = labelled > 0;
+    (void)unlabelled;
+    *out = s;
+    return 0;
+}
+
+static int next_list(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
+{
+    if (s->next >= s->n)
+        return 0;
+    const list_entry *e = &s->e[s->next];
+    char full[8192];
+    if (e->path[0] == '/')
+        snprintf(full, sizeof full, "%s", e->path);
+    else
+        snprintf(full, sizeof full, "%s/%s", s->dir, e->path);
+    stbi_image_free(s->img);
+    int w, h, comp;
+    s->img = stbi_load(full, &w, &h, &comp, 1);
+    if (!s->img) {
+        FILE *t = fopen(full, "rb");
+        const char *why = t ? stbi_failure_reason() : strerror(errno);
+        if (t)
+            fclose(t);
+        return fv_err(err, err_len, "%s:%d: %s: %s", s->path, e->line, e->path, why ? why : "cannot read image");
+    }
+    f->luma = s->img;
+    f->w = w;
+    f->h = h;
+    f->stride = w;
+    f->index = s->next++;
+    f->name = e->path;
+    f->has_label = e->has_label;
+    f->label_x = e->x;
+    f->label_y = e->y;
+    return 1;
+}
+
+int fv_eyesrc_next(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
+{
+    return s->is_list ? next_list(s, f, err, err_len) : next_y4m(s, f, err, err_len);
+}
+
+long fv_eyesrc_count(const fv_eyesrc *s) { return s->is_list ? s->n : -1; }
+int fv_eyesrc_has_labels(const fv_eyesrc *s) { return s->labels; }
+
+void fv_eyesrc_close(fv_eyesrc *s)
+{
+    if (!s)
+        return;
+    if (s->f)
+        fclose(s->f);
+    free(s->frame);
+    for (long i = 0; i < s->n; i++)
+        free(s->e[i].path);
+    free(s->e);
+    stbi_image_free(s->img);
+    free(s);
+}

@@ -1,0 +1,34 @@
+/* fovea platform: eye-image sources for the tracker. A YUV4MPEG2 video (C420* / C422 / C444 /
+ * Cmono, 8 bit; only the luma plane is used) or an image list (lines `PATH [X Y]`, PATH relative
+ * to the list's folder, `#` comments and blank lines skipped; X Y an optional pupil label).
+ * Errors are one line naming the file (and line or frame) and the problem. */
+#ifndef FOVEA_EYESRC_H
+#define FOVEA_EYESRC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct fv_eyesrc fv_eyesrc;
+
+typedef struct fv_eye_frame {
+    const uint8_t *luma; /* valid until the next call */
+    int w, h;
+    ptrdiff_t stride;
+    long index;          /* 0-based frame / list entry */
+    const char *name;    /* list: the PATH as written in the list; video: NULL */
+    int has_label;
+    float label_x, label_y;
+} fv_eye_frame;
+
+/* 0 on success; -1 with a reason in err (missing file, not YUV4MPEG2, bad header, unsupported
+ * colour space; for lists: a malformed line, no entries). The whole list is parsed here. */
+int fv_eyesrc_open_y4m(fv_eyesrc **s, const char *path, char *err, size_t err_len);
+int fv_eyesrc_open_list(fv_eyesrc **s, const char *path, char *err, size_t err_len);
+/* 1: a frame in *f; 0: end of input; -1: error in err (truncated frame, bad FRAME marker,
+ * unreadable image). */
+int fv_eyesrc_next(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len);
+long fv_eyesrc_count(const fv_eyesrc *s); /* list entries; -1 for a video */
+int fv_eyesrc_has_labels(const fv_eyesrc *s);
+void fv_eyesrc_close(fv_eyesrc *s);
+
+#endif

@@ -1,0 +1,699 @@
+/* fovea eye tracker tests: ellipse fit against known ellipses; the tracker against the synthetic
+ * renderer's ground truth (clean, noisy / low-contrast / partly covered, blinks); calibration
+ * against a known polynomial; the whole chain gaze -> synthetic frames -> tracker ->
+ * calibration -> gaze in degrees; the gaze filter; calibration files. Deterministic. Frames are
+ * 320x240 with 2x2 supersampling and few in number, to stay quick under ASan and qemu. */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "testutil.h"
+
+#include "calibfile.h"
+#include "eyesrc.h"
+#include "eyetrack/calib.h"
+#include "eyetrack/eyetrack.h"
+#include "eyetrack/gazefilter.h"
+#include "eyetrack/synth.h"
+
+#define W 320
+#define H 240
+
+static uint64_t rng = 0xe7e7e7ull;
+static float rnd(void) { return fv_test_randf(&rng); }
+
+static int cmp_float(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+static float median(float *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_float);
+    return n % 2 ? v[n / 2] : 0.5f * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* ------------------------------------------------------------------ ellipse */
+
+static void test_ellipse_fit(void **state)
+{
+    (void)state;
+    rng = 0x1111ull; /* each test its own draws, whatever runs before it */
+    for (int k = 0; k < 50; k++) {
+        const double cx = 20 + 200 * rnd(), cy = 20 + 200 * rnd(), a = 3 + 40 * rnd(), b = a * (0.3 + 0.7 * rnd());
+        const double th = 3.14159265358979 * rnd();
+        float x[64], y[64];
+        const int n = 6 + (int)(rnd() * 58);
+        const double arc = k % 3 == 0 ? 3.14159265358979 : 6.28318530717959; /* half arcs too */
+        for (int i = 0; i < n; i++) {
+            const double t = arc * i / n;
+            x[i] = (float)(cx + a * cos(t) * cos(th) - b * sin(t) * sin(th));
+            y[i] = (float)(cy + a * cos(t) * sin(th) + b * sin(t) * cos(th));
+        }
+        fv_ellipse e;
+        assert_int_equal(fv_ellipse_fit(x, y, n, &e), 0);
+        /* float inputs: errors of ~1e-5 relative */
+        const double tol = 1e-3 * (1 + a);
+        if (fabs(e.cx - cx) > tol || fabs(e.cy - cy) > tol || fabs(e.a - a) > tol || fabs(e.b - b) > tol)
+            fail_msg("ellipse %d: got c=(%g,%g) a=%g b=%g, want (%g,%g) %g %g", k, e.cx, e.cy, e.a, e.b, cx, cy, a, b);
+        if (a - b > 0.05 * a) { /* the angle is defined (mod pi) */
+            double d = fmod(fabs(e.angle - th), 3.14159265358979);
+            d = fmin(d, 3.14159265358979 - d);
+            assert_true(d < 1e-3);
+        }
+        for (int i = 0; i < n; i++)
+            assert_true(fv_ellipse_distance(&e, x[i], y[i]) < tol);
+        assert_true(fabs(fv_ellipse_distance(&e, e.cx + (e.a + 2) * cos(e.angle), e.cy + (e.a + 2) * sin(e.angle)) - 2) < 1e-6);
+    }
+    float lx[10], ly[10];
+    for (int i = 0; i < 10; i++)
+        lx[i] = (float)i, ly[i] = 2.0f * i + 1; /* collinear: no ellipse */
+    fv_ellipse e;
+    assert_int_equal(fv_ellipse_fit(lx, ly, 10, &e), -1);
+    assert_int_equal(fv_ellipse_fit(lx, ly, 4, &e), -1);
+}
+
+/* ------------------------------------------------------------------ tracker on synthetic frames */
+
+typedef struct {
+    float pupil_err, glint_max_err;
+    int glints_visible, glints_matched, found, status;
+} frame_eval;
+
+static frame_eval eval_frame(fv_eye_tracker *t, const fv_synth_params *p, const fv_synth_state *s, uint64_t seed,
+                             int history, uint8_t *img)
+{
+    fv_synth_truth gt;
+    fv_synth_render(p, s, seed, img, p->w, &gt);
+    fv_eye_result r;
+    assert_int_equal((history ? fv_track_frame : fv_track_image)(t, img, p->w, p->h, p->w, &r), 0);
+    frame_eval e = { 0 };
+    e.found = r.found;
+    e.status = r.status;
+    e.pupil_err = r.found ? hypotf(r.pupil_x - gt.pupil_x, r.pupil_y - gt.pupil_y) : INFINITY;
+    for (int k = 0; k < gt.n_glints; k++) {
+        if (!gt.glint_visible[k])
+            continue;
+        e.glints_visible++;
+        float best = INFINITY;
+        for (int j = 0; j < r.n_glints; j++)
+            best = fminf(best, hypotf(r.glints[j].x - gt.glint_x[k], r.glints[j].y - gt.glint_y[k]));
+        if (best < 1.0f) {
+            e.glints_matched++;
+            e.glint_max_err = fmaxf(e.glint_max_err, best);
+        }
+    }
+    return e;
+}
+
+static void test_synthetic_clean(void **state)
+{
+    (void)state;
+    rng = 0x2222ull; /* each test its own draws, whatever runs before it */
+    fv_synth_params p;
+    fv_synth_default_params(&p, W, H);
+    p.noise_sigma = 0;
+    p.supersample = 2;
+    uint8_t *img = malloc(W * H);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    assert_non_null(t);
+    enum { N = 9 };
+    float err[N];
+    int vis = 0, matched = 0;
+    for (int i = 0; i < N; i++) {
+        p.n_leds = 2 + i % 5;
+        const fv_synth_state s = { -20.0f + 40.0f * rnd(), -12.0f + 24.0f * rnd(), 1.6f + 1.2f * rnd(), 1.0f };
+        const frame_eval e = eval_frame(t, &p, &s, (uint64_t)i, 0, img);
+        assert_true(e.found);
+        err[i] = e.pupil_err;
+        vis += e.glints_visible;
+        matched += e.glints_matched;
+        printf("[ eyetrack ] clean %d: gaze (%.1f, %.1f) pupil %.2f mm: error %.3f px, glints %d/%d (max err %.2f px)\n",
+               i, (double)s.yaw_deg, (double)s.pitch_deg, (double)s.pupil_mm, (double)e.pupil_err, e.glints_matched,
+               e.glints_visible, (double)e.glint_max_err);
+        assert_true(e.pupil_err < 1.0f);
+    }
+    const float med = median(err, N);
+    printf("[ eyetrack ] clean frames: median pupil error %.3f px (bound 0.5), glints found %d of %d visible\n",
+           (double)med, matched, vis);
+    assert_true(med < 0.5f);
+    assert_true(vis > 0);
+    assert_true(matched * 10 >= vis * 9); /* >= 90% of the visible glints within 1 px */
+    fv_eye_destroy(t);
+    free(img);
+}
+
+static void test_synthetic_noisy(void **state)
+{
+    (void)state;
+    rng = 0x3333ull; /* each test its own draws, whatever runs before it */
+    fv_synth_params p;
+    fv_synth_default_params(&p, W, H);
+    p.supersample = 2;
+    uint8_t *img = malloc(W * H);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    enum { N = 9 };
+    float err[N];
+    for (int i = 0; i < N; i++) {
+        /* heavy noise, low contrast (dim), lids half over the pupil on every third frame */
+        p.noise_sigma = 6.0f + 4.0f * (i % 3);
+        p.brightness = i % 2 ? 0.55f : 1.0f;
+        /* every third frame looks up into a half-closed lid: part of the pupil is covered */
+        const int lid = i % 3 == 2;
+        const fv_synth_state s = { -15.0f + 30.0f * rnd(), lid ? 5.0f + 6.0f * rnd() : -8.0f + 16.0f * rnd(),
+                                   1.8f + 0.8f * rnd(), lid ? 0.5f : 1.0f };
+        fv_synth_truth gt;
+        fv_synth_truth_of(&p, &s, &gt);
+        const frame_eval e = eval_frame(t, &p, &s, 100u + (uint64_t)i, 0, img);
+        err[i] = e.pupil_err;
+        printf("[ eyetrack ] noisy %d: gaze (%.1f, %.1f) pupil %.2f mm sigma %.0f brightness %.2f open %.1f (pupil %.0f%% "
+               "visible): error %.3f px\n",
+               i, (double)s.yaw_deg, (double)s.pitch_deg, (double)s.pupil_mm, (double)p.noise_sigma,
+               (double)p.brightness, (double)s.open, 100.0 * gt.pupil_visible, (double)e.pupil_err);
+        assert_true(e.found);
+        /* stated bounds per frame: 3 px with the whole pupil in view, 8 px when the lid covers
+         * part of it (with sigma 14 and dim light the lid's shadow merges with the pupil) */
+        assert_true(e.pupil_err < (gt.pupil_visible >= 0.99f ? 3.0f : 8.0f));
+    }
+    const float med = median(err, N);
+    printf("[ eyetrack ] noisy frames: median pupil error %.3f px (bound 1.0)\n", (double)med);
+    assert_true(med < 1.0f);
+    fv_eye_destroy(t);
+    free(img);
+}
+
+/* Pupils partly under the upper lid, low noise: the lid's edge must not flatten the fit.
+ * Stated bound: 6 px with at least 75% of the pupil in view (measured 1.2-5.6 px: the weakest
+ * part of the tracker); below that (55-69% in view: 2.5-11 px) printed, not bounded. */
+static void test_partial_occlusion(void **state)
+{
+    (void)state;
+    static const fv_synth_state cases[] = {
+        { 10.1f, 6.2f, 2.25f, 0.5f }, { -5.6f, 5.8f, 2.06f, 0.5f }, { 4.5f, 7.4f, 1.93f, 0.5f },
+        { -10.0f, 10.0f, 2.4f, 0.55f }, { 5.0f, 12.0f, 2.2f, 0.6f }, { -12.0f, 8.0f, 2.8f, 0.5f },
+        { 0.0f, 8.0f, 2.5f, 0.45f }, { 0.0f, 3.0f, 2.5f, 0.35f },
+    };
+    fv_synth_params p;
+    fv_synth_default_params(&p, W, H);
+    p.supersample = 2;
+    p.noise_sigma = 3.0f;
+    uint8_t *img = malloc(W * H);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        fv_synth_truth gt;
+        fv_synth_truth_of(&p, &cases[i], &gt);
+        const frame_eval e = eval_frame(t, &p, &cases[i], 500u + (uint64_t)i, 0, img);
+        printf("[ eyetrack ] lid over the pupil: %.0f%% visible: error %.2f px%s\n", 100.0 * gt.pupil_visible,
+               (double)e.pupil_err, gt.pupil_visible >= 0.75f ? " (bound 6)" : "");
+        assert_true(e.found);
+        if (gt.pupil_visible >= 0.75f)
+            assert_true(e.pupil_err < 6.0f);
+    }
+    fv_eye_destroy(t);
+    free(img);
+}
+
+static void test_blinks(void **state)
+{
+    (void)state;
+    fv_synth_params p;
+    fv_synth_default_params(&p, W, H);
+    p.supersample = 1;
+    uint8_t *img = malloc(W * H);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    /* open, closing, closed, opening, open */
+    static const float open[] = { 1, 1, 1, 1, 0.3f, 0.0f, 0.0f, 0.0f, 0.3f, 1, 1 };
+    const int n = (int)(sizeof open / sizeof open[0]);
+    for (int i = 0; i < n; i++) {
+        const fv_synth_state s = { 5.0f, -3.0f, 2.2f, open[i] };
+        const frame_eval e = eval_frame(t, &p, &s, 200u + (uint64_t)i, 1, img);
+        printf("[ eyetrack ] blink sequence %d: open %.1f -> status %d error %.2f\n", i, (double)open[i], e.status,
+               (double)e.pupil_err);
+        if (open[i] == 0.0f)
+            assert_int_not_equal(e.status, FV_EYE_OK); /* flagged as blink / lost */
+        if (open[i] == 1.0f) {
+            assert_int_equal(e.status, FV_EYE_OK);
+            assert_true(e.pupil_err < 1.0f);
+        }
+    }
+    /* without history a closed eye still gives no confident pupil */
+    fv_eye_reset(t);
+    const fv_synth_state closed = { 0, 0, 2.2f, 0.0f };
+    fv_synth_truth gt;
+    fv_synth_render(&p, &closed, 7, img, W, &gt);
+    fv_eye_result r;
+    assert_int_equal(fv_track_image(t, img, W, H, W, &r), 0);
+    printf("[ eyetrack ] closed eye, no history: found %d confidence %.2f\n", r.found, (double)r.confidence);
+    fv_eye_destroy(t);
+    free(img);
+}
+
+static void test_bad_args(void **state)
+{
+    (void)state;
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    uint8_t img[64 * 64];
+    memset(img, 128, sizeof img);
+    fv_eye_result r;
+    assert_int_equal(fv_track_frame(t, NULL, 64, 64, 64, &r), -1);
+    assert_int_equal(fv_track_frame(t, img, 4, 64, 64, &r), -1);
+    assert_int_equal(fv_track_frame(t, img, 64, 64, 32, &r), -1);
+    /* a flat grey image: no pupil */
+    assert_int_equal(fv_track_frame(t, img, 64, 64, 64, &r), 0);
+    assert_int_equal(r.found, 0);
+    assert_true(r.confidence == 0.0f);
+    fv_eye_destroy(t);
+    fv_eye_destroy(NULL);
+}
+
+/* Odd sizes, strides, unaligned rows and degenerate content: no crash, no read outside the
+ * rows given (the buffer is exact-size: ASan would see it), results inside the image. */
+static void test_robustness(void **state)
+{
+    (void)state;
+    rng = 0x4444ull; /* each test its own draws, whatever runs before it */
+    static const int sz[][2] = { { 8, 8 }, { 8, 300 }, { 300, 8 }, { 17, 13 }, { 161, 99 }, { 97, 161 }, { 640, 480 } };
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    for (size_t k = 0; k < sizeof sz / sizeof sz[0]; k++) {
+        const int w = sz[k][0], h = sz[k][1];
+        const ptrdiff_t stride = w + 3;
+        for (int content = 0; content < 5; content++) {
+            const size_t bytes = (size_t)stride * (size_t)(h - 1) + (size_t)w + 1;
+            uint8_t *buf = malloc(bytes), *img = buf + 1; /* odd address, exact size */
+            assert_non_null(buf);
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < stride && (size_t)(y * stride + x) < bytes - 1; x++) {
+                    const uint64_t r = fv_test_rand(&rng);
+                    img[y * stride + x] = content == 0 ? 0 : content == 1 ? 255 : content == 2 ? (uint8_t)r
+                                          : content == 3 ? (uint8_t)(x + y) : ((x / 3 + y / 3) & 1 ? 255 : 0);
+                }
+            fv_eye_result r;
+            for (int mode = 0; mode < 2; mode++) {
+                assert_int_equal((mode ? fv_track_frame : fv_track_image)(t, img, w, h, stride, &r), 0);
+                assert_true(r.confidence >= 0.0f && r.confidence <= 1.0f);
+                assert_true(r.n_glints >= 0 && r.n_glints <= FV_EYE_MAX_GLINTS);
+                if (r.found)
+                    assert_true(r.pupil_x >= 0 && r.pupil_x <= w && r.pupil_y >= 0 && r.pupil_y <= h);
+                if (content < 2) /* flat: nothing to find */
+                    assert_int_equal(r.found, 0);
+            }
+            free(buf);
+        }
+    }
+    fv_eye_destroy(t);
+}
+
+/* ------------------------------------------------------------------ calibration */
+
+static void poly(const double a[6], double u, double v, double *out)
+{
+    *out = a[0] + a[1] * u + a[2] * v + a[3] * u * v + a[4] * u * u + a[5] * v * v;
+}
+
+static void test_calib_recovers_polynomial(void **state)
+{
+    (void)state;
+    rng = 0x5555ull; /* each test its own draws, whatever runs before it */
+    /* a known mapping from the input (pixels) to gaze (deg), in the normalised terms */
+    const double A[6] = { 1.5, 18.0, -0.7, 0.9, -1.2, 0.4 }, B[6] = { -2.0, 0.5, -12.0, 0.3, 0.8, -1.1 };
+    enum { N = 27 };
+    float ix[N], iy[N], yaw[N], pitch[N];
+    for (int i = 0; i < N; i++) { /* 3x3 grid, 3 jittered samples per point */
+        ix[i] = 100.0f + 12.0f * (float)(i % 3 - 1) + (rnd() - 0.5f);
+        iy[i] = 80.0f + 9.0f * (float)((i / 3) % 3 - 1) + (rnd() - 0.5f);
+    }
+    fv_calib c;
+    /* the fit's normalisation is computed from the inputs: evaluate the truth with the same */
+    double mx = 0, my = 0, s = 0;
+    for (int i = 0; i < N; i++)
+        mx += ix[i], my += iy[i];
+    mx /= N, my /= N;
+    for (int i = 0; i < N; i++)
+        s = fmax(s, fmax(fabs(ix[i] - mx), fabs(iy[i] - my)));
+    for (int i = 0; i < N; i++) {
+        double g;
+        poly(A, (ix[i] - mx) / s, (iy[i] - my) / s, &g);
+        yaw[i] = (float)g;
+        poly(B, (ix[i] - mx) / s, (iy[i] - my) / s, &g);
+        pitch[i] = (float)g;
+    }
+    float res[N];
+    assert_int_equal(fv_calib_fit(&c, FV_CALIB_PUPIL_GLINT, ix, iy, yaw, pitch, N, res), 0);
+    for (int k = 0; k < 6; k++) {
+        if (fabs(c.a[k] - A[k]) > 1e-3 || fabs(c.b[k] - B[k]) > 1e-3)
+            fail_msg("coefficient %d: got %g %g, want %g %g", k, c.a[k], c.b[k], A[k], B[k]);
+    }
+    printf("[ eyetrack ] calibration on an exact polynomial: rms %.2e deg, max %.2e deg\n", c.rms_deg, c.max_deg);
+    assert_true(c.rms_deg < 1e-3);
+    /* one gross outlier (a blink frame's junk) is dropped and the mapping still recovered */
+    yaw[5] += 20.0f;
+    assert_int_equal(fv_calib_fit(&c, FV_CALIB_PUPIL_GLINT, ix, iy, yaw, pitch, N, res), 0);
+    assert_int_equal(c.n_used, N - 1);
+    assert_true(res[5] > 10.0f);
+    for (int k = 0; k < 6; k++)
+        assert_true(fabs(c.a[k] - A[k]) < 1e-3 && fabs(c.b[k] - B[k]) < 1e-3);
+    /* degenerate: all inputs on a line cannot determine 6 coefficients */
+    for (int i = 0; i < N; i++)
+        iy[i] = ix[i];
+    assert_int_equal(fv_calib_fit(&c, FV_CALIB_PUPIL, ix, iy, yaw, pitch, N, NULL), -1);
+    assert_int_equal(fv_calib_fit(&c, FV_CALIB_PUPIL, ix, iy, yaw, pitch, 5, NULL), -1);
+    /* angles: 90 degrees between straight ahead and yaw 90; small angles accurate */
+    assert_true(fabs(fv_gaze_angle_deg(0, 0, 90, 0) - 90) < 1e-9);
+    assert_true(fabs(fv_gaze_angle_deg(10, 0, 10, 0.001) - 0.001) < 1e-9);
+    float ty[9], tp[9];
+    fv_calib_targets_3x3(15, 10, ty, tp);
+    assert_true(ty[0] == -15 && tp[0] == 10 && ty[4] == 0 && tp[4] == 0 && ty[8] == 15 && tp[8] == -10);
+}
+
+static void test_calib_file(void **state)
+{
+    (void)state;
+    fv_calib c = { 0 }, d;
+    c.input = FV_CALIB_PUPIL;
+    c.u0 = 1.25, c.v0 = -3.5, c.s = 7.0;
+    for (int k = 0; k < 6; k++)
+        c.a[k] = 0.1 * k - 0.3, c.b[k] = 1.0 / (k + 3);
+    c.rms_deg = 0.25, c.max_deg = 0.5, c.n_used = 9;
+    char path[] = "/tmp/fovea_calib_XXXXXX";
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    char err[256];
+    assert_int_equal(fv_calib_save(&c, path, err, sizeof err), 0);
+    assert_int_equal(fv_calib_load(&d, path, err, sizeof err), 0);
+    assert_int_equal(d.input, c.input);
+    assert_memory_equal(d.a, c.a, sizeof c.a); /* %.17g round-trips exactly */
+    assert_memory_equal(d.b, c.b, sizeof c.b);
+    assert_true(d.u0 == c.u0 && d.v0 == c.v0 && d.s == c.s && d.n_used == 9);
+    static const struct { const char *text, *want; } bad[] = {
+        { "", "missing 'fovea-calibration 1'" },
+        { "fovea-calibration 2\n", "line 1: expected 'fovea-calibration 1'" },
+        { "fovea-calibration 1\ninput eye\n", "line 2: input must be" },
+        { "fovea-calibration 1\ninput pupil\nnorm 1 2 0\n", "line 3: norm needs" },
+        { "fovea-calibration 1\ninput pupil\nnorm 1 2 3\nyaw_deg 1 2 3 4 5\n", "line 4: yaw_deg needs 6 numbers" },
+        { "fovea-calibration 1\ninput pupil\nnorm 1 2 3\nyaw_deg 1 2 3 4 5 6\n", "missing pitch_deg" },
+        { "fovea-calibration 1\nbogus 1\n", "line 2: unknown key 'bogus'" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        assert_int_equal(fv_calib_parse(&d, bad[i].text, err, sizeof err), -1);
+        if (!strstr(err, bad[i].want))
+            fail_msg("parse error '%s' lacks '%s'", err, bad[i].want);
+    }
+    FILE *f = fopen(path, "w");
+    fputs("fovea-calibration 1\ninput pupil\nnorm x\n", f);
+    fclose(f);
+    assert_int_equal(fv_calib_load(&d, path, err, sizeof err), -1);
+    assert_non_null(strstr(err, path));
+    assert_non_null(strstr(err, "line 3"));
+    unlink(path);
+    assert_int_equal(fv_calib_load(&d, path, err, sizeof err), -1);
+    assert_non_null(strstr(err, "No such file"));
+}
+
+/* ------------------------------------------------------------------ end to end */
+
+static void test_end_to_end(void **state)
+{
+    (void)state;
+    rng = 0x6666ull; /* each test its own draws, whatever runs before it */
+    fv_synth_params p;
+    fv_synth_default_params(&p, W, H);
+    p.supersample = 2;
+    p.noise_sigma = 3.0f;
+    uint8_t *img = malloc(W * H);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    /* calibration: the 3x3 targets, 2 frames each, pupil size drifting */
+    enum { PER = 2, NC = 9 * PER, NT = 12 };
+    float ty[9], tp[9], gx[NC], gy[NC], px[NC], py[NC], yaw[NC], pitch[NC];
+    fv_calib_targets_3x3(18.0f, 12.0f, ty, tp);
+    int ng = 0, np = 0;
+    float gyaw[NC], gpitch[NC];
+    for (int i = 0; i < NC; i++) {
+        const fv_synth_state s = { ty[i / PER], tp[i / PER], 2.0f + 0.3f * sinf((float)i), 1.0f };
+        fv_synth_truth gt;
+        fv_synth_render(&p, &s, 300u + (uint64_t)i, img, W, &gt);
+        fv_eye_result r;
+        assert_int_equal(fv_track_image(t, img, W, H, W, &r), 0);
+        assert_true(r.found);
+        px[np] = r.pupil_x, py[np] = r.pupil_y, yaw[np] = s.yaw_deg, pitch[np] = s.pitch_deg, np++;
+        if (r.has_pg)
+            gx[ng] = r.pg_x, gy[ng] = r.pg_y, gyaw[ng] = s.yaw_deg, gpitch[ng] = s.pitch_deg, ng++;
+    }
+    fv_calib cg, cp;
+    assert_true(ng >= 12);
+    assert_int_equal(fv_calib_fit(&cg, FV_CALIB_PUPIL_GLINT, gx, gy, gyaw, gpitch, ng, NULL), 0);
+    assert_int_equal(fv_calib_fit(&cp, FV_CALIB_PUPIL, px, py, yaw, pitch, np, NULL), 0);
+    printf("[ eyetrack ] calibration residuals: pupil-glint rms %.3f max %.3f deg (%d samples); pupil only rms %.3f max %.3f deg\n",
+           cg.rms_deg, cg.max_deg, ng, cp.rms_deg, cp.max_deg);
+    /* test gazes inside the calibrated range, different pupil sizes and noise */
+    float eg[NT], ep[NT];
+    int ne = 0;
+    for (int i = 0; i < NT; i++) {
+        const fv_synth_state s = { -16.0f + 32.0f * rnd(), -10.0f + 20.0f * rnd(), 1.8f + 0.8f * rnd(), 1.0f };
+        fv_synth_truth gt;
+        fv_synth_render(&p, &s, 400u + (uint64_t)i, img, W, &gt);
+        fv_eye_result r;
+        assert_int_equal(fv_track_image(t, img, W, H, W, &r), 0);
+        assert_true(r.found);
+        float a, b;
+        fv_calib_apply(&cp, r.pupil_x, r.pupil_y, &a, &b);
+        ep[i] = (float)fv_gaze_angle_deg(a, b, s.yaw_deg, s.pitch_deg);
+        if (r.has_pg) {
+            fv_calib_apply(&cg, r.pg_x, r.pg_y, &a, &b);
+            eg[ne++] = (float)fv_gaze_angle_deg(a, b, s.yaw_deg, s.pitch_deg);
+        }
+    }
+    float mg = 0, xg = 0, mp = 0, xp = 0;
+    for (int i = 0; i < ne; i++)
+        mg += eg[i] / ne, xg = fmaxf(xg, eg[i]);
+    for (int i = 0; i < NT; i++)
+        mp += ep[i] / NT, xp = fmaxf(xp, ep[i]);
+    printf("[ eyetrack ] end to end gaze error: pupil-glint mean %.3f max %.3f deg (%d frames); pupil only mean %.3f max %.3f deg\n",
+           (double)mg, (double)xg, ne, (double)mp, (double)xp);
+    assert_true(ne >= NT - 2);
+    assert_true(mg < 1.0f && xg < 2.0f);
+    assert_true(mp < 1.0f && xp < 2.0f);
+    fv_eye_destroy(t);
+    free(img);
+}
+
+/* ------------------------------------------------------------------ gaze filter */
+
+static void test_gaze_filter(void **state)
+{
+    (void)state;
+    rng = 0x7777ull; /* each test its own draws, whatever runs before it */
+    fv_gaze_filter f;
+    fv_gaze_filter_init(&f, NULL);
+    fv_gaze_out o;
+    const double dt = 1000.0 / 120.0;
+    double t = 0;
+    /* fixation at (5, -2) with 0.2 deg rms jitter per axis: the output jitters much less */
+    double si = 0, so = 0;
+    int n = 0;
+    for (int i = 0; i < 120; i++, t += dt) {
+        const float jx = 0.2f * (rnd() - 0.5f) * 3.46f, jy = 0.2f * (rnd() - 0.5f) * 3.46f;
+        fv_gaze_filter_update(&f, t, 1, 5.0f + jx, -2.0f + jy, 0.9f, &o);
+        if (i >= 60) {
+            assert_int_equal(o.state, FV_GAZE_FIXATION);
+            si += (double)jx * jx + (double)jy * jy;
+            so += (o.yaw_deg - 5.0) * (o.yaw_deg - 5.0) + (o.pitch_deg + 2.0) * (o.pitch_deg + 2.0);
+            n++;
+        }
+    }
+    printf("[ eyetrack ] 1-euro in fixation: rms jitter %.3f -> %.3f deg\n", sqrt(si / n), sqrt(so / n));
+    assert_true(sqrt(so / n) < 0.5 * sqrt(si / n));
+    /* saccade of 15 deg over 5 samples (~360 deg/s): followed without lag */
+    for (int i = 1; i <= 5; i++, t += dt) {
+        fv_gaze_filter_update(&f, t, 1, 5.0f + 3.0f * i, -2.0f, 0.9f, &o);
+        assert_int_equal(o.state, FV_GAZE_SACCADE);
+        assert_true(fabsf(o.yaw_deg - (5.0f + 3.0f * i)) < 1e-4f);
+    }
+    /* a single wild sample (40 deg away in one frame: 4800 deg/s) is rejected */
+    fv_gaze_filter_update(&f, t, 1, 20.0f, -2.0f, 0.9f, &o), t += dt;
+    fv_gaze_filter_update(&f, t, 1, -20.0f, 20.0f, 0.9f, &o), t += dt;
+    assert_true(fabsf(o.yaw_deg - 20.0f) < 0.5f && fabsf(o.pitch_deg + 2.0f) < 0.5f);
+    fv_gaze_filter_update(&f, t, 1, 20.0f, -2.0f, 0.9f, &o), t += dt;
+    assert_true(fabsf(o.yaw_deg - 20.0f) < 0.5f);
+    /* ...but a jump that stays (tracker re-locked, 3 agreeing samples) is accepted */
+    for (int i = 0; i < 3; i++, t += dt)
+        fv_gaze_filter_update(&f, t, 1, -10.0f, 5.0f, 0.9f, &o);
+    assert_true(fabsf(o.yaw_deg + 10.0f) < 1e-4f && fabsf(o.pitch_deg - 5.0f) < 1e-4f);
+    /* blink: hold the last good gaze with falling confidence, then LOST */
+    const float gy = o.yaw_deg, gp = o.pitch_deg;
+    float last_conf = 1.0f;
+    const double t_blink = t;
+    for (; t < t_blink + 400.0; t += dt) {
+        fv_gaze_filter_update(&f, t, 0, 0, 0, 0, &o);
+        assert_true(o.yaw_deg == gy && o.pitch_deg == gp);
+        if (t - t_blink < 290.0) {
+            assert_int_equal(o.state, FV_GAZE_HOLD);
+            assert_true(o.confidence <= last_conf && o.confidence > 0.0f);
+            last_conf = o.confidence;
+        }
+    }
+    assert_int_equal(o.state, FV_GAZE_LOST);
+    assert_true(o.confidence == 0.0f);
+    /* the renderer's fovea scale */
+    assert_true(fv_fovea_radius_scale(1.0f) == 1.0f && fv_fovea_radius_scale(0.8f) == 1.0f);
+    assert_true(fv_fovea_radius_scale(0.0f) == 2.0f && fv_fovea_radius_scale(NAN) == 2.0f);
+    assert_true(fabsf(fv_fovea_radius_scale(0.5f) - 1.5f) < 1e-6f);
+    assert_true(fv_fovea_radius_scale(0.6f) < fv_fovea_radius_scale(0.4f));
+}
+
+/* ------------------------------------------------------------------ the bundled video */
+
+/* assets/eye_synth.y4m (made at build time by tools/gen_eye from the bundled gaze trace) through
+ * the Y4M reader and the tracker with history, against assets/eye_synth.csv. */
+static void test_bundled_video(void **state)
+{
+    (void)state;
+    char err[512];
+    fv_eyesrc *src;
+    if (fv_eyesrc_open_y4m(&src, "assets/eye_synth.y4m", err, sizeof err))
+        fail_msg("%s (run from the repository root after make)", err);
+    FILE *f = fopen("assets/eye_synth.csv", "r");
+    assert_non_null(f);
+    char line[2048];
+    assert_non_null(fgets(line, sizeof line, f)); /* header */
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    float err_px[512];
+    int n_open = 0, vis = 0, matched = 0, closed = 0, closed_flagged = 0, open_ok = 0, frames = 0;
+    fv_eye_frame fr;
+    int rc;
+    while ((rc = fv_eyesrc_next(src, &fr, err, sizeof err)) == 1) {
+        assert_non_null(fgets(line, sizeof line, f));
+        /* frame,t_ms,yaw,pitch,open,blink,pupil_x,pupil_y,pupil_r_px,pupil_visible,n_glints,g0_x,g0_y,... */
+        float v[11], gx[6], gy[6];
+        int gv[6];
+        char *p = line;
+        for (int k = 0; k < 11; k++) {
+            v[k] = strtof(p, &p);
+            assert_true(*p == ',');
+            p++;
+        }
+        for (int k = 0; k < 6; k++) {
+            gv[k] = *p != ',';
+            gx[k] = gv[k] ? strtof(p, &p) : 0;
+            p++;
+            gy[k] = gv[k] ? strtof(p, &p) : 0;
+            if (*p == ',')
+                p++;
+        }
+        fv_eye_result r;
+        assert_int_equal(fv_track_frame(t, fr.luma, fr.w, fr.h, fr.stride, &r), 0);
+        frames++;
+        if (v[9] >= 0.99f) { /* pupil fully visible */
+            open_ok += r.status == FV_EYE_OK;
+            err_px[n_open++] = r.found ? hypotf(r.pupil_x - v[6], r.pupil_y - v[7]) : INFINITY;
+            for (int k = 0; k < 6; k++) {
+                if (!gv[k])
+                    continue;
+                vis++;
+                for (int j = 0; j < r.n_glints; j++)
+                    if (hypotf(r.glints[j].x - gx[k], r.glints[j].y - gy[k]) < 1.0f) {
+                        matched++;
+                        break;
+                    }
+            }
+        }
+        if (v[9] == 0.0f) { /* pupil completely covered */
+            closed++;
+            closed_flagged += r.status != FV_EYE_OK;
+        }
+    }
+    assert_int_equal(rc, 0);
+    fclose(f);
+    float sorted[512];
+    memcpy(sorted, err_px, (size_t)n_open * sizeof *sorted);
+    const float med = median(sorted, n_open), worst = sorted[n_open - 1];
+    printf("[ eyetrack ] bundled video: %d frames; pupil fully visible in %d: median error %.3f px, max %.3f px, "
+           "status OK in %d; glints found %d of %d visible (within 1 px); pupil covered in %d: %d flagged blink/lost\n",
+           frames, n_open, (double)med, (double)worst, open_ok, matched, vis, closed, closed_flagged);
+    assert_true(frames >= 60 && n_open >= 40 && closed >= 2);
+    assert_true(med < 0.5f);
+    assert_true(worst < 2.0f);
+    assert_true(matched * 10 >= vis * 9);
+    assert_int_equal(closed_flagged, closed);
+    assert_true(open_ok * 10 >= n_open * 9);
+    fv_eye_destroy(t);
+    fv_eyesrc_close(src);
+}
+
+/* ------------------------------------------------------------------ real infrared crops */
+
+/* Every 15th labelled MRL image (~300, both sensors) through the list reader and the tracker:
+ * a regression guard on the figures docs/eyetrack.md reports for all 4,485 (79.8% within 5 px,
+ * 54.2% within 3 px there). Skipped when ../shared is not there. */
+static void test_mrl_subset(void **state)
+{
+    (void)state;
+    char rel[1024], dirp[4096], list[4200], line[2048], err[512];
+    snprintf(rel, sizeof rel, "%s/assets/eyes/mrl-dev", fv_test_shared());
+    FILE *in = NULL;
+    if (realpath(rel, dirp)) { /* the subset list lives elsewhere: absolute paths */
+        snprintf(list, sizeof list, "%s/pupil.txt", dirp);
+        in = fopen(list, "r");
+    }
+    if (!in) {
+        printf("[ eyetrack ] %s/pupil.txt not found: MRL subset skipped\n", rel);
+        skip();
+    }
+    char sub[] = "/tmp/fovea_mrl_XXXXXX";
+    const int fd = mkstemp(sub);
+    assert_true(fd >= 0);
+    FILE *out = fdopen(fd, "w");
+    int i = 0;
+    while (fgets(line, sizeof line, in))
+        if (i++ % 15 == 0)
+            fprintf(out, "%s/%s", dirp, line);
+    fclose(in);
+    fclose(out);
+    fv_eyesrc *src;
+    const int orc = fv_eyesrc_open_list(&src, sub, err, sizeof err);
+    unlink(sub); /* read in full by the open */
+    if (orc)
+        fail_msg("%s", err);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    int n = 0, w3 = 0, w5 = 0, found = 0;
+    fv_eye_frame fr;
+    int rc;
+    while ((rc = fv_eyesrc_next(src, &fr, err, sizeof err)) == 1) {
+        fv_eye_result r;
+        assert_true(fr.has_label);
+        assert_int_equal(fv_track_image(t, fr.luma, fr.w, fr.h, fr.stride, &r), 0);
+        const float e = r.found ? hypotf(r.pupil_x - fr.label_x, r.pupil_y - fr.label_y) : INFINITY;
+        n++, found += r.found, w3 += e <= 3.0f, w5 += e <= 5.0f;
+    }
+    if (rc < 0)
+        fail_msg("%s", err);
+    fv_eyesrc_close(src);
+    fv_eye_destroy(t);
+    printf("[ eyetrack ] MRL subset: %d images, found %d, within 3 px %.1f%%, within 5 px %.1f%% (bounds 48%%, 74%%)\n",
+           n, found, 100.0 * w3 / n, 100.0 * w5 / n);
+    assert_true(n >= 250);
+    assert_true(w3 >= 0.48 * n);
+    assert_true(w5 >= 0.74 * n);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ellipse_fit),
+        cmocka_unit_test(test_bad_args),
+        cmocka_unit_test(test_robustness),
+        cmocka_unit_test(test_synthetic_clean),
+        cmocka_unit_test(test_synthetic_noisy),
+        cmocka_unit_test(test_partial_occlusion),
+        cmocka_unit_test(test_blinks),
+        cmocka_unit_test(test_calib_recovers_polynomial),
+        cmocka_unit_test(test_calib_file),
+        cmocka_unit_test(test_end_to_end),
+        cmocka_unit_test(test_gaze_filter),
+        cmocka_unit_test(test_bundled_video),
+        cmocka_unit_test(test_mrl_subset),
+    };
+    return cmocka_run_group_tests_name("eyetrack", tests, NULL, NULL);
+}

@@ -1,0 +1,227 @@
+/* fovea: checkasm-style tests of the eye tracker's kernels (fv_dsp et_*): every ISA version this
+ * machine runs against the plain-C reference, on random and edge inputs (all 0, all 255,
+ * thresholds 0, 1, 255, 256), odd sizes, unaligned rows, with canaries around every output.
+ * Integer kernels: the bound is exact equality. The references themselves are checked against
+ * the formulas on hand-computed cases. Deterministic (fixed-seed splitmix64). */
+#include <stdio.h>
+#include <string.h>
+
+#include "testutil.h"
+
+#include "dsp.h"
+
+#define CANARY 32
+static const uint8_t canary8 = 0xa5;
+static const uint32_t canary32 = 0xdeadbeefu;
+
+static const int sizes[] = { 1, 2, 3, 7, 8, 9, 15, 16, 17, 31, 32, 33, 47, 63, 64, 65, 95, 127, 160, 319, 320, 641 };
+#define NSIZES ((int)(sizeof sizes / sizeof sizes[0]))
+
+static const unsigned isa_list[] = {
+#if defined(__x86_64__)
+    FV_ISA_SSE41, FV_ISA_AVX2,
+#elif defined(__aarch64__)
+    FV_ISA_NEON,
+#endif
+    0
+};
+
+static uint64_t rng = 0xe7e5eedull;
+
+enum { M_RANDOM, M_ZERO, M_FULL, M_EXTREME, M_COUNT };
+
+static void fill8(uint8_t *p, int n, int mode)
+{
+    for (int i = 0; i < n; i++) {
+        const uint64_t r = fv_test_rand(&rng);
+        p[i] = mode == M_ZERO ? 0 : mode == M_FULL ? 255 : mode == M_EXTREME ? ((r & 1) ? 255 : 0) : (uint8_t)r;
+    }
+}
+
+/* exact-size input at an offset into its allocation (unaligned rows; ASan sees over-reads) */
+static uint8_t *in8(int n, int off, uint8_t **base)
+{
+    *base = malloc((size_t)n + (size_t)off);
+    assert_non_null(*base);
+    return *base + off;
+}
+
+static uint8_t *out8(int n, int off, uint8_t **base)
+{
+    *base = malloc((size_t)n + (size_t)off + 2 * CANARY);
+    assert_non_null(*base);
+    memset(*base, canary8, (size_t)n + (size_t)off + 2 * CANARY);
+    return *base + off + CANARY;
+}
+
+static void canaries8(const uint8_t *p, int n, const char *isa, const char *k)
+{
+    for (int i = 1; i <= CANARY; i++)
+        if (p[-i] != canary8 || p[n + i - 1] != canary8)
+            fail_msg("%s %s n=%d: wrote outside its output (canary %d)", isa, k, n, i);
+}
+
+typedef void (*runner)(const fv_dsp *d, const char *isa, int n, int off, int mode);
+
+static void run_down2(const fv_dsp *d, const char *isa, int n, int off, int mode)
+{
+    uint8_t *ba, *bb, *br, *bt;
+    uint8_t *a = in8(2 * n, off, &ba), *b = in8(2 * n, off, &bb);
+    fill8(a, 2 * n, mode);
+    fill8(b, 2 * n, mode);
+    uint8_t *r = out8(n, off, &br), *t = out8(n, off, &bt);
+    fv_et_down2_row_c(r, a, b, n);
+    d->et_down2_row(t, a, b, n);
+    canaries8(t, n, isa, "et_down2_row");
+    for (int i = 0; i < n; i++) {
+        /* the reference against the formula too */
+        const int want = (a[2 * i] + a[2 * i + 1] + b[2 * i] + b[2 * i + 1] + 2) >> 2;
+        assert_int_equal(r[i], want);
+        if (t[i] != r[i])
+            fail_msg("%s et_down2_row n=%d off=%d mode=%d: pixel %d: c=%d %s=%d", isa, n, off, mode, i, r[i], isa, t[i]);
+    }
+    free(ba), free(bb), free(br), free(bt);
+}
+
+static void run_integral(const fv_dsp *d, const char *isa, int n, int off, int mode)
+{
+    uint8_t *bs;
+    uint8_t *s = in8(n, off, &bs);
+    fill8(s, n, mode);
+    uint32_t *above = malloc(((size_t)n + 1) * sizeof *above);
+    uint32_t *r = malloc(((size_t)n + 2 * CANARY) * sizeof *r), *t = malloc(((size_t)n + 2 * CANARY + 1) * sizeof *t);
+    assert_non_null(above);
+    assert_non_null(r);
+    assert_non_null(t);
+    for (int i = 0; i < n; i++) /* near the top of the range too: the sums wrap mod 2^32 alike */
+        above[i] = mode == M_EXTREME ? 0xffffff00u + (uint32_t)i : (uint32_t)(fv_test_rand(&rng) >> 40);
+    uint32_t *tp = t + CANARY + (off & 1); /* 4-byte aligned, not 16 */
+    for (int i = 0; i < n + 2 * CANARY; i++)
+        r[i] = canary32;
+    for (int i = 0; i < n + 2 * CANARY + 1; i++)
+        t[i] = canary32;
+    fv_et_integral_row_c(r + CANARY, above, s, n);
+    d->et_integral_row(tp, above, s, n);
+    for (int i = 1; i <= CANARY; i++)
+        if (tp[-i] != canary32 || tp[n + i - 1] != canary32)
+            fail_msg("%s et_integral_row n=%d: wrote outside its output", isa, n);
+    uint32_t run = 0;
+    for (int i = 0; i < n; i++) {
+        run += s[i];
+        assert_int_equal(r[CANARY + i], above[i] + run);
+        if (tp[i] != r[CANARY + i])
+            fail_msg("%s et_integral_row n=%d off=%d mode=%d: %d: c=%u %s=%u", isa, n, off, mode, i, r[CANARY + i], isa,
+                     tp[i]);
+    }
+    free(bs), free(above), free(r), free(t);
+}
+
+static void run_thresh(const fv_dsp *d, const char *isa, int n, int off, int mode)
+{
+    static const int ts[] = { 0, 1, 2, 127, 128, 129, 200, 254, 255, 256, -1 };
+    uint8_t *bs, *br, *bt;
+    uint8_t *s = in8(n, off, &bs);
+    fill8(s, n, mode);
+    uint8_t *r = out8(n, off, &br), *t = out8(n, off, &bt);
+    for (int k = 0; k < (int)(sizeof ts / sizeof ts[0]); k++) {
+        const int th = ts[k] < 0 ? (int)(fv_test_rand(&rng) % 257) : ts[k];
+        const int cr = fv_et_thresh_row_c(r, s, n, th), ct = d->et_thresh_row(t, s, n, th);
+        canaries8(t, n, isa, "et_thresh_row");
+        int want = 0;
+        for (int i = 0; i < n; i++) {
+            assert_int_equal(r[i], s[i] >= th ? 255 : 0);
+            want += s[i] >= th;
+            if (t[i] != r[i])
+                fail_msg("%s et_thresh_row n=%d t=%d: pixel %d (%d): c=%d %s=%d", isa, n, th, i, s[i], r[i], isa, t[i]);
+        }
+        assert_int_equal(cr, want);
+        if (ct != cr)
+            fail_msg("%s et_thresh_row n=%d t=%d: count c=%d %s=%d", isa, n, th, cr, isa, ct);
+    }
+    free(bs), free(br), free(bt);
+}
+
+static void run_all(const char *kernel, runner fn, size_t member)
+{
+    int tested = 0;
+    fv_dsp ref;
+    fv_dsp_init(&ref, FV_ISA_C);
+    for (int k = 0; isa_list[k]; k++) {
+        const unsigned isa = isa_list[k];
+        if (!(fv_cpu_isas() & isa)) {
+            printf("[ kernels  ] %s: %-7s not on this CPU, skipped\n", kernel, fv_isa_name(isa));
+            continue;
+        }
+        fv_dsp d;
+        fv_dsp_init(&d, isa);
+        void *pr, *pd;
+        memcpy(&pr, (char *)&ref + member, sizeof pr);
+        memcpy(&pd, (char *)&d + member, sizeof pd);
+        if (pr == pd) {
+            printf("[ kernels  ] %s: %-7s has no version of its own, skipped\n", kernel, fv_isa_name(isa));
+            continue;
+        }
+        int runs = 0;
+        for (int si = 0; si < NSIZES; si++)
+            for (int off = 0; off < 3; off++)
+                for (int mode = 0; mode < M_COUNT; mode++, runs++)
+                    fn(&d, fv_isa_name(isa), sizes[si], off, mode);
+        for (int r = 0; r < 100; r++, runs++)
+            fn(&d, fv_isa_name(isa), 1 + (int)(fv_test_rand(&rng) % 400), (int)(fv_test_rand(&rng) % 17), M_RANDOM);
+        printf("[ kernels  ] %s: %-7s == c on %d rows (exact)\n", kernel, fv_isa_name(isa), runs);
+        tested++;
+    }
+    printf("[ kernels  ] %s: %d ISA version(s) tested\n", kernel, tested);
+}
+
+static void test_down2(void **state)
+{
+    (void)state;
+    run_all("et_down2_row", run_down2, offsetof(fv_dsp, et_down2_row));
+}
+static void test_integral(void **state)
+{
+    (void)state;
+    run_all("et_integral_row", run_integral, offsetof(fv_dsp, et_integral_row));
+}
+static void test_thresh(void **state)
+{
+    (void)state;
+    run_all("et_thresh_row", run_thresh, offsetof(fv_dsp, et_thresh_row));
+}
+
+static void test_reference_by_hand(void **state)
+{
+    (void)state;
+    /* (0+1+2+3+2)>>2 = 2, (255*4+2)>>2 = 255, (1+0+0+0+2)>>2 = 0, (1+1+0+0+2)>>2 = 1 */
+    const uint8_t a[8] = { 0, 1, 255, 255, 1, 0, 1, 1 }, b[8] = { 2, 3, 255, 255, 0, 0, 0, 0 };
+    uint8_t o[4];
+    fv_et_down2_row_c(o, a, b, 4);
+    assert_int_equal(o[0], 2);
+    assert_int_equal(o[1], 255);
+    assert_int_equal(o[2], 0);
+    assert_int_equal(o[3], 1);
+    const uint32_t above[4] = { 10, 20, 30, 0xffffffffu };
+    const uint8_t s[4] = { 1, 2, 3, 4 };
+    uint32_t ii[4];
+    fv_et_integral_row_c(ii, above, s, 4);
+    assert_int_equal(ii[0], 11);
+    assert_int_equal(ii[1], 23);
+    assert_int_equal(ii[2], 36);
+    assert_int_equal(ii[3], 9); /* 0xffffffff + 10 wraps */
+    uint8_t m[4];
+    assert_int_equal(fv_et_thresh_row_c(m, s, 4, 3), 2);
+    assert_int_equal(m[0], 0);
+    assert_int_equal(m[2], 255);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reference_by_hand),
+        cmocka_unit_test(test_down2),
+        cmocka_unit_test(test_integral),
+        cmocka_unit_test(test_thresh),
+    };
+    return cmocka_run_group_tests_name("kernels_eyetrack", tests, NULL, NULL);
+}
