@@ -740,7 +740,7 @@ static void drain_to_newest(fv_v4l2 *cam, struct v4l2_buffer *b)
     }
 }
 
-fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, char *err, size_t err_len)
+fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, char *err, size_t err_len)
 {
     int64_t deadline = mono_ns() + (int64_t)(timeout_ms > 0 ? timeout_ms : 0) * 1000000;
     if (cam->held >= 0) { /* the zero-copy frame lent by the previous call goes back */

@@ -5,7 +5,7 @@
  *   fv_v4l2 cam;
  *   if (fv_v4l2_open(&cam, &cfg, err, sizeof err)) ...                  // one-line reason in err
  *   for (;;) {
- *       fv_eye_frame f;
+ *       fv_v4l2_frame f;
  *       switch (fv_v4l2_next(&cam, 5, &f, err, sizeof err)) {           // waits at most 5 ms
  *       case FV_V4L2_FRAME:   track(f.luma, f.width, f.height, f.stride, f.t_ns); break;
  *       case FV_V4L2_TIMEOUT: break;                                    // no new frame yet
@@ -75,7 +75,7 @@ int fv_v4l2_config_formats(fv_v4l2_config *cfg, const char *list, char *err, siz
 int fv_v4l2_config_ctrl(fv_v4l2_config *cfg, const char *name_eq_value, char *err, size_t err_len);
 
 /* One camera frame reduced to 8-bit luma. */
-typedef struct fv_eye_frame {
+typedef struct fv_v4l2_frame {
     const uint8_t *luma;   /* width x height, rows stride bytes apart; valid until the next
                             * fv_v4l2_next or fv_v4l2_close on the same camera */
     int width, height;
@@ -85,7 +85,7 @@ typedef struct fv_eye_frame {
     int t_from_driver;     /* 1: the driver's buffer timestamp; 0: taken at dequeue (the driver's
                             * timestamps are not monotonic, or it gave none) */
     uint32_t fourcc;       /* the pixel format the luma was reduced from */
-} fv_eye_frame;
+} fv_v4l2_frame;
 
 typedef enum {
     FV_V4L2_ERROR = -1,    /* err says what failed; the camera stays open (call close) */
@@ -139,7 +139,7 @@ int fv_v4l2_open(fv_v4l2 *cam, const fv_v4l2_config *cfg, char *err, size_t err_
 /* Waits at most timeout_ms (0 = just look; negative counts as 0) for the next frame. While the
  * device is gone it tries to reopen it on the fv_v4l2_backoff_ns schedule, sleeping only within
  * timeout_ms, and returns FV_V4L2_GONE with the last reopen failure in err. */
-fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_eye_frame *out, char *err, size_t err_len);
+fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, char *err, size_t err_len);
 
 /* Stops streaming, unmaps and closes. Safe after a failed fv_v4l2_open and when called twice (not
  * on a camera never passed to fv_v4l2_open). The struct must not be copied while open. */

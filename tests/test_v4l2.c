@@ -167,7 +167,7 @@ static void expect_open_fails(const char *path, const char *call)
     assert_int_equal(cam.fd, -1);
     assert_false(cam.gone);
     /* A failed camera answers next() with an error, and closes twice without harm. */
-    fv_eye_frame f;
+    fv_v4l2_frame f;
     char err2[256] = "";
     assert_int_equal(fv_v4l2_next(&cam, 0, &f, err2, sizeof err2), FV_V4L2_ERROR);
     assert_contains(err2, "not open");
@@ -234,7 +234,7 @@ static void test_wait_for_device(void **st)
     char err[512] = "";
     assert_int_equal(fv_v4l2_open(&cam, &cfg, err, sizeof err), 0);
     assert_true(cam.gone);
-    fv_eye_frame f;
+    fv_v4l2_frame f;
     /* timeout 0 never sleeps, though the next attempt is 50+ ms away (best of 3: a loaded
      * machine may deschedule us once) */
     int64_t best = INT64_MAX;
@@ -680,7 +680,7 @@ static int fake_queued(const fake *f)
     return n;
 }
 
-static void assert_frame(const fv_eye_frame *fr, uint32_t seq, int w, int h)
+static void assert_frame(const fv_v4l2_frame *fr, uint32_t seq, int w, int h)
 {
     assert_int_equal(fr->width, w);
     assert_int_equal(fr->height, h);
@@ -726,7 +726,7 @@ static void test_fake_yuyv_stream(void **st)
     assert_contains(d, "120.00 fps");
     assert_contains(d, "driver monotonic");
 
-    fv_eye_frame fr;
+    fv_v4l2_frame fr;
     for (uint32_t seq = 0; seq < 3; seq++) {
         f.ready = 1;
         f.stamp_ns = now_ns() - 2000000;
@@ -783,7 +783,7 @@ static void test_fake_grey_zero_copy(void **st)
     if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
         fail_msg("%s", err);
     assert_false(cam.timestamps_monotonic);
-    fv_eye_frame fr;
+    fv_v4l2_frame fr;
     f.ready = 1;
     f.stamp_ns = 12345; /* garbage: must not be used */
     int64_t t0 = now_ns();
@@ -817,7 +817,7 @@ static void test_fake_unplug_reopen(void **st)
     fv_v4l2 cam;
     if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
         fail_msg("%s", err);
-    fv_eye_frame fr;
+    fv_v4l2_frame fr;
     f.ready = 1;
     f.stamp_ns = now_ns() - 1000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
@@ -882,7 +882,7 @@ static void test_fake_latest_and_copy(void **st)
     fv_v4l2 cam;
     if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
         fail_msg("%s", err);
-    fv_eye_frame fr;
+    fv_v4l2_frame fr;
     /* three frames waiting: the newest is returned, the two older handed back */
     f.ready = 3;
     f.stamp_ns = now_ns() - 1000000;
@@ -1121,7 +1121,7 @@ static void test_fake_mjpeg_stream(void **st)
     if (fv_v4l2_open(&cam, &cfg, err, sizeof err))
         fail_msg("%s", err);
     assert_int_equal(cam.fourcc, FV_PIX_MJPEG);
-    fv_eye_frame fr;
+    fv_v4l2_frame fr;
     f.ready = 1;
     f.stamp_ns = now_ns() - 1000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
@@ -1175,7 +1175,7 @@ static void test_real_device(void **st)
     }
     int got = 0;
     for (int i = 0; i < 3; i++) {
-        fv_eye_frame f;
+        fv_v4l2_frame f;
         fv_v4l2_status s = fv_v4l2_next(&cam, 2000, &f, err, sizeof err);
         if (s != FV_V4L2_FRAME)
             break;
