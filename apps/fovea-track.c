@@ -3,6 +3,7 @@
  * with detection rates when the list carries pupil labels. */
 #include <getopt.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,7 +27,10 @@ static void usage(FILE *f)
             "(lines PATH X Y) it prints detection rates within 1, 2, 3 and 5 px and the median error.\n"
             "  --images LIST      image list: lines PATH [X Y], PATH relative to the list's folder\n"
             "  --video FILE       YUV4MPEG2 video (C420*, C422, C444, Cmono; luma is used)\n"
-            "  --device DEV       V4L2 camera (not wired yet)\n"
+            "  --device DEV       V4L2 camera (GREY, Y10/Y12/Y16, YUYV/UYVY or MJPEG; runs until --frames\n"
+            "                     or Ctrl-C, then writes the CSV and the summary)\n"
+            "  --ctrl NAME=VALUE  camera control, e.g. exposure_time_absolute=100 (repeatable)\n"
+            "  --camera-size WxH  camera frame size to ask for (default 640x480)\n"
             "  --out FILE         CSV output (written atomically)\n"
             "  --frames N         stop after N images / frames\n"
             "  --bench N          track each frame N times and report the median time per frame\n"
@@ -35,7 +39,16 @@ static void usage(FILE *f)
             "  --help             this text\n");
 }
 
-enum { OPT_IMAGES = 1, OPT_VIDEO, OPT_DEVICE, OPT_OUT, OPT_FRAMES, OPT_BENCH, OPT_ISA, OPT_QUIET, OPT_HELP };
+enum { OPT_IMAGES = 1, OPT_VIDEO, OPT_DEVICE, OPT_OUT, OPT_FRAMES, OPT_BENCH, OPT_ISA, OPT_QUIET, OPT_CTRL, OPT_CSIZE,
+       OPT_HELP };
+
+/* Ctrl-C ends a live capture cleanly (CSV committed, summary printed). */
+static volatile sig_atomic_t stop_requested;
+static void on_sigint(int sig)
+{
+    (void)sig;
+    stop_requested = 1;
+}
 
 static int64_t now_ns(void)
 {
@@ -113,6 +126,8 @@ int main(int argc, char **argv)
 {
     const char *images = NULL, *video = NULL, *device = NULL, *out_path = NULL;
     long max_frames = -1, bench = 1;
+    fv_v4l2_config cam_cfg;
+    fv_v4l2_config_default(&cam_cfg, NULL);
     unsigned isa_mask = ~0u;
     int quiet = 0;
     static const struct option opts[] = {
@@ -120,6 +135,7 @@ int main(int argc, char **argv)
         {"device", required_argument, 0, OPT_DEVICE}, {"out", required_argument, 0, OPT_OUT},
         {"frames", required_argument, 0, OPT_FRAMES}, {"bench", required_argument, 0, OPT_BENCH},
         {"isa", required_argument, 0, OPT_ISA}, {"quiet", no_argument, 0, OPT_QUIET},
+        {"ctrl", required_argument, 0, OPT_CTRL}, {"camera-size", required_argument, 0, OPT_CSIZE},
         {"help", no_argument, 0, OPT_HELP}, {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -139,6 +155,13 @@ int main(int argc, char **argv)
             else fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", optarg);
             break;
         case OPT_QUIET: quiet = 1; break;
+        case OPT_CTRL: {
+            char e[256];
+            if (fv_v4l2_config_ctrl(&cam_cfg, optarg, e, sizeof e))
+                fv_usage_error(prog, "--ctrl: %s", e);
+            break;
+        }
+        case OPT_CSIZE: fv_arg_size(prog, "--camera-size", optarg, &cam_cfg.width, &cam_cfg.height); break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         default: fv_bad_option(prog, argv);
         }
@@ -150,13 +173,30 @@ int main(int argc, char **argv)
         fv_usage_error(prog, "one of --images LIST, --video FILE or --device DEV is required");
     if (nsrc > 1)
         fv_usage_error(prog, "give only one of --images, --video and --device");
-    if (device)
-        fv_usage_error(prog, "--device %s: V4L2 capture is not wired yet (use --video or --images)", device);
+    if (!device && (cam_cfg.n_ctrls || cam_cfg.width != 640 || cam_cfg.height != 480))
+        fv_usage_error(prog, "--ctrl and --camera-size only apply to --device");
 
     char err[512];
     fv_eyesrc *src = NULL;
-    if ((images ? fv_eyesrc_open_list(&src, images, err, sizeof err) : fv_eyesrc_open_y4m(&src, video, err, sizeof err)))
+    if (device) {
+        cam_cfg.path = device;
+        /* a live camera: a few seconds without a frame (also while it is being reopened) end the run */
+        if (fv_eyesrc_open_v4l2(&src, &cam_cfg, 5000, &stop_requested, err, sizeof err)) {
+            char list[512];
+            if (fv_v4l2_list(NULL, NULL, list, sizeof list) > 0)
+                fv_usage_error(prog, "%s (capture devices here: %s)", err, list);
+            fv_usage_error(prog, "%s (no V4L2 capture device found here)", err);
+        }
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_sigint;
+        sigemptyset(&sa.sa_mask);
+        sigaction(SIGINT, &sa, NULL);
+        sigaction(SIGTERM, &sa, NULL);
+    } else if ((images ? fv_eyesrc_open_list(&src, images, err, sizeof err)
+                       : fv_eyesrc_open_y4m(&src, video, err, sizeof err))) {
         fv_usage_error(prog, "%s", err);
+    }
     fv_eye_params par;
     fv_eye_default_params(&par);
     par.isa_mask = isa_mask;
@@ -238,7 +278,7 @@ int main(int argc, char **argv)
     if (frames == 0) {
         if (out_path)
             fv_afile_abort(&out);
-        fv_usage_error(prog, "%s: no frames", images ? images : video);
+        fv_usage_error(prog, "%s: no frames", images ? images : video ? video : device);
     }
     if (out_path && fv_afile_commit(&out, err, sizeof err))
         fv_fail(prog, FV_EXIT_FAIL, "%s", err);

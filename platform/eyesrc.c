@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <time.h>
+
 #include <stb/stb_image.h>
 
 #include "err.h"
@@ -20,6 +22,11 @@ typedef struct {
 
 struct fv_eyesrc {
     int is_list;
+    /* camera */
+    fv_v4l2 *cam;
+    int silent_ms;
+    const volatile sig_atomic_t *stop;
+    long frames;
     char path[4096];
     /* y4m */
     FILE *f;
@@ -278,8 +285,67 @@ static int next_list(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
     return 1;
 }
 
+int fv_eyesrc_open_v4l2(fv_eyesrc **out, const fv_v4l2_config *cfg, int silent_ms, const volatile sig_atomic_t *stop,
+                        char *err, size_t err_len)
+{
+    *out = NULL;
+    fv_eyesrc *s = alloc_src(cfg->path ? cfg->path : "");
+    if (!s || !(s->cam = calloc(1, sizeof *s->cam))) {
+        free(s);
+        return fv_err(err, err_len, "out of memory");
+    }
+    if (fv_v4l2_open(s->cam, cfg, err, err_len)) {
+        free(s->cam);
+        free(s);
+        return -1;
+    }
+    s->silent_ms = silent_ms > 0 ? silent_ms : 1;
+    s->stop = stop;
+    *out = s;
+    return 0;
+}
+
+static int64_t mono_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int next_v4l2(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
+{
+    const int64_t since = mono_ns();
+    char why[512] = "";
+    while (!(s->stop && *s->stop)) {
+        fv_v4l2_frame vf;
+        /* short waits, so a stop request is seen within 100 ms */
+        const fv_v4l2_status st = fv_v4l2_next(s->cam, 100, &vf, why, sizeof why);
+        if (st == FV_V4L2_ERROR)
+            return fv_err(err, err_len, "%s", why);
+        if (st == FV_V4L2_FRAME) {
+            memset(f, 0, sizeof *f);
+            f->luma = vf.luma;
+            f->w = vf.width;
+            f->h = vf.height;
+            f->stride = (ptrdiff_t)vf.stride;
+            f->index = s->frames++;
+            f->t_ns = vf.t_ns;
+            return 1;
+        }
+        if (mono_ns() - since > (int64_t)s->silent_ms * 1000000) {
+            if (st == FV_V4L2_GONE)
+                return fv_err(err, err_len, "%s: no frame for %d ms, the device is gone (%s)", s->cam->path,
+                              s->silent_ms, why);
+            return fv_err(err, err_len, "%s: no frame for %d ms", s->cam->path, s->silent_ms);
+        }
+    }
+    return 0;
+}
+
 int fv_eyesrc_next(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
 {
+    if (s->cam)
+        return next_v4l2(s, f, err, err_len);
     return s->is_list ? next_list(s, f, err, err_len) : next_y4m(s, f, err, err_len);
 }
 
@@ -290,6 +356,10 @@ void fv_eyesrc_close(fv_eyesrc *s)
 {
     if (!s)
         return;
+    if (s->cam) {
+        fv_v4l2_close(s->cam);
+        free(s->cam);
+    }
     if (s->f)
         fclose(s->f);
     free(s->frame);

@@ -5,8 +5,11 @@
 #ifndef FOVEA_EYESRC_H
 #define FOVEA_EYESRC_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
+
+#include "v4l2.h"
 
 typedef struct fv_eyesrc fv_eyesrc;
 
@@ -18,12 +21,19 @@ typedef struct fv_eye_frame {
     const char *name;    /* list: the PATH as written in the list; video: NULL */
     int has_label;
     float label_x, label_y;
+    int64_t t_ns;        /* camera: capture time (CLOCK_MONOTONIC); files: 0 */
 } fv_eye_frame;
 
 /* 0 on success; -1 with a reason in err (missing file, not YUV4MPEG2, bad header, unsupported
  * colour space; for lists: a malformed line, no entries). The whole list is parsed here. */
 int fv_eyesrc_open_y4m(fv_eyesrc **s, const char *path, char *err, size_t err_len);
 int fv_eyesrc_open_list(fv_eyesrc **s, const char *path, char *err, size_t err_len);
+/* A live V4L2 camera (platform/v4l2.h; cfg as there). Frames come as they are captured; a
+ * camera that vanishes is reopened with back-off (fv_v4l2_next), and next() fails only when no
+ * frame has come for silent_ms. It ends (returns 0) once *stop is non-zero (a signal handler's
+ * flag; may be NULL). The whole struct is copied. */
+int fv_eyesrc_open_v4l2(fv_eyesrc **s, const fv_v4l2_config *cfg, int silent_ms, const volatile sig_atomic_t *stop,
+                        char *err, size_t err_len);
 /* 1: a frame in *f; 0: end of input; -1: error in err (truncated frame, bad FRAME marker,
  * unreadable image). */
 int fv_eyesrc_next(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len);

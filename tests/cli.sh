@@ -214,7 +214,12 @@ printf 'not a png' >"$T/bad.png"
 printf 'bad.png\n' >"$T/badimg.txt"
 expect_usage "track no source" 'one of --images LIST, --video FILE or --device DEV is required' $K
 expect_usage "track two sources" 'only one of' $K --video $V --images "$T/fields.txt"
-expect_usage "track device" 'V4L2 capture is not wired yet' $K --device /dev/video0
+# --device: the V4L2 path's errors name the call and the device (no camera on these machines)
+expect_usage "track device not v4l2" 'VIDIOC_QUERYCAP on /dev/null: .*not a V4L2 device' $K --device /dev/null --out "$T/k1.csv"
+expect_usage "track device missing" 'open on '"$T"'/video9: No such file' $K --device "$T/video9" --out "$T/k1.csv"
+expect_usage "track device is a file" 'VIDIOC_QUERYCAP on .*bad.png' $K --device "$T/bad.png" --out "$T/k1.csv"
+expect_usage "track bad ctrl" '--ctrl: control .bogus.: expected name=value' $K --device /dev/null --ctrl bogus
+expect_usage "track ctrl without device" '--ctrl and --camera-size only apply to --device' $K --video $V --ctrl gain=3
 expect_usage "track unknown flag" '--bogus: unknown option' $K --video $V --bogus
 expect_usage "track bad bench" '--bench: 0 is out of range' $K --video $V --bench 0
 expect_usage "track missing video" 'nope.y4m: No such file' $K --video "$T/nope.y4m" --out "$T/k1.csv"
