@@ -116,20 +116,7 @@ static void trace_tile(void *ctx, int index, int thread_id)
             py[k] = y0 + ly;
             float d[3];
             fv_camera_ray(cam, (float)px[k] + 0.5f, (float)py[k] + 0.5f, d);
-            rh.ray.org_x[k] = cam->eye_pos[0];
-            rh.ray.org_y[k] = cam->eye_pos[1];
-            rh.ray.org_z[k] = cam->eye_pos[2];
-            rh.ray.dir_x[k] = d[0];
-            rh.ray.dir_y[k] = d[1];
-            rh.ray.dir_z[k] = d[2];
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = INFINITY;
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = ~0u;
-            rh.ray.id[k] = (unsigned)k;
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+            fv_ray8_set(&rh, k, cam->eye_pos, d);
             valid[k] = -1;
             if (++k < 8)
                 continue;

@@ -2,6 +2,8 @@
 #ifndef FOVEA_RAYCAST_H
 #define FOVEA_RAYCAST_H
 
+#include <math.h>
+
 #include "camera.h"
 #include "pool.h"
 #include "pullpush.h"
@@ -26,6 +28,26 @@ static inline int fv_raycast_pulled_levels(const fv_pyramid *p)
 {
     return p->levels - 1 < FV_TILE_PULL_LEVELS ? p->levels - 1 : FV_TILE_PULL_LEVELS;
 }
+/* Lane k of an 8-ray packet: a primary ray from org along dir (tnear 0, tfar infinite, all
+ * masks), not hit yet. */
+static inline void fv_ray8_set(struct RTCRayHit8 *rh, int k, const float org[3], const float dir[3])
+{
+    rh->ray.org_x[k] = org[0];
+    rh->ray.org_y[k] = org[1];
+    rh->ray.org_z[k] = org[2];
+    rh->ray.dir_x[k] = dir[0];
+    rh->ray.dir_y[k] = dir[1];
+    rh->ray.dir_z[k] = dir[2];
+    rh->ray.tnear[k] = 0.0f;
+    rh->ray.tfar[k] = INFINITY;
+    rh->ray.time[k] = 0.0f;
+    rh->ray.mask[k] = ~0u;
+    rh->ray.id[k] = (unsigned)k;
+    rh->ray.flags[k] = 0;
+    rh->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+}
+
 typedef struct fv_raycast_opts {
     int phase;                     /* sampling pattern phase (fv_sampler_row) */
     const fv_taa_frame *taa;       /* NULL: no temporal reprojection */

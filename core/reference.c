@@ -113,20 +113,7 @@ static void ref_tile(void *ctx, int index, int thread_id)
                     d[c] -= a * inv_focus;
                 }
             }
-            rh.ray.org_x[k] = o[0];
-            rh.ray.org_y[k] = o[1];
-            rh.ray.org_z[k] = o[2];
-            rh.ray.dir_x[k] = d[0];
-            rh.ray.dir_y[k] = d[1];
-            rh.ray.dir_z[k] = d[2];
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = INFINITY;
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = ~0u;
-            rh.ray.id[k] = (unsigned)k;
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+            fv_ray8_set(&rh, k, o, d);
             valid[k] = -1;
             lane_px[k] = p;
             lane_s[k] = s;

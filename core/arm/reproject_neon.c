@@ -68,7 +68,7 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 /* The fill, four pixels at a time (vld4 / vst4 de-interleave r, g, b, depth): each lane does the
  * reference's operations (taa_fill_px). */
 static inline void taa_fill_row_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                              int x0, int y, int n)
+                                     int x0, int y, int n)
 {
     const float *hw, *hrow;
     float B[3];

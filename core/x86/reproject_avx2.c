@@ -72,7 +72,7 @@ static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_m
 
 /* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). */
 static inline void taa_fill_row_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                              int x0, int y, int n)
+                                     int x0, int y, int n)
 {
     const float *hw, *hrow;
     float B[3];
