@@ -195,15 +195,14 @@ void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, f
     taa_blend_c(f, t, rgbd, wgt, stride, x0, y0, w, h, flow);
 }
 
-static inline void fill_row_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                              int x0, int y, int n)
+/* no vector body: the scalar form does every pixel */
+static inline int no_vec(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                         const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
 {
-    const float *hw, *hrow;
-    float B[3];
-    if ((hrow = taa_fill_setup(f, t, y, &hw, B)))
-        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, (float)y + 0.5f, 0, n);
+    (void)f, (void)t, (void)rgbd, (void)wgt, (void)hrow, (void)hw, (void)B, (void)x0, (void)py, (void)ihi;
+    return ilo;
 }
-TAA_FILL_BLOCK(fill_c, fill_row_c)
+TAA_FILL_BLOCK(fill_c, no_vec)
 
 void fv_taa_fill_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                    ptrdiff_t stride, int x0, int y0, int w, int h)

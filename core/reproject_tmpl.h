@@ -162,15 +162,6 @@ static inline void taa_fill_span(const struct fv_taa_frame *f, const struct fv_t
     *ihi = hi < lo ? lo : hi;
 }
 
-/* The block form of a fill row function (each ISA's vector row, the reference's scalar one). */
-#define TAA_FILL_BLOCK(name, row)                                                                         \
-    static void name(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,  \
-                     ptrdiff_t stride, int x0, int y0, int w, int h)                                     \
-    {                                                                                                     \
-        for (int r = 0; r < h; r++)                                                                       \
-            row(f, t, rgbd + 4 * r * stride, wgt + r * stride, x0, y0 + r, w);                             \
-    }
-
 /* Row set-up of the fill: NULL when the history row is outside the previous image. */
 static inline const float *taa_fill_setup(const struct fv_taa_frame *f, const struct fv_taa_tile *t, int y,
                                           const float **hw, float B[3])
@@ -186,3 +177,26 @@ static inline const float *taa_fill_setup(const struct fv_taa_frame *f, const st
     *hw = L->wgt + o;
     return L->rgbd + 4 * o;
 }
+
+/* The fill of a block, defined by each ISA from its vector body
+ *   int vec(f, t, rgbd, wgt, hrow, hw, B, x0, py, ilo, ihi)
+ * which fills pixels ilo, ilo + step, ... of the contiguous span [ilo, ihi) (taa_fill_span) and
+ * returns the first pixel it did not do; the scalar form does the row's edges and the rest. */
+#define TAA_FILL_BLOCK(name, vec)                                                                         \
+    static void name(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,          \
+                     float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h)                     \
+    {                                                                                                     \
+        for (int r = 0; r < h; r++) {                                                                     \
+            float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;                          \
+            const float *hw, *hrow;                                                                       \
+            float B[3];                                                                                   \
+            if (!(hrow = taa_fill_setup(f, t, y0 + r, &hw, B)))                                           \
+                continue;                                                                                 \
+            const float py = (float)(y0 + r) + 0.5f;                                                      \
+            int ilo, ihi;                                                                                 \
+            taa_fill_span(f, t, x0, w, &ilo, &ihi);                                                       \
+            taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);                                    \
+            const int i = vec(f, t, rgbd, wgt, hrow, hw, B, x0, py, ilo, ihi);                            \
+            taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, w);                                      \
+        }                                                                                                 \
+    }

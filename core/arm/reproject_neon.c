@@ -67,18 +67,10 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 
 /* The fill, four pixels at a time (vld4 / vst4 de-interleave r, g, b, depth): each lane does the
  * reference's operations (taa_fill_px). */
-static inline void taa_fill_row_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                                     int x0, int y, int n)
+static inline int fill_vec_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                              const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
 {
-    const float *hw, *hrow;
-    float B[3];
-    if (!(hrow = taa_fill_setup(f, t, y, &hw, B)))
-        return;
-    const float py = (float)y + 0.5f;
     const int sx0 = x0 + t->flow_x;
-    int ilo, ihi;
-    taa_fill_span(f, t, x0, n, &ilo, &ihi);
-    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
     const float32x4_t zero = vdupq_n_f32(0.0f), half = vdupq_n_f32(0.5f), mhalf = vdupq_n_f32(-0.5f);
     static const int32_t lanes[4] = {0, 1, 2, 3};
     const int32x4_t lane = vld1q_s32(lanes);
@@ -116,10 +108,10 @@ static inline void taa_fill_row_neon(const struct fv_taa_frame *f, const struct 
         vst4q_f32(o, old);
         vst1q_f32(wgt + i, vbslq_f32(m, ws, w));
     }
-    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
+    return i;
 }
 
-TAA_FILL_BLOCK(taa_fill_neon, taa_fill_row_neon)
+TAA_FILL_BLOCK(taa_fill_neon, fill_vec_neon)
 
 void fv_reproject_init_neon(fv_dsp *d)
 {

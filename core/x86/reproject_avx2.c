@@ -71,18 +71,10 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1); }
 
 /* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). */
-static inline void taa_fill_row_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                                     int x0, int y, int n)
+static inline int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                              const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
 {
-    const float *hw, *hrow;
-    float B[3];
-    if (!(hrow = taa_fill_setup(f, t, y, &hw, B)))
-        return;
-    const float py = (float)y + 0.5f;
     const int sx0 = x0 + t->flow_x;
-    int ilo, ihi;
-    taa_fill_span(f, t, x0, n, &ilo, &ihi);
-    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), mhalf = _mm256_set1_ps(-0.5f);
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     int i = ilo;
@@ -132,10 +124,10 @@ static inline void taa_fill_row_avx2(const struct fv_taa_frame *f, const struct 
         }
         _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
     }
-    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
+    return i;
 }
 
-TAA_FILL_BLOCK(taa_fill_avx2, taa_fill_row_avx2)
+TAA_FILL_BLOCK(taa_fill_avx2, fill_vec_avx2)
 
 void fv_reproject_init_avx2(fv_dsp *d)
 {

@@ -64,18 +64,10 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 #include "reproject_tmpl.h"
 
 /* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px). */
-static inline void taa_fill_row_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                                      int x0, int y, int n)
+static inline int fill_vec_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                              const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
 {
-    const float *hw, *hrow;
-    float B[3];
-    if (!(hrow = taa_fill_setup(f, t, y, &hw, B)))
-        return;
-    const float py = (float)y + 0.5f;
     const int sx0 = x0 + t->flow_x;
-    int ilo, ihi;
-    taa_fill_span(f, t, x0, n, &ilo, &ihi);
-    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
     const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), mhalf = _mm_set1_ps(-0.5f);
     const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
     int i = ilo;
@@ -117,10 +109,10 @@ static inline void taa_fill_row_sse41(const struct fv_taa_frame *f, const struct
 #undef PUT
         _mm_storeu_ps(wgt + i, _mm_blendv_ps(w, ws, m));
     }
-    taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, i, n);
+    return i;
 }
 
-TAA_FILL_BLOCK(taa_fill_sse41, taa_fill_row_sse41)
+TAA_FILL_BLOCK(taa_fill_sse41, fill_vec_sse41)
 
 void fv_reproject_init_sse41(fv_dsp *d)
 {
