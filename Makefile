@@ -114,7 +114,7 @@ $(BUILD)/bin/%: apps/%.c $(PLIB) $(LIB)
 $(BUILD)/tools/%: tools/%.c $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $< $(LIB) $(ALL_LDFLAGS) $(LIBS) -o $@
-$(BUILD)/tests/%: tests/%.c tests/testutil.h $(PLIB) $(LIB)
+$(BUILD)/tests/%: tests/%.c tests/testutil.h tests/testscene.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Itests $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(TEST_LIBS) -o $@
 

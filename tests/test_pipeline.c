@@ -5,32 +5,17 @@
 #include <string.h>
 
 #include "testutil.h"
+#include "testscene.h"
 #include "pipeline.h"
 #include "raycast.h"
 #include "scene.h"
 
 #define AMBIENT 0.15f /* the scene's ambient term (see scene.c) */
 
-/* Axis-aligned quad facing +Z at depth z (eye at the origin looking down -Z). */
+
 static void add_quad(fv_scene *s, float x0, float y0, float x1, float y1, float z, const float rgb[3])
 {
-    float pos[] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
-    float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    uint32_t idx[] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc m;
-    memset(&m, 0, sizeof m);
-    m.positions = pos;
-    m.normals = nrm;
-    m.indices = idx;
-    m.vertex_count = 4;
-    m.index_count = 6;
-    m.base_color[0] = rgb[0];
-    m.base_color[1] = rgb[1];
-    m.base_color[2] = rgb[2];
-    m.base_color[3] = 1.0f;
-    m.texture = -1;
-    char err[256];
-    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    fv_test_add_quad(s, x0, y0, x1, y1, z, rgb, -1);
 }
 
 static const float wall_rgb[3] = {0.5f, 0.25f, 1.0f}, card_rgb[3] = {0.2f, 0.8f, 0.4f};

@@ -11,25 +11,14 @@
 #include "raycast.h"
 #include "reference.h"
 #include "scene.h"
+#include "testscene.h"
 
-/* Axis-aligned quad facing +Z at depth z (the eye at the origin looks down -Z). */
+
+/* A grey quad (tests/testscene.h). */
 static void add_quad(fv_scene *s, float x0, float y0, float x1, float y1, float z, float grey)
 {
-    float pos[] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
-    float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    uint32_t idx[] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc m;
-    memset(&m, 0, sizeof m);
-    m.positions = pos;
-    m.normals = nrm;
-    m.indices = idx;
-    m.vertex_count = 4;
-    m.index_count = 6;
-    m.base_color[0] = m.base_color[1] = m.base_color[2] = grey;
-    m.base_color[3] = 1.0f;
-    m.texture = -1;
-    char err[256];
-    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    const float rgb[3] = {grey, grey, grey};
+    fv_test_add_quad(s, x0, y0, x1, y1, z, rgb, -1);
 }
 
 static fv_scene *commit(fv_scene *s)

@@ -7,34 +7,13 @@
 #include <string.h>
 
 #include "testutil.h"
+#include "testscene.h"
 #include "metrics.h"
 #include "pipeline.h"
 #include "raycast.h"
 #include "reproject.h"
 #include "scene.h"
 
-/* Axis-aligned quad facing +Z at depth z, optionally textured (uv over the quad). */
-static void add_quad(fv_scene *s, float x0, float y0, float x1, float y1, float z, const float rgb[3], int tex)
-{
-    float pos[] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
-    float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    float uv[] = {0, 1, 1, 1, 1, 0, 0, 0};
-    uint32_t idx[] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc m;
-    memset(&m, 0, sizeof m);
-    m.positions = pos;
-    m.normals = nrm;
-    m.uvs = uv;
-    m.indices = idx;
-    m.vertex_count = 4;
-    m.index_count = 6;
-    for (int k = 0; k < 3; k++)
-        m.base_color[k] = rgb[k];
-    m.base_color[3] = 1.0f;
-    m.texture = tex;
-    char err[256];
-    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
-}
 
 /* Directional light along -Z: shading does not depend on where the eye is, so a surface point
  * has the same colour from both poses and reprojected history can be compared exactly. */
@@ -200,7 +179,7 @@ static void test_exact_plane_shift(void **st)
     fv_scene *s = fv_scene_create();
     assert_non_null(s);
     const float white[3] = {1, 1, 1};
-    add_quad(s, -20, -20, 20, 20, -2.0f, white, noise_texture(s, 1024));
+    fv_test_add_quad(s, -20, -20, 20, 20, -2.0f, white, noise_texture(s, 1024));
     add_sun(s);
     char err[256];
     assert_int_equal(fv_scene_commit(s, err, sizeof err), 0);
@@ -330,8 +309,8 @@ static void test_no_ghost_on_disocclusion(void **st)
     fv_scene *s = fv_scene_create();
     assert_non_null(s);
     const float wall[3] = {0.1f, 0.6f, 0.3f}, card[3] = {1.0f, 0.05f, 0.05f};
-    add_quad(s, -30, -30, 30, 30, -5.0f, wall, -1);
-    add_quad(s, -0.25f, -0.6f, 0.25f, 0.6f, -1.0f, card, -1);
+    fv_test_add_quad(s, -30, -30, 30, 30, -5.0f, wall, -1);
+    fv_test_add_quad(s, -0.25f, -0.6f, 0.25f, 0.6f, -1.0f, card, -1);
     add_sun(s);
     char err[256];
     assert_int_equal(fv_scene_commit(s, err, sizeof err), 0);

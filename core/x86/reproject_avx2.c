@@ -11,47 +11,24 @@
 
 #include "dsp.h"
 #include "reproject.h"
-
-typedef __m128 acc4;
-
-static inline acc4 acc_zero(void) { return _mm_setzero_ps(); }
+#include "x86/reproject_x86.h"
 
 static inline void tap(const fv_pyr_level *L, float s, float t, float zexp, float inv_tol, acc4 *acc, float *accw)
 {
-    const __m128 st = _mm_floor_ps(_mm_setr_ps(s, t, 0.0f, 0.0f));
-    const float fs = _mm_cvtss_f32(st), ft = _mm_cvtss_f32(_mm_shuffle_ps(st, st, 1));
-    const int i = (int)fs, j = (int)ft;
-    const float fx = s - fs, fy = t - ft, omx = 1.0f - fx, omy = 1.0f - fy;
-    const ptrdiff_t o00 = (ptrdiff_t)j * L->stride + i, o01 = o00 + L->stride;
-    const __m256 top = _mm256_loadu_ps(L->rgbd + 4 * o00); /* c00 | c10 */
-    const __m256 bot = _mm256_loadu_ps(L->rgbd + 4 * o01); /* c01 | c11 */
+    const tap_pos p = tap_at(L, s, t);
+    const __m256 top = _mm256_loadu_ps(L->rgbd + 4 * p.o00); /* c00 | c10 */
+    const __m256 bot = _mm256_loadu_ps(L->rgbd + 4 * p.o01); /* c01 | c11 */
     /* depths in texel order 00, 01, 10, 11 */
     const __m256 zw = _mm256_unpackhi_ps(top, bot); /* (c00.b, c01.b, c00.d, c01.d | c10.b, c11.b, c10.d, c11.d) */
     const __m128 d = _mm_movehl_ps(_mm256_extractf128_ps(zw, 1), _mm256_castps256_ps128(zw));
-    const __m128 b = _mm_mul_ps(_mm_setr_ps(omx, omx, fx, fx), _mm_setr_ps(omy, fy, omy, fy));
-    const __m128 w = _mm_setr_ps(L->wgt[o00], L->wgt[o01], L->wgt[o00 + 1], L->wgt[o01 + 1]);
-    const __m128 absmask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-    const __m128 a = _mm_max_ps(_mm_sub_ps(_mm_set1_ps(1.0f),
-                                           _mm_mul_ps(_mm_and_ps(_mm_sub_ps(d, _mm_set1_ps(zexp)), absmask),
-                                                      _mm_set1_ps(inv_tol))),
-                                _mm_setzero_ps());
-    const __m128 wt = _mm_mul_ps(_mm_mul_ps(b, w), a);
+    const __m128 wt = tap_weights(L, &p, d, zexp, inv_tol);
     /* (w00 | w10) for the top row, (w01 | w11) for the bottom row, each broadcast over 4 lanes */
     const __m256 wt8 = _mm256_castps128_ps256(wt);
     const __m256 wtop = _mm256_permutevar8x32_ps(wt8, _mm256_setr_epi32(0, 0, 0, 0, 2, 2, 2, 2));
     const __m256 wbot = _mm256_permutevar8x32_ps(wt8, _mm256_setr_epi32(1, 1, 1, 1, 3, 3, 3, 3));
     const __m256 s8 = _mm256_add_ps(_mm256_mul_ps(wtop, top), _mm256_mul_ps(wbot, bot)); /* 00+01 | 10+11 */
     *acc = _mm_add_ps(*acc, _mm_add_ps(_mm256_castps256_ps128(s8), _mm256_extractf128_ps(s8, 1)));
-    const __m128 h = _mm_add_ps(wt, _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(2, 3, 0, 1)));
-    *accw = *accw + _mm_cvtss_f32(_mm_add_ss(h, _mm_movehl_ps(h, h)));
-}
-
-static inline void out_blend(float *px, acc4 acc, float accw, float alpha)
-{
-    const __m128 p = _mm_loadu_ps(px);
-    const __m128 h = _mm_div_ps(acc, _mm_set1_ps(accw));
-    const __m128 r = _mm_add_ps(h, _mm_mul_ps(_mm_set1_ps(alpha), _mm_sub_ps(p, h)));
-    _mm_storeu_ps(px, _mm_blend_ps(r, p, 8));
+    *accw = *accw + tap_weight_sum(wt);
 }
 
 static inline uint64_t sample_mask(const float *wgt, int n)
