@@ -138,10 +138,28 @@ static void check_no_leak(float gx, float gy)
     rig_free(&r);
 }
 
+static void bright_square_dark_far_bg(int x, int y, float px[4])
+{
+    const int in = x >= SQ_X0 && x < SQ_X1 && y >= SQ_Y0 && y < SQ_Y1;
+    px[0] = px[1] = px[2] = in ? 1.0f : 0.0f;
+    px[3] = in ? 1.0f : 10.0f;
+}
+
 static void test_far_does_not_leak_fovea(void **st)
 {
     (void)st;
     check_no_leak(90.0f, 80.0f); /* the square is in the Gaussian (centre) region */
+    /* and in the centre the far layer holds only far samples: the blurred background next to
+     * the sharp square does not take the square's colour (it is in front of it) */
+    rig r;
+    rig_init(&r, bright_square_dark_far_bg, FV_DOF_STRONG, 1.0f, 90.0f, 80.0f);
+    r.v.r0_px = 80.0f, r.v.r1_px = 120.0f; /* all of it in the fovea (the transition blends in pyramid taps) */
+    rig_run(&r, NULL, ~0u);
+    for (int d = 1; d <= 6; d++) {
+        assert_float_equal(out_px(&r, SQ_X1 - 1 + d, 80)[0], 0.0f, 1e-6f);
+        assert_float_equal(out_px(&r, 90, SQ_Y0 - d)[1], 0.0f, 1e-6f);
+    }
+    rig_free(&r);
 }
 
 static void test_far_does_not_leak_periphery(void **st)
