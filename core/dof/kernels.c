@@ -115,17 +115,11 @@ void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args 
             for (int k = 0; k < 3; k++)
                 o[k] = o[k] + cov * (p[k] / p[3] - o[k]);
         }
-        if (a->gain > 0.0f && t > 0.0f && a->enh_fp) {
-            int e = (int)(ecc / a->enh_step);
-            const float fp = a->enh_fp[e < a->enh_n - 1 ? e : a->enh_n - 1];
-            if (fp > 1.0f) {
-                float q[4];
-                quincunx(a->pyr, 2.0f * fp, fx, fy, q);
-                const float gt = a->gain * t;
-                for (int k = 0; k < 3; k++) {
-                    const float v = o[k] + gt * (o[k] - q[k]);
-                    o[k] = v > 0.0f ? v : 0.0f;
-                }
+        if (a->enh && t > 0.0f) {
+            const float *b = a->enh + 4 * x, gt = a->gain * t;
+            for (int k = 0; k < 3; k++) {
+                const float v = o[k] + gt * (o[k] - b[k]);
+                o[k] = v > 0.0f ? v : 0.0f;
             }
         }
         out[4 * x + 0] = o[0];

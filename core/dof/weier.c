@@ -121,6 +121,7 @@ typedef struct {
     float *t_near_own;
     int centre_y0, centre_y1; /* rows where the Gaussian far layer is needed (+- kernel) */
     int centre_x0, centre_x1;
+    int enh_level;      /* contrast enhancement: the pyramid level of the peripheral blur, 0 = off */
 } wctx;
 
 static void coc_band(void *ctx, int band, int tid)
@@ -271,6 +272,25 @@ static void vpass_band(void *ctx, int band, int tid)
     }
 }
 
+/* Level L bilinearly up-sampled to row y of level 0 (pixel centres), the same taps as
+ * fv_dof_tap_c, done separably: the level's two rows are blended once, then each pixel reads two
+ * texels. tmp holds the level's row (4 floats a texel). */
+static void upsample_row(const fv_pyr_level *L, int level, int y, int w, float *restrict tmp, float *restrict dst)
+{
+    const float sc = 1.0f / (float)(1 << level);
+    const float v = ((float)y + 0.5f) * sc - 0.5f, fv = floorf(v), ay = v - fv;
+    const float *ra = L->rgbd + 4 * (ptrdiff_t)clampi((int)fv, 0, L->h - 1) * L->stride;
+    const float *rb = L->rgbd + 4 * (ptrdiff_t)clampi((int)fv + 1, 0, L->h - 1) * L->stride;
+    for (int i = 0; i < 4 * L->w; i++)
+        tmp[i] = ra[i] + ay * (rb[i] - ra[i]);
+    for (int x = 0; x < w; x++) {
+        const float u = ((float)x + 0.5f) * sc - 0.5f, fu = floorf(u), ax = u - fu;
+        const int i0 = clampi((int)fu, 0, L->w - 1), i1 = clampi((int)fu + 1, 0, L->w - 1);
+        for (int c = 0; c < 4; c++)
+            dst[4 * x + c] = tmp[4 * i0 + c] + ax * (tmp[4 * i1 + c] - tmp[4 * i0 + c]);
+    }
+}
+
 static void combine_band(void *ctx, int band, int tid)
 {
     (void)tid;
@@ -286,12 +306,16 @@ static void combine_band(void *ctx, int band, int tid)
         .r0 = v->r0_px,
         .inv_tr = v->r1_px > v->r0_px ? 1.0f / (v->r1_px - v->r0_px) : 1e30f,
         .gain = v->prm->contrast_gain,
-        .enh_fp = v->enh_fp,
-        .enh_n = v->enh_n,
-        .enh_step = v->enh_step,
     };
+    float *enh = x->wk->p4[1] + 4 * y0 * st; /* far_h is consumed: the band's enhancement rows */
     for (int y = y0; y < y1; y++) {
         a.y = y;
+        a.enh = NULL;
+        if (x->enh_level > 0) {
+            float *e = enh + 4 * (y - y0) * st;
+            upsample_row(&v->pyr->lv[x->enh_level], x->enh_level, y, x->w, x->wk->p4[3] + 4 * y0 * st, e);
+            a.enh = e;
+        }
         a.sharp = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
         a.coc = x->wk->p1[0] + y * st;
         a.far = y >= x->centre_y0 && y < x->centre_y1 ? x->wk->p4[0] + 4 * y * st : NULL;
@@ -323,6 +347,15 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x.centre_x0 = clampi((int)floorf(v->gaze_x - reach), 0, x.w), x.centre_x1 = clampi((int)ceilf(v->gaze_x + reach), 0, x.w);
     x.centre_y0 = clampi((int)floorf(v->gaze_y - reach), 0, x.h), x.centre_y1 = clampi((int)ceilf(v->gaze_y + reach), 0, x.h);
 
+    /* Patney's kernel follows the sampling footprint 1/sqrt(p): the level whose texel covers the
+     * periphery's footprint; its strength ramps with the transition weight t */
+    if (v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0) {
+        float fp = 1.0f;
+        for (int i = 0; i < v->enh_n; i++)
+            fp = v->enh_fp[i] > fp ? v->enh_fp[i] : fp;
+        int L = (int)floorf(log2f(fp) + 0.5f);
+        x.enh_level = clampi(L, 0, v->pyr->levels - 1);
+    }
     const int64_t t0 = fv_time_ns();
     fv_pool_run(pool, x.th, coc_band, &x);
     dilate_tiles(&x);

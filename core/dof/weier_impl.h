@@ -34,10 +34,8 @@ typedef struct fv_dof_combine_args {
     int has_near;
     float gx, gy;        /* point of regard, px */
     float r0, inv_tr;    /* region blend t = clamp((ecc - r0) * inv_tr, 0, 1) */
-    float gain;          /* contrast enhancement (0 = off) */
-    const float *enh_fp; /* blur footprint (px) per eccentricity step; NULL = no enhancement */
-    int enh_n;
-    float enh_step;
+    float gain;          /* contrast enhancement */
+    const float *enh;    /* the enhancement's blurred row (valid where t > 0); NULL = none */
 } fv_dof_combine_args;
 
 /* Scalar pieces every ISA's combine uses in the same order. */
