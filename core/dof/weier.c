@@ -194,22 +194,33 @@ static void hpass_band(void *ctx, int band, int tid)
                 x->dsp->dof_hgauss_row(fh, rgbd, coc, x->w, xs, n, sig, x->tab);
             }
         }
-        float *nh = x->wk->p4[3] + 4 * y * st, *nr = x->wk->p1[2] + y * st;
+        float *nh = x->wk->p4[3] + 4 * y * st, *nr = x->wk->p1[2] + y * st, *nw = x->wk->p1[1] + y * st;
+        /* each near sample's radius and box weight once per row (far_v's row is free until the
+         * vertical pass): radius -1 marks a sample that is not near */
+        float *sr = x->wk->p4[0] + 4 * y * st, *sw = sr + st;
+        int row_prepped = 0;
         for (int tx = 0; tx < x->tw; tx++) {
             const float reach = x->t_near[band * x->tw + tx];
             if (!(reach > 0.0f))
                 continue;
+            if (!row_prepped) {
+                for (int i = 0; i < x->w; i++) {
+                    const float r = coc[i] < 0.0f ? floorf(-coc[i] * 0.5f) : -1.0f;
+                    sr[i] = r;
+                    sw[i] = 1.0f / (2.0f * (r > 0.0f ? r : 0.0f) + 1.0f);
+                }
+                row_prepped = 1;
+            }
             const int R = (int)reach;
             for (int i = tx * TILE; i < (tx + 1) * TILE && i < x->w; i++) {
                 float acc[4] = {0, 0, 0, 0}, rmax = 0.0f;
-                for (int j = -R; j <= R; j++) {
+                const int jlo = i - R > 0 ? -R : -i, jhi = i + R < x->w ? R : x->w - 1 - i;
+                for (int j = jlo; j <= jhi; j++) {
                     const int s = i + j;
-                    if (s < 0 || s >= x->w || !(coc[s] < 0.0f))
+                    const float r = sr[s];
+                    if (r < (float)(j < 0 ? -j : j)) /* not near (-1), or does not reach */
                         continue;
-                    const float r = floorf(-coc[s] * 0.5f);
-                    if (r < (float)(j < 0 ? -j : j))
-                        continue;
-                    const float wgt = 1.0f / (2.0f * r + 1.0f);
+                    const float wgt = sw[s];
                     for (int c = 0; c < 3; c++)
                         acc[c] += wgt * rgbd[4 * s + c];
                     acc[3] += wgt;
@@ -217,6 +228,7 @@ static void hpass_band(void *ctx, int band, int tid)
                 }
                 memcpy(nh + 4 * i, acc, sizeof acc);
                 nr[i] = rmax;
+                nw[i] = 1.0f / (2.0f * rmax + 1.0f);
             }
         }
     }
@@ -262,7 +274,7 @@ static void vpass_band(void *ctx, int band, int tid)
                     const float r = x->wk->p1[2][s * st + i];
                     if (!(nh[3] > 0.0f) || r < (float)(j < 0 ? -j : j))
                         continue;
-                    const float wgt = 1.0f / (2.0f * r + 1.0f);
+                    const float wgt = x->wk->p1[1][s * st + i];
                     for (int c = 0; c < 4; c++)
                         acc[c] += wgt * nh[c];
                 }
