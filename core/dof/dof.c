@@ -56,6 +56,8 @@ void fv_dof_work_free(fv_dof_work *wk)
     for (int i = 0; i < FV_DOF_PLANES1; i++)
         free(wk->p1[i]);
     free(wk->gauss);
+    free(wk->aux);
+    free(wk->rows);
     memset(wk, 0, sizeof *wk);
 }
 

@@ -70,6 +70,8 @@ typedef struct fv_dof_work {
     float *p4[FV_DOF_PLANES4];
     float *p1[FV_DOF_PLANES1];
     struct fv_dof_gauss_tab *gauss; /* the layered filter's Gaussian weights (constant) */
+    float *aux, *rows;              /* the layered filter's own scratch, grown on first use */
+    size_t aux_len, rows_len;
 } fv_dof_work;
 int fv_dof_work_init(fv_dof_work *wk, int w, int h, ptrdiff_t stride); /* 0, or -1: no memory */
 void fv_dof_work_free(fv_dof_work *wk);

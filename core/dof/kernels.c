@@ -64,67 +64,37 @@ void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride
     }
 }
 
-/* Five quincunx taps (or one when the offset is under 1/8 px) of the blur of diameter c. */
-static void quincunx(const fv_pyramid *pyr, float c, float fx, float fy, float q[4])
-{
-    int L;
-    float o;
-    fv_dof_footprint(c, pyr->levels - 1, &L, &o);
-    const fv_pyr_level *lv = &pyr->lv[L];
-    q[0] = q[1] = q[2] = q[3] = 0.0f;
-    fv_dof_tap_c(lv, L, fx, fy, q);
-    if (o >= 0.125f) {
-        fv_dof_tap_c(lv, L, fx - o, fy - o, q);
-        fv_dof_tap_c(lv, L, fx + o, fy - o, q);
-        fv_dof_tap_c(lv, L, fx - o, fy + o, q);
-        fv_dof_tap_c(lv, L, fx + o, fy + o, q);
-        for (int k = 0; k < 4; k++)
-            q[k] *= 0.2f;
-    }
-}
-
 void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n)
 {
-    const float fy = (float)a->y + 0.5f, dy = fy - a->gy;
     for (int x = x0; x < x0 + n; x++) {
         const float *s = a->sharp + 4 * x;
-        float o[3] = {s[0], s[1], s[2]};
-        const float c = a->coc[x], fx = (float)x + 0.5f, dx = fx - a->gx;
-        const float ecc = sqrtf(dx * dx + dy * dy);
-        float t = (ecc - a->r0) * a->inv_tr;
-        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
-        if (c > 0.0f) {
-            float f[3] = {0.0f, 0.0f, 0.0f}, q[4];
-            if (t < 1.0f && a->far && x >= a->far_x0 && x < a->far_x1 && a->far[4 * x + 3] > 0.0f) {
-                const float *p = a->far + 4 * x;
-                for (int k = 0; k < 3; k++)
-                    f[k] = p[k] / p[3];
-            }
-            if (t > 0.0f) {
-                quincunx(a->pyr, c, fx, fy, q);
-                for (int k = 0; k < 3; k++)
-                    f[k] = f[k] + t * (q[k] - f[k]);
-            }
-            const float af = c < 1.0f ? c : 1.0f;
-            for (int k = 0; k < 3; k++)
-                o[k] = o[k] + af * (f[k] - o[k]);
+        float o0 = s[0], o1 = s[1], o2 = s[2];
+        const float c = a->coc[x];
+        if (c > 0.0f) { /* towards the far layer: fully from a CoC of one pixel on */
+            const float af = c < 1.0f ? c : 1.0f, *f = a->far + 4 * x;
+            o0 = o0 + af * (f[0] - o0);
+            o1 = o1 + af * (f[1] - o1);
+            o2 = o2 + af * (f[2] - o2);
         }
-        if (a->has_near && a->near[4 * x + 3] > 0.0f) {
-            const float *p = a->near + 4 * x;
-            const float cov = p[3] < 1.0f ? p[3] : 1.0f;
-            for (int k = 0; k < 3; k++)
-                o[k] = o[k] + cov * (p[k] / p[3] - o[k]);
+        const float *nr = a->near + 4 * x;
+        if (nr[3] > 0.0f) { /* the near layer over it, by its coverage */
+            const float cov = nr[3] < 1.0f ? nr[3] : 1.0f;
+            o0 = o0 + cov * (nr[0] / nr[3] - o0);
+            o1 = o1 + cov * (nr[1] / nr[3] - o1);
+            o2 = o2 + cov * (nr[2] / nr[3] - o2);
         }
-        if (a->enh && t > 0.0f) {
-            const float *b = a->enh + 4 * x, gt = a->gain * t;
-            for (int k = 0; k < 3; k++) {
-                const float v = o[k] + gt * (o[k] - b[k]);
-                o[k] = v > 0.0f ? v : 0.0f;
+        if (a->enh) {
+            const float g = a->gain * a->t[x], *b = a->enh + 4 * x;
+            if (g > 0.0f) {
+                const float v0 = o0 + g * (o0 - b[0]), v1 = o1 + g * (o1 - b[1]), v2 = o2 + g * (o2 - b[2]);
+                o0 = v0 > 0.0f ? v0 : 0.0f;
+                o1 = v1 > 0.0f ? v1 : 0.0f;
+                o2 = v2 > 0.0f ? v2 : 0.0f;
             }
         }
-        out[4 * x + 0] = o[0];
-        out[4 * x + 1] = o[1];
-        out[4 * x + 2] = o[2];
+        out[4 * x + 0] = o0;
+        out[4 * x + 1] = o1;
+        out[4 * x + 2] = o2;
         out[4 * x + 3] = s[3];
     }
 }
