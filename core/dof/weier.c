@@ -171,40 +171,50 @@ static void coc_band(void *ctx, int band, int tid)
     const int y0 = band * TILE, y1 = mini(y0 + TILE, x->h);
     for (int y = y0; y < y1; y++)
         x->dsp->dof_coc_row(x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w, x->K, x->dn, x->df);
+    /* one sweep for the tile statistics and the quarter-resolution near source: per 4x4 block
+     * the near pixels' colour sum, count and largest |c|; per tile the largest near and far c */
+    const float inv_blk = 1.0f / (LOW * LOW);
+    for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
+        float *src = x->l_src + 4 * (ptrdiff_t)by * x->lw, *rr = x->l_r + (ptrdiff_t)by * x->lw;
+        memset(src, 0, (size_t)x->lw * 4 * sizeof(float));
+        for (int i = 0; i < x->lw; i++)
+            rr[i] = 0.0f; /* the largest |c| of the block's near pixels, for now */
+        for (int y = by * LOW; y < mini(by * LOW + LOW, x->h); y++) {
+            const float *c = x->wk->p1[0] + y * st, *p = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
+            for (int i = 0; i < x->w; i++) {
+                if (!(c[i] < 0.0f))
+                    continue;
+                float *b = src + 4 * (i / LOW);
+                b[0] += p[4 * i], b[1] += p[4 * i + 1], b[2] += p[4 * i + 2], b[3] += 1.0f;
+                rr[i / LOW] = -c[i] > rr[i / LOW] ? -c[i] : rr[i / LOW];
+            }
+        }
+        for (int i = 0; i < x->lw; i++) {
+            const float cmax = rr[i], *b = src + 4 * i;
+            float r = floorf(cmax * 0.5f); /* the largest near radius in pixels, capped */
+            r = r < (float)FV_DOF_RMAX ? r : (float)FV_DOF_RMAX;
+            /* the tile's largest near radius (first block of the tile in the band: reset) */
+            float *tn = &x->t_near_own[band * x->tw + i * LOW / TILE];
+            if (by == y0 / LOW && i * LOW % TILE == 0)
+                *tn = 0.0f;
+            *tn = r > *tn ? r : *tn;
+            /* radius in blocks, rounded; -1: no near pixel (rr[i] becomes it) */
+            const float rb = b[3] > 0.0f ? floorf((r + 0.5f * LOW) / LOW) : -1.0f;
+            rr[i] = rb;
+            x->l_w[(ptrdiff_t)by * x->lw + i] = 1.0f / (2.0f * (rb > 0.0f ? rb : 0.0f) + 1.0f);
+            for (int k = 0; k < 4; k++)
+                src[4 * i + k] *= inv_blk;
+        }
+    }
     for (int tx = 0; tx < x->tw; tx++) {
-        float nr = 0.0f, fc = 0.0f;
+        float fc = 0.0f;
         for (int y = y0; y < y1; y++) {
             const float *c = x->wk->p1[0] + y * st;
-            for (int i = tx * TILE; i < mini((tx + 1) * TILE, x->w); i++) {
-                nr = -c[i] > nr ? -c[i] : nr;
+            for (int i = tx * TILE; i < mini((tx + 1) * TILE, x->w); i++)
                 fc = c[i] > fc ? c[i] : fc;
-            }
         }
-        x->t_near_own[band * x->tw + tx] = fminf(floorf(nr * 0.5f), (float)FV_DOF_RMAX);
         x->t_fsig_own[band * x->tw + tx] = fc * 0.25f;
     }
-    /* the quarter-resolution near source of this band's 4x4 blocks: the near pixels' mean
-     * colour times their share of the block, and the block's radius in blocks (rounded) */
-    for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++)
-        for (int bx = 0; bx < x->lw; bx++) {
-            float s[4] = {0, 0, 0, 0}, rmax = 0.0f;
-            for (int y = by * LOW; y < mini(by * LOW + LOW, x->h); y++) {
-                const float *c = x->wk->p1[0] + y * st, *p = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
-                for (int i = bx * LOW; i < mini(bx * LOW + LOW, x->w); i++)
-                    if (c[i] < 0.0f) {
-                        for (int k = 0; k < 3; k++)
-                            s[k] += p[4 * i + k];
-                        s[3] += 1.0f;
-                        rmax = fmaxf(rmax, fminf(floorf(-c[i] * 0.5f), (float)FV_DOF_RMAX));
-                    }
-            }
-            const ptrdiff_t o = (ptrdiff_t)by * x->lw + bx;
-            for (int k = 0; k < 4; k++)
-                x->l_src[4 * o + k] = s[k] * (1.0f / (LOW * LOW));
-            const float r = s[3] > 0.0f ? floorf((rmax + 0.5f * LOW) / LOW) : -1.0f;
-            x->l_r[o] = r;
-            x->l_w[o] = 1.0f / (2.0f * fmaxf(r, 0.0f) + 1.0f);
-        }
 }
 
 /* Each tile learns the largest near radius / far sigma of the tiles within reach. */
@@ -292,9 +302,10 @@ static void hpass_band(void *ctx, int band, int tid)
                 const int lo = x->cx0 - FV_DOF_RMAX > 0 ? x->cx0 - FV_DOF_RMAX : 0;
                 const int hi = mini(x->cx1 + FV_DOF_RMAX, x->w);
                 for (int i = lo; i < hi; i++) {
-                    const float r = coc[i] < 0.0f ? fminf(floorf(-coc[i] * 0.5f), (float)FV_DOF_RMAX) : -1.0f;
+                    const float rc = floorf(-coc[i] * 0.5f);
+                    const float r = coc[i] < 0.0f ? (rc < (float)FV_DOF_RMAX ? rc : (float)FV_DOF_RMAX) : -1.0f;
                     sr[i] = r;
-                    sw[i] = 1.0f / (2.0f * fmaxf(r, 0.0f) + 1.0f);
+                    sw[i] = 1.0f / (2.0f * (r > 0.0f ? r : 0.0f) + 1.0f);
                     for (int c = 0; c < 3; c++)
                         s4[4 * i + c] = rgbd[4 * i + c];
                     s4[4 * i + 3] = 1.0f;
@@ -464,7 +475,7 @@ static void vcombine_band(void *ctx, int band, int tid)
                 if (!(t > 0.0f) || (!(lup[4 * i + 3] > 0.0f) && !(near[4 * i + 3] > 0.0f)))
                     continue; /* nothing near either way: stays 0 */
                 /* a near pixel's own block blur shows only as far as its CoC exceeds the block */
-                const float s = coc[i] < 0.0f ? fminf(1.0f, -coc[i] * (1.0f / LOW)) : 1.0f;
+                const float cs = -coc[i] * (1.0f / LOW), s = coc[i] < 0.0f ? (cs < 1.0f ? cs : 1.0f) : 1.0f;
                 for (int k = 0; k < 4; k++)
                     near[4 * i + k] = near[4 * i + k] + t * (s * lup[4 * i + k] - near[4 * i + k]);
             }
