@@ -76,15 +76,29 @@ void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args 
             o1 = o1 + af * (f[1] - o1);
             o2 = o2 + af * (f[2] - o2);
         }
-        const float *nr = a->near + 4 * x;
-        if (nr[3] > 0.0f) { /* the near layer over it, by its coverage */
-            const float cov = nr[3] < 1.0f ? nr[3] : 1.0f;
-            o0 = o0 + cov * (nr[0] / nr[3] - o0);
-            o1 = o1 + cov * (nr[1] / nr[3] - o1);
-            o2 = o2 + cov * (nr[2] / nr[3] - o2);
+        /* the near layer: full resolution, blended by t towards the quarter-resolution one, in
+         * which a near pixel's own block blur counts only as far as its CoC exceeds the block */
+        float n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, n3 = 0.0f;
+        if (a->near) {
+            const float *p = a->near + 4 * x;
+            n0 = p[0], n1 = p[1], n2 = p[2], n3 = p[3];
+        }
+        const float t = a->t[x];
+        if (a->lnear && t > 0.0f) {
+            const float cs = -c * 0.25f, s = c < 0.0f ? (cs < 1.0f ? cs : 1.0f) : 1.0f, *q = a->lnear + 4 * x;
+            n0 = n0 + t * (s * q[0] - n0);
+            n1 = n1 + t * (s * q[1] - n1);
+            n2 = n2 + t * (s * q[2] - n2);
+            n3 = n3 + t * (s * q[3] - n3);
+        }
+        if (n3 > 0.0f) { /* over the image by its coverage */
+            const float cov = n3 < 1.0f ? n3 : 1.0f;
+            o0 = o0 + cov * (n0 / n3 - o0);
+            o1 = o1 + cov * (n1 / n3 - o1);
+            o2 = o2 + cov * (n2 / n3 - o2);
         }
         if (a->enh) {
-            const float g = a->gain * a->t[x], *b = a->enh + 4 * x;
+            const float g = a->gain * t, *b = a->enh + 4 * x;
             if (g > 0.0f) {
                 const float v0 = o0 + g * (o0 - b[0]), v1 = o1 + g * (o1 - b[1]), v2 = o2 + g * (o2 - b[2]);
                 o0 = v0 > 0.0f ? v0 : 0.0f;

@@ -435,9 +435,12 @@ static void vcombine_band(void *ctx, int band, int tid)
                         far[4 * i + k] /= far[4 * i + 3];
         }
         far_periphery(x, tid, y, coc, trow, sharp, far);
-        /* near: full resolution in the centre rectangle, quarter resolution where t > 0 */
-        memset(near, 0, (size_t)x->w * 4 * sizeof(float));
-        if (centre_row)
+        /* near: full resolution in the centre rectangle (pixels with t < 1); the quarter-
+         * resolution layer up-sampled is blended in by t in the combine */
+        float *nfull = NULL;
+        if (centre_row) {
+            nfull = near;
+            memset(near, 0, (size_t)x->w * 4 * sizeof(float));
             for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
                 const int reach = (int)x->t_near[(y / TILE) * x->tw + tx];
                 if (reach <= 0)
@@ -465,20 +468,12 @@ static void vcombine_band(void *ctx, int band, int tid)
                     memcpy(near + 4 * i, acc, sizeof acc);
                 }
             }
+        }
+        float *lup = NULL;
         if (x->l_reach >= 0) {
-            /* the quarter-resolution layer up-sampled where t > 0 and a near block can reach */
-            float *lup = slot(x, tid, 3);
+            lup = slot(x, tid, 3);
             const img4 im = {x->l_v, x->lw, x->lh, x->lw};
             upsample_row(&im, 2, &x->xt[2], y, x->w, slot(x, tid, 4), lup); /* LOW = 2^2 */
-            for (int i = 0; i < x->w; i++) {
-                const float t = trow[i];
-                if (!(t > 0.0f) || (!(lup[4 * i + 3] > 0.0f) && !(near[4 * i + 3] > 0.0f)))
-                    continue; /* nothing near either way: stays 0 */
-                /* a near pixel's own block blur shows only as far as its CoC exceeds the block */
-                const float cs = -coc[i] * (1.0f / LOW), s = coc[i] < 0.0f ? (cs < 1.0f ? cs : 1.0f) : 1.0f;
-                for (int k = 0; k < 4; k++)
-                    near[4 * i + k] = near[4 * i + k] + t * (s * lup[4 * i + k] - near[4 * i + k]);
-            }
         }
         if (enh) {
             const fv_pyr_level *lv = &v->pyr->lv[x->enh_level];
@@ -486,8 +481,8 @@ static void vcombine_band(void *ctx, int band, int tid)
             upsample_row(&im, x->enh_level, &x->xt[x->enh_level], y, x->w, slot(x, tid, 6), enh);
         }
         const int64_t tb = fv_time_ns();
-        fv_dof_combine_args a = {
-            .sharp = sharp, .coc = coc, .far = far, .near = near, .t = trow, .enh = enh, .gain = v->prm->contrast_gain};
+        fv_dof_combine_args a = {.sharp = sharp, .coc = coc, .far = far, .near = nfull, .lnear = lup, .t = trow,
+                                 .enh = enh, .gain = v->prm->contrast_gain};
         x->dsp->dof_combine_row(x->out + 4 * (ptrdiff_t)y * x->out_stride, &a, 0, x->w);
         const int64_t tc = fv_time_ns();
         filter_ns += (double)(tb - ta);

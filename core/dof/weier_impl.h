@@ -27,7 +27,8 @@ typedef struct fv_dof_combine_args {
     const float *sharp; /* level 0 row (r, g, b, depth_m) */
     const float *coc;   /* signed CoC row, px */
     const float *far;   /* far layer colour (r, g, b, -), read where coc > 0 */
-    const float *near;  /* near layer: premultiplied colour, coverage in .w */
+    const float *near;  /* full-resolution near layer: premultiplied colour, coverage in .w; NULL = 0 */
+    const float *lnear; /* the quarter-resolution near layer up-sampled (same form); NULL = 0 */
     const float *t;     /* transition weight per pixel: 0 in the fovea .. 1 in the periphery */
     const float *enh;   /* contrast enhancement's blurred row; NULL = off */
     float gain;         /* contrast enhancement gain (used with enh) */
