@@ -334,10 +334,11 @@ static void test_hussain_regions_and_min_rule(void **st)
     assert_float_equal(out_px(f.out, IMP_X, IMP_Y)[0], 0.0550718f, 1e-4f);
     assert_float_equal(out_px(f.out, IMP_X - 1, IMP_Y)[0], 0.0463224f, 1e-4f);
 
-    /* first blend ring, R 12.5: B = (12.5 - 10) / 5 = 0.5; O = 0.5 I_near + 0.5 input */
-    gaze_at_distance(&f, 12.5f);
+    /* first blend ring, R 11.25: B = (11.25 - 10) / 5 = 0.25; O = B I_near + (1 - B) input
+     * = 0.25 * 0.0550718 + 0.75 = 0.7637680 (eq. (3) as printed would give 0.2913039) */
+    gaze_at_distance(&f, 11.25f);
     run(&f, 0, NULL, f.out);
-    assert_float_equal(out_px(f.out, IMP_X, IMP_Y)[0], 0.5f * 0.0550718f + 0.5f, 1e-4f);
+    assert_float_equal(out_px(f.out, IMP_X, IMP_Y)[0], 0.7637680f, 1e-4f);
 
     /* fovea (R 3, the neighbours within 10 px too): the input */
     gaze_at_distance(&f, 3.0f);
