@@ -357,6 +357,75 @@ static void test_hussain_regions_and_min_rule(void **st)
     fx_free(&f);
 }
 
+/* ------------------------------------------------------------------ mantiuk */
+
+/* colour linear in x (red) and y (green) on a far plane */
+static void ramp_scene(int x, int y, float px[4], const void *arg)
+{
+    (void)arg;
+    px[0] = 0.01f * (float)x, px[1] = 0.01f * (float)y, px[2] = 0.5f, px[3] = 5.0f;
+}
+
+/* Mantiuk eq. (1): focus 0.5 m, plane 5 m, a 4.49 mm, f 22.3 mm:
+ * CoC = 4.49 * 22.3 / 477.7 * |1 - 0.1| = 0.1886453 mm; * E (53.571429 px/mm) = 10.105823 px, a
+ * disc of radius 5.052912 px. Bilinear taps of a linear ramp are exact, so the mean of the 15
+ * samples is the ramp at the mean offset: the table's mean is (0.0125667, -0.0049533), so
+ * red = 0.01 (45 + 5.052912 * 0.0125667) = 0.4506350 and green = 0.01 (35 - 5.052912 * 0.0049533)
+ * = 0.3497497 at pixel (45, 35). (A diameter-sized disc would give 0.4512700.) */
+static void test_mantiuk_disc_size(void **st)
+{
+    (void)st;
+    fixture f;
+    fx_init(&f);
+    fx_scene(&f, ramp_scene, NULL);
+    f.view.focus_m = 0.5f;
+    run(&f, 1, NULL, f.out);
+    assert_float_equal(out_px(f.out, 45, 35)[0], 0.4506350f, 2e-6f);
+    assert_float_equal(out_px(f.out, 45, 35)[1], 0.3497497f, 2e-6f);
+    assert_true(out_px(f.out, 45, 35)[2] == 0.5f);
+    fx_free(&f);
+}
+
+/* ------------------------------------------------------------------ konrad */
+
+/* a white square at square_m before a black background at background_m */
+static void bw_square_scene(int x, int y, float px[4], const void *arg)
+{
+    const sq_scene_arg *a = arg;
+    const float v = in_square(x, y) ? 1.0f : 0.0f;
+    px[0] = px[1] = px[2] = v, px[3] = in_square(x, y) ? a->square_m : a->background_m;
+}
+
+/* Zhou's factors by hand, thin-lens CoC 4.49e-3 |1/F - 1/D| * 600 * 2 px.
+ * - Far impulse (focus 0.5 m, plane 5 m): CoC 9.69840 px, r 4.84920 (r^2 23.5147); every pixel has
+ *   the same radius, so the weights are 1 for each of the N pixels with dx^2 + dy^2 <= r^2:
+ *   columns dx 0, +-1, +-2, +-3, +-4 hold 9, 9, 9, 7, 5 -> N = 69, the impulse keeps 1/69.
+ * - Near square (0.5 m) before an in-focus background (3 m): r 4.49 (r^2 20.1601). The background
+ *   pixel C left of the square's edge (x = 34) has area factor 1 (a sharp pixel), the square's
+ *   pixels 1 / (pi 20.1601) = 1 / 63.33482; those within reach: dx = 1..4 hold 9, 9, 7, 5 -> 30.
+ *   out = (30 / 63.33482) / (1 + 30 / 63.33482) = 0.3214234. Background pixels never reach C. */
+static void test_konrad_factors(void **st)
+{
+    (void)st;
+    fixture f;
+    fx_init(&f);
+    const impulse_arg a = {5.0f};
+    fx_scene(&f, impulse_scene, &a);
+    f.view.focus_m = 0.5f;
+    run(&f, 2, NULL, f.out);
+    assert_float_equal(out_px(f.out, IMP_X, IMP_Y)[0], 1.0f / 69.0f, 1e-6f);
+    assert_float_equal(out_px(f.out, IMP_X + 4, IMP_Y + 2)[0], 1.0f / 69.0f, 1e-6f);
+    assert_true(out_px(f.out, IMP_X + 4, IMP_Y + 3)[0] == 0.0f);
+
+    const sq_scene_arg s = {0.5f, 3.0f};
+    fx_scene(&f, bw_square_scene, &s);
+    f.view.focus_m = 3.0f;
+    run(&f, 2, NULL, f.out);
+    assert_float_equal(out_px(f.out, SQ_X0 - 1, 35)[0], 0.3214234f, 2e-6f);
+    assert_true(out_px(f.out, SQ_X0 - 5, 35)[0] == 0.0f); /* beyond 4.49 px */
+    fx_free(&f);
+}
+
 /* ------------------------------------------------------------------ liu */
 
 /* Liu eq. (12) on a far plane: focus 0.5 m, plane 5 m; C = tau_e f_e (1/F - 1/D)
@@ -410,6 +479,8 @@ int main(void)
         cmocka_unit_test(test_near_blur_spreads_past_silhouette),
         cmocka_unit_test(test_thread_count_invariant),
         cmocka_unit_test(test_hussain_regions_and_min_rule),
+        cmocka_unit_test(test_mantiuk_disc_size),
+        cmocka_unit_test(test_konrad_factors),
         cmocka_unit_test(test_liu_chroma_discs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
