@@ -39,26 +39,27 @@ typedef struct ko_job {
     fv_dm_tiles tiles;
 } ko_job;
 
-/* signed CoC radius in pixels, capped -> p1[0] */
+static inline float ko_area(float r) { return fmaxf(FV_DM_PI_F * r * r, 1.0f); }
+
+/* signed CoC radius in pixels, capped -> p1[0]; 1 / disc area (factor 2) -> p1[3] */
 static void ko_coc_row(void *ctx, int y, int tid)
 {
     (void)tid;
     const ko_job *j = ctx;
-    float *r = j->wk->p1[0] + y * j->wk->stride;
+    float *r = j->wk->p1[0] + y * j->wk->stride, *ia = j->wk->p1[3] + y * j->wk->stride;
     for (int x = 0; x < j->w; x++) {
         const float h = 0.5f * fv_dof_thin_lens_px(j->v, fv_dm_px(j->L, x, y)[3]);
         r[x] = fminf(fmaxf(h, -FV_DM_MAX_R_PX), FV_DM_MAX_R_PX);
+        ia[x] = 1.0f / ko_area(r[x]);
     }
 }
-
-static inline float ko_area(float r) { return fmaxf(FV_DM_PI_F * r * r, 1.0f); }
 
 static void ko_filter_row(void *ctx, int y, int tid)
 {
     (void)tid;
     const ko_job *j = ctx;
     const ptrdiff_t st = j->wk->stride;
-    const float *rad = j->wk->p1[0];
+    const float *rad = j->wk->p1[0], *iar = j->wk->p1[3];
     float *o = j->out + 4 * y * j->os;
     for (int x = 0; x < j->w; x++) {
         const float *c = fv_dm_px(j->L, x, y);
@@ -75,7 +76,7 @@ static void ko_filter_row(void *ctx, int y, int tid)
                 const float rs = rad[py * st + px], rp = fabsf(rs);
                 if ((float)(dx * dx + dy * dy) > rp * rp) /* factor 1 */
                     continue;
-                float wgt = ac / ko_area(rp); /* factor 2, relative to C's */
+                float wgt = ac * iar[py * st + px]; /* factor 2, relative to C's */
                 if (rs > 0.0f && rc < rp)     /* factor 3 */
                     wgt *= rc / rp;
                 if (!(wgt > 0.0f))

@@ -42,6 +42,11 @@
 /* extra refractive power of the eye for the display's red, green, blue relative to green, D */
 static const float liu_lca_d[3] = {-0.445f, 0.0f, 0.571f};
 
+static inline float liu_area(float r) { return fmaxf(FV_DM_PI_F * r * r, 1.0f); }
+
+/* |(dx, dy)| for the gather window */
+#define LIU_WIN ((int)FV_DM_MAX_R_PX + 1)
+
 typedef struct liu_job {
     const fv_dof_view *v;
     const fv_pyr_level *L;
@@ -52,33 +57,36 @@ typedef struct liu_job {
     fv_coc_liu liu;
     float shift_mm[3]; /* tau_e f_e dP per channel (0 without chroma) */
     fv_dm_tiles tiles;
+    float dist[2 * LIU_WIN + 1][2 * LIU_WIN + 1]; /* |(dx, dy)|, index + LIU_WIN */
 } liu_job;
 
-/* signed CoC radius per channel, pixels, capped -> p4[0] (r, g, b, unused) */
+/* signed CoC radius per channel, pixels, capped, and the largest |radius| -> p4[0] (r, g, b, max);
+ * 1 / disc area per channel -> p4[1] (the filter's per-tap weight without a division) */
 static void liu_coc_row(void *ctx, int y, int tid)
 {
     (void)tid;
     const liu_job *j = ctx;
-    float *r = j->wk->p4[0] + 4 * y * j->wk->stride;
+    float *r = j->wk->p4[0] + 4 * y * j->wk->stride, *ia = j->wk->p4[1] + 4 * y * j->wk->stride;
     for (int x = 0; x < j->w; x++) {
         const float base = fv_coc_liu_mm(&j->liu, j->v->focus_m, fv_dm_px(j->L, x, y)[3]), mag = fabsf(base);
+        float m = 0.0f;
         for (int ch = 0; ch < 3; ch++) {
             const float c = base + fminf(fmaxf(j->shift_mm[ch], -mag), mag);
-            const float h = 0.5f * c * j->v->e_px_per_mm;
-            r[4 * x + ch] = fminf(fmaxf(h, -FV_DM_MAX_R_PX), FV_DM_MAX_R_PX);
+            const float h = fminf(fmaxf(0.5f * c * j->v->e_px_per_mm, -FV_DM_MAX_R_PX), FV_DM_MAX_R_PX);
+            r[4 * x + ch] = h;
+            ia[4 * x + ch] = 1.0f / liu_area(h);
+            m = fabsf(h) > m ? fabsf(h) : m;
         }
-        r[4 * x + 3] = 0.0f;
+        r[4 * x + 3] = m, ia[4 * x + 3] = 0.0f;
     }
 }
-
-static inline float liu_area(float r) { return fmaxf(FV_DM_PI_F * r * r, 1.0f); }
 
 static void liu_filter_row(void *ctx, int y, int tid)
 {
     (void)tid;
     const liu_job *j = ctx;
     const ptrdiff_t st = j->wk->stride;
-    const float *rad = j->wk->p4[0];
+    const float *rad = j->wk->p4[0], *iar = j->wk->p4[1];
     float *o = j->out + 4 * y * j->os;
     for (int x = 0; x < j->w; x++) {
         const float *c = fv_dm_px(j->L, x, y);
@@ -92,19 +100,20 @@ static void liu_filter_row(void *ctx, int y, int tid)
         }
         for (int dy = -R; dy <= R; dy++) {
             const int py = fv_dm_clampi(y + dy, 0, j->h - 1);
+            const float *drow = j->dist[dy + LIU_WIN] + LIU_WIN;
             for (int dx = -R; dx <= R; dx++) {
-                if (!dx && !dy)
-                    continue;
                 const int px = fv_dm_clampi(x + dx, 0, j->w - 1);
-                const float *p = fv_dm_px(j->L, px, py), *rp = rad + 4 * (py * st + px);
-                const float d = sqrtf((float)(dx * dx + dy * dy));
+                const float *rp = rad + 4 * (py * st + px), d = drow[dx];
+                if (rp[3] + 0.5f <= d || (!dx && !dy)) /* no channel's disc reaches C */
+                    continue;
+                const float *p = fv_dm_px(j->L, px, py), *ia = iar + 4 * (py * st + px);
                 const int behind = p[3] > c[3];
                 for (int ch = 0; ch < 3; ch++) {
                     const float r = fabsf(rp[ch]), reach = behind && rc[ch] < r ? rc[ch] : r;
                     const float cov = fminf(fmaxf(reach - d + 0.5f, 0.0f), 1.0f);
                     if (!(cov > 0.0f))
                         continue;
-                    const float wgt = cov * ac[ch] / liu_area(r);
+                    const float wgt = cov * ac[ch] * ia[ch];
                     a[ch] += wgt * p[ch];
                     sw[ch] += wgt;
                 }
@@ -125,6 +134,10 @@ void fv_dof_liu(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out
     j.liu.pupil_mm = v->prm->pupil_mm;
     for (int ch = 0; ch < 3; ch++) /* dioptres are 1/m: 1e-3 per mm */
         j.shift_mm[ch] = v->prm->chroma ? j.liu.pupil_mm * j.liu.focal_mm * liu_lca_d[ch] * 1e-3f : 0.0f;
+
+    for (int dy = -LIU_WIN; dy <= LIU_WIN; dy++)
+        for (int dx = -LIU_WIN; dx <= LIU_WIN; dx++)
+            j.dist[dy + LIU_WIN][dx + LIU_WIN] = sqrtf((float)(dx * dx + dy * dy));
 
     int64_t t0 = fv_time_ns();
     fv_pool_run(pool, j.h, liu_coc_row, &j);
