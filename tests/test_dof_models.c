@@ -250,7 +250,8 @@ static void mixed_scene(int x, int y, float px[4], const void *arg)
         px[3] = 1000.0f; /* a miss */
 }
 
-/* (4) 1 thread and 3 threads give the same bits (gaze inside the image, Liu with chroma). */
+/* (4) 1 thread and 3 threads give the same bits (gaze inside the image, Liu with chroma), and so
+ * does an output with a wider row stride. */
 static void test_thread_count_invariant(void **st)
 {
     (void)st;
@@ -273,6 +274,15 @@ static void test_thread_count_invariant(void **st)
             fail();
         }
         assert_true(max_change(&f, f.out, sel_square) > 0.01f); /* not trivially equal */
+        /* rows of the output further apart than the image is wide: the same pixels */
+        const ptrdiff_t os = W + 3;
+        float *wide = malloc((size_t)os * H * 4 * sizeof(float));
+        assert_non_null(wide);
+        fv_dof_times t;
+        models[m].fn(&f.view, &f.wk, wide, os, p3, &f.dsp, &t);
+        for (int y = 0; y < H; y++)
+            assert_memory_equal(wide + 4 * y * os, out_px(f.out, 0, y), (size_t)W * 4 * sizeof(float));
+        free(wide);
     }
     fv_pool_destroy(p1);
     fv_pool_destroy(p3);
