@@ -48,6 +48,8 @@ typedef struct fv_eye_params {
                                  the eye): the reported centre moves this fraction of the way
                                  from the detection to the image centre (a second, independent
                                  estimate of the pupil) and stays on pixel centres; 0 = off */
+    float glint_weight;      /* small frames: and this fraction of the way toward a glint
+                                within the search box's half-size of its centre; 0 = off */
     int max_glints;          /* <= FV_EYE_MAX_GLINTS */
 } fv_eye_params;
 
