@@ -710,7 +710,7 @@ static int bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float
             if (v - best <= 0 || v < q[-1] || v < q[1] || v < q[-stride] || v < q[stride] || v < q[-stride - 1] ||
                 v < q[-stride + 1] || v < q[stride - 1] || v < q[stride + 1])
                 continue;
-            /* median of the 24 ring pixels by counting */
+            /* median of the 24 ring pixels (insertion sort) */
             uint8_t ring[24];
             int n = 0;
             for (int k = -3; k <= 3; k++) {
