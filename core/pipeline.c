@@ -112,9 +112,9 @@ void fv_pipeline_destroy(fv_pipeline *p)
     if (!p)
         return;
     fv_pool_destroy(p->pool);
-    fv_sampler_free(&p->smp);
     for (int k = 0; k < FOVEA_STEPS; k++)
         fv_sampler_free(&p->wide[k]);
+    fv_sampler_free(&p->smp);
     for (int e = 0; e < 2; e++)
         for (int b = 0; b < 2; b++)
             fv_pyramid_free(&p->eyes[e].pyr[b]);
