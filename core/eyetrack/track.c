@@ -770,7 +770,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     const int ng = find_glints(t, luma, w, h, stride, &p, work, stack, gl);
     if (small) {
         /* The box centre, moved toward the crop's centre (the crop is the eye detector's own
-         * estimate: on MRL the labels sit ~10% of the way from the detection to the centre)
+         * estimate: on MRL the labels sit ~8% of the way from the detection to the centre)
          * and toward a corneal reflection inside the box (it hides part of the pupil, and its
          * inpainted area looks less dark than the pupil, which pushes the box away from it),
          * then on a pixel centre again like the box it came from. */
