@@ -42,6 +42,7 @@ struct fv_pipeline {
     fv_dof_work dof_work;    /* scratch shared by the eyes (rendered one after the other) */
     float *enh_fp;           /* contrast enhancement footprint per eccentricity step */
     int enh_n;
+    const fv_sampler *enh_for; /* the sampler enh_fp was computed for (the fovea may widen) */
     int64_t t_ns;            /* the frame time set by fv_pipeline_set_time_ns; INT64_MIN: none */
     eye_state eyes[2];
     uint8_t srgb[SRGB_LUT + 1]; /* linear [0,1] -> sRGB 8-bit */
@@ -138,10 +139,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
                 fv_err(err, err_len, "out of memory");
                 goto bad;
             }
-            for (int i = 0; i < p->enh_n; i++) {
-                const float pr = fv_sampler_probability(&p->smp, 4.0f * (float)i, 0.0f);
-                p->enh_fp[i] = pr > 0.0f ? 1.0f / sqrtf(pr) : 1.0f;
-            }
+            p->enh_for = NULL; /* filled for the sampler in force at the first frame */
         }
     }
     p->pool = fv_pool_create(cfg->threads);
@@ -228,6 +226,13 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
         st->stage_ms[FV_STAGE_COC] = focus_ms;
         return;
     }
+    if (p->enh_fp && p->enh_for != p->smp_cur) {
+        for (int i = 0; i < p->enh_n; i++) {
+            const float pr = fv_sampler_probability(p->smp_cur, 4.0f * (float)i, 0.0f);
+            p->enh_fp[i] = pr > 0.0f ? 1.0f / sqrtf(pr) : 1.0f;
+        }
+        p->enh_for = p->smp_cur;
+    }
     fv_dof_view v = {
         .pyr = pyr,
         .focus_m = focus_m,
@@ -235,8 +240,8 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
         .blur_scale = fv_dof_presets[dp->preset].e_scale,
         .gaze_x = gx,
         .gaze_y = gy,
-        .r0_px = p->smp.r0_px,
-        .r1_px = p->smp.r1_px,
+        .r0_px = p->smp_cur->r0_px, /* the fovea in force (widened when the gaze is doubtful) */
+        .r1_px = p->smp_cur->r1_px,
         .prm = dp,
         .enh_fp = p->enh_fp,
         .enh_n = p->enh_n,
