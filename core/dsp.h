@@ -93,8 +93,9 @@ typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, in
  * dof_vgauss_row: for x in [x0, x0+n): dst[x] = sum_j g_j src[clamp(y + j, ylo, yhi - 1)][x]
  *   (4 channels; src rows stride pixels apart).
  * dof_combine_row: out[x] for x in [x0, x0+n): o = sharp; towards far by min(1, coc) where
- *   coc > 0; near n = near (or 0), blended by t towards s * lnear where t > 0 (s = min(1, -coc/4)
- *   for near pixels, else 1); towards n.rgb / n.w by min(1, n.w) where n.w > 0; with enh,
+ *   coc > 0, by t min(1, -coc) where coc < 0; near n = near (or 0), blended by t towards
+ *   s * lnear where t > 0 (s = 0 for near pixels, else 1); towards n.rgb / n.w by min(1, n.w)
+ *   where n.w > 0; with enh,
  *   o = max(0, o + gain t (o - enh)) where gain t > 0; depth copied (fv_dof_combine_row_c has
  *   the order of operations). */
 struct fv_dof_gauss_tab;
