@@ -165,6 +165,10 @@ bench: deps
 	@mkdir -p out/bench
 	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 30 --json out/bench/range.json
 	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 30 --yaw-rate 30 --json out/bench/range-turning.json
+	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 30 --dof weak --json out/bench/range-dof.json
+	for m in hussain mantiuk konrad liu; do \
+	    $(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 5 --warmup 1 --dof weak --dof-model $$m \
+	        --json out/bench/range-dof-$$m.json || exit 1; done
 
 PREFIX ?= /usr/local
 install: all
