@@ -1,0 +1,214 @@
+/* fovea: depth-of-field kernels, AArch64 Advanced SIMD. Bit-identical to the C references in
+ * core/dof/kernels.c: one pixel = one float32x4_t (the references add channel by channel in the
+ * same order), true division (FDIV), multiply-by-scalar then add (no FMLA: the tree is built with
+ * -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the depths); the
+ * Gaussians 4 output pixels at a time so 4 independent add chains overlap.
+ *
+ * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
+ * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
+ * it (the table holds 0 there, core/dof/weier_impl.h), and an accumulator that starts at +0 is
+ * never -0 (x + y is -0 only if both are -0), so adding +-0 leaves its bits unchanged. The same
+ * argument lets the horizontal pass add +0 (a masked tap) for a near sample instead of skipping
+ * it. The values read for those extra taps lie in the rows / columns the call covers and must be
+ * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
+#include <arm_neon.h>
+#include <math.h>
+
+#include "dof/weier_impl.h"
+#include "dsp.h"
+
+#define CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
+
+static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+static inline int maxi(int a, int b) { return a > b ? a : b; }
+
+static inline float32x4_t sel(uint32x4_t m, float32x4_t a, float32x4_t b) { return vbslq_f32(m, a, b); }
+
+static void coc_row_neon(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
+{
+    const float32x4_t idn = vdupq_n_f32(1.0f / dn), idf = vdupq_n_f32(1.0f / df);
+    const float32x4_t vdn = vdupq_n_f32(dn), vdf = vdupq_n_f32(df), lo = vdupq_n_f32(FV_DOF_MIN_DEPTH_M);
+    const float32x4_t one = vdupq_n_f32(1.0f), zero = vdupq_n_f32(0.0f);
+    int x = 0;
+    for (; x + 4 <= n; x += 4) {
+        const float32x4_t d = vld4q_f32(rgbd + 4 * x).val[3];
+        const float32x4_t g = sel(vcgtq_f32(d, lo), d, lo);
+        const float32x4_t ig = vdivq_f32(one, g);
+        const float32x4_t nr = vmulq_n_f32(vsubq_f32(idn, ig), K);
+        const float32x4_t fr = vmulq_n_f32(vsubq_f32(idf, ig), K);
+        vst1q_f32(coc + x, sel(vcltq_f32(g, vdn), nr, sel(vcgtq_f32(g, vdf), fr, zero)));
+    }
+    if (x < n)
+        fv_dof_coc_row_c(coc + x, rgbd + 4 * x, n - x, K, dn, df);
+}
+
+/* (r, g, b, 1) for a far sample (coc > 0), +0 otherwise, positions base .. base+len-1 clamped
+ * into [0, w). */
+static inline void mask_row(float *restrict m, const float *rgbd, const float *coc, int w, int base, int len)
+{
+    for (int k = 0; k < len; k++) {
+        const int q = clampi(base + k, 0, w - 1);
+        const float32x4_t p = vsetq_lane_f32(1.0f, vld1q_f32(rgbd + 4 * q), 3);
+        const uint32x4_t far = vcgtq_f32(vdupq_n_f32(coc[q]), vdupq_n_f32(0.0f));
+        vst1q_f32(m + 4 * k, vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(p), far)));
+    }
+}
+
+static inline float32x4_t g1(const float *m, const float *wt, int R)
+{
+    float32x4_t a = vdupq_n_f32(0.0f);
+    for (int j = -R; j <= R; j++)
+        a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(m + 4 * j), wt[j < 0 ? -j : j]));
+    return a;
+}
+
+static void hgauss_row_neon(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                            const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    float m[4 * (CH + 2 * FV_DOF_RMAX)];
+    for (int c0 = 0; c0 < n; c0 += CH) {
+        const int cn = n - c0 < CH ? n - c0 : CH;
+        const uint8_t *sg = sig + c0;
+        int Rc = 0;
+        for (int i = 0; i < cn; i++)
+            Rc = maxi(Rc, tab->rad[sg[i]]);
+        mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
+        const float *mc = m + 4 * Rc; /* output pixel c0 + i at mc + 4 i */
+        float *d = dst + 4 * (ptrdiff_t)(x0 + c0);
+        int i = 0;
+        for (; i + 4 <= cn; i += 4) {
+            const uint8_t *s = sg + i;
+            const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
+            const int R = maxi(maxi(tab->rad[s[0]], tab->rad[s[1]]), maxi(tab->rad[s[2]], tab->rad[s[3]]));
+            float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
+            for (int j = -R; j <= R; j++) {
+                const int k = j < 0 ? -j : j;
+                const float *p = mc + 4 * (i + j);
+                a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
+                a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
+                a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
+                a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
+            }
+            vst1q_f32(d + 4 * i, vmulq_n_f32(a0, tab->inv[s[0]]));
+            vst1q_f32(d + 4 * i + 4, vmulq_n_f32(a1, tab->inv[s[1]]));
+            vst1q_f32(d + 4 * i + 8, vmulq_n_f32(a2, tab->inv[s[2]]));
+            vst1q_f32(d + 4 * i + 12, vmulq_n_f32(a3, tab->inv[s[3]]));
+        }
+        for (; i < cn; i++)
+            vst1q_f32(d + 4 * i, vmulq_n_f32(g1(mc + 4 * i, tab->w[sg[i]], tab->rad[sg[i]]), tab->inv[sg[i]]));
+    }
+}
+
+static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
+                            int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const uint8_t *s = sig + i;
+        const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
+        const int R = maxi(maxi(tab->rad[s[0]], tab->rad[s[1]]), maxi(tab->rad[s[2]], tab->rad[s[3]]));
+        const float *col = src + 4 * (ptrdiff_t)(x0 + i);
+        float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
+        for (int j = -R; j <= R; j++) {
+            const int k = j < 0 ? -j : j;
+            const float *p = col + 4 * (ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride;
+            a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
+            a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
+            a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
+            a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
+        }
+        float *o = dst + 4 * (ptrdiff_t)(x0 + i);
+        vst1q_f32(o, a0);
+        vst1q_f32(o + 4, a1);
+        vst1q_f32(o + 8, a2);
+        vst1q_f32(o + 12, a3);
+    }
+    for (; i < n; i++) {
+        const float *wt = tab->w[sig[i]], *col = src + 4 * (ptrdiff_t)(x0 + i);
+        const int R = tab->rad[sig[i]];
+        float32x4_t a = vdupq_n_f32(0.0f);
+        for (int j = -R; j <= R; j++)
+            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + 4 * (ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride),
+                                         wt[j < 0 ? -j : j]));
+        vst1q_f32(dst + 4 * (ptrdiff_t)(x0 + i), a);
+    }
+}
+
+/* fv_dof_tap_c: acc + ((b00 r0[x0] + b10 r0[x1]) + (b01 r1[x0] + b11 r1[x1])) */
+static inline float32x4_t tap(const fv_pyr_level *L, int level, float fx, float fy, float32x4_t acc)
+{
+    const float sc = 1.0f / (float)(1 << level);
+    const float u = fx * sc - 0.5f, v = fy * sc - 0.5f;
+    const float fu = floorf(u), fv = floorf(v);
+    const float ax = u - fu, ay = v - fv;
+    const int x0 = clampi((int)fu, 0, L->w - 1), x1 = clampi((int)fu + 1, 0, L->w - 1);
+    const int y0 = clampi((int)fv, 0, L->h - 1), y1 = clampi((int)fv + 1, 0, L->h - 1);
+    const float *r0 = L->rgbd + 4 * (ptrdiff_t)y0 * L->stride, *r1 = L->rgbd + 4 * (ptrdiff_t)y1 * L->stride;
+    const float b00 = (1.0f - ax) * (1.0f - ay), b10 = ax * (1.0f - ay), b01 = (1.0f - ax) * ay, b11 = ax * ay;
+    const float32x4_t t0 = vaddq_f32(vmulq_n_f32(vld1q_f32(r0 + 4 * x0), b00), vmulq_n_f32(vld1q_f32(r0 + 4 * x1), b10));
+    const float32x4_t t1 = vaddq_f32(vmulq_n_f32(vld1q_f32(r1 + 4 * x0), b01), vmulq_n_f32(vld1q_f32(r1 + 4 * x1), b11));
+    return vaddq_f32(acc, vaddq_f32(t0, t1));
+}
+
+static inline float32x4_t quincunx(const fv_pyramid *pyr, float c, float fx, float fy)
+{
+    int L;
+    float o;
+    fv_dof_footprint(c, pyr->levels - 1, &L, &o);
+    const fv_pyr_level *lv = &pyr->lv[L];
+    float32x4_t q = tap(lv, L, fx, fy, vdupq_n_f32(0.0f)); /* 0 + tap, as the reference (-0 -> +0) */
+    if (o >= 0.125f) {
+        q = tap(lv, L, fx - o, fy - o, q);
+        q = tap(lv, L, fx + o, fy - o, q);
+        q = tap(lv, L, fx - o, fy + o, q);
+        q = tap(lv, L, fx + o, fy + o, q);
+        q = vmulq_n_f32(q, 0.2f);
+    }
+    return q;
+}
+
+/* a + s (b - a) */
+static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float s) { return vaddq_f32(a, vmulq_n_f32(vsubq_f32(b, a), s)); }
+
+static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
+{
+    const float fy = (float)a->y + 0.5f, dy = fy - a->gy;
+    const float32x4_t zero = vdupq_n_f32(0.0f);
+    for (int x = x0; x < x0 + n; x++) {
+        const float32x4_t s = vld1q_f32(a->sharp + 4 * x);
+        float32x4_t o = s; /* lane 3 is carried along unused and replaced by the depth at the end */
+        const float c = a->coc[x], fx = (float)x + 0.5f, dx = fx - a->gx;
+        const float ecc = sqrtf(dx * dx + dy * dy);
+        float t = (ecc - a->r0) * a->inv_tr;
+        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        if (c > 0.0f) {
+            float32x4_t f = zero;
+            if (t < 1.0f && a->far && x >= a->far_x0 && x < a->far_x1 && a->far[4 * x + 3] > 0.0f) {
+                const float32x4_t p = vld1q_f32(a->far + 4 * x);
+                f = vdivq_f32(p, vdupq_laneq_f32(p, 3));
+            }
+            if (t > 0.0f)
+                f = lerp(f, quincunx(a->pyr, c, fx, fy), t);
+            o = lerp(o, f, c < 1.0f ? c : 1.0f);
+        }
+        if (a->has_near && a->near[4 * x + 3] > 0.0f) {
+            const float32x4_t p = vld1q_f32(a->near + 4 * x);
+            const float cov = a->near[4 * x + 3] < 1.0f ? a->near[4 * x + 3] : 1.0f;
+            o = lerp(o, vdivq_f32(p, vdupq_laneq_f32(p, 3)), cov);
+        }
+        if (a->enh && t > 0.0f) {
+            const float32x4_t b = vld1q_f32(a->enh + 4 * x);
+            const float32x4_t v = vaddq_f32(o, vmulq_n_f32(vsubq_f32(o, b), a->gain * t));
+            o = sel(vcgtq_f32(v, zero), v, zero); /* v > 0 ? v : +0 (FMAX would keep a NaN) */
+        }
+        vst1q_f32(out + 4 * x, vcopyq_laneq_f32(o, 3, s, 3));
+    }
+}
+
+void fv_dof_init_neon(fv_dsp *d)
+{
+    d->dof_coc_row = coc_row_neon;
+    d->dof_hgauss_row = hgauss_row_neon;
+    d->dof_vgauss_row = vgauss_row_neon;
+    d->dof_combine_row = combine_row_neon;
+}

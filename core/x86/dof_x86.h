@@ -1,0 +1,215 @@
+/* fovea: the 128-bit pieces of the depth-of-field kernels shared by the SSE4.1 and AVX2 versions
+ * (each .c file includes this and is built with its own ISA flags). One pixel = one __m128
+ * (r, g, b, depth or weight): the references (core/dof/kernels.c) add channel by channel in the
+ * same order, so a vector of 4 channel accumulators gives their bits.
+ *
+ * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
+ * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
+ * it (the table holds 0 there, core/dof/weier_impl.h), and an accumulator that starts at +0 is
+ * never -0 (x + y is -0 only if both are -0), so adding +-0 leaves its bits unchanged. The same
+ * argument lets the horizontal pass add +0 (a masked tap) for a near sample instead of skipping
+ * it. The values read for those extra taps lie in the rows / columns the call covers and must be
+ * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
+#ifndef FOVEA_DOF_X86_H
+#define FOVEA_DOF_X86_H
+
+#include <math.h>
+#include <smmintrin.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dof/weier_impl.h"
+#include "dsp.h"
+
+#define DOF_CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
+
+static inline int dof_clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+static inline int dof_maxi(int a, int b) { return a > b ? a : b; }
+
+/* ---- coc_row: 4 pixels ---- */
+typedef struct {
+    __m128 K, idn, idf, dn, df;
+} dof_coc4_k;
+
+static inline dof_coc4_k dof_coc4_setup(float K, float dn, float df)
+{
+    dof_coc4_k k;
+    k.K = _mm_set1_ps(K);
+    k.idn = _mm_set1_ps(1.0f / dn);
+    k.idf = _mm_set1_ps(1.0f / df);
+    k.dn = _mm_set1_ps(dn);
+    k.df = _mm_set1_ps(df);
+    return k;
+}
+
+/* depths of 4 pixels -> their CoCs: g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 */
+static inline __m128 dof_coc4(__m128 d, const dof_coc4_k *k)
+{
+    const __m128 g = _mm_max_ps(d, _mm_set1_ps(FV_DOF_MIN_DEPTH_M)); /* d > min ? d : min */
+    const __m128 ig = _mm_div_ps(_mm_set1_ps(1.0f), g);
+    const __m128 nr = _mm_mul_ps(k->K, _mm_sub_ps(k->idn, ig));
+    const __m128 fr = _mm_and_ps(_mm_mul_ps(k->K, _mm_sub_ps(k->idf, ig)), _mm_cmpgt_ps(g, k->df));
+    return _mm_blendv_ps(fr, nr, _mm_cmplt_ps(g, k->dn));
+}
+
+/* lane 3 of 4 consecutive pixels */
+static inline __m128 dof_depth4(const float *rgbd)
+{
+    const __m128 h01 = _mm_unpackhi_ps(_mm_loadu_ps(rgbd), _mm_loadu_ps(rgbd + 4));       /* z0 z1 d0 d1 */
+    const __m128 h23 = _mm_unpackhi_ps(_mm_loadu_ps(rgbd + 8), _mm_loadu_ps(rgbd + 12));  /* z2 z3 d2 d3 */
+    return _mm_movehl_ps(h23, h01);
+}
+
+/* ---- hgauss_row ---- */
+
+/* The row as the far layer sees it, positions base .. base+len-1 clamped into [0, w):
+ * (r, g, b, 1) for a far sample (coc > 0), +0 otherwise (so g * m adds exactly what the
+ * reference adds, or +-0 for a skipped tap). 16-byte aligned m. */
+static inline void dof_mask_row(float *restrict m, const float *rgbd, const float *coc, int w, int base, int len)
+{
+    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+    for (int k = 0; k < len; k++) {
+        const int q = dof_clampi(base + k, 0, w - 1);
+        const __m128 p = _mm_blend_ps(_mm_loadu_ps(rgbd + 4 * q), one, 8);
+        _mm_store_ps(m + 4 * k, _mm_and_ps(p, _mm_cmpgt_ps(_mm_set1_ps(coc[q]), zero)));
+    }
+}
+
+/* One pixel, its own radius; m at the pixel's position. */
+static inline __m128 dof_g1(const float *m, const float *wt, int R)
+{
+    __m128 a = _mm_setzero_ps();
+    for (int j = -R; j <= R; j++)
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(wt[j < 0 ? -j : j]), _mm_loadu_ps(m + 4 * j)));
+    return a;
+}
+
+/* Four neighbouring pixels (m at the first one's position, pixels `step` floats apart), the
+ * block's largest radius R (see the top of this file). */
+static inline void dof_g4(__m128 a[4], const float *m, ptrdiff_t step, const float *const wt[4], int R)
+{
+    __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
+    for (int j = -R; j <= R; j++) {
+        const int k = j < 0 ? -j : j;
+        const float *p = m + 4 * (ptrdiff_t)j;
+        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(wt[0][k]), _mm_loadu_ps(p)));
+        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(wt[1][k]), _mm_loadu_ps(p + step)));
+        a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_set1_ps(wt[2][k]), _mm_loadu_ps(p + 2 * step)));
+        a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_set1_ps(wt[3][k]), _mm_loadu_ps(p + 3 * step)));
+    }
+    a[0] = a0, a[1] = a1, a[2] = a2, a[3] = a3;
+}
+
+/* ---- vgauss_row ---- */
+
+/* Four neighbouring pixels of row y, the block's largest radius R; col points at the first
+ * pixel's column in row 0 of src. */
+static inline void dof_vg4(float *dst, const float *col, ptrdiff_t stride, int y, int ylo, int yhi,
+                           const float *const wt[4], int R)
+{
+    __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
+    for (int j = -R; j <= R; j++) {
+        const int k = j < 0 ? -j : j;
+        const float *p = col + 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
+        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(wt[0][k]), _mm_loadu_ps(p)));
+        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(wt[1][k]), _mm_loadu_ps(p + 4)));
+        a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_set1_ps(wt[2][k]), _mm_loadu_ps(p + 8)));
+        a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_set1_ps(wt[3][k]), _mm_loadu_ps(p + 12)));
+    }
+    _mm_storeu_ps(dst, a0);
+    _mm_storeu_ps(dst + 4, a1);
+    _mm_storeu_ps(dst + 8, a2);
+    _mm_storeu_ps(dst + 12, a3);
+}
+
+static inline void dof_vg1(float *dst, const float *col, ptrdiff_t stride, int y, int ylo, int yhi, const float *wt,
+                           int R)
+{
+    __m128 a = _mm_setzero_ps();
+    for (int j = -R; j <= R; j++) {
+        const float *p = col + 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(wt[j < 0 ? -j : j]), _mm_loadu_ps(p)));
+    }
+    _mm_storeu_ps(dst, a);
+}
+
+/* ---- combine_row: the scalar control flow of the reference, colours as vectors ---- */
+
+static inline __m128 dof_bcast3(__m128 v) { return _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 3, 3)); }
+
+/* fv_dof_tap_c: acc + ((b00 r0[x0] + b10 r0[x1]) + (b01 r1[x0] + b11 r1[x1])) */
+static inline __m128 dof_tap(const fv_pyr_level *L, int level, float fx, float fy, __m128 acc)
+{
+    const float sc = 1.0f / (float)(1 << level);
+    const float u = fx * sc - 0.5f, v = fy * sc - 0.5f;
+    const float fu = floorf(u), fv = floorf(v);
+    const float ax = u - fu, ay = v - fv;
+    const int x0 = dof_clampi((int)fu, 0, L->w - 1), x1 = dof_clampi((int)fu + 1, 0, L->w - 1);
+    const int y0 = dof_clampi((int)fv, 0, L->h - 1), y1 = dof_clampi((int)fv + 1, 0, L->h - 1);
+    const float *r0 = L->rgbd + 4 * (ptrdiff_t)y0 * L->stride, *r1 = L->rgbd + 4 * (ptrdiff_t)y1 * L->stride;
+    const float b00 = (1.0f - ax) * (1.0f - ay), b10 = ax * (1.0f - ay), b01 = (1.0f - ax) * ay, b11 = ax * ay;
+    const __m128 t0 = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(b00), _mm_loadu_ps(r0 + 4 * x0)),
+                                 _mm_mul_ps(_mm_set1_ps(b10), _mm_loadu_ps(r0 + 4 * x1)));
+    const __m128 t1 = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(b01), _mm_loadu_ps(r1 + 4 * x0)),
+                                 _mm_mul_ps(_mm_set1_ps(b11), _mm_loadu_ps(r1 + 4 * x1)));
+    return _mm_add_ps(acc, _mm_add_ps(t0, t1));
+}
+
+static inline __m128 dof_quincunx(const fv_pyramid *pyr, float c, float fx, float fy)
+{
+    int L;
+    float o;
+    fv_dof_footprint(c, pyr->levels - 1, &L, &o);
+    const fv_pyr_level *lv = &pyr->lv[L];
+    __m128 q = dof_tap(lv, L, fx, fy, _mm_setzero_ps()); /* 0 + tap, as the reference (-0 -> +0) */
+    if (o >= 0.125f) {
+        q = dof_tap(lv, L, fx - o, fy - o, q);
+        q = dof_tap(lv, L, fx + o, fy - o, q);
+        q = dof_tap(lv, L, fx - o, fy + o, q);
+        q = dof_tap(lv, L, fx + o, fy + o, q);
+        q = _mm_mul_ps(q, _mm_set1_ps(0.2f));
+    }
+    return q;
+}
+
+/* a + s (b - a), s broadcast */
+static inline __m128 dof_lerp(__m128 a, __m128 b, float s)
+{
+    return _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(s), _mm_sub_ps(b, a)));
+}
+
+static inline void dof_combine_row_x86(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
+{
+    const float fy = (float)a->y + 0.5f, dy = fy - a->gy;
+    for (int x = x0; x < x0 + n; x++) {
+        const __m128 s = _mm_loadu_ps(a->sharp + 4 * x);
+        __m128 o = s; /* lane 3 is carried along unused and replaced by the depth at the end */
+        const float c = a->coc[x], fx = (float)x + 0.5f, dx = fx - a->gx;
+        const float ecc = sqrtf(dx * dx + dy * dy);
+        float t = (ecc - a->r0) * a->inv_tr;
+        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        if (c > 0.0f) {
+            __m128 f = _mm_setzero_ps();
+            if (t < 1.0f && a->far && x >= a->far_x0 && x < a->far_x1 && a->far[4 * x + 3] > 0.0f) {
+                const __m128 p = _mm_loadu_ps(a->far + 4 * x);
+                f = _mm_div_ps(p, dof_bcast3(p));
+            }
+            if (t > 0.0f)
+                f = dof_lerp(f, dof_quincunx(a->pyr, c, fx, fy), t);
+            o = dof_lerp(o, f, c < 1.0f ? c : 1.0f);
+        }
+        if (a->has_near && a->near[4 * x + 3] > 0.0f) {
+            const __m128 p = _mm_loadu_ps(a->near + 4 * x);
+            const float cov = a->near[4 * x + 3] < 1.0f ? a->near[4 * x + 3] : 1.0f;
+            o = dof_lerp(o, _mm_div_ps(p, dof_bcast3(p)), cov);
+        }
+        if (a->enh && t > 0.0f) {
+            const __m128 b = _mm_loadu_ps(a->enh + 4 * x);
+            const __m128 v = _mm_add_ps(o, _mm_mul_ps(_mm_set1_ps(a->gain * t), _mm_sub_ps(o, b)));
+            o = _mm_max_ps(v, _mm_setzero_ps()); /* v > 0 ? v : +0 */
+        }
+        _mm_storeu_ps(out + 4 * x, _mm_blend_ps(o, s, 8));
+    }
+}
+
+#endif
