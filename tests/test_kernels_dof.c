@@ -61,8 +61,8 @@ static buf out_new(size_t count, int off)
 
 static unsigned long compared; /* floats compared, all ISAs */
 
-static void compare(const float *ref, const float *got, size_t count, const char *isa, const char *kernel,
-                    const char *what)
+static void compare(const float *ref, const float *got, size_t count, size_t per_px, const char *isa,
+                    const char *kernel, const char *what)
 {
     for (size_t i = 0; i < count; i++) {
         uint32_t a, b;
@@ -70,7 +70,7 @@ static void compare(const float *ref, const float *got, size_t count, const char
         memcpy(&b, got + i, 4);
         if (a != b)
             fail_msg("%s %s (%s): float %zu (pixel %zu channel %zu): c=%.9g (%a) %s=%.9g (%a)", isa, kernel, what, i,
-                     i / 4, i % 4, (double)ref[i], (double)ref[i], isa, (double)got[i], (double)got[i]);
+                     i / per_px, i % per_px, (double)ref[i], (double)ref[i], isa, (double)got[i], (double)got[i]);
     }
     compared += count;
 }
@@ -139,7 +139,7 @@ static void run_coc(const fv_dsp *d, const char *isa)
             buf r = out_new((size_t)nn, off), t = out_new((size_t)nn, off);
             fv_dof_coc_row_c(r.p, in.p, nn, K, dn, df);
             d->dof_coc_row(t.p, in.p, nn, K, dn, df);
-            compare(r.p, t.p, (size_t)nn + CANARY, isa, "coc_row", "coc + canaries");
+            compare(r.p, t.p, (size_t)nn + CANARY, 1, isa, "coc_row", "coc + canaries");
             for (int i = 0; i < nn; i++)
                 assert_true(isfinite(r.p[i]));
             free(in.base), free(r.base), free(t.base);
@@ -207,7 +207,7 @@ static void run_hgauss1(const fv_dsp *d, const char *isa, int w, int x0, int n, 
     buf r = out_new(4 * (size_t)w, off), t = out_new(4 * (size_t)w, off);
     fv_dof_hgauss_row_c(r.p, rgbd.p, coc.p, w, x0, n, sig, &tab);
     d->dof_hgauss_row(t.p, rgbd.p, coc.p, w, x0, n, sig, &tab);
-    compare(r.p, t.p, 4 * (size_t)w + CANARY, isa, "hgauss_row", "whole row + canaries");
+    compare(r.p, t.p, 4 * (size_t)w + CANARY, 4, isa, "hgauss_row", "whole row + canaries");
     for (int i = 4 * x0; i < 4 * (x0 + n); i++)
         assert_true(isfinite(r.p[i]));
     free(sig), free(rgbd.base), free(coc.base), free(r.base), free(t.base);
@@ -251,7 +251,7 @@ static void run_vgauss1(const fv_dsp *d, const char *isa, int w, int h, int x0, 
     buf r = out_new(4 * (size_t)w, off), t = out_new(4 * (size_t)w, off);
     fv_dof_vgauss_row_c(r.p, src.p, stride, y, ylo, yhi, x0, n, sig, &tab);
     d->dof_vgauss_row(t.p, src.p, stride, y, ylo, yhi, x0, n, sig, &tab);
-    compare(r.p, t.p, 4 * (size_t)w + CANARY, isa, "vgauss_row", "whole row + canaries");
+    compare(r.p, t.p, 4 * (size_t)w + CANARY, 4, isa, "vgauss_row", "whole row + canaries");
     free(sig), free(src.base), free(r.base), free(t.base);
 }
 
@@ -322,7 +322,7 @@ static void run_combine1(const fv_dsp *d, const char *isa, const fv_pyramid *pyr
     buf r = out_new(4 * (size_t)w, off), t = out_new(4 * (size_t)w, off);
     fv_dof_combine_row_c(r.p, &a, x0, n);
     d->dof_combine_row(t.p, &a, x0, n);
-    compare(r.p, t.p, 4 * (size_t)w + CANARY, isa, "combine_row", "whole row + canaries");
+    compare(r.p, t.p, 4 * (size_t)w + CANARY, 4, isa, "combine_row", "whole row + canaries");
     for (int x = x0; x < x0 + n; x++) {
         for (int c = 0; c < 4; c++)
             assert_true(isfinite(r.p[4 * x + c]));
