@@ -155,6 +155,20 @@ static inline __m128 dof_tap(const fv_pyr_level *L, int level, float fx, float f
     return _mm_add_ps(acc, _mm_add_ps(t0, t1));
 }
 
+/* acc + ((b00 r0[x0] + b10 r0[x1]) + (b01 r1[x0] + b11 r1[x1])), weights broadcast */
+static inline __m128 dof_tap_w(const float *r0, const float *r1, int x0, int x1, __m128 b00, __m128 b10, __m128 b01,
+                               __m128 b11, __m128 acc)
+{
+    const __m128 t0 = _mm_add_ps(_mm_mul_ps(b00, _mm_loadu_ps(r0 + 4 * x0)), _mm_mul_ps(b10, _mm_loadu_ps(r0 + 4 * x1)));
+    const __m128 t1 = _mm_add_ps(_mm_mul_ps(b01, _mm_loadu_ps(r1 + 4 * x0)), _mm_mul_ps(b11, _mm_loadu_ps(r1 + 4 * x1)));
+    return _mm_add_ps(acc, _mm_add_ps(t0, t1));
+}
+
+#define DOF_LANE(v, k) _mm_shuffle_ps((v), (v), _MM_SHUFFLE((k), (k), (k), (k)))
+
+/* The quincunx of the reference: the centre tap, then the four corner taps added in its order,
+ * their positions and weights computed at once in the lanes of one vector (the same IEEE
+ * operations per lane as fv_dof_tap_c's scalar code; floor = ROUNDPS, the clamps on integers). */
 static inline __m128 dof_quincunx(const fv_pyramid *pyr, float c, float fx, float fy)
 {
     int L;
@@ -163,10 +177,32 @@ static inline __m128 dof_quincunx(const fv_pyramid *pyr, float c, float fx, floa
     const fv_pyr_level *lv = &pyr->lv[L];
     __m128 q = dof_tap(lv, L, fx, fy, _mm_setzero_ps()); /* 0 + tap, as the reference (-0 -> +0) */
     if (o >= 0.125f) {
-        q = dof_tap(lv, L, fx - o, fy - o, q);
-        q = dof_tap(lv, L, fx + o, fy - o, q);
-        q = dof_tap(lv, L, fx - o, fy + o, q);
-        q = dof_tap(lv, L, fx + o, fy + o, q);
+        const __m128 sc = _mm_set1_ps(1.0f / (float)(1 << L)), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f);
+        const float xm = fx - o, xp = fx + o, ym = fy - o, yp = fy + o;
+        const __m128 u = _mm_sub_ps(_mm_mul_ps(_mm_setr_ps(xm, xp, xm, xp), sc), half);
+        const __m128 v = _mm_sub_ps(_mm_mul_ps(_mm_setr_ps(ym, ym, yp, yp), sc), half);
+        const __m128 fu = _mm_floor_ps(u), fv = _mm_floor_ps(v);
+        const __m128 ax = _mm_sub_ps(u, fu), ay = _mm_sub_ps(v, fv);
+        const __m128i iu = _mm_cvttps_epi32(fu), iv = _mm_cvttps_epi32(fv), i1 = _mm_set1_epi32(1);
+        const __m128i zi = _mm_setzero_si128(), wm = _mm_set1_epi32(lv->w - 1), hm = _mm_set1_epi32(lv->h - 1);
+        int x0[4], x1[4], y0[4], y1[4];
+        _mm_storeu_si128((__m128i *)x0, _mm_min_epi32(_mm_max_epi32(iu, zi), wm));
+        _mm_storeu_si128((__m128i *)x1, _mm_min_epi32(_mm_max_epi32(_mm_add_epi32(iu, i1), zi), wm));
+        _mm_storeu_si128((__m128i *)y0, _mm_min_epi32(_mm_max_epi32(iv, zi), hm));
+        _mm_storeu_si128((__m128i *)y1, _mm_min_epi32(_mm_max_epi32(_mm_add_epi32(iv, i1), zi), hm));
+        const __m128 omx = _mm_sub_ps(one, ax), omy = _mm_sub_ps(one, ay);
+        const __m128 b00 = _mm_mul_ps(omx, omy), b10 = _mm_mul_ps(ax, omy), b01 = _mm_mul_ps(omx, ay);
+        const __m128 b11 = _mm_mul_ps(ax, ay);
+        const float *rg = lv->rgbd;
+        const ptrdiff_t st = 4 * lv->stride;
+#define DOF_CORNER(k)                                                                                           \
+        q = dof_tap_w(rg + st * y0[k], rg + st * y1[k], x0[k], x1[k], DOF_LANE(b00, k), DOF_LANE(b10, k),        \
+                      DOF_LANE(b01, k), DOF_LANE(b11, k), q)
+        DOF_CORNER(0);
+        DOF_CORNER(1);
+        DOF_CORNER(2);
+        DOF_CORNER(3);
+#undef DOF_CORNER
         q = _mm_mul_ps(q, _mm_set1_ps(0.2f));
     }
     return q;
