@@ -41,105 +41,76 @@ static inline __m256 wpair(const float *wa, const float *wb, int k)
     return _mm256_blend_ps(_mm256_broadcast_ss(wa + k), _mm256_broadcast_ss(wb + k), 0xf0);
 }
 
-static inline int rad8(const fv_dof_gauss_tab *tab, const uint8_t *s)
-{
-    int R = 0;
-    for (int k = 0; k < 8; k++)
-        R = dof_maxi(R, tab->rad[s[k]]);
-    return R;
-}
-
-/* 8 neighbouring pixels at p (contiguous), the block's largest radius R; tap j at p + 4 j. */
-static inline void g8(__m256 a[4], const float *p0, const float *const wt[8], int R)
+/* 8 neighbouring pixels (pairs in the halves of 4 accumulators), the block's largest radius R. */
+static inline void g8(__m256 a[4], const float *p, const ptrdiff_t *off, const float *const wt[8], int R)
 {
     __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
-    for (int j = -R; j <= R; j++) {
-        const int k = j < 0 ? -j : j;
-        const float *p = p0 + 4 * (ptrdiff_t)j;
-        a0 = _mm256_add_ps(a0, _mm256_mul_ps(wpair(wt[0], wt[1], k), _mm256_loadu_ps(p)));
-        a1 = _mm256_add_ps(a1, _mm256_mul_ps(wpair(wt[2], wt[3], k), _mm256_loadu_ps(p + 8)));
-        a2 = _mm256_add_ps(a2, _mm256_mul_ps(wpair(wt[4], wt[5], k), _mm256_loadu_ps(p + 16)));
-        a3 = _mm256_add_ps(a3, _mm256_mul_ps(wpair(wt[6], wt[7], k), _mm256_loadu_ps(p + 24)));
+    int one = 1;
+    for (int k = 1; k < 8; k++)
+        one &= wt[k] == wt[0];
+    if (one) { /* one sigma: one broadcast a tap */
+        for (int j = -R; j <= R; j++) {
+            const float *q = p + off[j];
+            const __m256 g = _mm256_broadcast_ss(wt[0] + (j < 0 ? -j : j));
+            a0 = _mm256_add_ps(a0, _mm256_mul_ps(g, _mm256_loadu_ps(q)));
+            a1 = _mm256_add_ps(a1, _mm256_mul_ps(g, _mm256_loadu_ps(q + 8)));
+            a2 = _mm256_add_ps(a2, _mm256_mul_ps(g, _mm256_loadu_ps(q + 16)));
+            a3 = _mm256_add_ps(a3, _mm256_mul_ps(g, _mm256_loadu_ps(q + 24)));
+        }
+    } else {
+        for (int j = -R; j <= R; j++) {
+            const int k = j < 0 ? -j : j;
+            const float *q = p + off[j];
+            a0 = _mm256_add_ps(a0, _mm256_mul_ps(wpair(wt[0], wt[1], k), _mm256_loadu_ps(q)));
+            a1 = _mm256_add_ps(a1, _mm256_mul_ps(wpair(wt[2], wt[3], k), _mm256_loadu_ps(q + 8)));
+            a2 = _mm256_add_ps(a2, _mm256_mul_ps(wpair(wt[4], wt[5], k), _mm256_loadu_ps(q + 16)));
+            a3 = _mm256_add_ps(a3, _mm256_mul_ps(wpair(wt[6], wt[7], k), _mm256_loadu_ps(q + 24)));
+        }
     }
     a[0] = a0, a[1] = a1, a[2] = a2, a[3] = a3;
 }
 
-static void hgauss_row_avx2(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
-                            const uint8_t *sig, const fv_dof_gauss_tab *tab)
-{
-    _Alignas(32) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];
-    for (int c0 = 0; c0 < n; c0 += DOF_CH) {
-        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH;
-        const uint8_t *sg = sig + c0;
-        int Rc = 0;
-        for (int i = 0; i < cn; i++)
-            Rc = dof_maxi(Rc, tab->rad[sg[i]]);
-        dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
-        const float *mc = m + 4 * Rc; /* output pixel c0 + i at mc + 4 i */
-        float *d = dst + 4 * (ptrdiff_t)(x0 + c0);
-        int i = 0;
-        for (; i + 8 <= cn; i += 8) {
-            const uint8_t *s = sg + i;
-            const float *const wt[8] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]],
-                                        tab->w[s[4]], tab->w[s[5]], tab->w[s[6]], tab->w[s[7]]};
-            __m256 a[4];
-            g8(a, mc + 4 * i, wt, rad8(tab, s));
-            for (int k = 0; k < 4; k++) {
-                const __m256 inv = _mm256_setr_m128(_mm_set1_ps(tab->inv[s[2 * k]]), _mm_set1_ps(tab->inv[s[2 * k + 1]]));
-                _mm256_storeu_ps(d + 4 * (i + 2 * k), _mm256_mul_ps(a[k], inv));
-            }
-        }
-        if (i + 4 <= cn) {
-            const uint8_t *s = sg + i;
-            const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
-            const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
-            __m128 a[4];
-            dof_g4(a, mc + 4 * i, 4, wt, R);
-            for (int k = 0; k < 4; k++)
-                _mm_storeu_ps(d + 4 * (i + k), _mm_mul_ps(a[k], _mm_set1_ps(tab->inv[s[k]])));
-            i += 4;
-        }
-        for (; i < cn; i++)
-            _mm_storeu_ps(d + 4 * i, _mm_mul_ps(dof_g1(mc + 4 * i, tab->w[sg[i]], tab->rad[sg[i]]),
-                                                _mm_set1_ps(tab->inv[sg[i]])));
-    }
-}
-
-static void vgauss_row_avx2(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
-                            int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
+/* n pixels from p (output d), 8 at a time, then 4 and 1; norm: times inv[s]. */
+static inline void gauss_8(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
+                           const fv_dof_gauss_tab *tab, int norm)
 {
     int i = 0;
     for (; i + 8 <= n; i += 8) {
         const uint8_t *s = sig + i;
         const float *const wt[8] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]],
                                     tab->w[s[4]], tab->w[s[5]], tab->w[s[6]], tab->w[s[7]]};
-        const int R = rad8(tab, s);
-        const float *col = src + 4 * (ptrdiff_t)(x0 + i);
-        __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
-        for (int j = -R; j <= R; j++) {
-            const int k = j < 0 ? -j : j;
-            const float *p = col + 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
-            a0 = _mm256_add_ps(a0, _mm256_mul_ps(wpair(wt[0], wt[1], k), _mm256_loadu_ps(p)));
-            a1 = _mm256_add_ps(a1, _mm256_mul_ps(wpair(wt[2], wt[3], k), _mm256_loadu_ps(p + 8)));
-            a2 = _mm256_add_ps(a2, _mm256_mul_ps(wpair(wt[4], wt[5], k), _mm256_loadu_ps(p + 16)));
-            a3 = _mm256_add_ps(a3, _mm256_mul_ps(wpair(wt[6], wt[7], k), _mm256_loadu_ps(p + 24)));
+        __m256 a[4];
+        g8(a, p + 4 * i, off, wt, dof_span_rad(s, 8, tab));
+        for (int k = 0; k < 4; k++) {
+            const __m256 inv = _mm256_setr_m128(_mm_set1_ps(tab->inv[s[2 * k]]), _mm_set1_ps(tab->inv[s[2 * k + 1]]));
+            _mm256_storeu_ps(d + 4 * (i + 2 * k), norm ? _mm256_mul_ps(a[k], inv) : a[k]);
         }
-        float *o = dst + 4 * (ptrdiff_t)(x0 + i);
-        _mm256_storeu_ps(o, a0);
-        _mm256_storeu_ps(o + 8, a1);
-        _mm256_storeu_ps(o + 16, a2);
-        _mm256_storeu_ps(o + 24, a3);
     }
-    if (i + 4 <= n) {
-        const uint8_t *s = sig + i;
-        const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
-        const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
-        dof_vg4(dst + 4 * (ptrdiff_t)(x0 + i), src + 4 * (ptrdiff_t)(x0 + i), stride, y, ylo, yhi, wt, R);
-        i += 4;
+    if (i < n)
+        dof_gauss_4(d + 4 * i, p + 4 * i, off, n - i, sig + i, tab, norm);
+}
+
+static void hgauss_row_avx2(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                            const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    _Alignas(32) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    dof_offsets_h(off, FV_DOF_RMAX);
+    for (int c0 = 0; c0 < n; c0 += DOF_CH) {
+        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);
+        dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
+        /* output pixel c0 + i from m + 4 (Rc + i) */
+        gauss_8(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);
     }
-    for (; i < n; i++)
-        dof_vg1(dst + 4 * (ptrdiff_t)(x0 + i), src + 4 * (ptrdiff_t)(x0 + i), stride, y, ylo, yhi, tab->w[sig[i]],
-                tab->rad[sig[i]]);
+}
+
+static void vgauss_row_avx2(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
+                            int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    const int R = dof_span_rad(sig, n, tab);
+    dof_offsets_v(off, R, stride, y, ylo, yhi);
+    gauss_8(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
 }
 
 static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, int x0, int n)

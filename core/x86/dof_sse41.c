@@ -18,44 +18,23 @@ static void hgauss_row_sse41(float *restrict dst, const float *rgbd, const float
                              const uint8_t *sig, const fv_dof_gauss_tab *tab)
 {
     _Alignas(16) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    dof_offsets_h(off, FV_DOF_RMAX);
     for (int c0 = 0; c0 < n; c0 += DOF_CH) {
-        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH;
-        const uint8_t *sg = sig + c0;
-        int Rc = 0;
-        for (int i = 0; i < cn; i++)
-            Rc = dof_maxi(Rc, tab->rad[sg[i]]);
+        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);
         dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
-        const float *mc = m + 4 * Rc; /* output pixel c0 + i at mc + 4 i */
-        float *d = dst + 4 * (ptrdiff_t)(x0 + c0);
-        int i = 0;
-        for (; i + 4 <= cn; i += 4) {
-            const uint8_t *s = sg + i;
-            const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
-            const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
-            __m128 a[4];
-            dof_g4(a, mc + 4 * i, 4, wt, R);
-            for (int k = 0; k < 4; k++)
-                _mm_storeu_ps(d + 4 * (i + k), _mm_mul_ps(a[k], _mm_set1_ps(tab->inv[s[k]])));
-        }
-        for (; i < cn; i++)
-            _mm_storeu_ps(d + 4 * i, _mm_mul_ps(dof_g1(mc + 4 * i, tab->w[sg[i]], tab->rad[sg[i]]),
-                                                _mm_set1_ps(tab->inv[sg[i]])));
+        /* output pixel c0 + i from m + 4 (Rc + i) */
+        dof_gauss_4(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);
     }
 }
 
 static void vgauss_row_sse41(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
                              int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
 {
-    int i = 0;
-    for (; i + 4 <= n; i += 4) {
-        const uint8_t *s = sig + i;
-        const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
-        const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
-        dof_vg4(dst + 4 * (ptrdiff_t)(x0 + i), src + 4 * (ptrdiff_t)(x0 + i), stride, y, ylo, yhi, wt, R);
-    }
-    for (; i < n; i++)
-        dof_vg1(dst + 4 * (ptrdiff_t)(x0 + i), src + 4 * (ptrdiff_t)(x0 + i), stride, y, ylo, yhi, tab->w[sig[i]],
-                tab->rad[sig[i]]);
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    const int R = dof_span_rad(sig, n, tab);
+    dof_offsets_v(off, R, stride, y, ylo, yhi);
+    dof_gauss_4(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
 }
 
 static void combine_row_sse41(float *restrict out, const fv_dof_combine_args *a, int x0, int n)

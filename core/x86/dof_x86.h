@@ -75,62 +75,84 @@ static inline void dof_mask_row(float *restrict m, const float *rgbd, const floa
     }
 }
 
-/* One pixel, its own radius; m at the pixel's position. */
-static inline __m128 dof_g1(const float *m, const float *wt, int R)
+/* ---- the Gaussians' taps: tap j of the pixel at p is at p + off[j] (off points at the entry of
+ * j = 0 and holds the span's largest radius either way): the masked row's neighbours for the
+ * horizontal pass, the clamped rows for the vertical one. Pixel k of a block is at p + 4 k. */
+
+/* One pixel, its own radius. */
+static inline __m128 dof_g1(const float *p, const ptrdiff_t *off, const float *wt, int R)
 {
     __m128 a = _mm_setzero_ps();
     for (int j = -R; j <= R; j++)
-        a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(wt[j < 0 ? -j : j]), _mm_loadu_ps(m + 4 * j)));
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(wt[j < 0 ? -j : j]), _mm_loadu_ps(p + off[j])));
     return a;
 }
 
-/* Four neighbouring pixels (m at the first one's position, pixels `step` floats apart), the
- * block's largest radius R (see the top of this file). */
-static inline void dof_g4(__m128 a[4], const float *m, ptrdiff_t step, const float *const wt[4], int R)
+/* Four neighbouring pixels, the block's largest radius R (see the top of this file). */
+static inline void dof_g4(__m128 a[4], const float *p, const ptrdiff_t *off, const float *const wt[4], int R)
 {
     __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
-    for (int j = -R; j <= R; j++) {
-        const int k = j < 0 ? -j : j;
-        const float *p = m + 4 * (ptrdiff_t)j;
-        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(wt[0][k]), _mm_loadu_ps(p)));
-        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(wt[1][k]), _mm_loadu_ps(p + step)));
-        a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_set1_ps(wt[2][k]), _mm_loadu_ps(p + 2 * step)));
-        a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_set1_ps(wt[3][k]), _mm_loadu_ps(p + 3 * step)));
+    if (wt[0] == wt[1] && wt[0] == wt[2] && wt[0] == wt[3]) { /* one sigma: one broadcast a tap */
+        for (int j = -R; j <= R; j++) {
+            const float *q = p + off[j];
+            const __m128 g = _mm_set1_ps(wt[0][j < 0 ? -j : j]);
+            a0 = _mm_add_ps(a0, _mm_mul_ps(g, _mm_loadu_ps(q)));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(g, _mm_loadu_ps(q + 4)));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(g, _mm_loadu_ps(q + 8)));
+            a3 = _mm_add_ps(a3, _mm_mul_ps(g, _mm_loadu_ps(q + 12)));
+        }
+    } else {
+        for (int j = -R; j <= R; j++) {
+            const int k = j < 0 ? -j : j;
+            const float *q = p + off[j];
+            a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(wt[0][k]), _mm_loadu_ps(q)));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(wt[1][k]), _mm_loadu_ps(q + 4)));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_set1_ps(wt[2][k]), _mm_loadu_ps(q + 8)));
+            a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_set1_ps(wt[3][k]), _mm_loadu_ps(q + 12)));
+        }
     }
     a[0] = a0, a[1] = a1, a[2] = a2, a[3] = a3;
 }
 
-/* ---- vgauss_row ---- */
-
-/* Four neighbouring pixels of row y, the block's largest radius R; col points at the first
- * pixel's column in row 0 of src. */
-static inline void dof_vg4(float *dst, const float *col, ptrdiff_t stride, int y, int ylo, int yhi,
-                           const float *const wt[4], int R)
+/* n pixels from p (output d), 4 at a time; norm: times inv[s] (the horizontal pass). */
+static inline void dof_gauss_4(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
+                               const fv_dof_gauss_tab *tab, int norm)
 {
-    __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
-    for (int j = -R; j <= R; j++) {
-        const int k = j < 0 ? -j : j;
-        const float *p = col + 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
-        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(wt[0][k]), _mm_loadu_ps(p)));
-        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(wt[1][k]), _mm_loadu_ps(p + 4)));
-        a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_set1_ps(wt[2][k]), _mm_loadu_ps(p + 8)));
-        a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_set1_ps(wt[3][k]), _mm_loadu_ps(p + 12)));
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const uint8_t *s = sig + i;
+        const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
+        const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
+        __m128 a[4];
+        dof_g4(a, p + 4 * i, off, wt, R);
+        for (int k = 0; k < 4; k++)
+            _mm_storeu_ps(d + 4 * (i + k), norm ? _mm_mul_ps(a[k], _mm_set1_ps(tab->inv[s[k]])) : a[k]);
     }
-    _mm_storeu_ps(dst, a0);
-    _mm_storeu_ps(dst + 4, a1);
-    _mm_storeu_ps(dst + 8, a2);
-    _mm_storeu_ps(dst + 12, a3);
+    for (; i < n; i++) {
+        const __m128 a = dof_g1(p + 4 * i, off, tab->w[sig[i]], tab->rad[sig[i]]);
+        _mm_storeu_ps(d + 4 * i, norm ? _mm_mul_ps(a, _mm_set1_ps(tab->inv[sig[i]])) : a);
+    }
 }
 
-static inline void dof_vg1(float *dst, const float *col, ptrdiff_t stride, int y, int ylo, int yhi, const float *wt,
-                           int R)
+/* The offsets of the taps j in [-R, R]: the horizontal pass's (neighbours in the masked row)
+ * and the vertical pass's (rows clamped into [ylo, yhi), relative to row 0). off points at j = 0. */
+static inline void dof_offsets_h(ptrdiff_t *off, int R)
 {
-    __m128 a = _mm_setzero_ps();
-    for (int j = -R; j <= R; j++) {
-        const float *p = col + 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
-        a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(wt[j < 0 ? -j : j]), _mm_loadu_ps(p)));
-    }
-    _mm_storeu_ps(dst, a);
+    for (int j = -R; j <= R; j++)
+        off[j] = 4 * (ptrdiff_t)j;
+}
+static inline void dof_offsets_v(ptrdiff_t *off, int R, ptrdiff_t stride, int y, int ylo, int yhi)
+{
+    for (int j = -R; j <= R; j++)
+        off[j] = 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
+}
+
+static inline int dof_span_rad(const uint8_t *sig, int n, const fv_dof_gauss_tab *tab)
+{
+    int R = 0;
+    for (int i = 0; i < n; i++)
+        R = dof_maxi(R, tab->rad[sig[i]]);
+    return R;
 }
 
 /* ---- combine_row: the scalar control flow of the reference, colours as vectors ---- */
