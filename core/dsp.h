@@ -92,6 +92,11 @@ typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, in
  *   (coc > 0), taps clamped to [0, w): dst[x] = (sum g rgb, sum g) * inv[sig] (premultiplied).
  * dof_vgauss_row: for x in [x0, x0+n): dst[x] = sum_j g_j src[clamp(y + j, ylo, yhi - 1)][x]
  *   (4 channels; src rows stride pixels apart).
+ *   The ISA versions of both Gaussians run blocks of neighbouring pixels to the block's largest
+ *   radius, adding w = 0 taps (the table's zeros) beyond a pixel's own: same bits (an
+ *   accumulator starting at +0 is never -0, so + (+-0) changes nothing), but they read (not
+ *   use) those extra taps, in the row's [0, w) / the rows [ylo, yhi) at columns [x0, x0+n),
+ *   which must hold finite values there (far samples' colours; far_h).
  * dof_combine_row: out[x] for x in [x0, x0+n): sharp, far layer, near layer and contrast
  *   enhancement (fv_dof_combine_row_c has the order of operations). */
 struct fv_dof_gauss_tab;
