@@ -97,8 +97,11 @@ typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, in
  *   accumulator starting at +0 is never -0, so + (+-0) changes nothing), but they read (not
  *   use) those extra taps, in the row's [0, w) / the rows [ylo, yhi) at columns [x0, x0+n),
  *   which must hold finite values there (far samples' colours; far_h).
- * dof_combine_row: out[x] for x in [x0, x0+n): sharp, far layer, near layer and contrast
- *   enhancement (fv_dof_combine_row_c has the order of operations). */
+ * dof_combine_row: out[x] for x in [x0, x0+n): o = sharp; towards far by min(1, coc) where
+ *   coc > 0; near n = near (or 0), blended by t towards s * lnear where t > 0 (s = min(1, -coc/4)
+ *   for near pixels, else 1); towards n.rgb / n.w by min(1, n.w) where n.w > 0; with enh,
+ *   o = max(0, o + gain t (o - enh)) where gain t > 0; depth copied (fv_dof_combine_row_c has
+ *   the order of operations). */
 struct fv_dof_gauss_tab;
 struct fv_dof_combine_args;
 typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);

@@ -67,7 +67,7 @@ enum {
     "  --gaze-error-deg E tracker's angular error: focus sampling radius (default 1)\n"          \
     "  --accommodation-ms T  focus time constant (default 370; 0 = instant)\n"                   \
     "  --dof-tolerance-m T   depth range kept sharp around the focus, +-T (default 0.2)\n"      \
-    "  --contrast-gain G  peripheral contrast enhancement (Patney 2016; default 0.5, 0 = off)\n" \
+    "  --contrast-gain G  peripheral contrast enhancement (Patney 2016; default 0 = off)\n" \
     "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
 /* After getopt_long: no stray words, a scene was given, option combinations agree (r0 <= r1);

@@ -177,10 +177,13 @@ static void near_blurred_square(int x, int y, float px[4])
     px[3] = in ? 0.3f : 2.0f;
 }
 
-static void check_near_spreads(float gx, float gy)
+/* In the fovea the near layer is the full-resolution box: the exact coverage profile. */
+static void test_near_spreads_fovea(void **st)
 {
+    (void)st;
     rig r;
-    rig_init(&r, near_blurred_square, FV_DOF_MEDIUM, 2.0f, gx, gy);
+    rig_init(&r, near_blurred_square, FV_DOF_MEDIUM, 2.0f, 90.0f, 80.0f);
+    r.v.r0_px = 90.0f, r.v.r1_px = 130.0f; /* the square and its surround in the fovea */
     rig_run(&r, NULL, ~0u);
     /* near CoC = 0.00449 * 600 * 2 * (1/0.3 - 1/1.8) = 14.97 px: radius floor(7.48) = 7 */
     const int R = 7, ym = (SQ_Y0 + SQ_Y1) / 2;
@@ -192,23 +195,36 @@ static void check_near_spreads(float gx, float gy)
         assert_float_equal(out_px(&r, SQ_X0 - d, ym)[1], expect, 1e-4f);
     }
     /* beyond reach the background is untouched */
-    assert_memory_equal(out_px(&r, SQ_X1 + R + 1, ym), in_px(&r, SQ_X1 + R + 1, ym), 4 * sizeof(float));
+    assert_memory_equal(out_px(&r, SQ_X1 + R, ym), in_px(&r, SQ_X1 + R, ym), 4 * sizeof(float));
     assert_memory_equal(out_px(&r, 5, 5), in_px(&r, 5, 5), 4 * sizeof(float));
     /* the object's inside, far from its edges, keeps its colour */
     assert_float_equal(out_px(&r, 90, ym)[0], 1.0f, 1e-5f);
     rig_free(&r);
 }
 
-static void test_near_spreads_fovea(void **st)
-{
-    (void)st;
-    check_near_spreads(90.0f, 80.0f);
-}
-
+/* In the periphery the near layer is the same filter on 4x4 blocks, up-sampled: the spread
+ * falls off monotonically over about the same reach and leaves the rest alone. */
 static void test_near_spreads_periphery(void **st)
 {
     (void)st;
-    check_near_spreads(-500.0f, -500.0f);
+    rig r;
+    rig_init(&r, near_blurred_square, FV_DOF_MEDIUM, 2.0f, -500.0f, -500.0f);
+    rig_run(&r, NULL, ~0u);
+    const int ym = (SQ_Y0 + SQ_Y1) / 2;
+    float prev = 1.0f;
+    for (int d = 1; d <= 12; d++) {
+        const float v = out_px(&r, SQ_X1 - 1 + d, ym)[0];
+        assert_true(v <= prev + 1e-6f);
+        prev = v;
+    }
+    assert_true(out_px(&r, SQ_X1, ym)[0] > 0.3f);   /* spreads past the silhouette */
+    assert_true(out_px(&r, SQ_X1 + 4, ym)[0] > 0.1f);
+    assert_true(out_px(&r, SQ_X1 + 6, ym)[0] < out_px(&r, SQ_X1, ym)[0]);
+    /* two blocks of reach plus the up-sampling's texel: nothing beyond 16 px */
+    assert_memory_equal(out_px(&r, SQ_X1 + 16, ym), in_px(&r, SQ_X1 + 16, ym), 4 * sizeof(float));
+    assert_memory_equal(out_px(&r, 5, 5), in_px(&r, 5, 5), 4 * sizeof(float));
+    assert_float_equal(out_px(&r, 90, ym)[0], 1.0f, 1e-5f);
+    rig_free(&r);
 }
 
 /* A far vertical step edge at one depth, in the centre: the far layer is a Gaussian of sigma

@@ -17,7 +17,6 @@
 
 #include "dof/weier_impl.h"
 #include "dsp.h"
-#include "pullpush.h"
 
 #define SPAN 128 /* TILE * 8, the span of core/dof/weier.c's Gaussian calls */
 #define ROWS 8   /* rows cycled through per timed pass (in cache) */
@@ -59,8 +58,7 @@ typedef struct {
     uint8_t *sigh, *sigv;           /* ROWS rows of sigma indices of the two passes */
     float *plane;                   /* VROWS rows of far_h */
     float *dst;                     /* ROWS output rows */
-    fv_pyramid pyr;
-    float *near, *far, *enh;        /* one row each */
+    float *near, *lnear, *far, *enh, *t; /* one row each */
 } bench;
 
 enum { K_COC, K_HG, K_VG, K_COMB, K_N };
@@ -87,16 +85,13 @@ static double pass(const bench *b, const fv_dsp *d, int k)
                                   &b->tab);
             break;
         default: {
-            /* gaze in the row's middle: centre (far layer) within 200 px, periphery (pyramid
-             * taps and contrast enhancement) beyond 320 px, the blend between */
+            /* as core/dof/weier.c: the whole row at once; near layers and enhancement on
+             * odd rows only (tiles no near sample reaches; contrast enhancement off by default) */
             const fv_dof_combine_args a = {
-                .pyr = &b->pyr, .y = r, .sharp = b->pyr.lv[0].rgbd + 4 * (ptrdiff_t)r * b->pyr.lv[0].stride,
-                .coc = coc, .far = b->far, .far_x0 = W / 2 - 240, .far_x1 = W / 2 + 240, .near = b->near,
-                .has_near = r & 1, .gx = 0.5f * (float)W, .gy = (float)r, .r0 = 200.0f, .inv_tr = 1.0f / 120.0f,
-                .gain = 0.5f, .enh = b->enh,
+                .sharp = rgbd, .coc = coc, .far = b->far, .near = r & 1 ? b->near : NULL,
+                .lnear = r & 1 ? b->lnear : NULL, .t = b->t, .enh = r & 1 ? b->enh : NULL, .gain = 0.5f,
             };
-            for (int xs = 0; xs < W; xs += 16)
-                d->dof_combine_row(dst, &a, xs, W - xs < 16 ? W - xs : 16);
+            d->dof_combine_row(dst, &a, 0, W);
         }
         }
     }
@@ -169,8 +164,10 @@ int main(int argc, char **argv)
     b.near = malloc(4 * sizeof(float) * (size_t)W);
     b.far = malloc(4 * sizeof(float) * (size_t)W);
     b.enh = malloc(4 * sizeof(float) * (size_t)W);
+    b.lnear = malloc(4 * sizeof(float) * (size_t)W);
+    b.t = malloc(sizeof(float) * (size_t)W);
     if (!b.rgbd || !b.coc || !b.sigh || !b.sigv || !b.plane || !b.dst || !ref || !b.near || !b.far || !b.enh ||
-        fv_pyramid_init(&b.pyr, W, ROWS)) {
+        !b.lnear || !b.t) {
         fprintf(stderr, "bench_dof: out of memory\n");
         return 1;
     }
@@ -181,26 +178,23 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < 4 * (size_t)W * VROWS; i++)
         b.plane[i] = rnd();
+    /* near layer in runs (objects), t: 0 within 200 px of the row's middle (the fovea), 1
+     * beyond 320 px (the periphery), the transition between */
+    float nw = 0.0f;
     for (int x = 0; x < W; x++) {
-        const float nw = rnd() < 0.7f ? 0.0f : rnd(), fw = 0.2f + rnd();
+        if (rnd() < 0.02f)
+            nw = rnd() < 0.6f ? 0.0f : 0.2f + rnd();
+        const float fw = 0.2f + rnd(), lw = rnd() < 0.5f ? 0.0f : rnd();
         for (int c = 0; c < 3; c++) {
             b.near[4 * x + c] = nw * rnd();
-            b.far[4 * x + c] = fw * rnd();
+            b.lnear[4 * x + c] = lw * rnd();
+            b.far[4 * x + c] = rnd();
             b.enh[4 * x + c] = rnd();
         }
-        b.near[4 * x + 3] = nw, b.far[4 * x + 3] = fw, b.enh[4 * x + 3] = rnd();
+        b.near[4 * x + 3] = nw, b.lnear[4 * x + 3] = lw, b.far[4 * x + 3] = fw, b.enh[4 * x + 3] = rnd();
+        const float e = fabsf((float)x + 0.5f - 0.5f * (float)W), tt = (e - 200.0f) / 120.0f;
+        b.t[x] = tt > 0.0f ? (tt < 1.0f ? tt : 1.0f) : 0.0f;
     }
-    fv_pyr_level *l0 = &b.pyr.lv[0];
-    for (int y = 0; y < ROWS; y++)
-        for (int x = 0; x < W; x++) {
-            const ptrdiff_t o = (ptrdiff_t)y * l0->stride + x;
-            memcpy(l0->rgbd + 4 * o, b.rgbd + 4 * ((size_t)y * (size_t)W + (size_t)x), 4 * sizeof(float));
-            l0->wgt[o] = rnd() < 0.5f ? 1.0f : 0.0f;
-        }
-    fv_dsp c;
-    fv_dsp_init(&c, FV_ISA_C);
-    fv_pullpush(&b.pyr, &c, NULL);
-
     const unsigned isas[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_SSE41 | FV_ISA_AVX2, FV_ISA_NEON};
     printf("bench_dof: %d-pixel rows, median of %d runs, one thread, CPU time; ns per output pixel (x the C reference's speed)\n",
            W, b.reps);
@@ -255,8 +249,7 @@ int main(int argc, char **argv)
     }
     if (bad)
         printf("bench_dof: ! marks an ISA whose output differs from the C reference's\n");
-    fv_pyramid_free(&b.pyr);
     free(b.rgbd), free(b.coc), free(b.sigh), free(b.sigv), free(b.plane), free(b.dst), free(ref), free(b.near), free(b.far),
-        free(b.enh);
+        free(b.enh), free(b.lnear), free(b.t);
     return bad;
 }

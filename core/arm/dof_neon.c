@@ -1,8 +1,9 @@
 /* fovea: depth-of-field kernels, AArch64 Advanced SIMD. Bit-identical to the C references in
- * core/dof/kernels.c: one pixel = one float32x4_t (the references add channel by channel in the
- * same order), true division (FDIV), multiply-by-scalar then add (no FMLA: the tree is built with
- * -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the depths); the
- * Gaussians 4 output pixels at a time so 4 independent add chains overlap.
+ * core/dof/kernels.c: in the Gaussians one pixel = one float32x4_t (the references add channel
+ * by channel in the same order); true division (FDIV), multiply then add (no FMLA: the tree is
+ * built with -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the depths); the
+ * Gaussians 4 output pixels at a time so 4 independent add chains overlap; the combine 4 pixels
+ * at a time as channel vectors.
  *
  * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
  * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
@@ -12,7 +13,6 @@
  * it. The values read for those extra taps lie in the rows / columns the call covers and must be
  * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
 #include <arm_neon.h>
-#include <math.h>
 
 #include "dof/weier_impl.h"
 #include "dsp.h"
@@ -134,75 +134,63 @@ static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t str
     }
 }
 
-/* fv_dof_tap_c: acc + ((b00 r0[x0] + b10 r0[x1]) + (b01 r1[x0] + b11 r1[x1])) */
-static inline float32x4_t tap(const fv_pyr_level *L, int level, float fx, float fy, float32x4_t acc)
-{
-    const float sc = 1.0f / (float)(1 << level);
-    const float u = fx * sc - 0.5f, v = fy * sc - 0.5f;
-    const float fu = floorf(u), fv = floorf(v);
-    const float ax = u - fu, ay = v - fv;
-    const int x0 = clampi((int)fu, 0, L->w - 1), x1 = clampi((int)fu + 1, 0, L->w - 1);
-    const int y0 = clampi((int)fv, 0, L->h - 1), y1 = clampi((int)fv + 1, 0, L->h - 1);
-    const float *r0 = L->rgbd + 4 * (ptrdiff_t)y0 * L->stride, *r1 = L->rgbd + 4 * (ptrdiff_t)y1 * L->stride;
-    const float b00 = (1.0f - ax) * (1.0f - ay), b10 = ax * (1.0f - ay), b01 = (1.0f - ax) * ay, b11 = ax * ay;
-    const float32x4_t t0 = vaddq_f32(vmulq_n_f32(vld1q_f32(r0 + 4 * x0), b00), vmulq_n_f32(vld1q_f32(r0 + 4 * x1), b10));
-    const float32x4_t t1 = vaddq_f32(vmulq_n_f32(vld1q_f32(r1 + 4 * x0), b01), vmulq_n_f32(vld1q_f32(r1 + 4 * x1), b11));
-    return vaddq_f32(acc, vaddq_f32(t0, t1));
-}
-
-static inline float32x4_t quincunx(const fv_pyramid *pyr, float c, float fx, float fy)
-{
-    int L;
-    float o;
-    fv_dof_footprint(c, pyr->levels - 1, &L, &o);
-    const fv_pyr_level *lv = &pyr->lv[L];
-    float32x4_t q = tap(lv, L, fx, fy, vdupq_n_f32(0.0f)); /* 0 + tap, as the reference (-0 -> +0) */
-    if (o >= 0.125f) {
-        q = tap(lv, L, fx - o, fy - o, q);
-        q = tap(lv, L, fx + o, fy - o, q);
-        q = tap(lv, L, fx - o, fy + o, q);
-        q = tap(lv, L, fx + o, fy + o, q);
-        q = vmulq_n_f32(q, 0.2f);
-    }
-    return q;
-}
-
 /* a + s (b - a) */
-static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float s) { return vaddq_f32(a, vmulq_n_f32(vsubq_f32(b, a), s)); }
+static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float32x4_t s) { return vaddq_f32(a, vmulq_f32(s, vsubq_f32(b, a))); }
 
+/* 4 pixels at a time without branches: LD4 splits them into channel vectors, so the per-pixel
+ * scalars (coc, t, coverage) are plain lanes; each step is computed for the 4 and kept per pixel
+ * by a select on the reference's condition (a pixel whose step the reference skips keeps its
+ * bits; the skipped step may read and compute garbage, which the select drops). */
 static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {
-    const float fy = (float)a->y + 0.5f, dy = fy - a->gy;
-    const float32x4_t zero = vdupq_n_f32(0.0f);
-    for (int x = x0; x < x0 + n; x++) {
-        const float32x4_t s = vld1q_f32(a->sharp + 4 * x);
-        float32x4_t o = s; /* lane 3 is carried along unused and replaced by the depth at the end */
-        const float c = a->coc[x], fx = (float)x + 0.5f, dx = fx - a->gx;
-        const float ecc = sqrtf(dx * dx + dy * dy);
-        float t = (ecc - a->r0) * a->inv_tr;
-        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
-        if (c > 0.0f) {
-            float32x4_t f = zero;
-            if (t < 1.0f && a->far && x >= a->far_x0 && x < a->far_x1 && a->far[4 * x + 3] > 0.0f) {
-                const float32x4_t p = vld1q_f32(a->far + 4 * x);
-                f = vdivq_f32(p, vdupq_laneq_f32(p, 3));
+    const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f);
+    int x = x0;
+    for (; x + 4 <= x0 + n; x += 4) {
+        const float32x4x4_t s = vld4q_f32(a->sharp + 4 * x);
+        float32x4_t o[3] = {s.val[0], s.val[1], s.val[2]};
+        const float32x4_t c = vld1q_f32(a->coc + x), t = vld1q_f32(a->t + x);
+        const uint32x4_t far = vcgtq_f32(c, zero);
+        if (vmaxvq_u32(far)) {
+            const float32x4x4_t f = vld4q_f32(a->far + 4 * x);
+            const float32x4_t af = sel(vcltq_f32(c, one), c, one);
+            for (int k = 0; k < 3; k++)
+                o[k] = sel(far, lerp(o[k], f.val[k], af), o[k]);
+        }
+        float32x4x4_t nv = {{zero, zero, zero, zero}};
+        if (a->near)
+            nv = vld4q_f32(a->near + 4 * x);
+        const uint32x4_t tp = vcgtq_f32(t, zero);
+        if (a->lnear && vmaxvq_u32(tp)) {
+            const float32x4_t cs = vmulq_n_f32(vnegq_f32(c), 0.25f);
+            const float32x4_t sc = sel(vcltq_f32(c, zero), sel(vcltq_f32(cs, one), cs, one), one);
+            const float32x4x4_t q = vld4q_f32(a->lnear + 4 * x);
+            for (int k = 0; k < 4; k++)
+                nv.val[k] = sel(tp, vaddq_f32(nv.val[k], vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q.val[k]), nv.val[k]))),
+                                nv.val[k]);
+        }
+        const float32x4_t n3 = nv.val[3];
+        const uint32x4_t pos = vcgtq_f32(n3, zero);
+        if (vmaxvq_u32(pos)) {
+            const float32x4_t cov = sel(vcltq_f32(n3, one), n3, one);
+            for (int k = 0; k < 3; k++)
+                o[k] = sel(pos, lerp(o[k], vdivq_f32(nv.val[k], n3), cov), o[k]);
+        }
+        if (a->enh) {
+            const float32x4_t g = vmulq_n_f32(t, a->gain);
+            const uint32x4_t gp = vcgtq_f32(g, zero);
+            if (vmaxvq_u32(gp)) {
+                const float32x4x4_t b = vld4q_f32(a->enh + 4 * x);
+                for (int k = 0; k < 3; k++) {
+                    const float32x4_t v = vaddq_f32(o[k], vmulq_f32(g, vsubq_f32(o[k], b.val[k])));
+                    o[k] = sel(gp, sel(vcgtq_f32(v, zero), v, zero), o[k]); /* v > 0 ? v : +0 */
+                }
             }
-            if (t > 0.0f)
-                f = lerp(f, quincunx(a->pyr, c, fx, fy), t);
-            o = lerp(o, f, c < 1.0f ? c : 1.0f);
         }
-        if (a->has_near && a->near[4 * x + 3] > 0.0f) {
-            const float32x4_t p = vld1q_f32(a->near + 4 * x);
-            const float cov = a->near[4 * x + 3] < 1.0f ? a->near[4 * x + 3] : 1.0f;
-            o = lerp(o, vdivq_f32(p, vdupq_laneq_f32(p, 3)), cov);
-        }
-        if (a->enh && t > 0.0f) {
-            const float32x4_t b = vld1q_f32(a->enh + 4 * x);
-            const float32x4_t v = vaddq_f32(o, vmulq_n_f32(vsubq_f32(o, b), a->gain * t));
-            o = sel(vcgtq_f32(v, zero), v, zero); /* v > 0 ? v : +0 (FMAX would keep a NaN) */
-        }
-        vst1q_f32(out + 4 * x, vcopyq_laneq_f32(o, 3, s, 3));
+        const float32x4x4_t r = {{o[0], o[1], o[2], s.val[3]}};
+        vst4q_f32(out + 4 * x, r);
     }
+    if (x < x0 + n)
+        fv_dof_combine_row_c(out, a, x, x0 + n - x);
 }
 
 void fv_dof_init_neon(fv_dsp *d)

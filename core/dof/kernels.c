@@ -64,67 +64,51 @@ void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride
     }
 }
 
-/* Five quincunx taps (or one when the offset is under 1/8 px) of the blur of diameter c. */
-static void quincunx(const fv_pyramid *pyr, float c, float fx, float fy, float q[4])
-{
-    int L;
-    float o;
-    fv_dof_footprint(c, pyr->levels - 1, &L, &o);
-    const fv_pyr_level *lv = &pyr->lv[L];
-    q[0] = q[1] = q[2] = q[3] = 0.0f;
-    fv_dof_tap_c(lv, L, fx, fy, q);
-    if (o >= 0.125f) {
-        fv_dof_tap_c(lv, L, fx - o, fy - o, q);
-        fv_dof_tap_c(lv, L, fx + o, fy - o, q);
-        fv_dof_tap_c(lv, L, fx - o, fy + o, q);
-        fv_dof_tap_c(lv, L, fx + o, fy + o, q);
-        for (int k = 0; k < 4; k++)
-            q[k] *= 0.2f;
-    }
-}
-
 void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n)
 {
-    const float fy = (float)a->y + 0.5f, dy = fy - a->gy;
     for (int x = x0; x < x0 + n; x++) {
         const float *s = a->sharp + 4 * x;
-        float o[3] = {s[0], s[1], s[2]};
-        const float c = a->coc[x], fx = (float)x + 0.5f, dx = fx - a->gx;
-        const float ecc = sqrtf(dx * dx + dy * dy);
-        float t = (ecc - a->r0) * a->inv_tr;
-        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
-        if (c > 0.0f) {
-            float f[3] = {0.0f, 0.0f, 0.0f}, q[4];
-            if (t < 1.0f && a->far && x >= a->far_x0 && x < a->far_x1 && a->far[4 * x + 3] > 0.0f) {
-                const float *p = a->far + 4 * x;
-                for (int k = 0; k < 3; k++)
-                    f[k] = p[k] / p[3];
-            }
-            if (t > 0.0f) {
-                quincunx(a->pyr, c, fx, fy, q);
-                for (int k = 0; k < 3; k++)
-                    f[k] = f[k] + t * (q[k] - f[k]);
-            }
-            const float af = c < 1.0f ? c : 1.0f;
-            for (int k = 0; k < 3; k++)
-                o[k] = o[k] + af * (f[k] - o[k]);
+        float o0 = s[0], o1 = s[1], o2 = s[2];
+        const float c = a->coc[x];
+        if (c > 0.0f) { /* towards the far layer: fully from a CoC of one pixel on */
+            const float af = c < 1.0f ? c : 1.0f, *f = a->far + 4 * x;
+            o0 = o0 + af * (f[0] - o0);
+            o1 = o1 + af * (f[1] - o1);
+            o2 = o2 + af * (f[2] - o2);
         }
-        if (a->has_near && a->near[4 * x + 3] > 0.0f) {
+        /* the near layer: full resolution, blended by t towards the quarter-resolution one, in
+         * which a near pixel's own block blur counts only as far as its CoC exceeds the block */
+        float n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, n3 = 0.0f;
+        if (a->near) {
             const float *p = a->near + 4 * x;
-            const float cov = p[3] < 1.0f ? p[3] : 1.0f;
-            for (int k = 0; k < 3; k++)
-                o[k] = o[k] + cov * (p[k] / p[3] - o[k]);
+            n0 = p[0], n1 = p[1], n2 = p[2], n3 = p[3];
         }
-        if (a->enh && t > 0.0f) {
-            const float *b = a->enh + 4 * x, gt = a->gain * t;
-            for (int k = 0; k < 3; k++) {
-                const float v = o[k] + gt * (o[k] - b[k]);
-                o[k] = v > 0.0f ? v : 0.0f;
+        const float t = a->t[x];
+        if (a->lnear && t > 0.0f) {
+            const float cs = -c * 0.25f, s = c < 0.0f ? (cs < 1.0f ? cs : 1.0f) : 1.0f, *q = a->lnear + 4 * x;
+            n0 = n0 + t * (s * q[0] - n0);
+            n1 = n1 + t * (s * q[1] - n1);
+            n2 = n2 + t * (s * q[2] - n2);
+            n3 = n3 + t * (s * q[3] - n3);
+        }
+        if (n3 > 0.0f) { /* over the image by its coverage */
+            const float cov = n3 < 1.0f ? n3 : 1.0f;
+            o0 = o0 + cov * (n0 / n3 - o0);
+            o1 = o1 + cov * (n1 / n3 - o1);
+            o2 = o2 + cov * (n2 / n3 - o2);
+        }
+        if (a->enh) {
+            const float g = a->gain * t, *b = a->enh + 4 * x;
+            if (g > 0.0f) {
+                const float v0 = o0 + g * (o0 - b[0]), v1 = o1 + g * (o1 - b[1]), v2 = o2 + g * (o2 - b[2]);
+                o0 = v0 > 0.0f ? v0 : 0.0f;
+                o1 = v1 > 0.0f ? v1 : 0.0f;
+                o2 = v2 > 0.0f ? v2 : 0.0f;
             }
         }
-        out[4 * x + 0] = o[0];
-        out[4 * x + 1] = o[1];
-        out[4 * x + 2] = o[2];
+        out[4 * x + 0] = o0;
+        out[4 * x + 1] = o1;
+        out[4 * x + 2] = o2;
         out[4 * x + 3] = s[3];
     }
 }

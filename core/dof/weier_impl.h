@@ -22,24 +22,16 @@ typedef struct fv_dof_gauss_tab {
 } fv_dof_gauss_tab;
 void fv_dof_gauss_tab_init(fv_dof_gauss_tab *t);
 
-/* One row span of the combine (dsp dof_combine_row). */
+/* One row of the combine (dsp dof_combine_row): the layers the filter made for that row. */
 typedef struct fv_dof_combine_args {
-    const fv_pyramid *pyr;
-    int y;
-    const float *sharp;  /* level 0 row (r, g, b, depth_m) */
-    const float *coc;    /* signed CoC row, px */
-    const float *far;    /* far_v row (premultiplied, weight in .w), valid in [far_x0, far_x1); NULL: none */
-    int far_x0, far_x1;
-    const float *near;   /* near_v row (premultiplied, coverage in .w), read only if has_near */
-    int has_near;
-    float gx, gy;        /* point of regard, px */
-    float r0, inv_tr;    /* region blend t = clamp((ecc - r0) * inv_tr, 0, 1) */
-    float gain;          /* contrast enhancement */
-    const float *enh;    /* the enhancement's blurred row (valid where t > 0); NULL = none */
+    const float *sharp; /* level 0 row (r, g, b, depth_m) */
+    const float *coc;   /* signed CoC row, px */
+    const float *far;   /* far layer colour (r, g, b, -), read where coc > 0 */
+    const float *near;  /* full-resolution near layer: premultiplied colour, coverage in .w; NULL = 0 */
+    const float *lnear; /* the quarter-resolution near layer up-sampled (same form); NULL = 0 */
+    const float *t;     /* transition weight per pixel: 0 in the fovea .. 1 in the periphery */
+    const float *enh;   /* contrast enhancement's blurred row; NULL = off */
+    float gain;         /* contrast enhancement gain (used with enh) */
 } fv_dof_combine_args;
-
-/* Scalar pieces every ISA's combine uses in the same order. */
-void fv_dof_footprint(float c, int max_level, int *level, float *offset);
-void fv_dof_tap_c(const fv_pyr_level *L, int level, float fx, float fy, float acc[4]);
 
 #endif

@@ -2,7 +2,7 @@
  * intrinsics). The CoC takes 8 pixels at a time; the Gaussians 8 output pixels at a time as four
  * 256-bit accumulators of two pixels each (each 128-bit half with its own pixel's weights), the
  * rest with the 128-bit pieces of core/x86/dof_x86.h, which also has why the bits are the
- * references'. The combine is the 128-bit one (per-pixel control flow), VEX-encoded. */
+ * references'. The combine takes 8 pixels at a time without branches (see there). */
 #include <immintrin.h>
 
 #include "x86/dof_x86.h"
@@ -113,9 +113,59 @@ static void vgauss_row_avx2(float *restrict dst, const float *src, ptrdiff_t str
     gauss_8(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
 }
 
+/* a + s (b - a) */
+static inline __m256 lerp8(__m256 a, __m256 b, __m256 s) { return _mm256_add_ps(a, _mm256_mul_ps(s, _mm256_sub_ps(b, a))); }
+
+/* 8 pixels at a time without branches: two pixels a 256-bit vector, each step computed for both
+ * and kept per pixel by a select on the reference's condition (so a pixel whose step the
+ * reference skips keeps its bits; the skipped step may read and compute garbage, which the
+ * select drops). The per-pixel scalars (coc, t and what follows from them) are computed for the
+ * 8 pixels at once, then spread over the pairs' halves. */
 static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {
-    dof_combine_row_x86(out, a, x0, n);
+    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps(), gain = _mm256_set1_ps(a->gain);
+    const __m256 msign = _mm256_set1_ps(-0.0f), quarter = _mm256_set1_ps(0.25f);
+    int x = x0;
+    for (; x + 8 <= x0 + n; x += 8) {
+        const __m256 c8 = _mm256_loadu_ps(a->coc + x), t8 = _mm256_loadu_ps(a->t + x);
+        const int anyfar = _mm256_movemask_ps(_mm256_cmp_ps(c8, zero, _CMP_GT_OQ));
+        /* lnear's scale: c < 0 ? min(-c * 0.25, 1) : 1 */
+        const __m256 sc8 = _mm256_blendv_ps(one, _mm256_min_ps(_mm256_mul_ps(_mm256_xor_ps(c8, msign), quarter), one),
+                                            _mm256_cmp_ps(c8, zero, _CMP_LT_OQ));
+        const int anyl = a->lnear && _mm256_movemask_ps(_mm256_cmp_ps(t8, zero, _CMP_GT_OQ));
+        const __m256 g8 = _mm256_mul_ps(gain, t8);
+        const int anyg = a->enh && _mm256_movemask_ps(_mm256_cmp_ps(g8, zero, _CMP_GT_OQ));
+        for (int p = 0; p < 4; p++) {
+            const int xp = x + 2 * p;
+            const __m256i idx = _mm256_setr_epi32(2 * p, 2 * p, 2 * p, 2 * p, 2 * p + 1, 2 * p + 1, 2 * p + 1, 2 * p + 1);
+            const __m256 s = _mm256_loadu_ps(a->sharp + 4 * xp);
+            __m256 o = s;
+            if (anyfar) {
+                const __m256 c = _mm256_permutevar8x32_ps(c8, idx);
+                o = _mm256_blendv_ps(o, lerp8(o, _mm256_loadu_ps(a->far + 4 * xp), _mm256_min_ps(c, one)),
+                                     _mm256_cmp_ps(c, zero, _CMP_GT_OQ));
+            }
+            __m256 nv = a->near ? _mm256_loadu_ps(a->near + 4 * xp) : zero;
+            if (anyl) {
+                const __m256 t = _mm256_permutevar8x32_ps(t8, idx), sc = _mm256_permutevar8x32_ps(sc8, idx);
+                const __m256 q = _mm256_mul_ps(sc, _mm256_loadu_ps(a->lnear + 4 * xp));
+                nv = _mm256_blendv_ps(nv, _mm256_add_ps(nv, _mm256_mul_ps(t, _mm256_sub_ps(q, nv))),
+                                      _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
+            }
+            const __m256 n3 = _mm256_permute_ps(nv, _MM_SHUFFLE(3, 3, 3, 3));
+            const __m256 pos = _mm256_cmp_ps(n3, zero, _CMP_GT_OQ);
+            if (_mm256_movemask_ps(pos))
+                o = _mm256_blendv_ps(o, lerp8(o, _mm256_div_ps(nv, n3), _mm256_min_ps(n3, one)), pos);
+            if (anyg) {
+                const __m256 g = _mm256_permutevar8x32_ps(g8, idx);
+                const __m256 v = _mm256_add_ps(o, _mm256_mul_ps(g, _mm256_sub_ps(o, _mm256_loadu_ps(a->enh + 4 * xp))));
+                o = _mm256_blendv_ps(o, _mm256_max_ps(v, zero), _mm256_cmp_ps(g, zero, _CMP_GT_OQ)); /* v > 0 ? v : +0 */
+            }
+            _mm256_storeu_ps(out + 4 * xp, _mm256_blend_ps(o, s, 0x88));
+        }
+    }
+    if (x < x0 + n)
+        dof_combine_row_x86(out, a, x, x0 + n - x);
 }
 
 void fv_dof_init_avx2(fv_dsp *d)

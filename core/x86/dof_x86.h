@@ -13,7 +13,6 @@
 #ifndef FOVEA_DOF_X86_H
 #define FOVEA_DOF_X86_H
 
-#include <math.h>
 #include <smmintrin.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -155,80 +154,10 @@ static inline int dof_span_rad(const uint8_t *sig, int n, const fv_dof_gauss_tab
     return R;
 }
 
-/* ---- combine_row: the scalar control flow of the reference, colours as vectors ---- */
+/* ---- combine_row, one pixel at a time: the reference's control flow, colours as vectors (the
+ * SSE4.1 version; the AVX2 one's tail) ---- */
 
 static inline __m128 dof_bcast3(__m128 v) { return _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 3, 3)); }
-
-/* fv_dof_tap_c: acc + ((b00 r0[x0] + b10 r0[x1]) + (b01 r1[x0] + b11 r1[x1])) */
-static inline __m128 dof_tap(const fv_pyr_level *L, int level, float fx, float fy, __m128 acc)
-{
-    const float sc = 1.0f / (float)(1 << level);
-    const float u = fx * sc - 0.5f, v = fy * sc - 0.5f;
-    const float fu = floorf(u), fv = floorf(v);
-    const float ax = u - fu, ay = v - fv;
-    const int x0 = dof_clampi((int)fu, 0, L->w - 1), x1 = dof_clampi((int)fu + 1, 0, L->w - 1);
-    const int y0 = dof_clampi((int)fv, 0, L->h - 1), y1 = dof_clampi((int)fv + 1, 0, L->h - 1);
-    const float *r0 = L->rgbd + 4 * (ptrdiff_t)y0 * L->stride, *r1 = L->rgbd + 4 * (ptrdiff_t)y1 * L->stride;
-    const float b00 = (1.0f - ax) * (1.0f - ay), b10 = ax * (1.0f - ay), b01 = (1.0f - ax) * ay, b11 = ax * ay;
-    const __m128 t0 = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(b00), _mm_loadu_ps(r0 + 4 * x0)),
-                                 _mm_mul_ps(_mm_set1_ps(b10), _mm_loadu_ps(r0 + 4 * x1)));
-    const __m128 t1 = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(b01), _mm_loadu_ps(r1 + 4 * x0)),
-                                 _mm_mul_ps(_mm_set1_ps(b11), _mm_loadu_ps(r1 + 4 * x1)));
-    return _mm_add_ps(acc, _mm_add_ps(t0, t1));
-}
-
-/* acc + ((b00 r0[x0] + b10 r0[x1]) + (b01 r1[x0] + b11 r1[x1])), weights broadcast */
-static inline __m128 dof_tap_w(const float *r0, const float *r1, int x0, int x1, __m128 b00, __m128 b10, __m128 b01,
-                               __m128 b11, __m128 acc)
-{
-    const __m128 t0 = _mm_add_ps(_mm_mul_ps(b00, _mm_loadu_ps(r0 + 4 * x0)), _mm_mul_ps(b10, _mm_loadu_ps(r0 + 4 * x1)));
-    const __m128 t1 = _mm_add_ps(_mm_mul_ps(b01, _mm_loadu_ps(r1 + 4 * x0)), _mm_mul_ps(b11, _mm_loadu_ps(r1 + 4 * x1)));
-    return _mm_add_ps(acc, _mm_add_ps(t0, t1));
-}
-
-#define DOF_LANE(v, k) _mm_shuffle_ps((v), (v), _MM_SHUFFLE((k), (k), (k), (k)))
-
-/* The quincunx of the reference: the centre tap, then the four corner taps added in its order,
- * their positions and weights computed at once in the lanes of one vector (the same IEEE
- * operations per lane as fv_dof_tap_c's scalar code; floor = ROUNDPS, the clamps on integers). */
-static inline __m128 dof_quincunx(const fv_pyramid *pyr, float c, float fx, float fy)
-{
-    int L;
-    float o;
-    fv_dof_footprint(c, pyr->levels - 1, &L, &o);
-    const fv_pyr_level *lv = &pyr->lv[L];
-    __m128 q = dof_tap(lv, L, fx, fy, _mm_setzero_ps()); /* 0 + tap, as the reference (-0 -> +0) */
-    if (o >= 0.125f) {
-        const __m128 sc = _mm_set1_ps(1.0f / (float)(1 << L)), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f);
-        const float xm = fx - o, xp = fx + o, ym = fy - o, yp = fy + o;
-        const __m128 u = _mm_sub_ps(_mm_mul_ps(_mm_setr_ps(xm, xp, xm, xp), sc), half);
-        const __m128 v = _mm_sub_ps(_mm_mul_ps(_mm_setr_ps(ym, ym, yp, yp), sc), half);
-        const __m128 fu = _mm_floor_ps(u), fv = _mm_floor_ps(v);
-        const __m128 ax = _mm_sub_ps(u, fu), ay = _mm_sub_ps(v, fv);
-        const __m128i iu = _mm_cvttps_epi32(fu), iv = _mm_cvttps_epi32(fv), i1 = _mm_set1_epi32(1);
-        const __m128i zi = _mm_setzero_si128(), wm = _mm_set1_epi32(lv->w - 1), hm = _mm_set1_epi32(lv->h - 1);
-        int x0[4], x1[4], y0[4], y1[4];
-        _mm_storeu_si128((__m128i *)x0, _mm_min_epi32(_mm_max_epi32(iu, zi), wm));
-        _mm_storeu_si128((__m128i *)x1, _mm_min_epi32(_mm_max_epi32(_mm_add_epi32(iu, i1), zi), wm));
-        _mm_storeu_si128((__m128i *)y0, _mm_min_epi32(_mm_max_epi32(iv, zi), hm));
-        _mm_storeu_si128((__m128i *)y1, _mm_min_epi32(_mm_max_epi32(_mm_add_epi32(iv, i1), zi), hm));
-        const __m128 omx = _mm_sub_ps(one, ax), omy = _mm_sub_ps(one, ay);
-        const __m128 b00 = _mm_mul_ps(omx, omy), b10 = _mm_mul_ps(ax, omy), b01 = _mm_mul_ps(omx, ay);
-        const __m128 b11 = _mm_mul_ps(ax, ay);
-        const float *rg = lv->rgbd;
-        const ptrdiff_t st = 4 * lv->stride;
-#define DOF_CORNER(k)                                                                                           \
-        q = dof_tap_w(rg + st * y0[k], rg + st * y1[k], x0[k], x1[k], DOF_LANE(b00, k), DOF_LANE(b10, k),        \
-                      DOF_LANE(b01, k), DOF_LANE(b11, k), q)
-        DOF_CORNER(0);
-        DOF_CORNER(1);
-        DOF_CORNER(2);
-        DOF_CORNER(3);
-#undef DOF_CORNER
-        q = _mm_mul_ps(q, _mm_set1_ps(0.2f));
-    }
-    return q;
-}
 
 /* a + s (b - a), s broadcast */
 static inline __m128 dof_lerp(__m128 a, __m128 b, float s)
@@ -238,33 +167,28 @@ static inline __m128 dof_lerp(__m128 a, __m128 b, float s)
 
 static inline void dof_combine_row_x86(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {
-    const float fy = (float)a->y + 0.5f, dy = fy - a->gy;
     for (int x = x0; x < x0 + n; x++) {
         const __m128 s = _mm_loadu_ps(a->sharp + 4 * x);
         __m128 o = s; /* lane 3 is carried along unused and replaced by the depth at the end */
-        const float c = a->coc[x], fx = (float)x + 0.5f, dx = fx - a->gx;
-        const float ecc = sqrtf(dx * dx + dy * dy);
-        float t = (ecc - a->r0) * a->inv_tr;
-        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
-        if (c > 0.0f) {
-            __m128 f = _mm_setzero_ps();
-            if (t < 1.0f && a->far && x >= a->far_x0 && x < a->far_x1 && a->far[4 * x + 3] > 0.0f) {
-                const __m128 p = _mm_loadu_ps(a->far + 4 * x);
-                f = _mm_div_ps(p, dof_bcast3(p));
+        const float c = a->coc[x], t = a->t[x];
+        if (c > 0.0f)
+            o = dof_lerp(o, _mm_loadu_ps(a->far + 4 * x), c < 1.0f ? c : 1.0f);
+        __m128 nv = a->near ? _mm_loadu_ps(a->near + 4 * x) : _mm_setzero_ps();
+        if (a->lnear && t > 0.0f) {
+            const float cs = -c * 0.25f, sc = c < 0.0f ? (cs < 1.0f ? cs : 1.0f) : 1.0f;
+            const __m128 q = _mm_mul_ps(_mm_set1_ps(sc), _mm_loadu_ps(a->lnear + 4 * x));
+            nv = _mm_add_ps(nv, _mm_mul_ps(_mm_set1_ps(t), _mm_sub_ps(q, nv)));
+        }
+        const float n3 = _mm_cvtss_f32(dof_bcast3(nv));
+        if (n3 > 0.0f)
+            o = dof_lerp(o, _mm_div_ps(nv, dof_bcast3(nv)), n3 < 1.0f ? n3 : 1.0f);
+        if (a->enh) {
+            const float g = a->gain * t;
+            if (g > 0.0f) {
+                const __m128 b = _mm_loadu_ps(a->enh + 4 * x);
+                const __m128 v = _mm_add_ps(o, _mm_mul_ps(_mm_set1_ps(g), _mm_sub_ps(o, b)));
+                o = _mm_max_ps(v, _mm_setzero_ps()); /* v > 0 ? v : +0 */
             }
-            if (t > 0.0f)
-                f = dof_lerp(f, dof_quincunx(a->pyr, c, fx, fy), t);
-            o = dof_lerp(o, f, c < 1.0f ? c : 1.0f);
-        }
-        if (a->has_near && a->near[4 * x + 3] > 0.0f) {
-            const __m128 p = _mm_loadu_ps(a->near + 4 * x);
-            const float cov = a->near[4 * x + 3] < 1.0f ? a->near[4 * x + 3] : 1.0f;
-            o = dof_lerp(o, _mm_div_ps(p, dof_bcast3(p)), cov);
-        }
-        if (a->enh && t > 0.0f) {
-            const __m128 b = _mm_loadu_ps(a->enh + 4 * x);
-            const __m128 v = _mm_add_ps(o, _mm_mul_ps(_mm_set1_ps(a->gain * t), _mm_sub_ps(o, b)));
-            o = _mm_max_ps(v, _mm_setzero_ps()); /* v > 0 ? v : +0 */
         }
         _mm_storeu_ps(out + 4 * x, _mm_blend_ps(o, s, 8));
     }
