@@ -101,7 +101,9 @@ typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, in
  *   coc > 0; near n = near (or 0), blended by t towards s * lnear where t > 0 (s = min(1, -coc/4)
  *   for near pixels, else 1); towards n.rgb / n.w by min(1, n.w) where n.w > 0; with enh,
  *   o = max(0, o + gain t (o - enh)) where gain t > 0; depth copied (fv_dof_combine_row_c has
- *   the order of operations). */
+ *   the order of operations). The ISA versions may read (never use) far, lnear and enh pixels of
+ *   [x0, x0+n) the reference skips: they compute a step for several pixels and keep it by a
+ *   select on the reference's condition. */
 struct fv_dof_gauss_tab;
 struct fv_dof_combine_args;
 typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);

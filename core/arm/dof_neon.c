@@ -1,9 +1,9 @@
 /* fovea: depth-of-field kernels, AArch64 Advanced SIMD. Bit-identical to the C references in
  * core/dof/kernels.c: in the Gaussians one pixel = one float32x4_t (the references add channel
  * by channel in the same order); true division (FDIV), multiply then add (no FMLA: the tree is
- * built with -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the depths); the
- * Gaussians 4 output pixels at a time so 4 independent add chains overlap; the combine 4 pixels
- * at a time as channel vectors.
+ * built with -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the
+ * depths); the Gaussians 4 output pixels at a time so 4 independent add chains overlap; the
+ * combine 4 pixels at a time as channel vectors.
  *
  * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
  * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
