@@ -196,7 +196,8 @@ int main(int argc, char **argv)
         b.t[x] = tt > 0.0f ? (tt < 1.0f ? tt : 1.0f) : 0.0f;
     }
     const unsigned isas[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_SSE41 | FV_ISA_AVX2, FV_ISA_NEON};
-    printf("bench_dof: %d-pixel rows, median of %d runs, one thread, CPU time; ns per output pixel (x the C reference's speed)\n",
+    printf("bench_dof: %d-pixel rows, median of %d runs, one thread, CPU time;\n"
+           "ns per output pixel (x the C reference's speed, the median of the runs' ratios)\n",
            W, b.reps);
     int bad = 0;
     for (int noisy = 0; noisy < 2; noisy++) {
@@ -249,7 +250,7 @@ int main(int argc, char **argv)
     }
     if (bad)
         printf("bench_dof: ! marks an ISA whose output differs from the C reference's\n");
-    free(b.rgbd), free(b.coc), free(b.sigh), free(b.sigv), free(b.plane), free(b.dst), free(ref), free(b.near), free(b.far),
-        free(b.enh), free(b.lnear), free(b.t);
+    free(b.rgbd), free(b.coc), free(b.sigh), free(b.sigv), free(b.plane), free(b.dst), free(ref);
+    free(b.near), free(b.far), free(b.enh), free(b.lnear), free(b.t);
     return bad;
 }

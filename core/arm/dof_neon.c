@@ -135,7 +135,10 @@ static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t str
 }
 
 /* a + s (b - a) */
-static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float32x4_t s) { return vaddq_f32(a, vmulq_f32(s, vsubq_f32(b, a))); }
+static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float32x4_t s)
+{
+    return vaddq_f32(a, vmulq_f32(s, vsubq_f32(b, a)));
+}
 
 /* 4 pixels at a time without branches: LD4 splits them into channel vectors, so the per-pixel
  * scalars (coc, t, coverage) are plain lanes; each step is computed for the 4 and kept per pixel

@@ -114,7 +114,10 @@ static void vgauss_row_avx2(float *restrict dst, const float *src, ptrdiff_t str
 }
 
 /* a + s (b - a) */
-static inline __m256 lerp8(__m256 a, __m256 b, __m256 s) { return _mm256_add_ps(a, _mm256_mul_ps(s, _mm256_sub_ps(b, a))); }
+static inline __m256 lerp8(__m256 a, __m256 b, __m256 s)
+{
+    return _mm256_add_ps(a, _mm256_mul_ps(s, _mm256_sub_ps(b, a)));
+}
 
 /* 8 pixels at a time without branches: two pixels a 256-bit vector, each step computed for both
  * and kept per pixel by a select on the reference's condition (so a pixel whose step the
@@ -137,7 +140,8 @@ static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, 
         const int anyg = a->enh && _mm256_movemask_ps(_mm256_cmp_ps(g8, zero, _CMP_GT_OQ));
         for (int p = 0; p < 4; p++) {
             const int xp = x + 2 * p;
-            const __m256i idx = _mm256_setr_epi32(2 * p, 2 * p, 2 * p, 2 * p, 2 * p + 1, 2 * p + 1, 2 * p + 1, 2 * p + 1);
+            const int l = 2 * p, h = 2 * p + 1; /* the pair's pixels within the 8 */
+            const __m256i idx = _mm256_setr_epi32(l, l, l, l, h, h, h, h);
             const __m256 s = _mm256_loadu_ps(a->sharp + 4 * xp);
             __m256 o = s;
             if (anyfar) {
@@ -159,7 +163,8 @@ static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, 
             if (anyg) {
                 const __m256 g = _mm256_permutevar8x32_ps(g8, idx);
                 const __m256 v = _mm256_add_ps(o, _mm256_mul_ps(g, _mm256_sub_ps(o, _mm256_loadu_ps(a->enh + 4 * xp))));
-                o = _mm256_blendv_ps(o, _mm256_max_ps(v, zero), _mm256_cmp_ps(g, zero, _CMP_GT_OQ)); /* v > 0 ? v : +0 */
+                /* max: v > 0 ? v : +0 */
+                o = _mm256_blendv_ps(o, _mm256_max_ps(v, zero), _mm256_cmp_ps(g, zero, _CMP_GT_OQ));
             }
             _mm256_storeu_ps(out + 4 * xp, _mm256_blend_ps(o, s, 0x88));
         }
