@@ -1,7 +1,7 @@
 /* bench_dof: times the layered depth-of-field kernels (dsp.h dof_*) of every ISA this CPU runs on
  * production-sized rows (1280 pixels; far CoCs of 2..16 px, so Gaussian sigmas of 0.5..4 px and
  * radii 2..12), single thread, data in cache as in the pipeline's bands, the Gaussians called on
- * spans of 128 pixels as core/dof/weier.c calls them. Each run times one pass of every ISA back
+ * spans of 128 pixels and the combine on whole rows as core/dof/weier.c calls them. Each run times one pass of every ISA back
  * to back in this thread's CPU time; printed: ns per output pixel (the median of --reps runs, at
  * most 256) and the speed-up over C (the median of the runs' ratios). The outputs are also
  * compared with the C reference's (bit-identity; tests/test_kernels_dof checks it in depth).
