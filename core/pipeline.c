@@ -12,6 +12,7 @@
 const char *const fv_stage_names[FV_STAGE_COUNT] = {"trace", "reproject", "reconstruct", "coc", "dof_filter", "combine"};
 
 #define SRGB_LUT 4096
+#define FOVEA_STEPS 4 /* fovea scales 1, 1.25, 1.5, 1.75, 2 */
 
 typedef struct {
     fv_camera cam, prev_cam;
@@ -30,12 +31,18 @@ struct fv_pipeline {
     fv_pool *pool;
     fv_dsp dsp;
     fv_sampler smp;
+    /* fovea widened (fv_pipeline_set_fovea_scale): step k of FOVEA_STEPS scales r0, r1 by
+     * 1 + k / FOVEA_STEPS; wide[k - 1] is built on the step's first use and kept */
+    fv_sampler wide[FOVEA_STEPS];
+    const fv_sampler *smp_cur; /* the sampler in force: smp or one of wide */
+    int fovea_step;
     int taa;           /* reprojection runs (enabled and foveated) */
     int dof;           /* the depth-of-field stages run */
     fv_dof_model_fn dof_fn;
     fv_dof_work dof_work;    /* scratch shared by the eyes (rendered one after the other) */
     float *enh_fp;           /* contrast enhancement footprint per eccentricity step */
     int enh_n;
+    const fv_sampler *enh_for; /* the sampler enh_fp was computed for (the fovea may widen) */
     int64_t t_ns;            /* the frame time set by fv_pipeline_set_time_ns; INT64_MIN: none */
     eye_state eyes[2];
     uint8_t srgb[SRGB_LUT + 1]; /* linear [0,1] -> sRGB 8-bit */
@@ -87,6 +94,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         fv_err(err, err_len, "sampling parameters out of range: need 0 < r0 <= r1 <= 90 deg, 0 < p_min <= 1");
         goto bad;
     }
+    p->smp_cur = &p->smp;
     for (int e = 0; e < 2; e++)
         for (int b = 0; b < (p->taa ? 2 : 1); b++)
             if (fv_pyramid_init(&p->eyes[e].pyr[b], cfg->cam.width, cfg->cam.height)) {
@@ -131,10 +139,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
                 fv_err(err, err_len, "out of memory");
                 goto bad;
             }
-            for (int i = 0; i < p->enh_n; i++) {
-                const float pr = fv_sampler_probability(&p->smp, 4.0f * (float)i, 0.0f);
-                p->enh_fp[i] = pr > 0.0f ? 1.0f / sqrtf(pr) : 1.0f;
-            }
+            p->enh_for = NULL; /* filled for the sampler in force at the first frame */
         }
     }
     p->pool = fv_pool_create(cfg->threads);
@@ -159,6 +164,8 @@ void fv_pipeline_destroy(fv_pipeline *p)
     if (!p)
         return;
     fv_pool_destroy(p->pool);
+    for (int k = 0; k < FOVEA_STEPS; k++)
+        fv_sampler_free(&p->wide[k]);
     fv_sampler_free(&p->smp);
     for (int e = 0; e < 2; e++) {
         for (int b = 0; b < 2; b++)
@@ -219,6 +226,13 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
         st->stage_ms[FV_STAGE_COC] = focus_ms;
         return;
     }
+    if (p->enh_fp && p->enh_for != p->smp_cur) {
+        for (int i = 0; i < p->enh_n; i++) {
+            const float pr = fv_sampler_probability(p->smp_cur, 4.0f * (float)i, 0.0f);
+            p->enh_fp[i] = pr > 0.0f ? 1.0f / sqrtf(pr) : 1.0f;
+        }
+        p->enh_for = p->smp_cur;
+    }
     fv_dof_view v = {
         .pyr = pyr,
         .focus_m = focus_m,
@@ -226,8 +240,8 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
         .blur_scale = fv_dof_presets[dp->preset].e_scale,
         .gaze_x = gx,
         .gaze_y = gy,
-        .r0_px = p->smp.r0_px,
-        .r1_px = p->smp.r1_px,
+        .r0_px = p->smp_cur->r0_px, /* the fovea in force (widened when the gaze is doubtful) */
+        .r1_px = p->smp_cur->r1_px,
         .prm = dp,
         .enh_fp = p->enh_fp,
         .enh_n = p->enh_n,
@@ -256,7 +270,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     const int dst = p->taa ? es->cur ^ 1 : 0;
     fv_pyramid *pyr = &es->pyr[dst];
     fv_taa_frame tf;
-    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp.phases) : 0, .taa_prm = &p->cfg.taa};
+    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa};
     int64_t t0 = fv_time_ns();
     if (p->taa && es->hist_valid) {
         fv_taa_frame_setup(&tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
@@ -265,7 +279,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     /* The S_in pattern moves by whole pixels with the point of regard. */
     int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
     double taa_ms = NAN;
-    st->samples = fv_raycast(p->scene, &es->cam, &p->smp, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
+    st->samples = fv_raycast(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     int64_t t1 = fv_time_ns();
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
     fv_pullpush_from(pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(pyr));
@@ -299,7 +313,33 @@ const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye)
     return &es->pyr[es->cur];
 }
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye) { return &p->eyes[slot(eye)].cam; }
-const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p) { return &p->smp; }
+const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p) { return p->smp_cur; }
+
+int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale)
+{
+    /* NaN: as doubtful as it gets (fv_fovea_radius_scale's convention) */
+    const float s = scale == scale ? scale : 2.0f;
+    const int k = s <= 1.0f ? 0 : s >= 2.0f ? FOVEA_STEPS : (int)lrintf((s - 1.0f) * FOVEA_STEPS);
+    if (k == 0 || p->cfg.samp.full) { /* full sampling has no fovea to widen */
+        p->smp_cur = &p->smp;
+        p->fovea_step = 0;
+        return 0;
+    }
+    fv_sampler *w = &p->wide[k - 1];
+    if (!w->s_in) {
+        fv_sampling_params sp = p->smp.prm; /* as created (rotation decided there) */
+        const float f = 1.0f + (float)k / FOVEA_STEPS;
+        sp.r1_deg = fminf(90.0f, sp.r1_deg * f);
+        sp.r0_deg = fminf(sp.r1_deg, sp.r0_deg * f);
+        if (fv_sampler_init(w, p->smp.width, p->smp.height, p->eyes[0].cam.focal_px, &sp))
+            return -1; /* the scale in force stays */
+    }
+    p->smp_cur = w;
+    p->fovea_step = k;
+    return 0;
+}
+
+float fv_pipeline_fovea_scale(const fv_pipeline *p) { return 1.0f + (float)p->fovea_step / FOVEA_STEPS; }
 fv_pool *fv_pipeline_pool(fv_pipeline *p) { return p->pool; }
 const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p) { return &p->dsp; }
 

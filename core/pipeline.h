@@ -62,7 +62,18 @@ void fv_pipeline_reset_history(fv_pipeline *p);
 /* The eye's reconstruction pyramid after its last render (level 0 = the image). */
 const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye);
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye);
+/* The sampling pattern in force (it changes with fv_pipeline_set_fovea_scale). */
 const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p);
+/* Widens the fovea for the following frames (both eyes) when the gaze is doubtful: r0 and r1
+ * times `scale` (r1 capped at 90 deg), the scale rounded to a step of 0.25 in [1, 2] (below 1:
+ * 1; NaN: 2), as fv_fovea_radius_scale (eyetrack/gazefilter.h) gives it for the gaze filter's
+ * confidence. Each step's sampling tables are built on its first use, here and not during a
+ * frame, and kept until fv_pipeline_destroy: calling this every frame allocates nothing once
+ * each step has been visited, and a step always gives the same pattern. No effect with full
+ * sampling. 0 on success, -1 when there is no memory for the step's tables (the scale in force
+ * stays). */
+int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale);
+float fv_pipeline_fovea_scale(const fv_pipeline *p); /* the step in force: 1 .. 2 */
 fv_pool *fv_pipeline_pool(fv_pipeline *p);
 const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 

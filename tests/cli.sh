@@ -193,6 +193,18 @@ else
     bad "replay --dof failed: $(cat "$T/err")"
 fi
 
+# every model renders, and changes the image (focused at 0.3 m: the tunnel blurs by ~5 px)
+$R --scene $SCENE --frames 1 --size 320x360 --out "$T/m_none" --quiet 2>/dev/null
+for m in weier hussain mantiuk konrad liu; do
+    if $R --scene $SCENE --frames 1 --size 320x360 --dof strong --dof-model $m --focus-m 0.3 --out "$T/m_$m" --quiet 2>"$T/err"; then
+        cmp -s "$T/m_$m/frame_00000.png" "$T/m_none/frame_00000.png" && bad "--dof-model $m changed nothing" || ok
+    else
+        bad "--dof-model $m failed: $(cat "$T/err")"
+    fi
+done
+$R --scene $SCENE --frames 1 --size 320x360 --dof strong --dof-model liu --chroma on --focus-m 0.3 --out "$T/m_liuc" --quiet 2>/dev/null &&
+    ! cmp -s "$T/m_liuc/frame_00000.png" "$T/m_liu/frame_00000.png" && ok || bad "--chroma on changed nothing"
+
 # Bench JSON has the documented fields; null for stages not built yet (and for reprojection in
 # the full mode, which needs none)
 if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/b.json" >"$T/out" 2>"$T/err"; then

@@ -277,9 +277,9 @@ static void test_vgauss_row(void **state)
 
 static long comb_far, comb_lnear, comb_near, comb_enh; /* how often the steps ran (reference) */
 
-/* Rows of w pixels; the span [x0, x0 + n). What the reference does not read (far where coc <= 0,
- * lnear where t <= 0, enh where gain t <= 0) holds NaN / Inf: an ISA version may read it but
- * must not let it through. */
+/* Rows of w pixels; the span [x0, x0 + n). What the reference does not read (far unless coc > 0
+ * or coc < 0 < t, lnear where t <= 0, enh where gain t <= 0) holds NaN / Inf: an ISA version may
+ * read it but must not let it through. */
 static void run_combine1(const fv_dsp *d, const char *isa, int w, int x0, int n, int off)
 {
     const size_t w4 = 4 * (size_t)w;
@@ -311,7 +311,7 @@ static void run_combine1(const fv_dsp *d, const char *isa, int w, int x0, int n,
             enh.p[4 * i + c] = colour();
         }
         const float bad = rndi(2) ? NAN : -INFINITY;
-        if (!(coc.p[i] > 0.0f))
+        if (!(coc.p[i] > 0.0f) && !(coc.p[i] < 0.0f && t.p[i] > 0.0f))
             far.p[4 * i + rndi(4)] = bad;
         if (!(t.p[i] > 0.0f))
             lnear.p[4 * i + rndi(4)] = bad;
@@ -335,7 +335,7 @@ static void run_combine1(const fv_dsp *d, const char *isa, int w, int x0, int n,
     for (int x = x0; x < x0 + n; x++) {
         for (int c = 0; c < 4; c++)
             assert_true(isfinite(r.p[4 * x + c]));
-        comb_far += coc.p[x] > 0.0f;
+        comb_far += coc.p[x] > 0.0f || (coc.p[x] < 0.0f && t.p[x] > 0.0f);
         comb_lnear += a.lnear && t.p[x] > 0.0f;
         comb_near += a.near && near.p[4 * x + 3] > 0.0f;
         comb_enh += a.enh && gain * t.p[x] > 0.0f;

@@ -152,20 +152,22 @@ static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, 
         const float32x4x4_t s = vld4q_f32(a->sharp + 4 * x);
         float32x4_t o[3] = {s.val[0], s.val[1], s.val[2]};
         const float32x4_t c = vld1q_f32(a->coc + x), t = vld1q_f32(a->t + x);
-        const uint32x4_t far = vcgtq_f32(c, zero);
+        const uint32x4_t cneg = vcltq_f32(c, zero), tp = vcgtq_f32(t, zero);
+        /* towards the pixel's own blur by ab = c > 0 ? min(c, 1) : c < 0 && t > 0 ? t min(-c, 1) : 0 */
+        const float32x4_t nc = vnegq_f32(c);
+        const float32x4_t abn = sel(vandq_u32(cneg, tp), vmulq_f32(t, sel(vcltq_f32(nc, one), nc, one)), zero);
+        const float32x4_t ab = sel(vcgtq_f32(c, zero), sel(vcltq_f32(c, one), c, one), abn);
+        const uint32x4_t far = vcgtq_f32(ab, zero);
         if (vmaxvq_u32(far)) {
             const float32x4x4_t f = vld4q_f32(a->far + 4 * x);
-            const float32x4_t af = sel(vcltq_f32(c, one), c, one);
             for (int k = 0; k < 3; k++)
-                o[k] = sel(far, lerp(o[k], f.val[k], af), o[k]);
+                o[k] = sel(far, lerp(o[k], f.val[k], ab), o[k]);
         }
         float32x4x4_t nv = {{zero, zero, zero, zero}};
         if (a->near)
             nv = vld4q_f32(a->near + 4 * x);
-        const uint32x4_t tp = vcgtq_f32(t, zero);
         if (a->lnear && vmaxvq_u32(tp)) {
-            const float32x4_t cs = vmulq_n_f32(vnegq_f32(c), 0.25f);
-            const float32x4_t sc = sel(vcltq_f32(c, zero), sel(vcltq_f32(cs, one), cs, one), one);
+            const float32x4_t sc = sel(cneg, zero, one); /* c < 0 ? 0 : 1 */
             const float32x4x4_t q = vld4q_f32(a->lnear + 4 * x);
             for (int k = 0; k < 4; k++)
                 nv.val[k] = sel(tp, vaddq_f32(nv.val[k], vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q.val[k]), nv.val[k]))),

@@ -68,7 +68,8 @@ float fv_dof_thin_lens_px(const fv_dof_view *v, float depth_m)
     return v->prm->pupil_mm * 1e-3f * (1.0f / v->focus_m - 1.0f / g) * v->focal_px * v->blur_scale;
 }
 
-/* Models not built in this tree are NULL: the pipeline refuses them by name. */
 const fv_dof_model_fn fv_dof_model_fns[FV_DOF_MODEL_COUNT] = {
-    [FV_DOF_MODEL_WEIER] = fv_dof_weier,
+    [FV_DOF_MODEL_WEIER] = fv_dof_weier,     [FV_DOF_MODEL_HUSSAIN] = fv_dof_hussain,
+    [FV_DOF_MODEL_MANTIUK] = fv_dof_mantiuk, [FV_DOF_MODEL_KONRAD] = fv_dof_konrad,
+    [FV_DOF_MODEL_LIU] = fv_dof_liu,
 };

@@ -70,22 +70,29 @@ void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args 
         const float *s = a->sharp + 4 * x;
         float o0 = s[0], o1 = s[1], o2 = s[2];
         const float c = a->coc[x];
-        if (c > 0.0f) { /* towards the far layer: fully from a CoC of one pixel on */
-            const float af = c < 1.0f ? c : 1.0f, *f = a->far + 4 * x;
-            o0 = o0 + af * (f[0] - o0);
-            o1 = o1 + af * (f[1] - o1);
-            o2 = o2 + af * (f[2] - o2);
+        const float t = a->t[x];
+        /* towards the pixel's own blur: the far layer, fully from a CoC of one pixel on; a near
+         * pixel's pyramid blur in the periphery, faded in by t */
+        float ab = 0.0f;
+        if (c > 0.0f)
+            ab = c < 1.0f ? c : 1.0f;
+        else if (c < 0.0f && t > 0.0f)
+            ab = t * (-c < 1.0f ? -c : 1.0f);
+        if (ab > 0.0f) {
+            const float *f = a->far + 4 * x;
+            o0 = o0 + ab * (f[0] - o0);
+            o1 = o1 + ab * (f[1] - o1);
+            o2 = o2 + ab * (f[2] - o2);
         }
-        /* the near layer: full resolution, blended by t towards the quarter-resolution one, in
-         * which a near pixel's own block blur counts only as far as its CoC exceeds the block */
+        /* the near layer: full resolution, blended by t towards the quarter-resolution one,
+         * which only spreads near pixels over the others (a near pixel has its own blur above) */
         float n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, n3 = 0.0f;
         if (a->near) {
             const float *p = a->near + 4 * x;
             n0 = p[0], n1 = p[1], n2 = p[2], n3 = p[3];
         }
-        const float t = a->t[x];
         if (a->lnear && t > 0.0f) {
-            const float cs = -c * 0.25f, s = c < 0.0f ? (cs < 1.0f ? cs : 1.0f) : 1.0f, *q = a->lnear + 4 * x;
+            const float s = c < 0.0f ? 0.0f : 1.0f, *q = a->lnear + 4 * x;
             n0 = n0 + t * (s * q[0] - n0);
             n1 = n1 + t * (s * q[1] - n1);
             n2 = n2 + t * (s * q[2] - n2);

@@ -13,8 +13,8 @@
  *        samples, so in-focus foreground never bleeds into the far layer; pixels in focus carry
  *        their tile's largest far sigma through the horizontal pass so that far pixels above and
  *        below gather across them. Periphery: the reconstruction pyramid, read at the level the
- *        CoC selects (level L up-sampled bilinearly has a standard deviation of about 2^L / 2,
- *        so L = log2(c / 2)), interpolated between the two nearest levels. Weier reads one level
+ *        CoC selects (level L up-sampled bilinearly has a standard deviation of about 2^L / 2),
+ *        interpolated between the two nearest levels to the disc's variance. Weier reads one level
  *        with five quincunx taps per pixel; up-sampling whole rows of two levels gives a smoother
  *        result at a fraction of the cost (measured in docs/dof.md). Across the transition
  *        region both are computed and blended linearly in eccentricity (Weier's vertical pass).
@@ -198,8 +198,9 @@ static void coc_band(void *ctx, int band, int tid)
             if (by == y0 / LOW && i * LOW % TILE == 0)
                 *tn = 0.0f;
             *tn = r > *tn ? r : *tn;
-            /* radius in blocks, rounded; -1: no near pixel (rr[i] becomes it) */
-            const float rb = b[3] > 0.0f ? floorf((r + 0.5f * LOW) / LOW) : -1.0f;
+            /* radius in whole blocks (the up-sampling adds about one); -1: no near pixel (rr[i]
+             * becomes it) */
+            const float rb = b[3] > 0.0f ? floorf(r / LOW) : -1.0f;
             rr[i] = rb;
             x->l_w[(ptrdiff_t)by * x->lw + i] = 1.0f / (2.0f * (rb > 0.0f ? rb : 0.0f) + 1.0f);
             for (int k = 0; k < 4; k++)
@@ -349,20 +350,23 @@ static void lvpass_band(void *ctx, int band, int tid)
 /* Per-thread row buffers of the fused pass. */
 static float *slot(const wctx *x, int tid, int k) { return x->wk->rows + ((size_t)tid * NSLOT + (size_t)k) * 4 * (size_t)x->w; }
 
-/* The far layer's peripheral blur for the pixels of row y with c > 0 and t > 0 in [x0, x1):
- * the two nearest up-sampled pyramid levels, blended (level 0 is the sharp row). */
-static void far_periphery(const wctx *x, int tid, int y, const float *coc, const float *trow, const float *sharp,
-                          float *restrict far)
+/* The periphery's blur of every out-of-focus pixel of row y with t > 0, by its own |c|: the two
+ * nearest up-sampled pyramid levels, interpolated (level 0 is the sharp row). Far pixels blend
+ * it into the centre's Gaussian by t; near pixels' own blur is this alone (the combine fades it
+ * in by t), the quarter-resolution near layer only spreading them over their surroundings. */
+static void blur_periphery(const wctx *x, int tid, int y, const float *coc, const float *trow, const float *sharp,
+                           float *restrict blur)
 {
     const fv_pyramid *pyr = x->v->pyr;
-    /* which levels this row needs */
-    int need = 0;
-    for (int i = 0; i < x->w; i++)
-        if (coc[i] > 0.0f && trow[i] > 0.0f) {
-            const float l = x->lambda[mini((int)(coc[i] * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
+    int need = 0; /* the levels this row needs */
+    for (int i = 0; i < x->w; i++) {
+        const float a = coc[i] < 0.0f ? -coc[i] : coc[i];
+        if (a > 0.0f && trow[i] > 0.0f) {
+            const float l = x->lambda[mini((int)(a * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
             const int L = (int)l + (l > (float)(int)l);
             need = L > need ? L : need;
         }
+    }
     need = mini(need, x->up_levels);
     float *up[MAX_UP_LEVEL + 1];
     up[0] = (float *)sharp;
@@ -374,16 +378,16 @@ static void far_periphery(const wctx *x, int tid, int y, const float *coc, const
         upsample_row(&im, L, &x->xt[L], y, x->w, tmp, up[L]);
     }
     for (int i = 0; i < x->w; i++) {
-        const float t = trow[i];
-        if (!(coc[i] > 0.0f && t > 0.0f))
+        const float t = trow[i], a = coc[i] < 0.0f ? -coc[i] : coc[i];
+        if (!(a > 0.0f && t > 0.0f))
             continue;
-        float l = x->lambda[mini((int)(coc[i] * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
+        float l = x->lambda[mini((int)(a * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
         l = l < (float)need ? l : (float)need;
         const int L0 = (int)l, L1 = L0 < need ? L0 + 1 : L0;
-        const float a = l - (float)L0;
+        const float f = l - (float)L0;
         for (int k = 0; k < 3; k++) {
-            const float pv = up[L0][4 * i + k] + a * (up[L1][4 * i + k] - up[L0][4 * i + k]);
-            far[4 * i + k] = t < 1.0f ? far[4 * i + k] + t * (pv - far[4 * i + k]) : pv;
+            const float pv = up[L0][4 * i + k] + f * (up[L1][4 * i + k] - up[L0][4 * i + k]);
+            blur[4 * i + k] = coc[i] > 0.0f && t < 1.0f ? blur[4 * i + k] + t * (pv - blur[4 * i + k]) : pv;
         }
     }
 }
@@ -434,7 +438,7 @@ static void vcombine_band(void *ctx, int band, int tid)
                     for (int k = 0; k < 3; k++)
                         far[4 * i + k] /= far[4 * i + 3];
         }
-        far_periphery(x, tid, y, coc, trow, sharp, far);
+        blur_periphery(x, tid, y, coc, trow, sharp, far);
         /* near: full resolution in the centre rectangle (pixels with t < 1); the quarter-
          * resolution layer up-sampled is blended in by t in the combine */
         float *nfull = NULL;
@@ -553,9 +557,22 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->cx0 = clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = clampi((int)ceilf(v->gaze_x + reach), 0, x->w);
     x->cy0 = clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
     x->up_levels = mini(MAX_UP_LEVEL, v->pyr->levels - 1);
+    /* CoC -> continuous level: interpolating two levels mixes their variances, so match the
+     * variance c^2 / 16 of the disc. Level L up-sampled bilinearly to pixel centres has about
+     * the box's (4^L - 1) / 12 plus the tent's 4^L / 6 averaged over phases, (3 4^L - 1) / 12
+     * per axis for L >= 1 (sigma ~ 2^L / 2); level 0 is the sharp image, variance 0. */
     for (int i = 0; i <= 64 * LAMBDA_STEPS; i++) {
-        const float c = (float)i / LAMBDA_STEPS; /* level L up-sampled: sigma ~ 2^L / 2 = c / 4 */
-        x->lambda[i] = c > 2.0f ? log2f(c * 0.5f) : 0.0f;
+        const float c = (float)i / LAMBDA_STEPS, var = c * c * (1.0f / 16.0f);
+        float lo = 0.0f, l = 0.0f;
+        for (int L = 1; L <= MAX_UP_LEVEL; L++) {
+            const float hi = (3.0f * (float)(1 << (2 * L)) - 1.0f) / 12.0f;
+            if (var < hi) {
+                l = (float)(L - 1) + (var - lo) / (hi - lo);
+                break;
+            }
+            lo = hi, l = (float)L;
+        }
+        x->lambda[i] = l;
     }
     /* Patney's kernel follows the sampling footprint 1/sqrt(p): the level whose texel covers the
      * periphery's footprint; its strength ramps with the transition weight t */

@@ -26,7 +26,8 @@ void fv_dof_gauss_tab_init(fv_dof_gauss_tab *t);
 typedef struct fv_dof_combine_args {
     const float *sharp; /* level 0 row (r, g, b, depth_m) */
     const float *coc;   /* signed CoC row, px */
-    const float *far;   /* far layer colour (r, g, b, -), read where coc > 0 */
+    const float *far;   /* the pixel's own blur (r, g, b, -): read where coc > 0, and where coc < 0
+                         * and t > 0 (a near pixel's periphery blur) */
     const float *near;  /* full-resolution near layer: premultiplied colour, coverage in .w; NULL = 0 */
     const float *lnear; /* the quarter-resolution near layer up-sampled (same form); NULL = 0 */
     const float *t;     /* transition weight per pixel: 0 in the fovea .. 1 in the periphery */

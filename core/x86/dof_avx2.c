@@ -127,15 +127,18 @@ static inline __m256 lerp8(__m256 a, __m256 b, __m256 s)
 static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {
     const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps(), gain = _mm256_set1_ps(a->gain);
-    const __m256 msign = _mm256_set1_ps(-0.0f), quarter = _mm256_set1_ps(0.25f);
+    const __m256 msign = _mm256_set1_ps(-0.0f);
     int x = x0;
     for (; x + 8 <= x0 + n; x += 8) {
         const __m256 c8 = _mm256_loadu_ps(a->coc + x), t8 = _mm256_loadu_ps(a->t + x);
-        const int anyfar = _mm256_movemask_ps(_mm256_cmp_ps(c8, zero, _CMP_GT_OQ));
-        /* lnear's scale: c < 0 ? min(-c * 0.25, 1) : 1 */
-        const __m256 sc8 = _mm256_blendv_ps(one, _mm256_min_ps(_mm256_mul_ps(_mm256_xor_ps(c8, msign), quarter), one),
-                                            _mm256_cmp_ps(c8, zero, _CMP_LT_OQ));
-        const int anyl = a->lnear && _mm256_movemask_ps(_mm256_cmp_ps(t8, zero, _CMP_GT_OQ));
+        const __m256 cneg = _mm256_cmp_ps(c8, zero, _CMP_LT_OQ), tpos = _mm256_cmp_ps(t8, zero, _CMP_GT_OQ);
+        /* towards the pixel's own blur by ab = c > 0 ? min(c, 1) : c < 0 && t > 0 ? t min(-c, 1) : 0 */
+        const __m256 abn = _mm256_and_ps(_mm256_mul_ps(t8, _mm256_min_ps(_mm256_xor_ps(c8, msign), one)),
+                                         _mm256_and_ps(cneg, tpos));
+        const __m256 ab8 = _mm256_blendv_ps(abn, _mm256_min_ps(c8, one), _mm256_cmp_ps(c8, zero, _CMP_GT_OQ));
+        const int anyfar = _mm256_movemask_ps(_mm256_cmp_ps(ab8, zero, _CMP_GT_OQ));
+        const __m256 sc8 = _mm256_blendv_ps(one, zero, cneg); /* lnear's scale: c < 0 ? 0 : 1 */
+        const int anyl = a->lnear && _mm256_movemask_ps(tpos);
         const __m256 g8 = _mm256_mul_ps(gain, t8);
         const int anyg = a->enh && _mm256_movemask_ps(_mm256_cmp_ps(g8, zero, _CMP_GT_OQ));
         for (int p = 0; p < 4; p++) {
@@ -145,9 +148,9 @@ static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, 
             const __m256 s = _mm256_loadu_ps(a->sharp + 4 * xp);
             __m256 o = s;
             if (anyfar) {
-                const __m256 c = _mm256_permutevar8x32_ps(c8, idx);
-                o = _mm256_blendv_ps(o, lerp8(o, _mm256_loadu_ps(a->far + 4 * xp), _mm256_min_ps(c, one)),
-                                     _mm256_cmp_ps(c, zero, _CMP_GT_OQ));
+                const __m256 ab = _mm256_permutevar8x32_ps(ab8, idx);
+                o = _mm256_blendv_ps(o, lerp8(o, _mm256_loadu_ps(a->far + 4 * xp), ab),
+                                     _mm256_cmp_ps(ab, zero, _CMP_GT_OQ));
             }
             __m256 nv = a->near ? _mm256_loadu_ps(a->near + 4 * xp) : zero;
             if (anyl) {

@@ -171,11 +171,16 @@ static inline void dof_combine_row_x86(float *restrict out, const fv_dof_combine
         const __m128 s = _mm_loadu_ps(a->sharp + 4 * x);
         __m128 o = s; /* lane 3 is carried along unused and replaced by the depth at the end */
         const float c = a->coc[x], t = a->t[x];
+        float ab = 0.0f;
         if (c > 0.0f)
-            o = dof_lerp(o, _mm_loadu_ps(a->far + 4 * x), c < 1.0f ? c : 1.0f);
+            ab = c < 1.0f ? c : 1.0f;
+        else if (c < 0.0f && t > 0.0f)
+            ab = t * (-c < 1.0f ? -c : 1.0f);
+        if (ab > 0.0f)
+            o = dof_lerp(o, _mm_loadu_ps(a->far + 4 * x), ab);
         __m128 nv = a->near ? _mm_loadu_ps(a->near + 4 * x) : _mm_setzero_ps();
         if (a->lnear && t > 0.0f) {
-            const float cs = -c * 0.25f, sc = c < 0.0f ? (cs < 1.0f ? cs : 1.0f) : 1.0f;
+            const float sc = c < 0.0f ? 0.0f : 1.0f;
             const __m128 q = _mm_mul_ps(_mm_set1_ps(sc), _mm_loadu_ps(a->lnear + 4 * x));
             nv = _mm_add_ps(nv, _mm_mul_ps(_mm_set1_ps(t), _mm_sub_ps(q, nv)));
         }
