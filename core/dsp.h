@@ -92,12 +92,19 @@ typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, in
  *   (coc > 0), taps clamped to [0, w): dst[x] = (sum g rgb, sum g) * inv[sig] (premultiplied).
  * dof_vgauss_row: for x in [x0, x0+n): dst[x] = sum_j g_j src[clamp(y + j, ylo, yhi - 1)][x]
  *   (4 channels; src rows stride pixels apart).
+ *   The ISA versions of both Gaussians run blocks of neighbouring pixels to the block's largest
+ *   radius, adding w = 0 taps (the table's zeros) beyond a pixel's own: same bits (an
+ *   accumulator starting at +0 is never -0, so + (+-0) changes nothing), but they read (not
+ *   use) those extra taps, in the row's [0, w) / the rows [ylo, yhi) at columns [x0, x0+n),
+ *   which must hold finite values there (far samples' colours; far_h).
  * dof_combine_row: out[x] for x in [x0, x0+n): o = sharp; towards far by min(1, coc) where
  *   coc > 0, by t min(1, -coc) where coc < 0; near n = near (or 0), blended by t towards
  *   s * lnear where t > 0 (s = 0 for near pixels, else 1); towards n.rgb / n.w by min(1, n.w)
  *   where n.w > 0; with enh,
  *   o = max(0, o + gain t (o - enh)) where gain t > 0; depth copied (fv_dof_combine_row_c has
- *   the order of operations). */
+ *   the order of operations). The ISA versions may read (never use) far, lnear and enh pixels of
+ *   [x0, x0+n) the reference skips: they compute a step for several pixels and keep it by a
+ *   select on the reference's condition. */
 struct fv_dof_gauss_tab;
 struct fv_dof_combine_args;
 typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);

@@ -1,0 +1,202 @@
+/* fovea: the 128-bit pieces of the depth-of-field kernels shared by the SSE4.1 and AVX2 versions
+ * (each .c file includes this and is built with its own ISA flags). One pixel = one __m128
+ * (r, g, b, depth or weight): the references (core/dof/kernels.c) add channel by channel in the
+ * same order, so a vector of 4 channel accumulators gives their bits.
+ *
+ * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
+ * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
+ * it (the table holds 0 there, core/dof/weier_impl.h), and an accumulator that starts at +0 is
+ * never -0 (x + y is -0 only if both are -0), so adding +-0 leaves its bits unchanged. The same
+ * argument lets the horizontal pass add +0 (a masked tap) for a near sample instead of skipping
+ * it. The values read for those extra taps lie in the rows / columns the call covers and must be
+ * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
+#ifndef FOVEA_DOF_X86_H
+#define FOVEA_DOF_X86_H
+
+#include <smmintrin.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dof/weier_impl.h"
+#include "dsp.h"
+
+#define DOF_CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
+
+static inline int dof_clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+static inline int dof_maxi(int a, int b) { return a > b ? a : b; }
+
+/* ---- coc_row: 4 pixels ---- */
+typedef struct {
+    __m128 K, idn, idf, dn, df;
+} dof_coc4_k;
+
+static inline dof_coc4_k dof_coc4_setup(float K, float dn, float df)
+{
+    dof_coc4_k k;
+    k.K = _mm_set1_ps(K);
+    k.idn = _mm_set1_ps(1.0f / dn);
+    k.idf = _mm_set1_ps(1.0f / df);
+    k.dn = _mm_set1_ps(dn);
+    k.df = _mm_set1_ps(df);
+    return k;
+}
+
+/* depths of 4 pixels -> their CoCs: g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 */
+static inline __m128 dof_coc4(__m128 d, const dof_coc4_k *k)
+{
+    const __m128 g = _mm_max_ps(d, _mm_set1_ps(FV_DOF_MIN_DEPTH_M)); /* d > min ? d : min */
+    const __m128 ig = _mm_div_ps(_mm_set1_ps(1.0f), g);
+    const __m128 nr = _mm_mul_ps(k->K, _mm_sub_ps(k->idn, ig));
+    const __m128 fr = _mm_and_ps(_mm_mul_ps(k->K, _mm_sub_ps(k->idf, ig)), _mm_cmpgt_ps(g, k->df));
+    return _mm_blendv_ps(fr, nr, _mm_cmplt_ps(g, k->dn));
+}
+
+/* lane 3 of 4 consecutive pixels */
+static inline __m128 dof_depth4(const float *rgbd)
+{
+    const __m128 h01 = _mm_unpackhi_ps(_mm_loadu_ps(rgbd), _mm_loadu_ps(rgbd + 4));       /* z0 z1 d0 d1 */
+    const __m128 h23 = _mm_unpackhi_ps(_mm_loadu_ps(rgbd + 8), _mm_loadu_ps(rgbd + 12));  /* z2 z3 d2 d3 */
+    return _mm_movehl_ps(h23, h01);
+}
+
+/* ---- hgauss_row ---- */
+
+/* The row as the far layer sees it, positions base .. base+len-1 clamped into [0, w):
+ * (r, g, b, 1) for a far sample (coc > 0), +0 otherwise (so g * m adds exactly what the
+ * reference adds, or +-0 for a skipped tap). 16-byte aligned m. */
+static inline void dof_mask_row(float *restrict m, const float *rgbd, const float *coc, int w, int base, int len)
+{
+    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+    for (int k = 0; k < len; k++) {
+        const int q = dof_clampi(base + k, 0, w - 1);
+        const __m128 p = _mm_blend_ps(_mm_loadu_ps(rgbd + 4 * q), one, 8);
+        _mm_store_ps(m + 4 * k, _mm_and_ps(p, _mm_cmpgt_ps(_mm_set1_ps(coc[q]), zero)));
+    }
+}
+
+/* ---- the Gaussians' taps: tap j of the pixel at p is at p + off[j] (off points at the entry of
+ * j = 0 and holds the span's largest radius either way): the masked row's neighbours for the
+ * horizontal pass, the clamped rows for the vertical one. Pixel k of a block is at p + 4 k. */
+
+/* One pixel, its own radius. */
+static inline __m128 dof_g1(const float *p, const ptrdiff_t *off, const float *wt, int R)
+{
+    __m128 a = _mm_setzero_ps();
+    for (int j = -R; j <= R; j++)
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(wt[j < 0 ? -j : j]), _mm_loadu_ps(p + off[j])));
+    return a;
+}
+
+/* Four neighbouring pixels, the block's largest radius R (see the top of this file). */
+static inline void dof_g4(__m128 a[4], const float *p, const ptrdiff_t *off, const float *const wt[4], int R)
+{
+    __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
+    if (wt[0] == wt[1] && wt[0] == wt[2] && wt[0] == wt[3]) { /* one sigma: one broadcast a tap */
+        for (int j = -R; j <= R; j++) {
+            const float *q = p + off[j];
+            const __m128 g = _mm_set1_ps(wt[0][j < 0 ? -j : j]);
+            a0 = _mm_add_ps(a0, _mm_mul_ps(g, _mm_loadu_ps(q)));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(g, _mm_loadu_ps(q + 4)));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(g, _mm_loadu_ps(q + 8)));
+            a3 = _mm_add_ps(a3, _mm_mul_ps(g, _mm_loadu_ps(q + 12)));
+        }
+    } else {
+        for (int j = -R; j <= R; j++) {
+            const int k = j < 0 ? -j : j;
+            const float *q = p + off[j];
+            a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(wt[0][k]), _mm_loadu_ps(q)));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(wt[1][k]), _mm_loadu_ps(q + 4)));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_set1_ps(wt[2][k]), _mm_loadu_ps(q + 8)));
+            a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_set1_ps(wt[3][k]), _mm_loadu_ps(q + 12)));
+        }
+    }
+    a[0] = a0, a[1] = a1, a[2] = a2, a[3] = a3;
+}
+
+/* n pixels from p (output d), 4 at a time; norm: times inv[s] (the horizontal pass). */
+static inline void dof_gauss_4(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
+                               const fv_dof_gauss_tab *tab, int norm)
+{
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const uint8_t *s = sig + i;
+        const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
+        const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
+        __m128 a[4];
+        dof_g4(a, p + 4 * i, off, wt, R);
+        for (int k = 0; k < 4; k++)
+            _mm_storeu_ps(d + 4 * (i + k), norm ? _mm_mul_ps(a[k], _mm_set1_ps(tab->inv[s[k]])) : a[k]);
+    }
+    for (; i < n; i++) {
+        const __m128 a = dof_g1(p + 4 * i, off, tab->w[sig[i]], tab->rad[sig[i]]);
+        _mm_storeu_ps(d + 4 * i, norm ? _mm_mul_ps(a, _mm_set1_ps(tab->inv[sig[i]])) : a);
+    }
+}
+
+/* The offsets of the taps j in [-R, R]: the horizontal pass's (neighbours in the masked row)
+ * and the vertical pass's (rows clamped into [ylo, yhi), relative to row 0). off points at j = 0. */
+static inline void dof_offsets_h(ptrdiff_t *off, int R)
+{
+    for (int j = -R; j <= R; j++)
+        off[j] = 4 * (ptrdiff_t)j;
+}
+static inline void dof_offsets_v(ptrdiff_t *off, int R, ptrdiff_t stride, int y, int ylo, int yhi)
+{
+    for (int j = -R; j <= R; j++)
+        off[j] = 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
+}
+
+static inline int dof_span_rad(const uint8_t *sig, int n, const fv_dof_gauss_tab *tab)
+{
+    int R = 0;
+    for (int i = 0; i < n; i++)
+        R = dof_maxi(R, tab->rad[sig[i]]);
+    return R;
+}
+
+/* ---- combine_row, one pixel at a time: the reference's control flow, colours as vectors (the
+ * SSE4.1 version; the AVX2 one's tail) ---- */
+
+static inline __m128 dof_bcast3(__m128 v) { return _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 3, 3)); }
+
+/* a + s (b - a), s broadcast */
+static inline __m128 dof_lerp(__m128 a, __m128 b, float s)
+{
+    return _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(s), _mm_sub_ps(b, a)));
+}
+
+static inline void dof_combine_row_x86(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
+{
+    for (int x = x0; x < x0 + n; x++) {
+        const __m128 s = _mm_loadu_ps(a->sharp + 4 * x);
+        __m128 o = s; /* lane 3 is carried along unused and replaced by the depth at the end */
+        const float c = a->coc[x], t = a->t[x];
+        float ab = 0.0f;
+        if (c > 0.0f)
+            ab = c < 1.0f ? c : 1.0f;
+        else if (c < 0.0f && t > 0.0f)
+            ab = t * (-c < 1.0f ? -c : 1.0f);
+        if (ab > 0.0f)
+            o = dof_lerp(o, _mm_loadu_ps(a->far + 4 * x), ab);
+        __m128 nv = a->near ? _mm_loadu_ps(a->near + 4 * x) : _mm_setzero_ps();
+        if (a->lnear && t > 0.0f) {
+            const float sc = c < 0.0f ? 0.0f : 1.0f;
+            const __m128 q = _mm_mul_ps(_mm_set1_ps(sc), _mm_loadu_ps(a->lnear + 4 * x));
+            nv = _mm_add_ps(nv, _mm_mul_ps(_mm_set1_ps(t), _mm_sub_ps(q, nv)));
+        }
+        const float n3 = _mm_cvtss_f32(dof_bcast3(nv));
+        if (n3 > 0.0f)
+            o = dof_lerp(o, _mm_div_ps(nv, dof_bcast3(nv)), n3 < 1.0f ? n3 : 1.0f);
+        if (a->enh) {
+            const float g = a->gain * t;
+            if (g > 0.0f) {
+                const __m128 b = _mm_loadu_ps(a->enh + 4 * x);
+                const __m128 v = _mm_add_ps(o, _mm_mul_ps(_mm_set1_ps(g), _mm_sub_ps(o, b)));
+                o = _mm_max_ps(v, _mm_setzero_ps()); /* v > 0 ? v : +0 */
+            }
+        }
+        _mm_storeu_ps(out + 4 * x, _mm_blend_ps(o, s, 8));
+    }
+}
+
+#endif
