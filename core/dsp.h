@@ -107,6 +107,16 @@ typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, in
  *   select on the reference's condition. */
 struct fv_dof_gauss_tab;
 struct fv_dof_combine_args;
+struct fv_dof_pyrblur_args;
+/* dof_upsample_row: dst[x] = tmp[i0[x]] + ax[x] (tmp[i1[x]] - tmp[i0[x]]) for x in [0, n)
+ *   (4 channels; the horizontal half of a separable bilinear up-sampling).
+ * dof_pyrblur_row: for x in [x0, x0+n) with coc != 0 and t > 0: the continuous level
+ *   l = min(lambda[min(int(|coc| steps), max)], need), pv = up[L0] + f (up[L1] - up[L0])
+ *   (L0 = int l, L1 = min(L0 + 1, need), f = l - L0), blur[x] = coc > 0 && t < 1 ?
+ *   blur + t (pv - blur) : pv (4 channels); other pixels untouched. */
+typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                                       const float *ax, int n);
+typedef void (*fv_dof_pyrblur_row_fn)(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
 typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);
 typedef void (*fv_dof_hgauss_row_fn)(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
                                      const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
@@ -125,6 +135,8 @@ typedef struct fv_dsp {
     fv_dof_hgauss_row_fn dof_hgauss_row;
     fv_dof_vgauss_row_fn dof_vgauss_row;
     fv_dof_combine_row_fn dof_combine_row;
+    fv_dof_upsample_row_fn dof_upsample_row;
+    fv_dof_pyrblur_row_fn dof_pyrblur_row;
     /* eye tracker */
     fv_et_down2_row_fn et_down2_row;
     fv_et_integral_row_fn et_integral_row;
@@ -167,6 +179,9 @@ void fv_dof_hgauss_row_c(float *restrict dst, const float *rgbd, const float *co
 void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi, int x0,
                          int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
 void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
+void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                           const float *ax, int n);
+void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
 void fv_dof_init_c(fv_dsp *d);
 #if defined(__x86_64__)
 void fv_dof_init_sse41(fv_dsp *d);
