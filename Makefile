@@ -55,7 +55,9 @@ endif
 HW_DEFS := $(if $(filter libgpiod,$(HW_PKGS)),-DFV_HAVE_GPIOD) $(if $(filter libdrm,$(HW_PKGS)),-DFV_HAVE_DRM) \
            $(if $(filter sdl2,$(HW_PKGS)),-DFV_HAVE_SDL2)
 HW_CFLAGS := $(HW_DEFS) $(if $(HW_PKGS),$(shell $(PKG_CONFIG) --cflags $(HW_PKGS)))
-HW_LIBS := $(if $(HW_PKGS),-Wl,--push-state,--as-needed $(shell $(PKG_CONFIG) --libs $(HW_PKGS)) -Wl,--pop-state)
+AS_NEEDED := -Wl,--push-state,--as-needed
+AS_NEEDED_END := -Wl,--pop-state
+HW_LIBS := $(if $(HW_PKGS),$(AS_NEEDED) $(shell $(PKG_CONFIG) --libs $(HW_PKGS)) $(AS_NEEDED_END))
 
 ALL_CFLAGS = $(BASE_CFLAGS) $(CFLAGS)
 ALL_CXXFLAGS = $(BASE_CXXFLAGS) $(CXXFLAGS)
