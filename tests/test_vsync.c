@@ -91,7 +91,7 @@ static void test_errors(void **st)
         {"gpio:chip0:-1", "LINE must be"},
         {"gpio:chip0:2:up", "LINE must be"},
         {"timer:abc", "HZ must be"},
-        {"timer:1000", "HZ must be"},
+        {"timer:5000", "HZ must be"},
         {"replay:/nonexistent/e.txt", "No such file"},
         {"vblank", "want gpio:CHIP:LINE, timer:HZ or replay:FILE"},
     };
