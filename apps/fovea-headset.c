@@ -241,6 +241,13 @@ int main(int argc, char **argv)
     if (calib_path && !have_camera)
         fv_usage_error(prog, "--calibration only applies with --camera");
 
+    /* from here on SIGINT ends the run cleanly (start-up included: the loop stops at once) */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
     char err[1024];
     /* every input is checked before anything opens hardware */
     fv_calib calib;
@@ -308,12 +315,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: out of memory\n", prog);
         goto done;
     }
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
 
     int64_t period = fv_vsync_nominal_period_ns(a.vsync);
     if (period <= 0)
