@@ -41,7 +41,7 @@ int fv_gaze_ring_latest(fv_gaze_ring *r, int64_t before_ns, fv_gaze_sample *out)
 void fv_frameloop_default_params(fv_frameloop_params *p, int64_t nominal_period_ns)
 {
     p->nominal_period_ns = nominal_period_ns > 0 ? nominal_period_ns : 11111111;
-    p->budget_scale = 1.15;
+    p->budget_scale = 1.05;
     p->budget_margin_ns = 1000000;
     p->edge_grace_ns = p->nominal_period_ns / 4;
     p->budget_frames = 16;

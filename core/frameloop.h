@@ -67,7 +67,7 @@ typedef struct fv_frameloop_ops {
 
 typedef struct fv_frameloop_params {
     int64_t nominal_period_ns; /* for the predictor (and the timer fallback) */
-    double budget_scale;       /* 1.15 */
+    double budget_scale;       /* 1.05: a late frame costs one period, so the budget need not be generous */
     int64_t budget_margin_ns;  /* 1 ms: wake-up and present slack */
     int64_t edge_grace_ns;     /* wait this long past a predicted vsync for its edge: period / 4 */
     int budget_frames;         /* render times remembered: 16 */

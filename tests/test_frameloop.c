@@ -132,13 +132,13 @@ static void test_steady_and_latch(void **st)
         assert_false(r[i].late);
     }
     for (int i = 10; i < 40; i++) {
-        /* one frame per vsync, on the edge; woken one budget (5 ms x 1.15 + 1 ms) before it */
+        /* one frame per vsync, on the edge; woken one budget (5 ms x 1.05 + 1 ms) before it */
         assert_int_equal(r[i].photon_ns, r[i].target_ns);
         assert_true(r[i].photon_edge);
         assert_int_equal((r[i].photon_ns - T0) % P, 0);
         assert_int_equal(r[i].photon_ns - r[i - 1].photon_ns, P);
-        assert_int_equal(r[i].budget_ns, 6750000);
-        assert_int_equal(r[i].target_ns - r[i].ray_start_ns, 6750000);
+        assert_int_equal(r[i].budget_ns, 6250000);
+        assert_int_equal(r[i].target_ns - r[i].ray_start_ns, 6250000);
         assert_int_equal(r[i].vsync_state, FV_VSYNC_LOCKED);
     }
     assert_int_equal(l.late, 0);
@@ -147,7 +147,7 @@ static void test_steady_and_latch(void **st)
     fv_latency_summary s;
     fv_latency_summarise(r + 10, 30, &s);
     printf("latency p50 %.2f ms p99 %.2f ms, fps %.2f\n", s.p50_ms, s.p99_ms, s.fps);
-    assert_true(s.p99_ms <= 6.75 + 4.17 + 0.01);
+    assert_true(s.p99_ms <= 6.25 + 4.17 + 0.01);
     assert_true(s.fps > 89.99 && s.fps < 90.01);
     fv_gaze_ring_destroy(&ring);
 }
@@ -159,7 +159,7 @@ static void test_late_frame(void **st)
     fv_frameloop l;
     fv_gaze_ring ring;
     setup(&f, &l, &ring);
-    f.render_ns[20] = 15000000; /* one frame takes 15 ms against a 6.75 ms budget */
+    f.render_ns[20] = 15000000; /* one frame takes 15 ms against a 6.25 ms budget */
     fv_frame_record r[30];
     int present_before = 0;
     for (int i = 0; i < 30; i++) {
