@@ -127,9 +127,9 @@ $(PLIB): $(PLATFORM_OBJ)
 $(BUILD)/bin/%: apps/%.c $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) -o $@
-$(BUILD)/tools/%: tools/%.c $(LIB)
+$(BUILD)/tools/%: tools/%.c $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) $< $(LIB) $(ALL_LDFLAGS) $(LIBS) -o $@
+	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) -o $@
 $(BUILD)/tests/%: tests/%.c tests/testutil.h tests/testscene.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Itests $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) $(TEST_LIBS) -o $@
@@ -181,6 +181,10 @@ bench: deps
 	@mkdir -p out/bench
 	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 30 --json out/bench/range.json
 	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 30 --yaw-rate 30 --json out/bench/range-turning.json
+	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 30 --dof weak --json out/bench/range-dof.json
+	for m in hussain mantiuk konrad liu; do \
+	    $(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 5 --warmup 1 --dof weak --dof-model $$m \
+	        --json out/bench/range-dof-$$m.json || exit 1; done
 
 PREFIX ?= /usr/local
 install: all

@@ -152,9 +152,12 @@ int main(int argc, char **argv)
     int threads = cfg.threads > 0 ? cfg.threads : fv_online_cpus();
     fv_dsp dsp;
     fv_dsp_init(&dsp, cfg.isa_mask);
-    printf("%s: %s, %zu triangles (loaded in %.0f ms), %dx%d, %d thread%s, kernels %s, %d+%d frames, head %s\n",
+    printf("%s: %s, %zu triangles (loaded in %.0f ms), %dx%d, %d thread%s, kernels %s, %d+%d frames, head %s, "
+           "dof %s%s%s\n",
            prog, scene_path, fv_scene_triangle_count(scene), load_ms, W, H, threads, threads == 1 ? "" : "s",
-           fv_isa_name(dsp.isa), warmup, frames, yaw_rate != 0.0f ? "turning" : "static");
+           fv_isa_name(dsp.isa), warmup, frames, yaw_rate != 0.0f ? "turning" : "static",
+           fv_dof_presets[cfg.dof.preset].name, cfg.dof.preset ? " " : "",
+           cfg.dof.preset ? fv_dof_model_names[cfg.dof.model] : "");
     if (yaw_rate != 0.0f)
         printf("%s: head turning at %g deg/s (%.3f deg per 90 Hz frame)\n", prog, (double)yaw_rate,
                (double)yaw_rate / 90.0);
@@ -210,9 +213,10 @@ int main(int argc, char **argv)
             else
                 fputc(*c, f);
         fprintf(f, "\", \"width\": %d, \"height\": %d, \"threads\": %d, \"frames\": %d, \"warmup\": %d, "
-                   "\"isa\": \"%s\", \"triangles\": %zu, \"load_ms\": %.1f, \"yaw_rate_dps\": %g,\n \"runs\": [",
+                   "\"isa\": \"%s\", \"triangles\": %zu, \"load_ms\": %.1f, \"yaw_rate_dps\": %g, "
+                   "\"dof\": \"%s\", \"dof_model\": \"%s\",\n \"runs\": [",
                 W, H, threads, frames, warmup, fv_isa_name(dsp.isa), fv_scene_triangle_count(scene), load_ms,
-                (double)yaw_rate);
+                (double)yaw_rate, fv_dof_presets[cfg.dof.preset].name, fv_dof_model_names[cfg.dof.model]);
         for (int i = 0; i < nres; i++) {
             run_result *r = &res[i];
             fprintf(f, "%s\n  {\"mode\": \"%s\", \"samples_per_frame\": %ld, \"total_ms\": ", i ? "," : "", r->mode,

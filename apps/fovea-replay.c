@@ -38,15 +38,14 @@ static void usage(FILE *f)
             "                     PSNR against it (whole image, fovea < r0, periphery > r1)\n"
             "  --reference SPP    render ground-truth depth of field instead: SPP thin-lens rays\n"
             "                     per pixel (every pixel; stage columns empty, total_ms its time)\n"
-            "  --focus-m D        --reference focus distance in metres (default: the view depth\n"
-            "                     at the point of regard)\n"
-            "  --pupil-mm P       --reference pupil (lens aperture) diameter (default 4.49)\n"
+            "                     (--focus-m and --pupil-mm below set its lens; the default focus\n"
+            "                     is the view depth at the point of regard)\n"
             "  --window           show frames in a window (not built yet)\n"
             "  --quiet            no progress output\n" FV_COMMON_HELP "  --help             this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_TRACE, OPT_FRAMES, OPT_OUT, OPT_FULL, OPT_STEREO, OPT_Y4M, OPT_REF, OPT_WINDOW, OPT_HZ,
-       OPT_QUIET, OPT_VS_FULL, OPT_FOCUS, OPT_PUPIL, OPT_HELP };
+       OPT_QUIET, OPT_VS_FULL, OPT_HELP };
 
 /* --reference: the thin-lens ground truth (core/reference.h) of one eye into rgb8. The focus is
  * fixed by the caller for both eyes (they accommodate together). Progress counts tiles. */
@@ -106,7 +105,6 @@ int main(int argc, char **argv)
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0;
     fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
-    int focus_given = 0, pupil_given = 0;
     float hz = 90.0f;
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, {"trace", required_argument, 0, OPT_TRACE},
@@ -115,7 +113,6 @@ int main(int argc, char **argv)
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
         {"window", no_argument, 0, OPT_WINDOW}, {"hz", required_argument, 0, OPT_HZ},
         {"quiet", no_argument, 0, OPT_QUIET}, {"vs-full", no_argument, 0, OPT_VS_FULL},
-        {"focus-m", required_argument, 0, OPT_FOCUS}, {"pupil-mm", required_argument, 0, OPT_PUPIL},
         {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -132,8 +129,6 @@ int main(int argc, char **argv)
         case OPT_QUIET: quiet = 1; break;
         case OPT_VS_FULL: vs_full = 1; break;
         case OPT_REF: refp.spp = (int)fv_arg_long(prog, "--reference", optarg, 1, 65536); break;
-        case OPT_FOCUS: refp.focus_m = fv_arg_float(prog, "--focus-m", optarg, 0.05f, 1000.0f), focus_given = 1; break;
-        case OPT_PUPIL: refp.pupil_mm = fv_arg_float(prog, "--pupil-mm", optarg, 0.0f, 12.0f), pupil_given = 1; break;
         case OPT_WINDOW: fv_usage_error(prog, "--window: the window display is not built yet; use --out / --y4m");
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
@@ -145,8 +140,10 @@ int main(int argc, char **argv)
     fv_common_validate(prog, argc, argv, scene_path, &cfg);
     if (!out_dir)
         fv_usage_error(prog, "--out DIR is required (see --help)");
-    if ((focus_given || pupil_given) && !refp.spp)
-        fv_usage_error(prog, "%s only applies to --reference SPP", focus_given ? "--focus-m" : "--pupil-mm");
+    /* the reference's lens is the pipeline's eye: same pupil, same fixed focus if one is given */
+    const int focus_given = cfg.dof.focus.fixed_m > 0.0f;
+    refp.pupil_mm = cfg.dof.pupil_mm;
+    refp.focus_m = cfg.dof.focus.fixed_m;
     if (refp.spp && vs_full)
         fv_usage_error(prog, "--vs-full and --reference exclude each other");
     if (y4m_path && ((cfg.cam.width & 1) || (cfg.cam.height & 1)))
@@ -223,7 +220,7 @@ int main(int argc, char **argv)
         fprintf(csv.f, ",%s_ms", fv_stage_names[s]);
     /* dluma_periph: mean |luma change| against the previous frame outside r1 of both gazes
      * (temporal stability); psnr_*: against full sampling of the same frame (--vs-full) */
-    fprintf(csv.f, ",total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph\n");
+    fprintf(csv.f, ",total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph,focus_m\n");
 
     fv_progress prog_bar;
     const int neyes = stereo ? 2 : 1;
@@ -237,6 +234,9 @@ int main(int argc, char **argv)
         fv_trace_sample smp;
         double t_ms = t_first + (double)f * 1000.0 / hz;
         fv_trace_at(&tr, t_ms, &smp);
+        fv_pipeline_set_time_ns(pl, (int64_t)llround(t_ms * 1e6)); /* the focus filter's clock */
+        if (ref)
+            fv_pipeline_set_time_ns(ref, (int64_t)llround(t_ms * 1e6));
         fv_pose head = tr.has_head ? smp.head : view;
         fv_frame_stats st[2], sum;
         memset(&sum, 0, sizeof sum);
@@ -321,6 +321,7 @@ int main(int argc, char **argv)
         csv_num(csv.f, p_fov, "%.3f");
         csv_num(csv.f, p_per, "%.3f");
         csv_num(csv.f, fl, "%.4f");
+        csv_num(csv.f, refp.spp ? (double)refp.focus_m : (double)st[0].focus_m, "%.4f");
         fputc('\n', csv.f);
         if (!quiet && !refp.spp)
             fv_progress_update(&prog_bar, f + 1);

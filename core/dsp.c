@@ -26,6 +26,7 @@ void fv_dsp_init(fv_dsp *d, unsigned isa_mask)
     fv_pullpush_init_c(d);
     fv_reproject_init_c(d);
     fv_eyetrack_init_c(d);
+    fv_dof_init_c(d);
 #if defined(__x86_64__)
     if (avail & FV_ISA_SSE41) {
         fv_pullpush_init_sse41(d);

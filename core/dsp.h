@@ -85,12 +85,39 @@ typedef void (*fv_et_down2_row_fn)(uint8_t *restrict dst, const uint8_t *a, cons
 typedef void (*fv_et_integral_row_fn)(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
 typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, int n, int t);
 
+/* ---- layered depth of field (core/dof/weier.c; core/dof/weier_impl.h has the structs) ----
+ * dof_coc_row: coc[x] = g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 for x in [0, n),
+ *   g = max(depth_m of rgbd[x], 0.05) (the signed CoC of Weier eq. (3), simplified).
+ * dof_hgauss_row: for x in [x0, x0+n): the Gaussian sig[x-x0] over the row's FAR samples
+ *   (coc > 0), taps clamped to [0, w): dst[x] = (sum g rgb, sum g) * inv[sig] (premultiplied).
+ * dof_vgauss_row: for x in [x0, x0+n): dst[x] = sum_j g_j src[clamp(y + j, ylo, yhi - 1)][x]
+ *   (4 channels; src rows stride pixels apart).
+ * dof_combine_row: out[x] for x in [x0, x0+n): o = sharp; towards far by min(1, coc) where
+ *   coc > 0, by t min(1, -coc) where coc < 0; near n = near (or 0), blended by t towards
+ *   s * lnear where t > 0 (s = 0 for near pixels, else 1); towards n.rgb / n.w by min(1, n.w)
+ *   where n.w > 0; with enh,
+ *   o = max(0, o + gain t (o - enh)) where gain t > 0; depth copied (fv_dof_combine_row_c has
+ *   the order of operations). */
+struct fv_dof_gauss_tab;
+struct fv_dof_combine_args;
+typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);
+typedef void (*fv_dof_hgauss_row_fn)(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                                     const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+typedef void (*fv_dof_vgauss_row_fn)(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
+                                     int x0, int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+typedef void (*fv_dof_combine_row_fn)(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
+
 typedef struct fv_dsp {
     unsigned isa; /* the ISA actually selected (one FV_ISA_* value) */
     fv_pull_row_fn pull_row;
     fv_push_row_fn push_row;
     fv_taa_blend_fn taa_blend;
     fv_taa_fill_fn taa_fill;
+    /* depth of field */
+    fv_dof_coc_row_fn dof_coc_row;
+    fv_dof_hgauss_row_fn dof_hgauss_row;
+    fv_dof_vgauss_row_fn dof_vgauss_row;
+    fv_dof_combine_row_fn dof_combine_row;
     /* eye tracker */
     fv_et_down2_row_fn et_down2_row;
     fv_et_integral_row_fn et_integral_row;
@@ -124,6 +151,21 @@ void fv_reproject_init_avx2(fv_dsp *d);
 #elif defined(__aarch64__)
 void fv_pullpush_init_neon(fv_dsp *d);
 void fv_reproject_init_neon(fv_dsp *d);
+#endif
+
+/* depth of field */
+void fv_dof_coc_row_c(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);
+void fv_dof_hgauss_row_c(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                         const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi, int x0,
+                         int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
+void fv_dof_init_c(fv_dsp *d);
+#if defined(__x86_64__)
+void fv_dof_init_sse41(fv_dsp *d);
+void fv_dof_init_avx2(fv_dsp *d);
+#elif defined(__aarch64__)
+void fv_dof_init_neon(fv_dsp *d);
 #endif
 
 /* eye tracker */

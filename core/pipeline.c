@@ -12,6 +12,7 @@
 const char *const fv_stage_names[FV_STAGE_COUNT] = {"trace", "reproject", "reconstruct", "coc", "dof_filter", "combine"};
 
 #define SRGB_LUT 4096
+#define FOVEA_STEPS 4 /* fovea scales 1, 1.25, 1.5, 1.75, 2 */
 
 typedef struct {
     fv_camera cam, prev_cam;
@@ -19,6 +20,9 @@ typedef struct {
     int cur;           /* pyr[cur] holds the last rendered frame */
     int hist_valid;    /* pyr[cur] and prev_cam may be reprojected */
     long frame;        /* frames rendered: the sampling pattern's phase */
+    fv_focus focus;    /* depth of field: this eye's accommodation */
+    float *out;        /* depth of field: the final image (level 0's layout) */
+    int64_t last_t_ns; /* the time of its last frame (focus filter) */
 } eye_state;
 
 struct fv_pipeline {
@@ -27,7 +31,19 @@ struct fv_pipeline {
     fv_pool *pool;
     fv_dsp dsp;
     fv_sampler smp;
+    /* fovea widened (fv_pipeline_set_fovea_scale): step k of FOVEA_STEPS scales r0, r1 by
+     * 1 + k / FOVEA_STEPS; wide[k - 1] is built on the step's first use and kept */
+    fv_sampler wide[FOVEA_STEPS];
+    const fv_sampler *smp_cur; /* the sampler in force: smp or one of wide */
+    int fovea_step;
     int taa;           /* reprojection runs (enabled and foveated) */
+    int dof;           /* the depth-of-field stages run */
+    fv_dof_model_fn dof_fn;
+    fv_dof_work dof_work;    /* scratch shared by the eyes (rendered one after the other) */
+    float *enh_fp;           /* contrast enhancement footprint per eccentricity step */
+    int enh_n;
+    const fv_sampler *enh_for; /* the sampler enh_fp was computed for (the fovea may widen) */
+    int64_t t_ns;            /* the frame time set by fv_pipeline_set_time_ns; INT64_MIN: none */
     eye_state eyes[2];
     uint8_t srgb[SRGB_LUT + 1]; /* linear [0,1] -> sRGB 8-bit */
 };
@@ -46,6 +62,7 @@ void fv_pipeline_config_default(fv_pipeline_config *c)
     fv_sampling_params_default(&c->samp);
     c->samp.rotate = 1;
     fv_taa_params_default(&c->taa);
+    fv_dof_params_default(&c->dof);
     c->threads = 0;
     c->isa_mask = ~0u;
 }
@@ -77,12 +94,54 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         fv_err(err, err_len, "sampling parameters out of range: need 0 < r0 <= r1 <= 90 deg, 0 < p_min <= 1");
         goto bad;
     }
+    p->smp_cur = &p->smp;
     for (int e = 0; e < 2; e++)
         for (int b = 0; b < (p->taa ? 2 : 1); b++)
             if (fv_pyramid_init(&p->eyes[e].pyr[b], cfg->cam.width, cfg->cam.height)) {
                 fv_err(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
                 goto bad;
             }
+    p->t_ns = INT64_MIN;
+    p->eyes[0].last_t_ns = p->eyes[1].last_t_ns = INT64_MIN;
+    p->dof = cfg->dof.preset != FV_DOF_NONE;
+    if (p->dof) {
+        const fv_dof_params *dp = &cfg->dof;
+        if ((unsigned)dp->model >= FV_DOF_MODEL_COUNT || (unsigned)dp->preset >= FV_DOF_PRESET_COUNT ||
+            !(dp->pupil_mm > 0.0f && dp->pupil_mm <= 20.0f) || !(dp->tolerance_m >= 0.0f) ||
+            !(dp->contrast_gain >= 0.0f && dp->contrast_gain <= 4.0f) || !(dp->focus.error_deg >= 0.0f) ||
+            !(dp->focus.tau_ms >= 0.0f) || !(dp->focus.fixed_m >= 0.0f)) {
+            fv_err(err, err_len, "depth-of-field parameters out of range");
+            goto bad;
+        }
+        p->dof_fn = fv_dof_model_fns[dp->model];
+        if (!p->dof_fn) {
+            fv_err(err, err_len, "depth-of-field model '%s' is not built", fv_dof_model_names[dp->model]);
+            goto bad;
+        }
+        const fv_pyr_level *l0 = &p->eyes[0].pyr[0].lv[0];
+        if (fv_dof_work_init(&p->dof_work, l0->w, l0->h, l0->stride)) {
+            fv_err(err, err_len, "out of memory for depth-of-field buffers");
+            goto bad;
+        }
+        for (int e = 0; e < 2; e++) {
+            fv_focus_init(&p->eyes[e].focus, &dp->focus);
+            p->eyes[e].out = malloc((size_t)l0->stride * (size_t)l0->h * 4 * sizeof(float));
+            if (!p->eyes[e].out) {
+                fv_err(err, err_len, "out of memory for depth-of-field buffers");
+                goto bad;
+            }
+        }
+        if (!cfg->samp.full) {
+            /* Patney's enhancement kernel: the footprint of one sample, 1 / sqrt(density), per 4 px */
+            const float diag = sqrtf((float)cfg->cam.width * cfg->cam.width + (float)cfg->cam.height * cfg->cam.height);
+            p->enh_n = (int)(diag / 4.0f) + 2;
+            if (!(p->enh_fp = malloc((size_t)p->enh_n * sizeof(float)))) {
+                fv_err(err, err_len, "out of memory");
+                goto bad;
+            }
+            p->enh_for = NULL; /* filled for the sampler in force at the first frame */
+        }
+    }
     p->pool = fv_pool_create(cfg->threads);
     if (!p->pool) {
         fv_err(err, err_len, "cannot start %d worker threads", cfg->threads);
@@ -105,10 +164,16 @@ void fv_pipeline_destroy(fv_pipeline *p)
     if (!p)
         return;
     fv_pool_destroy(p->pool);
+    for (int k = 0; k < FOVEA_STEPS; k++)
+        fv_sampler_free(&p->wide[k]);
     fv_sampler_free(&p->smp);
-    for (int e = 0; e < 2; e++)
+    for (int e = 0; e < 2; e++) {
         for (int b = 0; b < 2; b++)
             fv_pyramid_free(&p->eyes[e].pyr[b]);
+        free(p->eyes[e].out);
+    }
+    fv_dof_work_free(&p->dof_work);
+    free(p->enh_fp);
     free(p);
 }
 
@@ -116,8 +181,79 @@ static inline int slot(fv_eye eye) { return eye == FV_EYE_RIGHT ? 1 : 0; }
 
 void fv_pipeline_reset_history(fv_pipeline *p)
 {
-    for (int e = 0; e < 2; e++)
+    for (int e = 0; e < 2; e++) {
         p->eyes[e].hist_valid = 0;
+        if (p->dof)
+            fv_focus_init(&p->eyes[e].focus, &p->cfg.dof.focus);
+    }
+}
+
+void fv_pipeline_set_time_ns(fv_pipeline *p, int64_t t_ns) { p->t_ns = t_ns; }
+
+/* The focus estimator's view of the reconstruction: level 0's depth at the nearest pixel. */
+static float pyr_depth(void *ctx, float x, float y)
+{
+    const fv_pyr_level *l0 = ctx;
+    const int i = (int)floorf(x), j = (int)floorf(y);
+    if (i < 0 || j < 0 || i >= l0->w || j >= l0->h)
+        return NAN;
+    return l0->rgbd[4 * ((ptrdiff_t)j * l0->stride + i) + 3];
+}
+
+/* Focus depth, CoC, filter, combine of one eye into es->out. */
+static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, float gaze_x, float gaze_y,
+                       fv_frame_stats *st)
+{
+    const fv_pyr_level *l0 = &pyr->lv[0];
+    const fv_dof_params *dp = &p->cfg.dof;
+    /* elapsed time since this eye's last frame */
+    float dt_ms = 1000.0f / 90.0f;
+    if (p->t_ns != INT64_MIN) {
+        if (es->last_t_ns != INT64_MIN && p->t_ns > es->last_t_ns)
+            dt_ms = (float)((double)(p->t_ns - es->last_t_ns) * 1e-6);
+        es->last_t_ns = p->t_ns;
+    }
+    const float gx = gaze_x * (float)l0->w, gy = gaze_y * (float)l0->h;
+    const float ppd = es->cam.focal_px * 0.017453292f;
+    int64_t t0 = fv_time_ns();
+    const float focus_m = fv_focus_update(&es->focus, pyr_depth, (void *)l0, gx, gy, ppd, dt_ms);
+    st->focus_m = focus_m;
+    const double focus_ms = (double)(fv_time_ns() - t0) * 1e-6;
+    if (!(focus_m > 0.0f)) { /* no depth under the gaze yet: nothing to focus on, show it sharp */
+        for (int y = 0; y < l0->h; y++)
+            memcpy(es->out + 4 * (ptrdiff_t)y * l0->stride, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride,
+                   (size_t)l0->w * 4 * sizeof(float));
+        st->stage_ms[FV_STAGE_COC] = focus_ms;
+        return;
+    }
+    if (p->enh_fp && p->enh_for != p->smp_cur) {
+        for (int i = 0; i < p->enh_n; i++) {
+            const float pr = fv_sampler_probability(p->smp_cur, 4.0f * (float)i, 0.0f);
+            p->enh_fp[i] = pr > 0.0f ? 1.0f / sqrtf(pr) : 1.0f;
+        }
+        p->enh_for = p->smp_cur;
+    }
+    fv_dof_view v = {
+        .pyr = pyr,
+        .focus_m = focus_m,
+        .focal_px = es->cam.focal_px,
+        .blur_scale = fv_dof_presets[dp->preset].e_scale,
+        .gaze_x = gx,
+        .gaze_y = gy,
+        .r0_px = p->smp_cur->r0_px, /* the fovea in force (widened when the gaze is doubtful) */
+        .r1_px = p->smp_cur->r1_px,
+        .prm = dp,
+        .enh_fp = p->enh_fp,
+        .enh_n = p->enh_n,
+        .enh_step = 4.0f,
+    };
+    v.e_px_per_mm = fv_retina_px_per_mm(v.focal_px, FV_EYE_IMAGE_DIST_MM) * v.blur_scale;
+    fv_dof_times t = {NAN, NAN, NAN};
+    p->dof_fn(&v, &p->dof_work, es->out, l0->stride, p->pool, &p->dsp, &t);
+    /* the focus estimate is part of the CoC stage (Weier's Table 1 has no row of its own) */
+    st->stage_ms[FV_STAGE_COC] = (isnan(t.coc_ms) ? 0.0 : t.coc_ms) + focus_ms;
+    st->stage_ms[FV_STAGE_DOF_FILTER] = t.filter_ms;
+    st->stage_ms[FV_STAGE_COMBINE] = t.combine_ms;
 }
 
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
@@ -134,7 +270,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     const int dst = p->taa ? es->cur ^ 1 : 0;
     fv_pyramid *pyr = &es->pyr[dst];
     fv_taa_frame tf;
-    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp.phases) : 0, .taa_prm = &p->cfg.taa};
+    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa};
     int64_t t0 = fv_time_ns();
     if (p->taa && es->hist_valid) {
         fv_taa_frame_setup(&tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
@@ -143,11 +279,15 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     /* The S_in pattern moves by whole pixels with the point of regard. */
     int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
     double taa_ms = NAN;
-    st->samples = fv_raycast(p->scene, &es->cam, &p->smp, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
+    st->samples = fv_raycast(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     int64_t t1 = fv_time_ns();
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
     fv_pullpush_from(pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(pyr));
     int64_t t2 = fv_time_ns();
+    st->focus_m = NAN;
+    if (p->dof)
+        render_dof(p, es, pyr, gaze_x, gaze_y, st);
+    int64_t t3 = fv_time_ns();
     es->cur = dst;
     es->prev_cam = es->cam;
     es->hist_valid = 1;
@@ -163,7 +303,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         st->stage_ms[FV_STAGE_TRACE] = cast_ms;
     }
     st->stage_ms[FV_STAGE_RECONSTRUCT] = (double)(t2 - t1) * 1e-6;
-    st->total_ms = (double)(t2 - t0) * 1e-6;
+    st->total_ms = (double)(t3 - t0) * 1e-6;
     return 0;
 }
 
@@ -173,15 +313,50 @@ const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye)
     return &es->pyr[es->cur];
 }
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye) { return &p->eyes[slot(eye)].cam; }
-const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p) { return &p->smp; }
+const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p) { return p->smp_cur; }
+
+int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale)
+{
+    /* NaN: as doubtful as it gets (fv_fovea_radius_scale's convention) */
+    const float s = scale == scale ? scale : 2.0f;
+    const int k = s <= 1.0f ? 0 : s >= 2.0f ? FOVEA_STEPS : (int)lrintf((s - 1.0f) * FOVEA_STEPS);
+    if (k == 0 || p->cfg.samp.full) { /* full sampling has no fovea to widen */
+        p->smp_cur = &p->smp;
+        p->fovea_step = 0;
+        return 0;
+    }
+    fv_sampler *w = &p->wide[k - 1];
+    if (!w->s_in) {
+        fv_sampling_params sp = p->smp.prm; /* as created (rotation decided there) */
+        const float f = 1.0f + (float)k / FOVEA_STEPS;
+        sp.r1_deg = fminf(90.0f, sp.r1_deg * f);
+        sp.r0_deg = fminf(sp.r1_deg, sp.r0_deg * f);
+        if (fv_sampler_init(w, p->smp.width, p->smp.height, p->eyes[0].cam.focal_px, &sp))
+            return -1; /* the scale in force stays */
+    }
+    p->smp_cur = w;
+    p->fovea_step = k;
+    return 0;
+}
+
+float fv_pipeline_fovea_scale(const fv_pipeline *p) { return 1.0f + (float)p->fovea_step / FOVEA_STEPS; }
 fv_pool *fv_pipeline_pool(fv_pipeline *p) { return p->pool; }
 const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p) { return &p->dsp; }
+
+const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride)
+{
+    const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
+    *stride = l0->stride;
+    return p->dof ? p->eyes[slot(eye)].out : l0->rgbd;
+}
 
 void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride)
 {
     const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
+    ptrdiff_t stride;
+    const float *img = fv_pipeline_image(p, eye, &stride);
     for (int y = 0; y < l0->h; y++) {
-        const float *s = l0->rgbd + 4 * y * l0->stride;
+        const float *s = img + 4 * y * stride;
         uint8_t *o = dst + y * dst_stride;
         for (int x = 0; x < l0->w; x++)
             for (int c = 0; c < 3; c++) {

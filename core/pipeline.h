@@ -1,12 +1,13 @@
 /* fovea: the per-eye frame pipeline (Weier et al. 2018): sample -> ray cast -> reproject (TAA)
- * -> pull-push reconstruction -> [focus depth, CoC, layered DoF filter, combine].
- * Stages in brackets are not built yet: their times are NAN ("-" in tables, null in JSON). */
+ * -> pull-push reconstruction -> focus depth, CoC, DoF filter, combine (core/dof/dof.h; with
+ * --dof none those stages do not run and their times are NAN: "-" in tables, null in JSON). */
 #ifndef FOVEA_PIPELINE_H
 #define FOVEA_PIPELINE_H
 
 #include <stddef.h>
 #include <stdint.h>
 #include "camera.h"
+#include "dof/dof.h"
 #include "dsp.h"
 #include "pool.h"
 #include "pullpush.h"
@@ -30,6 +31,7 @@ typedef struct fv_pipeline_config {
     fv_camera_desc cam;      /* size, vertical FOV, IPD, frustum shift */
     fv_sampling_params samp; /* r0, r1, p_min, full; rotate (default 1) with reprojection */
     fv_taa_params taa;       /* temporal reprojection (foveated only; full sampling needs none) */
+    fv_dof_params dof;       /* depth of field (preset none: off) */
     int threads;             /* 0 = online CPUs */
     unsigned isa_mask;       /* kernels allowed (FV_ISA_* bits); ~0u = the best this CPU runs */
 } fv_pipeline_config;
@@ -38,6 +40,7 @@ typedef struct fv_frame_stats {
     double stage_ms[FV_STAGE_COUNT]; /* NAN for a stage that is not built */
     double total_ms;                 /* wall time of the whole frame */
     long samples;                    /* rays cast */
+    float focus_m;                   /* the accommodated focus distance (NAN without DoF) */
 } fv_frame_stats;
 
 typedef struct fv_pipeline fv_pipeline;
@@ -51,15 +54,32 @@ void fv_pipeline_destroy(fv_pipeline *p);
  * from head pose `head` with the point of regard at normalised image coordinates (gaze_x, gaze_y). */
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
                        fv_frame_stats *stats);
+/* The time of the frames rendered next (CLOCK_MONOTONIC or a trace's clock), for the focus
+ * filter's accommodation. Without it every frame counts as 1/90 s after the last. */
+void fv_pipeline_set_time_ns(fv_pipeline *p, int64_t t_ns);
 /* Forgets both eyes' history (a cut, a teleport): the next frame starts afresh. */
 void fv_pipeline_reset_history(fv_pipeline *p);
 /* The eye's reconstruction pyramid after its last render (level 0 = the image). */
 const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye);
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye);
+/* The sampling pattern in force (it changes with fv_pipeline_set_fovea_scale). */
 const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p);
+/* Widens the fovea for the following frames (both eyes) when the gaze is doubtful: r0 and r1
+ * times `scale` (r1 capped at 90 deg), the scale rounded to a step of 0.25 in [1, 2] (below 1:
+ * 1; NaN: 2), as fv_fovea_radius_scale (eyetrack/gazefilter.h) gives it for the gaze filter's
+ * confidence. Each step's sampling tables are built on its first use, here and not during a
+ * frame, and kept until fv_pipeline_destroy: calling this every frame allocates nothing once
+ * each step has been visited, and a step always gives the same pattern. No effect with full
+ * sampling. 0 on success, -1 when there is no memory for the step's tables (the scale in force
+ * stays). */
+int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale);
+float fv_pipeline_fovea_scale(const fv_pipeline *p); /* the step in force: 1 .. 2 */
 fv_pool *fv_pipeline_pool(fv_pipeline *p);
 const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 
+/* The eye's last image (after depth of field, if on): 4 floats a pixel (linear r, g, b,
+ * depth_m), rows *stride pixels apart. */
+const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride);
 /* The eye's last image as sRGB-encoded 8-bit RGB, rows of dst_stride bytes. */
 void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride);
 

@@ -143,16 +143,36 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
             fv_usage_error(prog, "--pattern: '%s' is not one of rotate, static", arg);
         return 1;
     case FV_OPT_DOF:
-        if (!strcmp(arg, "none"))
-            return 1;
-        if (!strcmp(arg, "weak") || !strcmp(arg, "medium") || !strcmp(arg, "strong"))
-            fv_usage_error(prog, "--dof %s: depth of field is not built yet; only 'none' works", arg);
-        fv_usage_error(prog, "--dof: '%s' is not one of none, weak, medium, strong", arg);
+        if (fv_dof_preset_parse(arg, &cfg->dof.preset))
+            fv_usage_error(prog, "--dof: '%s' is not one of none, weak, medium, strong", arg);
+        return 1;
     case FV_OPT_DOF_MODEL:
-        if (!strcmp(arg, "weier") || !strcmp(arg, "hussain") || !strcmp(arg, "mantiuk") || !strcmp(arg, "konrad") ||
-            !strcmp(arg, "liu"))
-            fv_usage_error(prog, "--dof-model %s: depth of field is not built yet", arg);
-        fv_usage_error(prog, "--dof-model: '%s' is not one of weier, hussain, mantiuk, konrad, liu", arg);
+        if (fv_dof_model_parse(arg, &cfg->dof.model))
+            fv_usage_error(prog, "--dof-model: '%s' is not one of weier, hussain, mantiuk, konrad, liu", arg);
+        if (!fv_dof_model_fns[cfg->dof.model])
+            fv_usage_error(prog, "--dof-model %s: this model is not built yet", arg);
+        return 1;
+    case FV_OPT_FOCUS_M:
+        cfg->dof.focus.fixed_m = fv_arg_float(prog, "--focus-m", arg, 0.05f, 1000.0f);
+        return 1;
+    case FV_OPT_PUPIL_MM:
+        cfg->dof.pupil_mm = fv_arg_float(prog, "--pupil-mm", arg, 0.0f, 20.0f);
+        return 1;
+    case FV_OPT_GAZE_ERR:
+        cfg->dof.focus.error_deg = fv_arg_float(prog, "--gaze-error-deg", arg, 0.0f, 10.0f);
+        return 1;
+    case FV_OPT_DOF_TOL:
+        cfg->dof.tolerance_m = fv_arg_float(prog, "--dof-tolerance-m", arg, 0.0f, 10.0f);
+        return 1;
+    case FV_OPT_ACCOMMODATION:
+        cfg->dof.focus.tau_ms = fv_arg_float(prog, "--accommodation-ms", arg, 0.0f, 10000.0f);
+        return 1;
+    case FV_OPT_CONTRAST:
+        cfg->dof.contrast_gain = fv_arg_float(prog, "--contrast-gain", arg, 0.0f, 4.0f);
+        return 1;
+    case FV_OPT_CHROMA:
+        cfg->dof.chroma = fv_arg_onoff(prog, "--chroma", arg);
+        return 1;
     }
     return 0;
 }

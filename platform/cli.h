@@ -27,7 +27,8 @@ void fv_arg_size(const char *prog, const char *flag, const char *s, int *w, int 
 enum {
     FV_OPT_SIZE = 1000, FV_OPT_THREADS, FV_OPT_FOV, FV_OPT_IPD, FV_OPT_R0, FV_OPT_R1, FV_OPT_PMIN, FV_OPT_ISA,
     FV_OPT_DOF, FV_OPT_DOF_MODEL, FV_OPT_REPROJECT, FV_OPT_TAA_ALPHA, FV_OPT_TAA_TOL, FV_OPT_TAA_FILL,
-    FV_OPT_PATTERN,
+    FV_OPT_PATTERN, FV_OPT_FOCUS_M, FV_OPT_PUPIL_MM, FV_OPT_GAZE_ERR, FV_OPT_DOF_TOL, FV_OPT_ACCOMMODATION,
+    FV_OPT_CONTRAST, FV_OPT_CHROMA,
 };
 #define FV_COMMON_LONGOPTS                                                                     \
     {"size", required_argument, 0, FV_OPT_SIZE}, {"threads", required_argument, 0, FV_OPT_THREADS}, \
@@ -37,7 +38,11 @@ enum {
     {"dof", required_argument, 0, FV_OPT_DOF}, {"dof-model", required_argument, 0, FV_OPT_DOF_MODEL},   \
     {"reproject", required_argument, 0, FV_OPT_REPROJECT}, {"taa-alpha", required_argument, 0, FV_OPT_TAA_ALPHA}, \
     {"taa-depth-tol", required_argument, 0, FV_OPT_TAA_TOL}, {"taa-fill", required_argument, 0, FV_OPT_TAA_FILL}, \
-    {"pattern", required_argument, 0, FV_OPT_PATTERN}
+    {"pattern", required_argument, 0, FV_OPT_PATTERN}, {"focus-m", required_argument, 0, FV_OPT_FOCUS_M}, \
+    {"pupil-mm", required_argument, 0, FV_OPT_PUPIL_MM}, {"gaze-error-deg", required_argument, 0, FV_OPT_GAZE_ERR}, \
+    {"dof-tolerance-m", required_argument, 0, FV_OPT_DOF_TOL},                                   \
+    {"accommodation-ms", required_argument, 0, FV_OPT_ACCOMMODATION},                            \
+    {"contrast-gain", required_argument, 0, FV_OPT_CONTRAST}, {"chroma", required_argument, 0, FV_OPT_CHROMA}
 #define FV_COMMON_HELP                                                                             \
     "  --size WxH         eye image size in pixels (default 1280x1440)\n"                          \
     "  --fov DEG          vertical field of view (default 100)\n"                                  \
@@ -54,8 +59,16 @@ enum {
     "                     reprojection; static always without it)\n"                           \
     "  --threads N        worker threads (default: online CPUs)\n"                                 \
     "  --isa c|sse41|avx2|neon  cap the SIMD kernels (default: best available)\n"                  \
-    "  --dof none|weak|medium|strong   depth of field (only 'none' is built yet)\n"                \
-    "  --dof-model weier|hussain|mantiuk|konrad|liu   (needs --dof; not built yet)\n"
+    "  --dof none|weak|medium|strong   gaze-contingent depth of field (default none; weak is\n"  \
+    "                     the eye's own blur, medium x2, strong x4: docs/dof.md)\n"                \
+    "  --dof-model weier|hussain|mantiuk|konrad|liu   the filter (default weier, layered)\n"      \
+    "  --focus-m D        fixed focus distance in metres (default: estimated from the gaze)\n"   \
+    "  --pupil-mm P       pupil (lens aperture) diameter (default 4.49)\n"                         \
+    "  --gaze-error-deg E tracker's angular error: focus sampling radius (default 1)\n"          \
+    "  --accommodation-ms T  focus time constant (default 370; 0 = instant)\n"                   \
+    "  --dof-tolerance-m T   depth range kept sharp around the focus, +-T (default 0.2)\n"      \
+    "  --contrast-gain G  peripheral contrast enhancement (Patney 2016; default 0 = off)\n" \
+    "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
 /* After getopt_long: no stray words, a scene was given, option combinations agree (r0 <= r1);
  * exits 2 with a reason otherwise. */

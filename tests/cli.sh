@@ -42,7 +42,10 @@ for p in fovea-replay fovea-bench; do
     expect_usage "$p bad size" '--size: .640x. is not WxH' $B/$p --scene $SCENE $O --size 640x
     expect_usage "$p bad pmin" '--pmin: 1.5 is out of range' $B/$p --scene $SCENE $O --pmin 1.5
     expect_usage "$p r0 > r1" '--r0 30 must not exceed --r1 20' $B/$p --scene $SCENE $O --r0 30 --r1 20
-    expect_usage "$p dof not built" '--dof medium: depth of field is not built yet' $B/$p --scene $SCENE $O --dof medium
+    expect_usage "$p dof model bad" '--dof-model: .bokeh. is not one of' $B/$p --scene $SCENE $O --dof weak --dof-model bokeh
+    expect_usage "$p bad contrast gain" '--contrast-gain: 5 is out of range' $B/$p --scene $SCENE $O --dof weak --contrast-gain 5
+    expect_usage "$p bad gaze error" '--gaze-error-deg: -1 is out of range' $B/$p --scene $SCENE $O --dof weak --gaze-error-deg -1
+    expect_usage "$p bad chroma" '--chroma: .yes. is not one of on, off' $B/$p --scene $SCENE $O --chroma yes
     expect_usage "$p dof bad" '--dof: .blurry. is not one of' $B/$p --scene $SCENE $O --dof blurry
     expect_usage "$p stray arg" 'unexpected argument .extra.' $B/$p --scene $SCENE $O extra
     expect_usage "$p bad reproject" '--reproject: .maybe. is not one of on, off' $B/$p --scene $SCENE $O --reproject maybe
@@ -63,9 +66,8 @@ expect_usage "replay non-numeric trace" 'nan.csv:2: field 3 .*abc.* is not a fin
 expect_usage "replay wrong header" 'header.csv:1: header must start with t_ms,gaze_x,gaze_y' $R --scene $SCENE --out "$T/o2" --trace "$T/header.csv"
 expect_usage "replay empty trace" 'empty.csv: no samples' $R --scene $SCENE --out "$T/o2" --trace "$T/empty.csv"
 expect_usage "replay reference spp 0" '--reference: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 0
-expect_usage "replay focus without reference" '--focus-m only applies to --reference' $R --scene $SCENE --out "$T/o2" --focus-m 2
 expect_usage "replay bad focus" '--focus-m: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --focus-m 0
-expect_usage "replay bad pupil" '--pupil-mm: 20 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --pupil-mm 20
+expect_usage "replay bad pupil" '--pupil-mm: 25 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --pupil-mm 25
 expect_usage "replay reference vs-full" '--vs-full and --reference exclude each other' $R --scene $SCENE --out "$T/o2" --reference 4 --vs-full
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
 expect_usage "bench bad mode" '--mode: .fast. is not one of' $B/fovea-bench --scene $SCENE --mode fast
@@ -76,7 +78,7 @@ if $R --scene $SCENE --trace "$T/good.csv" --frames 3 --size 96x108 --out "$T/ru
     n=$(ls "$T/run" | grep -c '^frame_0000[0-2]\.png$')
     head=$(head -n 1 "$T/run/stats.csv")
     rows=$(wc -l <"$T/run/stats.csv")
-    want="frame,t_ms,gaze_x,gaze_y,samples,trace_ms,reproject_ms,reconstruct_ms,coc_ms,dof_filter_ms,combine_ms,total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph"
+    want="frame,t_ms,gaze_x,gaze_y,samples,trace_ms,reproject_ms,reconstruct_ms,coc_ms,dof_filter_ms,combine_ms,total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph,focus_m"
     [ "$n" -eq 3 ] && ok || bad "replay wrote $n frames, expected 3"
     [ "$head" = "$want" ] && ok || bad "stats.csv header: $head"
     [ "$rows" -eq 4 ] && ok || bad "stats.csv has $rows lines, expected 4"
@@ -173,6 +175,36 @@ fi
 expect_usage "replay odd y4m size" 'even frame sizes' $R --scene $SCENE --frames 1 --size 63x72 --y4m "$T/odd.y4m" --out "$T/odd"
 [ ! -e "$T/odd.y4m" ] && [ ! -e "$T/odd.y4m.tmp" ] && [ ! -e "$T/odd/stats.csv" ] && ok || bad "failed y4m run left files behind"
 
+# Depth of field: the DoF stage columns and the focus are filled; the blurred frame differs from
+# the sharp one; a fixed focus is reported as such; the same bytes for 1 and 3 threads
+if $R --scene $SCENE --frames 2 --size 96x108 --dof strong --out "$T/dof" --quiet 2>"$T/err" &&
+    $R --scene $SCENE --frames 2 --size 96x108 --dof strong --threads 3 --out "$T/dof3" --quiet 2>>"$T/err" &&
+    $R --scene $SCENE --frames 2 --size 96x108 --dof strong --focus-m 1.5 --out "$T/doff" --quiet 2>>"$T/err" &&
+    $R --scene $SCENE --frames 2 --size 96x108 --out "$T/nodof" --quiet 2>>"$T/err"; then
+    awk -F, 'NR == 3 && $9 != "" && $10 != "" && $11 != "" && $18 > 0 {ok = 1} END {exit !ok}' "$T/dof/stats.csv" && ok ||
+        bad "--dof stats: $(sed -n 3p "$T/dof/stats.csv")"
+    awk -F, 'NR == 3 && $9 == "" && $18 == "" {ok = 1} END {exit !ok}' "$T/nodof/stats.csv" && ok ||
+        bad "--dof none stats: $(sed -n 3p "$T/nodof/stats.csv")"
+    awk -F, 'NR >= 2 && $18 != "1.5000" {bad = 1} END {exit bad}' "$T/doff/stats.csv" && ok ||
+        bad "--focus-m 1.5 not reported: $(cut -d, -f18 "$T/doff/stats.csv" | tr '\n' ' ')"
+    cmp -s "$T/dof/frame_00001.png" "$T/nodof/frame_00001.png" && bad "--dof strong changed nothing" || ok
+    cmp -s "$T/dof/frame_00001.png" "$T/dof3/frame_00001.png" && ok || bad "--dof frames differ between 1 and 3 threads"
+else
+    bad "replay --dof failed: $(cat "$T/err")"
+fi
+
+# every model renders, and changes the image (focused at 0.3 m: the tunnel blurs by ~5 px)
+$R --scene $SCENE --frames 1 --size 320x360 --out "$T/m_none" --quiet 2>/dev/null
+for m in weier hussain mantiuk konrad liu; do
+    if $R --scene $SCENE --frames 1 --size 320x360 --dof strong --dof-model $m --focus-m 0.3 --out "$T/m_$m" --quiet 2>"$T/err"; then
+        cmp -s "$T/m_$m/frame_00000.png" "$T/m_none/frame_00000.png" && bad "--dof-model $m changed nothing" || ok
+    else
+        bad "--dof-model $m failed: $(cat "$T/err")"
+    fi
+done
+$R --scene $SCENE --frames 1 --size 320x360 --dof strong --dof-model liu --chroma on --focus-m 0.3 --out "$T/m_liuc" --quiet 2>/dev/null &&
+    ! cmp -s "$T/m_liuc/frame_00000.png" "$T/m_liu/frame_00000.png" && ok || bad "--chroma on changed nothing"
+
 # Bench JSON has the documented fields; null for stages not built yet (and for reprojection in
 # the full mode, which needs none)
 if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/b.json" >"$T/out" 2>"$T/err"; then
@@ -189,6 +221,14 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
             bad "turning bench JSON: $(cat "$T/t.json")"
     else
         bad "turning bench failed: $(cat "$T/err")"
+    fi
+    # with depth of field its three stages are measured
+    if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --mode foveated --dof weak \
+        --json "$T/d.json" >/dev/null 2>"$T/err"; then
+        grep -q '"coc": [0-9]' "$T/d.json" && grep -q '"dof_filter": [0-9]' "$T/d.json" &&
+            grep -q '"combine": [0-9]' "$T/d.json" && ok || bad "DoF bench JSON: $(cat "$T/d.json")"
+    else
+        bad "DoF bench failed: $(cat "$T/err")"
     fi
 else
     bad "bench failed: $(cat "$T/err")"

@@ -7,6 +7,7 @@
 #include "testutil.h"
 #include "testscene.h"
 #include "pipeline.h"
+#include "eyetrack/gazefilter.h"
 #include "raycast.h"
 #include "scene.h"
 
@@ -129,6 +130,95 @@ static void test_foveated_samples(void **st)
             }
         }
     assert_true(checked > 100);
+    fv_pipeline_destroy(p);
+    fv_scene_free(s);
+}
+
+/* Samples the sampler in force casts for the gaze at pixel (px, py), phase 0. */
+static long pattern_samples(const fv_sampler *smp, int w, int h, int px, int py)
+{
+    long n = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x += 64)
+            n += __builtin_popcountll(fv_sampler_row(smp, x, y, w - x < 64 ? w - x : 64, px, py, 0));
+    return n;
+}
+
+/* Pixels within radius rad (pixel centres) of (px + 0.5, py + 0.5) that the pattern leaves out. */
+static int holes_in_disc(const fv_sampler *smp, int w, int h, int px, int py, float rad)
+{
+    int holes = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float dx = (float)(x - px), dy = (float)(y - py);
+            if (dx * dx + dy * dy < rad * rad && !(fv_sampler_row(smp, x, y, 1, px, py, 0) & 1))
+                holes++;
+        }
+    return holes;
+}
+
+/* A doubtful gaze widens the fovea: with the scale fv_fovea_radius_scale gives a low confidence,
+ * r0 and r1 double, more rays are cast and the fully sampled disc is the wider one (the normal
+ * pattern has holes in it); the scale is quantised, a step's pattern is the same on every visit
+ * and going back to 1 restores the first pattern exactly. */
+static void test_fovea_scale(void **st)
+{
+    (void)st;
+    fv_scene *s = hand_scene();
+    fv_pipeline_config cfg;
+    fv_pipeline_config_default(&cfg);
+    cfg.cam.width = 320;
+    cfg.cam.height = 360;
+    cfg.threads = 2;
+    cfg.samp.rotate = 0; /* one pattern: the expected counts hold for every frame */
+    char err[256];
+    fv_pipeline *p = fv_pipeline_create(s, &cfg, err, sizeof err);
+    assert_non_null(p);
+    const float gx = 0.45f, gy = 0.55f;
+    const int px = (int)floorf(gx * 320), py = (int)floorf(gy * 360);
+    fv_frame_stats a, b, c, d;
+    assert_float_equal(fv_pipeline_fovea_scale(p), 1.0f, 0.0f);
+    const fv_sampler *s1 = fv_pipeline_sampler(p);
+    const float r0 = s1->r0_px, r1 = s1->r1_px;
+    assert_int_equal(fv_pipeline_render(p, FV_EYE_CENTER, &origin, gx, gy, &a), 0);
+    assert_int_equal(a.samples, pattern_samples(s1, 320, 360, px, py));
+    assert_int_equal(holes_in_disc(s1, 320, 360, px, py, r0), 0);
+    assert_true(holes_in_disc(s1, 320, 360, px, py, 1.9f * r0) > 100);
+
+    /* tracking confidence 0.1: scale 2 */
+    const float scale = fv_fovea_radius_scale(0.1f);
+    assert_float_equal(scale, 2.0f, 1e-6);
+    assert_int_equal(fv_pipeline_set_fovea_scale(p, scale), 0);
+    assert_float_equal(fv_pipeline_fovea_scale(p), 2.0f, 0.0f);
+    const fv_sampler *s2 = fv_pipeline_sampler(p);
+    assert_float_equal(s2->r0_px, 2.0f * r0, 1e-3f * r0);
+    assert_float_equal(s2->r1_px, 2.0f * r1, 1e-3f * r1);
+    assert_int_equal(fv_pipeline_render(p, FV_EYE_CENTER, &origin, gx, gy, &b), 0);
+    assert_int_equal(b.samples, pattern_samples(s2, 320, 360, px, py));
+    assert_true(b.samples > a.samples * 13 / 10); /* 27248 -> 40288 rays here */
+    assert_int_equal(holes_in_disc(s2, 320, 360, px, py, 1.99f * r0), 0);
+
+    /* in between: 1.3 is the 1.25 step; back to 1 and to 2 again: the same patterns */
+    assert_int_equal(fv_pipeline_set_fovea_scale(p, 1.3f), 0);
+    assert_float_equal(fv_pipeline_fovea_scale(p), 1.25f, 0.0f);
+    assert_int_equal(fv_pipeline_render(p, FV_EYE_CENTER, &origin, gx, gy, &c), 0);
+    assert_true(c.samples > a.samples && c.samples < b.samples);
+    assert_int_equal(fv_pipeline_set_fovea_scale(p, 0.5f), 0);
+    assert_ptr_equal(fv_pipeline_sampler(p), s1);
+    assert_int_equal(fv_pipeline_render(p, FV_EYE_CENTER, &origin, gx, gy, &d), 0);
+    assert_int_equal(d.samples, a.samples);
+    assert_int_equal(fv_pipeline_set_fovea_scale(p, NAN), 0); /* NaN confidence: widest */
+    assert_ptr_equal(fv_pipeline_sampler(p), s2);
+    assert_int_equal(fv_pipeline_render(p, FV_EYE_CENTER, &origin, gx, gy, &d), 0);
+    assert_int_equal(d.samples, b.samples);
+    fv_pipeline_destroy(p);
+
+    /* full sampling: nothing to widen */
+    cfg.samp.full = 1;
+    p = fv_pipeline_create(s, &cfg, err, sizeof err);
+    assert_non_null(p);
+    assert_int_equal(fv_pipeline_set_fovea_scale(p, 2.0f), 0);
+    assert_float_equal(fv_pipeline_fovea_scale(p), 1.0f, 0.0f);
     fv_pipeline_destroy(p);
     fv_scene_free(s);
 }
@@ -279,6 +369,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hand_scene_full),
         cmocka_unit_test(test_foveated_samples),
+        cmocka_unit_test(test_fovea_scale),
         cmocka_unit_test(test_thread_determinism),
         cmocka_unit_test(test_fused_pull_matches_pullpush),
         cmocka_unit_test(test_stereo_eyes),

@@ -35,7 +35,7 @@ typedef struct fv_dof_params {
     fv_dof_model model;
     float pupil_mm;        /* k / tau_e / a: 4.49 (the preset's pupil) */
     float tolerance_m;     /* Weier's t: 0.2 m */
-    float contrast_gain;   /* Patney 2016 peripheral contrast enhancement, 0 = off (default 0.5) */
+    float contrast_gain;   /* Patney 2016 peripheral contrast enhancement, 0 = off (the default) */
     int chroma;            /* liu: longitudinal chromatic aberration (Liu sec. 3.3.2), default 0 */
     fv_focus_params focus; /* focus estimation; focus.fixed_m > 0 fixes it */
 } fv_dof_params;
@@ -51,6 +51,11 @@ typedef struct fv_dof_view {
     float gaze_x, gaze_y;   /* point of regard in pixels */
     float r0_px, r1_px;     /* fovea and end of the transition region (sampling radii), pixels */
     const fv_dof_params *prm;
+    /* contrast enhancement (weier): the blur footprint in pixels (1 / sqrt(sampling density))
+     * at eccentricity i * enh_step pixels, i < enh_n; NULL for none (full sampling) */
+    const float *enh_fp;
+    int enh_n;
+    float enh_step;
 } fv_dof_view;
 
 /* Scratch a model may use, allocated once for the eye size (dof.c): FV_DOF_PLANES4 planes of
@@ -58,11 +63,15 @@ typedef struct fv_dof_view {
  * pixels apart (the pyramid level 0's stride). Contents are undefined on entry. */
 #define FV_DOF_PLANES4 4
 #define FV_DOF_PLANES1 4
+struct fv_dof_gauss_tab;
 typedef struct fv_dof_work {
     int w, h;
     ptrdiff_t stride;
     float *p4[FV_DOF_PLANES4];
     float *p1[FV_DOF_PLANES1];
+    struct fv_dof_gauss_tab *gauss; /* the layered filter's Gaussian weights (constant) */
+    float *aux, *rows;              /* the layered filter's own scratch, grown on first use */
+    size_t aux_len, rows_len;
 } fv_dof_work;
 int fv_dof_work_init(fv_dof_work *wk, int w, int h, ptrdiff_t stride); /* 0, or -1: no memory */
 void fv_dof_work_free(fv_dof_work *wk);

@@ -44,6 +44,14 @@ typedef struct fv_eye_params {
                                 min(w, h) (vignetted corners are dark) */
     float centre_prior;      /* search score penalty, grey levels per min(w, h) of distance
                                 from the image centre (the eye is roughly centred) */
+    float crop_centre_weight; /* small frames (min side <= 160: crops an eye detector centred on
+                                 the eye): the reported centre moves this fraction of the way
+                                 from the detection to the image centre (a second, independent
+                                 estimate of the pupil) and stays on pixel centres; 0 = off */
+    float glint_weight;      /* small frames: and this fraction of the way toward the most
+                                prominent bright spot (a corneal reflection) within the search
+                                box's half-size of its centre; 0 = off. Set both to 0 for a
+                                headset camera whose frames are this small. */
     int max_glints;          /* <= FV_EYE_MAX_GLINTS */
 } fv_eye_params;
 

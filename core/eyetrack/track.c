@@ -28,6 +28,7 @@
 #define SEARCH_MAX_SIDE 160 /* search image F: min side at most this */
 #define SEARCH_C_SIDE 64    /* exhaustive search image C: min side at most this */
 #define NRAYS 48
+#define SPOT_MIN 20 /* bright_spot: grey levels above the median of its surround */
 
 struct fv_eye_tracker {
     fv_eye_params p;
@@ -46,6 +47,9 @@ void fv_eye_default_params(fv_eye_params *p)
     p->max_radius_frac = 0.17f;
     p->border_frac = 0.1f;
     p->centre_prior = 20.0f;
+    /* both chosen on the even-numbered MRL images (docs/eyetrack.md) */
+    p->crop_centre_weight = 0.05f;
+    p->glint_weight = 0.3f;
     p->max_glints = FV_EYE_MAX_GLINTS;
 }
 
@@ -689,6 +693,46 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
 
 /* ---------------------------------------------------------------- frame */
 
+/* The most prominent small reflection within r of (cx, cy) in a small crop: a 3x3 local maximum
+ * at least SPOT_MIN grey levels above the median of the square ring 3 px around it (weaker and
+ * smaller than what find_glints accepts: at these sizes the reflection is a few pixels of
+ * a blurred spot). 1 and its pixel centre, or 0. */
+static int bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float cx, float cy, float r, float *ox,
+                       float *oy)
+{
+    const int x0 = imax(3, (int)floorf(cx - r)), x1 = imin(w - 4, (int)floorf(cx + r));
+    const int y0 = imax(3, (int)floorf(cy - r)), y1 = imin(h - 4, (int)floorf(cy + r));
+    int best = SPOT_MIN - 1, bx = -1, by = -1;
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            const uint8_t *q = img + y * stride + x;
+            const int v = q[0];
+            if (v - best <= 0 || v < q[-1] || v < q[1] || v < q[-stride] || v < q[stride] || v < q[-stride - 1] ||
+                v < q[-stride + 1] || v < q[stride - 1] || v < q[stride + 1])
+                continue;
+            /* median of the 24 ring pixels (insertion sort) */
+            uint8_t ring[24];
+            int n = 0;
+            for (int k = -3; k <= 3; k++) {
+                ring[n++] = q[-3 * stride + k], ring[n++] = q[3 * stride + k];
+                if (k > -3 && k < 3)
+                    ring[n++] = q[k * stride - 3], ring[n++] = q[k * stride + 3];
+            }
+            for (int i = 1; i < n; i++)
+                for (int j = i; j > 0 && ring[j - 1] > ring[j]; j--) {
+                    const uint8_t tmp = ring[j];
+                    ring[j] = ring[j - 1], ring[j - 1] = tmp;
+                }
+            const int con = v - (ring[11] + ring[12] + 1) / 2;
+            if (con > best)
+                best = con, bx = x, by = y;
+        }
+    if (bx < 0)
+        return 0;
+    *ox = bx + 0.5f, *oy = by + 0.5f;
+    return 1;
+}
+
 static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, fv_eye_result *r,
                  int history)
 {
@@ -723,9 +767,20 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
      * ellipse on the MRL images (lids, lashes and iris pull them). Headset-sized eyes: the ellipse
      * centre, else the dark-region centroid. */
     const int small = c.scale == 1;
+    const int ng = find_glints(t, luma, w, h, stride, &p, work, stack, gl);
     if (small) {
-        r->pupil_x = c.x;
-        r->pupil_y = c.y;
+        /* The box centre, moved toward the crop's centre (the crop is the eye detector's own
+         * estimate: on MRL the labels sit ~8% of the way from the detection to the centre)
+         * and toward a corneal reflection inside the box (it hides part of the pupil, and its
+         * inpainted area looks less dark than the pupil, which pushes the box away from it),
+         * then on a pixel centre again like the box it came from. */
+        const float a = fclampf(t->p.crop_centre_weight, 0.0f, 1.0f), gw = fclampf(t->p.glint_weight, 0.0f, 1.0f);
+        float px = c.x + a * (0.5f * (float)w - c.x), py = c.y + a * (0.5f * (float)h - c.y);
+        float gx, gy;
+        if (gw > 0 && bright_spot(luma, w, h, stride, c.x, c.y, c.r, &gx, &gy))
+            px += gw * (gx - c.x), py += gw * (gy - c.y);
+        r->pupil_x = floorf(px) + 0.5f;
+        r->pupil_y = floorf(py) + 0.5f;
     } else if (p.fit) {
         r->pupil_x = (float)p.e.cx;
         r->pupil_y = (float)p.e.cy;
@@ -745,7 +800,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     r->found = 1;
     r->status = FV_EYE_OK;
 
-    r->n_glints = find_glints(t, luma, w, h, stride, &p, work, stack, gl);
+    r->n_glints = ng;
     memcpy(r->glints, gl, (size_t)r->n_glints * sizeof *gl);
     if (r->n_glints) {
         float gx = 0, gy = 0;

@@ -1,0 +1,129 @@
+/* fovea: plain-C reference kernels of the layered depth-of-field filter (core/dof/weier.c).
+ * The hand-vectorised versions (core/x86/dof_*.c, core/arm/dof_neon.c) give the same bits: the
+ * 4-channel sums below are written channel by channel in the order the vector code adds. */
+#include <math.h>
+
+#include "dof/weier_impl.h"
+#include "dsp.h"
+
+static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+
+void fv_dof_coc_row_c(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
+{
+    const float inv_dn = 1.0f / dn, inv_df = 1.0f / df;
+    for (int x = 0; x < n; x++) {
+        const float g = rgbd[4 * x + 3] > FV_DOF_MIN_DEPTH_M ? rgbd[4 * x + 3] : FV_DOF_MIN_DEPTH_M;
+        const float ig = 1.0f / g;
+        /* near of d_n: K (1/g - 1/d_n) negated; far of d_f: K (1/d_f - 1/g); else 0 */
+        coc[x] = g < dn ? K * (inv_dn - ig) : g > df ? K * (inv_df - ig) : 0.0f;
+    }
+}
+
+void fv_dof_hgauss_row_c(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                         const uint8_t *sig, const struct fv_dof_gauss_tab *tab)
+{
+    for (int i = 0; i < n; i++) {
+        const int x = x0 + i, s = sig[i], R = tab->rad[s];
+        float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
+        for (int j = -R; j <= R; j++) {
+            const int q = clampi(x + j, 0, w - 1);
+            if (!(coc[q] > 0.0f))
+                continue; /* only far-field samples enter the far layer */
+            const float g = tab->w[s][j < 0 ? -j : j];
+            a0 += g * rgbd[4 * q + 0];
+            a1 += g * rgbd[4 * q + 1];
+            a2 += g * rgbd[4 * q + 2];
+            a3 += g;
+        }
+        const float inv = tab->inv[s];
+        dst[4 * x + 0] = a0 * inv;
+        dst[4 * x + 1] = a1 * inv;
+        dst[4 * x + 2] = a2 * inv;
+        dst[4 * x + 3] = a3 * inv;
+    }
+}
+
+void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi, int x0,
+                         int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab)
+{
+    for (int i = 0; i < n; i++) {
+        const int x = x0 + i, s = sig[i], R = tab->rad[s];
+        float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
+        for (int j = -R; j <= R; j++) {
+            const float *p = src + 4 * ((ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride + x);
+            const float g = tab->w[s][j < 0 ? -j : j];
+            a0 += g * p[0];
+            a1 += g * p[1];
+            a2 += g * p[2];
+            a3 += g * p[3];
+        }
+        dst[4 * x + 0] = a0;
+        dst[4 * x + 1] = a1;
+        dst[4 * x + 2] = a2;
+        dst[4 * x + 3] = a3;
+    }
+}
+
+void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n)
+{
+    for (int x = x0; x < x0 + n; x++) {
+        const float *s = a->sharp + 4 * x;
+        float o0 = s[0], o1 = s[1], o2 = s[2];
+        const float c = a->coc[x];
+        const float t = a->t[x];
+        /* towards the pixel's own blur: the far layer, fully from a CoC of one pixel on; a near
+         * pixel's pyramid blur in the periphery, faded in by t */
+        float ab = 0.0f;
+        if (c > 0.0f)
+            ab = c < 1.0f ? c : 1.0f;
+        else if (c < 0.0f && t > 0.0f)
+            ab = t * (-c < 1.0f ? -c : 1.0f);
+        if (ab > 0.0f) {
+            const float *f = a->far + 4 * x;
+            o0 = o0 + ab * (f[0] - o0);
+            o1 = o1 + ab * (f[1] - o1);
+            o2 = o2 + ab * (f[2] - o2);
+        }
+        /* the near layer: full resolution, blended by t towards the quarter-resolution one,
+         * which only spreads near pixels over the others (a near pixel has its own blur above) */
+        float n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, n3 = 0.0f;
+        if (a->near) {
+            const float *p = a->near + 4 * x;
+            n0 = p[0], n1 = p[1], n2 = p[2], n3 = p[3];
+        }
+        if (a->lnear && t > 0.0f) {
+            const float s = c < 0.0f ? 0.0f : 1.0f, *q = a->lnear + 4 * x;
+            n0 = n0 + t * (s * q[0] - n0);
+            n1 = n1 + t * (s * q[1] - n1);
+            n2 = n2 + t * (s * q[2] - n2);
+            n3 = n3 + t * (s * q[3] - n3);
+        }
+        if (n3 > 0.0f) { /* over the image by its coverage */
+            const float cov = n3 < 1.0f ? n3 : 1.0f;
+            o0 = o0 + cov * (n0 / n3 - o0);
+            o1 = o1 + cov * (n1 / n3 - o1);
+            o2 = o2 + cov * (n2 / n3 - o2);
+        }
+        if (a->enh) {
+            const float g = a->gain * t, *b = a->enh + 4 * x;
+            if (g > 0.0f) {
+                const float v0 = o0 + g * (o0 - b[0]), v1 = o1 + g * (o1 - b[1]), v2 = o2 + g * (o2 - b[2]);
+                o0 = v0 > 0.0f ? v0 : 0.0f;
+                o1 = v1 > 0.0f ? v1 : 0.0f;
+                o2 = v2 > 0.0f ? v2 : 0.0f;
+            }
+        }
+        out[4 * x + 0] = o0;
+        out[4 * x + 1] = o1;
+        out[4 * x + 2] = o2;
+        out[4 * x + 3] = s[3];
+    }
+}
+
+void fv_dof_init_c(fv_dsp *d)
+{
+    d->dof_coc_row = fv_dof_coc_row_c;
+    d->dof_hgauss_row = fv_dof_hgauss_row_c;
+    d->dof_vgauss_row = fv_dof_vgauss_row_c;
+    d->dof_combine_row = fv_dof_combine_row_c;
+}

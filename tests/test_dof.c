@@ -1,0 +1,343 @@
+/* The layered depth-of-field filter (core/dof/weier.c) on synthetic reconstructions: exactness in
+ * focus, no far-to-near leakage, near blur spreading past silhouettes, the far Gaussian against
+ * its formula, the CoC row against eq. (3), and thread-count invariance. */
+#include <math.h>
+#include <string.h>
+
+#include "testutil.h"
+#include "dof/dof.h"
+#include "dof/weier_impl.h"
+
+#define W 200
+#define H 160
+#define FOCAL 600.0f
+
+typedef struct {
+    fv_pyramid pyr;
+    fv_dsp dsp;
+    fv_dof_params prm;
+    fv_dof_view v;
+    fv_dof_work wk;
+    float *out;
+} rig;
+
+/* Pixel colour/depth setter type: fills (r, g, b, depth_m) of pixel (x, y). */
+typedef void (*scene_fn)(int x, int y, float px[4]);
+
+static void rig_init(rig *r, scene_fn scene, fv_dof_preset preset, float focus_m, float gx, float gy)
+{
+    assert_int_equal(fv_pyramid_init(&r->pyr, W, H), 0);
+    fv_pyr_level *l0 = &r->pyr.lv[0];
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            scene(x, y, l0->rgbd + 4 * ((ptrdiff_t)y * l0->stride + x));
+            l0->wgt[(ptrdiff_t)y * l0->stride + x] = 1.0f;
+        }
+    fv_dsp_init(&r->dsp, FV_ISA_C);
+    fv_pullpush(&r->pyr, &r->dsp, NULL);
+    fv_dof_params_default(&r->prm);
+    r->prm.preset = preset;
+    r->prm.contrast_gain = 0.0f;
+    memset(&r->v, 0, sizeof r->v);
+    r->v.pyr = &r->pyr;
+    r->v.focus_m = focus_m;
+    r->v.focal_px = FOCAL;
+    r->v.blur_scale = fv_dof_presets[preset].e_scale;
+    r->v.e_px_per_mm = FOCAL / 22.4f * r->v.blur_scale;
+    r->v.gaze_x = gx, r->v.gaze_y = gy;
+    r->v.r0_px = 30.0f, r->v.r1_px = 60.0f;
+    r->v.prm = &r->prm;
+    assert_int_equal(fv_dof_work_init(&r->wk, W, H, l0->stride), 0);
+    r->out = malloc((size_t)l0->stride * H * 4 * sizeof(float));
+    assert_non_null(r->out);
+}
+
+static void rig_run(rig *r, fv_pool *pool, unsigned isa)
+{
+    fv_dsp_init(&r->dsp, isa);
+    fv_dof_times t;
+    fv_dof_weier(&r->v, &r->wk, r->out, r->pyr.lv[0].stride, pool, &r->dsp, &t);
+    assert_true(t.coc_ms >= 0.0 && t.filter_ms >= 0.0 && t.combine_ms >= 0.0);
+}
+
+static void rig_free(rig *r)
+{
+    fv_pyramid_free(&r->pyr);
+    fv_dof_work_free(&r->wk);
+    free(r->out);
+}
+
+static const float *in_px(const rig *r, int x, int y) { return r->pyr.lv[0].rgbd + 4 * ((ptrdiff_t)y * r->pyr.lv[0].stride + x); }
+static const float *out_px(const rig *r, int x, int y) { return r->out + 4 * ((ptrdiff_t)y * r->pyr.lv[0].stride + x); }
+
+/* a high-frequency texture in [0.1, 0.9] */
+static float tex(int x, int y, int c) { return 0.1f + 0.8f * (float)(((x * 7 + y * 13 + c * 5) % 17)) / 16.0f; }
+
+static void plane_at_2m(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = 2.0f;
+}
+
+/* In focus everywhere: every pixel comes out exactly as it went in, with contrast enhancement
+ * off, and in the fovea also with it on. */
+static void test_in_focus_unchanged(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, plane_at_2m, FV_DOF_STRONG, 2.0f, 100.0f, 80.0f);
+    rig_run(&r, NULL, ~0u);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            assert_memory_equal(out_px(&r, x, y), in_px(&r, x, y), 4 * sizeof(float));
+    /* a plane within the tolerance (2.15 m, t 0.2 m) is in focus too */
+    r.v.focus_m = 2.15f;
+    r.prm.contrast_gain = 0.5f;
+    static const float fp[4] = {1.0f, 1.0f, 2.0f, 3.0f};
+    r.v.enh_fp = fp, r.v.enh_n = 4, r.v.enh_step = 20.0f;
+    rig_run(&r, NULL, ~0u);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const float dx = (float)x + 0.5f - 100.0f, dy = (float)y + 0.5f - 80.0f;
+            if (dx * dx + dy * dy < 30.0f * 30.0f) /* the fovea: no enhancement */
+                assert_memory_equal(out_px(&r, x, y), in_px(&r, x, y), 4 * sizeof(float));
+        }
+    rig_free(&r);
+}
+
+/* A near object (1 m, in focus) in front of a far textured background (10 m). */
+#define SQ_X0 60
+#define SQ_X1 120
+#define SQ_Y0 50
+#define SQ_Y1 110
+static void near_square_far_bg(int x, int y, float px[4])
+{
+    const int in = x >= SQ_X0 && x < SQ_X1 && y >= SQ_Y0 && y < SQ_Y1;
+    for (int c = 0; c < 3; c++)
+        px[c] = in ? 0.5f : tex(x, y, c);
+    px[3] = in ? 1.0f : 10.0f;
+}
+
+static void check_no_leak(float gx, float gy)
+{
+    rig r;
+    rig_init(&r, near_square_far_bg, FV_DOF_STRONG, 1.0f, gx, gy);
+    rig_run(&r, NULL, ~0u);
+    /* the background is blurred (far CoC = 0.00449 * (1/1.2 - 1/10) * 600 * 4 = 7.9 px) ... */
+    double bg_change = 0.0;
+    for (int y = 0; y < 40; y++)
+        for (int x = 0; x < W; x++)
+            bg_change += fabsf(out_px(&r, x, y)[0] - in_px(&r, x, y)[0]);
+    assert_true(bg_change / (40.0 * W) > 0.05);
+    /* ... but not one pixel of the in-focus square moves */
+    for (int y = SQ_Y0; y < SQ_Y1; y++)
+        for (int x = SQ_X0; x < SQ_X1; x++)
+            for (int c = 0; c < 3; c++)
+                assert_float_equal(out_px(&r, x, y)[c], 0.5f, 1e-6f);
+    rig_free(&r);
+}
+
+static void bright_square_dark_far_bg(int x, int y, float px[4])
+{
+    const int in = x >= SQ_X0 && x < SQ_X1 && y >= SQ_Y0 && y < SQ_Y1;
+    px[0] = px[1] = px[2] = in ? 1.0f : 0.0f;
+    px[3] = in ? 1.0f : 10.0f;
+}
+
+static void test_far_does_not_leak_fovea(void **st)
+{
+    (void)st;
+    check_no_leak(90.0f, 80.0f); /* the square is in the Gaussian (centre) region */
+    /* and in the centre the far layer holds only far samples: the blurred background next to
+     * the sharp square does not take the square's colour (it is in front of it) */
+    rig r;
+    rig_init(&r, bright_square_dark_far_bg, FV_DOF_STRONG, 1.0f, 90.0f, 80.0f);
+    r.v.r0_px = 80.0f, r.v.r1_px = 120.0f; /* all of it in the fovea (the transition blends in pyramid taps) */
+    rig_run(&r, NULL, ~0u);
+    for (int d = 1; d <= 6; d++) {
+        assert_float_equal(out_px(&r, SQ_X1 - 1 + d, 80)[0], 0.0f, 1e-6f);
+        assert_float_equal(out_px(&r, 90, SQ_Y0 - d)[1], 0.0f, 1e-6f);
+    }
+    rig_free(&r);
+}
+
+static void test_far_does_not_leak_periphery(void **st)
+{
+    (void)st;
+    check_no_leak(-500.0f, -500.0f); /* everything in the periphery: pyramid taps */
+}
+
+/* A near object (0.3 m, out of focus) in front of an in-focus background (2 m). */
+static void near_blurred_square(int x, int y, float px[4])
+{
+    const int in = x >= SQ_X0 && x < SQ_X1 && y >= SQ_Y0 && y < SQ_Y1;
+    for (int c = 0; c < 3; c++)
+        px[c] = in ? 1.0f : 0.0f;
+    px[3] = in ? 0.3f : 2.0f;
+}
+
+/* In the fovea the near layer is the full-resolution box: the exact coverage profile. */
+static void test_near_spreads_fovea(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, near_blurred_square, FV_DOF_MEDIUM, 2.0f, 90.0f, 80.0f);
+    r.v.r0_px = 90.0f, r.v.r1_px = 130.0f; /* the square and its surround in the fovea */
+    rig_run(&r, NULL, ~0u);
+    /* near CoC = 0.00449 * 600 * 2 * (1/0.3 - 1/1.8) = 14.97 px: radius floor(7.48) = 7 */
+    const int R = 7, ym = (SQ_Y0 + SQ_Y1) / 2;
+    for (int d = 1; d <= R; d++) {
+        /* outside the silhouette on the focused background, within reach: the object's colour
+         * spreads over it, less with distance (coverage of a box of 2R+1 = 15: (R + 1 - d) / 15) */
+        const float expect = (float)(R + 1 - d) / 15.0f;
+        assert_float_equal(out_px(&r, SQ_X1 - 1 + d, ym)[0], expect, 1e-4f);
+        assert_float_equal(out_px(&r, SQ_X0 - d, ym)[1], expect, 1e-4f);
+    }
+    /* beyond reach the background is untouched */
+    assert_memory_equal(out_px(&r, SQ_X1 + R, ym), in_px(&r, SQ_X1 + R, ym), 4 * sizeof(float));
+    assert_memory_equal(out_px(&r, 5, 5), in_px(&r, 5, 5), 4 * sizeof(float));
+    /* the object's inside, far from its edges, keeps its colour */
+    assert_float_equal(out_px(&r, 90, ym)[0], 1.0f, 1e-5f);
+    rig_free(&r);
+}
+
+/* In the periphery the near layer is the same filter on 4x4 blocks, up-sampled: the spread
+ * falls off monotonically over about the same reach and leaves the rest alone. */
+static void test_near_spreads_periphery(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, near_blurred_square, FV_DOF_MEDIUM, 2.0f, -500.0f, -500.0f);
+    rig_run(&r, NULL, ~0u);
+    const int ym = (SQ_Y0 + SQ_Y1) / 2;
+    float prev = 1.0f;
+    for (int d = 1; d <= 12; d++) {
+        const float v = out_px(&r, SQ_X1 - 1 + d, ym)[0];
+        assert_true(v <= prev + 1e-6f);
+        prev = v;
+    }
+    assert_true(out_px(&r, SQ_X1, ym)[0] > 0.3f);   /* spreads past the silhouette */
+    assert_true(out_px(&r, SQ_X1 + 4, ym)[0] > 0.1f);
+    assert_true(out_px(&r, SQ_X1 + 6, ym)[0] < out_px(&r, SQ_X1, ym)[0]);
+    /* two blocks of reach plus the up-sampling's texel: nothing beyond 16 px */
+    assert_memory_equal(out_px(&r, SQ_X1 + 16, ym), in_px(&r, SQ_X1 + 16, ym), 4 * sizeof(float));
+    assert_memory_equal(out_px(&r, 5, 5), in_px(&r, 5, 5), 4 * sizeof(float));
+    assert_float_equal(out_px(&r, 90, ym)[0], 1.0f, 1e-5f);
+    rig_free(&r);
+}
+
+/* A far vertical step edge at one depth, in the centre: the far layer is a Gaussian of sigma
+ * c / 4; the blurred edge follows 0.5 (1 + erf(d / (sigma sqrt 2))) (sampled at pixel centres). */
+static void far_step(int x, int y, float px[4])
+{
+    (void)y;
+    px[0] = px[1] = px[2] = x >= 100 ? 1.0f : 0.0f;
+    px[3] = 5.0f;
+}
+
+static void test_far_gaussian_profile(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, far_step, FV_DOF_STRONG, 0.6f, 100.0f, 80.0f);
+    r.prm.tolerance_m = 0.0f;
+    rig_run(&r, NULL, ~0u);
+    const float c = 0.00449f * (1.0f / 0.6f - 1.0f / 5.0f) * FOCAL * 4.0f; /* 15.8 px */
+    const float sigma = c / 4.0f;
+    const int q = (int)(sigma * FV_DOF_SIG_STEPS + 0.5f); /* the table's quantised sigma */
+    const double sq = (double)q / FV_DOF_SIG_STEPS;
+    for (int x = 85; x < 115; x++) {
+        /* discrete Gaussian: sum of weights over samples >= 100, normalised */
+        double num = 0.0, den = 0.0;
+        for (int j = -(int)ceil(3 * sq); j <= (int)ceil(3 * sq); j++) {
+            const double g = exp(-0.5 * j * j / (sq * sq));
+            den += g;
+            num += x + j >= 100 ? g : 0.0;
+        }
+        assert_float_equal(out_px(&r, x, 80)[0], (float)(num / den), 2e-5f);
+        /* and close to the continuous formula */
+        const double d = (double)x + 0.5 - 100.0;
+        assert_float_equal(out_px(&r, x, 80)[0], (float)(0.5 * (1.0 + erf(d / (sigma * sqrt(2.0))))), 0.03f);
+    }
+    rig_free(&r);
+}
+
+/* The CoC row kernel against eq. (3) in double (core/dof/coc.c), every ISA. */
+static void test_coc_row_matches_eq3(void **st)
+{
+    (void)st;
+    fv_coc_weier p;
+    fv_coc_weier_default(&p, FOCAL);
+    float rgbd[4 * 64], coc[64];
+    for (int i = 0; i < 64; i++) {
+        rgbd[4 * i + 3] = 0.04f * (float)(i + 1) * (float)(i + 1) / 8.0f; /* 5 mm .. 20 m */
+        rgbd[4 * i] = rgbd[4 * i + 1] = rgbd[4 * i + 2] = 0.0f;
+    }
+    const float focus = 1.0f, K = 0.00449f * FOCAL;
+    const unsigned isas[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_SSE41 | FV_ISA_AVX2, FV_ISA_NEON};
+    for (size_t k = 0; k < sizeof isas / sizeof isas[0]; k++) {
+        fv_dsp d;
+        fv_dsp_init(&d, isas[k]);
+        d.dof_coc_row(coc, rgbd, 64, K, focus - 0.2f, focus + 0.2f);
+        for (int i = 0; i < 64; i++) {
+            const float e = fv_coc_weier_px(&p, focus, rgbd[4 * i + 3]);
+            assert_float_equal(coc[i], e, 1e-3f + 1e-3f * fabsf(e));
+            if (rgbd[4 * i + 3] >= 0.8f && rgbd[4 * i + 3] <= 1.2f)
+                assert_true(coc[i] == 0.0f);
+        }
+    }
+}
+
+/* A busy scene: near, in-focus and far parts, the gaze so that all three regions appear. */
+static void busy(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = 0.3f + 0.02f * (float)((x * 3 + y * 5) % 97) + ((x / 20 + y / 20) & 1 ? 5.0f : 0.0f);
+}
+
+static void test_threads_and_isas_identical(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, busy, FV_DOF_MEDIUM, 1.0f, 70.0f, 60.0f);
+    r.prm.contrast_gain = 0.5f;
+    float fp[40];
+    for (int i = 0; i < 40; i++)
+        fp[i] = 1.0f + 0.2f * (float)i;
+    r.v.enh_fp = fp, r.v.enh_n = 40, r.v.enh_step = 8.0f;
+    const size_t n = (size_t)r.pyr.lv[0].stride * H * 4;
+    float *ref = malloc(n * sizeof(float));
+    assert_non_null(ref);
+    rig_run(&r, NULL, FV_ISA_C);
+    memcpy(ref, r.out, n * sizeof(float));
+    fv_pool *pool = fv_pool_create(3);
+    assert_non_null(pool);
+    const unsigned isas[] = {FV_ISA_C, ~0u};
+    for (size_t k = 0; k < 2; k++) {
+        memset(r.out, 0, n * sizeof(float));
+        rig_run(&r, pool, isas[k]);
+        for (int y = 0; y < H; y++)
+            assert_memory_equal(r.out + 4 * (size_t)y * r.pyr.lv[0].stride, ref + 4 * (size_t)y * r.pyr.lv[0].stride,
+                                W * 4 * sizeof(float));
+    }
+    fv_pool_destroy(pool);
+    free(ref);
+    rig_free(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_in_focus_unchanged),
+        cmocka_unit_test(test_far_does_not_leak_fovea),
+        cmocka_unit_test(test_far_does_not_leak_periphery),
+        cmocka_unit_test(test_near_spreads_fovea),
+        cmocka_unit_test(test_near_spreads_periphery),
+        cmocka_unit_test(test_far_gaussian_profile),
+        cmocka_unit_test(test_coc_row_matches_eq3),
+        cmocka_unit_test(test_threads_and_isas_identical),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,23 @@
+#!/bin/sh
+# Does the blur conceal sparse sampling? Foveated against full sampling, each with the same DoF
+# (or none), along the bundled gaze trace: mean luma PSNR in the periphery (outside r1) and over
+# the whole image, from fovea-replay --vs-full, skipping the first 10 frames (history warm-up).
+#   tools/measure_dof_fov.sh [OUT_DIR]   (env: BUILD=build SIZE=1280x1440 FRAMES=60 SCENE=assets/range.glb)
+set -eu
+cd "$(dirname "$0")/.."
+BUILD=${BUILD:-build}
+SIZE=${SIZE:-1280x1440}
+FRAMES=${FRAMES:-60}
+SCENE=${SCENE:-assets/range.glb}
+OUT=${1:-out/dof-fov}
+mkdir -p "$OUT"
+echo "| DoF | PSNR periphery dB | PSNR all dB | flicker periphery |" > "$OUT/table.md"
+echo "|---|---|---|---|" >> "$OUT/table.md"
+for dof in none weak medium strong; do
+    echo "measure_dof_fov: --dof $dof" >&2
+    "$BUILD/bin/fovea-replay" --scene "$SCENE" --trace assets/gaze_sweep.csv --frames "$FRAMES" --size "$SIZE" \
+        --vs-full --dof "$dof" --quiet --out "$OUT/$dof"
+    awk -F, -v d="$dof" 'NR > 11 && $16 != "" {p += $16; a += $14; f += $17; n++}
+        END {printf "| %s | %.2f | %.2f | %.4f |\n", d, p / n, a / n, f / n}' "$OUT/$dof/stats.csv" >> "$OUT/table.md"
+done
+cat "$OUT/table.md"
