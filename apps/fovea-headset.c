@@ -11,6 +11,7 @@
 #include "calibfile.h"
 #include "cli.h"
 #include "display.h"
+#include "eyetrack/gazefilter.h"
 #include "frameloop.h"
 #include "gazesrc.h"
 #include "lensfile.h"
@@ -135,6 +136,9 @@ static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
         head = ts.head;
     }
     const float gx = g ? g->x : 0.5f, gy = g ? g->y : 0.5f;
+    /* the focus filter accommodates in photon time; a doubtful gaze widens the fovea */
+    fv_pipeline_set_time_ns(a->pl, t_ns);
+    fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(g ? g->confidence : 0.0f));
     uint8_t *dst = a->img[a->back];
     for (int e = 0; e < 2; e++) {
         const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
