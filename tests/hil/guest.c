@@ -1,0 +1,717 @@
+/* fovea-hil: the hardware-in-the-loop checks that run inside the QEMU guest of `make test-hil`
+ * (tests/hil/run.sh boots Debian's kernel with tests/hil/init, which calls this program), plus
+ * the host-side comparison of the KMS screendump. Linked statically (busybox initramfs, no libc).
+ *
+ *   fovea-hil v4l2 CAP_DEV OUT_DEV VIDEO.y4m TRUTH.csv FRAMES
+ *   fovea-hil gpio CHIP_DEV LINE PULL_ATTR SECONDS
+ *   fovea-hil kms CARD_DEV CTL_TTY
+ *   fovea-hil kms-compare SHOT.ppm W H          (host side)
+ *
+ * Every check prints one line `HIL <name> PASS|FAIL key=value ...` on stdout, which the host
+ * parses; diagnostics go to stderr (the console too). Exit 0 when all of the subcommand's checks
+ * passed, 1 when one failed, 2 on bad usage. */
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <poll.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/mman.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <linux/v4l2-dv-timings.h>
+#include <linux/videodev2.h>
+
+#include "eyesrc.h"
+#include "eyetrack/eyetrack.h"
+#include "hil_vsync.h"
+#include "hil_display.h"
+#include "pattern.h"
+#include "v4l2.h"
+
+static int64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static void result(const char *name, int pass, const char *fmt, ...)
+{
+    char buf[512] = "";
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    printf("HIL %s %s %s\n", name, pass ? "PASS" : "FAIL", buf);
+    fflush(stdout);
+}
+
+static int xioctl(int fd, unsigned long req, void *arg)
+{
+    int r;
+    do
+        r = ioctl(fd, req, arg);
+    while (r < 0 && errno == EINTR);
+    return r;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The q-quantile (0..1) of n values, sorted in place (nearest rank). */
+static double quantile(double *v, int n, double q)
+{
+    if (n <= 0)
+        return NAN;
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    int i = (int)ceil(q * n) - 1;
+    if (i < 0)
+        i = 0;
+    if (i >= n)
+        i = n - 1;
+    return v[i];
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * V4L2: vivid's HDMI output looped back to its HDMI input. The synthetic eye video's frames are
+ * doubled (nearest neighbour, so the truth scales exactly by 2) to 640x480, the DMT 640x480p60
+ * timing vivid accepts on both ends, written to the output with raw V4L2 calls, captured through
+ * the project's platform/v4l2.c, compared byte for byte and tracked. */
+
+enum { LW = 640, LH = 480 };
+
+typedef struct truth_row {
+    float x, y;
+    int visible;
+} truth_row;
+
+/* pupil_x, pupil_y, pupil_visible of every frame of tools/gen_eye's ground truth. */
+static int read_truth(const char *path, truth_row *rows, int max)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "fovea-hil: %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    char line[1024];
+    int n = 0;
+    if (!fgets(line, sizeof line, f)) { /* header */
+        fclose(f);
+        return -1;
+    }
+    while (n < max && fgets(line, sizeof line, f)) {
+        /* frame,t_ms,yaw_deg,pitch_deg,open,blink,pupil_x,pupil_y,pupil_r_px,pupil_visible,... */
+        char *fld[10];
+        int k = 0;
+        char *p = line;
+        while (k < 10) {
+            fld[k++] = p;
+            p = strchr(p, ',');
+            if (!p)
+                break;
+            *p++ = 0;
+        }
+        if (k < 10)
+            break;
+        rows[n].x = strtof(fld[6], NULL);
+        rows[n].y = strtof(fld[7], NULL);
+        rows[n].visible = atoi(fld[9]);
+        n++;
+    }
+    fclose(f);
+    return n;
+}
+
+typedef struct vout {
+    int fd;
+    struct {
+        void *p;
+        size_t len;
+    } b[4];
+    int nb;
+} vout;
+
+static int set_hdmi_timings(int fd, int output, const char *dev)
+{
+    struct v4l2_dv_timings t = V4L2_DV_BT_DMT_640X480P60;
+    /* pick the HDMI input / output */
+    for (unsigned i = 0;; i++) {
+        char name[32];
+        if (output) {
+            struct v4l2_output o = {.index = i};
+            if (xioctl(fd, VIDIOC_ENUMOUTPUT, &o))
+                break;
+            memcpy(name, o.name, sizeof name);
+        } else {
+            struct v4l2_input in = {.index = i};
+            if (xioctl(fd, VIDIOC_ENUMINPUT, &in))
+                break;
+            memcpy(name, in.name, sizeof name);
+        }
+        name[31] = 0;
+        if (strstr(name, "HDMI")) {
+            int idx = (int)i;
+            if (xioctl(fd, output ? VIDIOC_S_OUTPUT : VIDIOC_S_INPUT, &idx)) {
+                fprintf(stderr, "fovea-hil: VIDIOC_S_%s %u on %s: %s\n", output ? "OUTPUT" : "INPUT", i, dev,
+                        strerror(errno));
+                return -1;
+            }
+            if (xioctl(fd, VIDIOC_S_DV_TIMINGS, &t)) {
+                fprintf(stderr, "fovea-hil: VIDIOC_S_DV_TIMINGS 640x480p60 on %s: %s\n", dev, strerror(errno));
+                return -1;
+            }
+            return 0;
+        }
+    }
+    fprintf(stderr, "fovea-hil: %s has no HDMI %s\n", dev, output ? "output" : "input");
+    return -1;
+}
+
+static int vout_open(vout *o, const char *dev)
+{
+    memset(o, 0, sizeof *o);
+    o->fd = open(dev, O_RDWR | O_NONBLOCK);
+    if (o->fd < 0) {
+        fprintf(stderr, "fovea-hil: open %s: %s\n", dev, strerror(errno));
+        return -1;
+    }
+    if (set_hdmi_timings(o->fd, 1, dev))
+        return -1;
+    struct v4l2_format f = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT};
+    f.fmt.pix.width = LW;
+    f.fmt.pix.height = LH;
+    f.fmt.pix.pixelformat = V4L2_PIX_FMT_GREY;
+    f.fmt.pix.field = V4L2_FIELD_NONE;
+    if (xioctl(o->fd, VIDIOC_S_FMT, &f) || f.fmt.pix.pixelformat != V4L2_PIX_FMT_GREY || f.fmt.pix.width != LW ||
+        f.fmt.pix.height != LH || f.fmt.pix.bytesperline != LW) {
+        fprintf(stderr, "fovea-hil: VIDIOC_S_FMT GREY %dx%d on %s: %s (got %ux%u bpl %u)\n", LW, LH, dev,
+                strerror(errno), f.fmt.pix.width, f.fmt.pix.height, f.fmt.pix.bytesperline);
+        return -1;
+    }
+    struct v4l2_requestbuffers rb = {.count = 4, .type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP};
+    if (xioctl(o->fd, VIDIOC_REQBUFS, &rb) || rb.count < 2) {
+        fprintf(stderr, "fovea-hil: VIDIOC_REQBUFS on %s: %s\n", dev, strerror(errno));
+        return -1;
+    }
+    o->nb = rb.count > 4 ? 4 : (int)rb.count;
+    for (int i = 0; i < o->nb; i++) {
+        struct v4l2_buffer b = {.index = (unsigned)i, .type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP};
+        if (xioctl(o->fd, VIDIOC_QUERYBUF, &b))
+            return -1;
+        o->b[i].len = b.length;
+        o->b[i].p = mmap(NULL, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, o->fd, b.m.offset);
+        if (o->b[i].p == MAP_FAILED)
+            return -1;
+    }
+    return 0;
+}
+
+static int vout_queue(vout *o, int i, const uint8_t *img)
+{
+    memcpy(o->b[i].p, img, (size_t)LW * LH);
+    struct v4l2_buffer b = {.index = (unsigned)i, .type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP};
+    b.bytesused = (unsigned)(LW * LH);
+    b.field = V4L2_FIELD_NONE;
+    return xioctl(o->fd, VIDIOC_QBUF, &b);
+}
+
+/* Index of an output buffer the driver is done with, or -1. */
+static int vout_dequeue(vout *o)
+{
+    struct v4l2_buffer b = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP};
+    if (xioctl(o->fd, VIDIOC_DQBUF, &b))
+        return -1;
+    return (int)b.index;
+}
+
+static void vout_close(vout *o)
+{
+    if (o->fd < 0)
+        return;
+    int type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
+    xioctl(o->fd, VIDIOC_STREAMOFF, &type);
+    for (int i = 0; i < o->nb; i++)
+        if (o->b[i].p && o->b[i].p != MAP_FAILED)
+            munmap(o->b[i].p, o->b[i].len);
+    close(o->fd);
+    o->fd = -1;
+}
+
+static int cmd_v4l2(int argc, char **argv)
+{
+    if (argc != 7) {
+        fprintf(stderr, "usage: fovea-hil v4l2 CAP_DEV OUT_DEV VIDEO.y4m TRUTH.csv FRAMES\n");
+        return 2;
+    }
+    const char *cap_dev = argv[2], *out_dev = argv[3], *video = argv[4], *truth_path = argv[5];
+    int frames = atoi(argv[6]);
+    if (frames < 1 || frames > 100000)
+        return 2;
+    char err[512];
+    truth_row *truth = calloc((size_t)frames, sizeof *truth);
+    uint8_t *img = malloc((size_t)LW * LH);
+    if (!truth || !img)
+        return 1;
+    int nt = read_truth(truth_path, truth, frames);
+    if (nt < frames) {
+        result("v4l2-loop", 0, "reason=truth-file-short rows=%d", nt);
+        return 1;
+    }
+    fv_eyesrc *src = NULL;
+    if (fv_eyesrc_open_y4m(&src, video, err, sizeof err)) {
+        result("v4l2-loop", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+
+    /* capture side first: HDMI input at the same timings (vivid only loops matching timings) */
+    int cfd = open(cap_dev, O_RDWR);
+    if (cfd < 0 || set_hdmi_timings(cfd, 0, cap_dev)) {
+        result("v4l2-loop", 0, "reason=capture-setup dev=%s", cap_dev);
+        return 1;
+    }
+    vout o;
+    if (vout_open(&o, out_dev)) {
+        result("v4l2-loop", 0, "reason=output-setup dev=%s", out_dev);
+        return 1;
+    }
+
+    /* the first frame in every output buffer, output streaming before the capture starts */
+    fv_eye_frame ef;
+    int64_t t0 = now_ns();
+    if (fv_eyesrc_next(src, &ef, err, sizeof err) != 1 || ef.w * 2 != LW || ef.h * 2 != LH) {
+        result("v4l2-loop", 0, "reason=\"video: %s (want 320x240)\"", err);
+        return 1;
+    }
+    for (int y = 0; y < LH; y++)
+        for (int x = 0; x < LW; x++)
+            img[(size_t)y * LW + x] = ef.luma[(y / 2) * ef.stride + x / 2];
+    for (int i = 0; i < o.nb; i++)
+        if (vout_queue(&o, i, img)) {
+            result("v4l2-loop", 0, "reason=\"VIDIOC_QBUF output: %s\"", strerror(errno));
+            return 1;
+        }
+    int type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
+    if (xioctl(o.fd, VIDIOC_STREAMON, &type)) {
+        result("v4l2-loop", 0, "reason=\"VIDIOC_STREAMON output: %s\"", strerror(errno));
+        return 1;
+    }
+
+    /* the project's capture: GREY at 640x480, loop on, on-screen text off (controls by name) */
+    fv_v4l2_config cfg;
+    fv_v4l2_config_default(&cfg, cap_dev);
+    cfg.width = LW;
+    cfg.height = LH;
+    if (fv_v4l2_config_formats(&cfg, "GREY", err, sizeof err) ||
+        fv_v4l2_config_ctrl(&cfg, "loop_video=1", err, sizeof err) ||
+        fv_v4l2_config_ctrl(&cfg, "osd_text_mode=2", err, sizeof err)) {
+        result("v4l2-loop", 0, "reason=\"config: %s\"", err);
+        return 1;
+    }
+    fv_v4l2 cam;
+    if (fv_v4l2_open(&cam, &cfg, err, sizeof err)) {
+        result("v4l2-loop", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+    char desc[512];
+    fv_v4l2_describe(&cam, desc, sizeof desc);
+    fprintf(stderr, "fovea-hil: capture: %s\n", desc);
+    close(cfd);
+
+    fv_eye_tracker *trk = fv_eye_create(NULL);
+    double *errs = malloc((size_t)frames * sizeof *errs);
+    if (!trk || !errs)
+        return 1;
+    int matched = 0, mismatched_frames = 0, n_err = 0, within2 = 0, visible = 0, captured = 0;
+    int64_t cap_ts_prev = 0;
+    int ts_monotonic = 1;
+    for (int i = 0; i < frames; i++) {
+        if (i > 0) {
+            if (fv_eyesrc_next(src, &ef, err, sizeof err) != 1) {
+                result("v4l2-loop", 0, "reason=\"video ended at frame %d: %s\"", i, err);
+                return 1;
+            }
+            for (int y = 0; y < LH; y++)
+                for (int x = 0; x < LW; x++)
+                    img[(size_t)y * LW + x] = ef.luma[(y / 2) * ef.stride + x / 2];
+        }
+        /* capture until frame i comes back (the frames before it may still be in the loop) */
+        int got = 0;
+        for (int tries = 0; tries < 12 && !got;) {
+            int bi;
+            while ((bi = vout_dequeue(&o)) >= 0)
+                if (vout_queue(&o, bi, img)) {
+                    result("v4l2-loop", 0, "reason=\"VIDIOC_QBUF output: %s\"", strerror(errno));
+                    return 1;
+                }
+            fv_v4l2_frame f;
+            fv_v4l2_status st = fv_v4l2_next(&cam, 1000, &f, err, sizeof err);
+            if (st == FV_V4L2_TIMEOUT) {
+                tries += 3;
+                continue;
+            }
+            if (st != FV_V4L2_FRAME) {
+                result("v4l2-loop", 0, "reason=\"%s\"", err);
+                return 1;
+            }
+            captured++;
+            tries++;
+            if (!f.t_from_driver || f.t_ns < cap_ts_prev)
+                ts_monotonic = 0;
+            cap_ts_prev = f.t_ns;
+            if (f.width != LW || f.height != LH)
+                continue;
+            int same = 1;
+            for (int y = 0; y < LH && same; y++)
+                same = !memcmp(f.luma + (size_t)y * f.stride, img + (size_t)y * LW, LW);
+            if (!same)
+                continue;
+            got = 1;
+            matched++;
+            fv_eye_result r;
+            if (fv_track_frame(trk, f.luma, f.width, f.height, (ptrdiff_t)f.stride, &r))
+                return 1;
+            if (truth[i].visible) {
+                visible++;
+                if (r.found) {
+                    double dx = r.pupil_x / 2 - truth[i].x, dy = r.pupil_y / 2 - truth[i].y;
+                    double e = sqrt(dx * dx + dy * dy);
+                    errs[n_err++] = e;
+                    within2 += e <= 2.0;
+                }
+            }
+        }
+        if (!got)
+            mismatched_frames++;
+    }
+    double secs = (double)(now_ns() - t0) / 1e9;
+    fv_eye_destroy(trk);
+    fv_v4l2_close(&cam);
+    vout_close(&o);
+    fv_eyesrc_close(src);
+
+    result("v4l2-loop", matched == frames && ts_monotonic,
+           "frames=%d identical=%d missing=%d captured=%d driver_ts_monotonic=%d secs=%.2f", frames, matched,
+           mismatched_frames, captured, ts_monotonic, secs);
+    double p50 = quantile(errs, n_err, 0.5), p95 = quantile(errs, n_err, 0.95);
+    double rate = visible ? (double)within2 / visible : 0;
+    /* the tracker's median on synthetic eyes is 0.06 px (docs/eyetrack.md); the thresholds leave
+     * room, and any corruption of the frames on their way through the kernel breaks them */
+    result("v4l2-track", visible > 0 && rate >= 0.95 && p50 <= 0.5,
+           "visible=%d found=%d within2px=%.3f err_p50_px=%.3f err_p95_px=%.3f", visible, n_err, rate, p50, p95);
+    free(errs);
+    free(truth);
+    free(img);
+    return matched == frames && rate >= 0.95 && p50 <= 0.5 ? 0 : 1;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * GPIO: a toggler thread drives the gpio-sim line at 90 Hz through its sysfs `pull` attribute
+ * (leaving out some edges); the vsync source reads the edges with their kernel timestamps and the
+ * predictor must lock to them. Lock error = the predictor's time for an edge, made before the edge
+ * arrived, minus the edge's kernel timestamp. */
+
+#define VS_HZ 90.0
+#define VS_PERIOD_NS ((int64_t)(1e9 / VS_HZ + 0.5))
+
+typedef struct toggler {
+    const char *pull;
+    double seconds;
+    int drop_every;        /* every Nth rising edge is left out (line stays low one period) */
+    volatile int stop;
+    long edges, dropped;
+    int fail;
+} toggler;
+
+static int write_attr(const char *path, const char *s)
+{
+    int fd = open(path, O_WRONLY);
+    if (fd < 0)
+        return -1;
+    ssize_t n = write(fd, s, strlen(s));
+    close(fd);
+    return n == (ssize_t)strlen(s) ? 0 : -1;
+}
+
+static void sleep_until(int64_t t)
+{
+    struct timespec ts = {.tv_sec = (time_t)(t / 1000000000), .tv_nsec = (long)(t % 1000000000)};
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
+    }
+}
+
+static void *toggle_main(void *arg)
+{
+    toggler *tg = arg;
+    int64_t start = now_ns() + 20000000;
+    long n = (long)(tg->seconds * VS_HZ);
+    for (long k = 0; k < n && !tg->stop; k++) {
+        int64_t t = start + k * VS_PERIOD_NS;
+        int drop = tg->drop_every > 0 && k > 90 && k % tg->drop_every == 0;
+        sleep_until(t);
+        if (!drop) {
+            if (write_attr(tg->pull, "pull-up")) {
+                tg->fail = errno ? errno : EIO;
+                break;
+            }
+            tg->edges++;
+        } else {
+            tg->dropped++;
+        }
+        sleep_until(t + VS_PERIOD_NS / 2);
+        if (write_attr(tg->pull, "pull-down")) {
+            tg->fail = errno ? errno : EIO;
+            break;
+        }
+    }
+    return NULL;
+}
+
+static int cmd_gpio(int argc, char **argv)
+{
+    if (argc != 6) {
+        fprintf(stderr, "usage: fovea-hil gpio CHIP_DEV LINE PULL_ATTR SECONDS\n");
+        return 2;
+    }
+    const char *chip = argv[2], *pull = argv[4];
+    int line = atoi(argv[3]);
+    double seconds = atof(argv[5]);
+    char err[512];
+    if (write_attr(pull, "pull-down")) {
+        result("gpio-lock", 0, "reason=\"write %s: %s\"", pull, strerror(errno));
+        return 1;
+    }
+    fv_hil_vsync *vs = fv_hil_vsync_open(chip, line, 1e9 / VS_HZ, err, sizeof err);
+    if (!vs) {
+        result("gpio-lock", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+    toggler tg = {.pull = pull, .seconds = seconds, .drop_every = 23};
+    pthread_t th;
+    if (pthread_create(&th, NULL, toggle_main, &tg)) {
+        result("gpio-lock", 0, "reason=pthread_create");
+        return 1;
+    }
+    size_t cap = (size_t)(seconds * VS_HZ) + 16;
+    double *lock = malloc(cap * sizeof *lock), *lock_abs = malloc(cap * sizeof *lock_abs);
+    double *after_drop = malloc(cap * sizeof *after_drop);
+    if (!lock || !lock_abs || !after_drop)
+        return 1;
+    int n_lock = 0, n_after = 0;
+    long edges = 0, gaps = 0;
+    int64_t deadline = now_ns() + (int64_t)((seconds + 2.0) * 1e9), last_edge = 0;
+    for (;;) {
+        int64_t edge_ns, predicted_ns;
+        int r = fv_hil_vsync_wait(vs, 200, &edge_ns, &predicted_ns, err, sizeof err);
+        if (r < 0) {
+            result("gpio-lock", 0, "reason=\"%s\"", err);
+            tg.stop = 1;
+            pthread_join(th, NULL);
+            return 1;
+        }
+        if (r == 0) { /* silent line: done when the toggler is */
+            if (now_ns() > deadline || (tg.edges + tg.dropped >= (long)(seconds * VS_HZ)))
+                break;
+            continue;
+        }
+        edges++;
+        int gap = last_edge && edge_ns - last_edge > VS_PERIOD_NS * 3 / 2;
+        gaps += gap;
+        last_edge = edge_ns;
+        /* the first second is the predictor's warm-up */
+        if (edges > 90 && predicted_ns) {
+            double e = (double)(predicted_ns - edge_ns) / 1e3; /* us */
+            if (gap)
+                after_drop[n_after++] = fabs(e);
+            else if (n_lock < (int)cap) {
+                lock[n_lock] = e;
+                lock_abs[n_lock++] = fabs(e);
+            }
+        }
+    }
+    tg.stop = 1;
+    pthread_join(th, NULL);
+    double period_ns = fv_hil_vsync_period_ns(vs);
+    fv_hil_vsync_close(vs);
+
+    double p50 = quantile(lock, n_lock, 0.5), a50 = quantile(lock_abs, n_lock, 0.5);
+    double a99 = quantile(lock_abs, n_lock, 0.99);
+    double d_max = n_after ? quantile(after_drop, n_after, 1.0) : NAN;
+    double period_err = fabs(period_ns - 1e9 / VS_HZ) / (1e9 / VS_HZ);
+    /* Locked: every edge (less the dropped ones) seen, the period within 0.5 %, and half of the
+     * predictions within 1 ms of the edge. The p99 is reported, not judged: under TCG on a shared
+     * 2-core host the guest's own toggling jitters by milliseconds. */
+    int pass = !tg.fail && edges >= tg.edges - 1 && period_err < 0.005 && a50 < 1000.0;
+    result("gpio-lock", pass,
+           "edges=%ld written=%ld period_us=%.2f lock_err_p50_us=%.1f abs_p50_us=%.1f abs_p99_us=%.1f n=%d", edges,
+           tg.edges, period_ns / 1e3, p50, a50, a99, n_lock);
+    /* Dropped edges: the edge after each gap is still predicted (the predictor counted the
+     * missing period instead of losing lock): within a quarter period. */
+    int pass_d = pass && tg.dropped > 0 && gaps >= tg.dropped && n_after > 0 && d_max < 1e6 / VS_HZ / 4;
+    result("gpio-dropped", pass_d, "dropped=%ld gaps_seen=%ld after_gap_abs_max_us=%.1f", tg.dropped, gaps, d_max);
+    free(lock);
+    free(lock_abs);
+    free(after_drop);
+    return pass && pass_d ? 0 : 1;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * KMS: modeset with one image, page-flip to the known pattern, say so on the console and wait
+ * for the host (which takes QEMU's screendump) to answer on the second serial port. */
+
+static int wait_host(const char *tty, int timeout_ms)
+{
+    int fd = open(tty, O_RDONLY | O_NOCTTY);
+    if (fd < 0) {
+        fprintf(stderr, "fovea-hil: open %s: %s\n", tty, strerror(errno));
+        return -1;
+    }
+    struct termios t;
+    if (tcgetattr(fd, &t) == 0) {
+        t.c_lflag &= ~(tcflag_t)(ICANON | ECHO | ECHOE | ECHOK | ECHONL | ISIG | IEXTEN);
+        t.c_iflag &= ~(tcflag_t)(ICRNL | IXON | INLCR | IGNCR);
+        t.c_cc[VMIN] = 1;
+        t.c_cc[VTIME] = 0;
+        tcsetattr(fd, TCSANOW, &t);
+    }
+    int64_t end = now_ns() + (int64_t)timeout_ms * 1000000;
+    char c;
+    int r = -1;
+    for (;;) {
+        int left = (int)((end - now_ns()) / 1000000);
+        if (left <= 0)
+            break;
+        struct pollfd p = {.fd = fd, .events = POLLIN};
+        if (poll(&p, 1, left) <= 0)
+            continue;
+        if (read(fd, &c, 1) == 1 && c == '\n') {
+            r = 0;
+            break;
+        }
+    }
+    close(fd);
+    return r;
+}
+
+static int cmd_kms(int argc, char **argv)
+{
+    if (argc != 4) {
+        fprintf(stderr, "usage: fovea-hil kms CARD_DEV CTL_TTY\n");
+        return 2;
+    }
+    char err[512];
+    fv_hil_display *d = fv_hil_display_open(argv[2], err, sizeof err);
+    if (!d) {
+        result("kms-flip", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+    int w = fv_hil_display_width(d), h = fv_hil_display_height(d);
+    uint32_t *px;
+    size_t pitch;
+    /* first image: shown by the modeset */
+    if (fv_hil_display_back(d, &px, &pitch, err, sizeof err)) {
+        result("kms-flip", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            px[(size_t)y * (pitch / 4) + x] = fv_hil_pattern_before(x, y);
+    if (fv_hil_display_present(d, err, sizeof err)) {
+        result("kms-flip", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+    /* second image: page flip, wait for its event */
+    if (fv_hil_display_back(d, &px, &pitch, err, sizeof err)) {
+        result("kms-flip", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            px[(size_t)y * (pitch / 4) + x] = fv_hil_pattern(x, y, w, h);
+    int64_t t = now_ns();
+    if (fv_hil_display_present(d, err, sizeof err)) {
+        result("kms-flip", 0, "reason=\"%s\"", err);
+        return 1;
+    }
+    double flip_ms = (double)(now_ns() - t) / 1e6;
+    printf("HIL-READY kms %d %d\n", w, h);
+    fflush(stdout);
+    int host = wait_host(argv[3], 30000);
+    fv_hil_display_close(d);
+    result("kms-flip", host == 0, "mode=%dx%d flip_ms=%.2f host_answered=%d", w, h, flip_ms, host == 0);
+    return host == 0 ? 0 : 1;
+}
+
+/* Host side: QEMU's screendump (binary PPM) against the pattern. */
+static int cmd_kms_compare(int argc, char **argv)
+{
+    if (argc != 5) {
+        fprintf(stderr, "usage: fovea-hil kms-compare SHOT.ppm W H\n");
+        return 2;
+    }
+    int w = atoi(argv[3]), h = atoi(argv[4]);
+    FILE *f = fopen(argv[2], "rb");
+    if (!f) {
+        result("kms-readback", 0, "reason=\"%s: %s\"", argv[2], strerror(errno));
+        return 1;
+    }
+    int pw = 0, ph = 0, maxv = 0;
+    if (fscanf(f, "P6 %d %d %d", &pw, &ph, &maxv) != 3 || fgetc(f) == EOF || maxv != 255) {
+        fclose(f);
+        result("kms-readback", 0, "reason=\"%s: not a binary 8-bit PPM\"", argv[2]);
+        return 1;
+    }
+    if (pw != w || ph != h) {
+        fclose(f);
+        result("kms-readback", 0, "reason=size got=%dx%d want=%dx%d", pw, ph, w, h);
+        return 1;
+    }
+    long bad = 0, before = 0;
+    int first_x = -1, first_y = -1;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            int r = fgetc(f), g = fgetc(f), b = fgetc(f);
+            if (b == EOF) {
+                fclose(f);
+                result("kms-readback", 0, "reason=truncated-ppm");
+                return 1;
+            }
+            uint32_t got = (uint32_t)r << 16 | (uint32_t)g << 8 | (uint32_t)b;
+            if (got != fv_hil_pattern(x, y, w, h)) {
+                if (!bad) {
+                    first_x = x;
+                    first_y = y;
+                }
+                bad++;
+                before += got == fv_hil_pattern_before(x, y);
+            }
+        }
+    fclose(f);
+    result("kms-readback", bad == 0, "size=%dx%d differing_pixels=%ld still_old_image=%ld first_diff=%d,%d", w, h,
+           bad, before, first_x, first_y);
+    return bad == 0 ? 0 : 1;
+}
+
+int main(int argc, char **argv)
+{
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    if (argc >= 2 && !strcmp(argv[1], "v4l2"))
+        return cmd_v4l2(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "gpio"))
+        return cmd_gpio(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "kms"))
+        return cmd_kms(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "kms-compare"))
+        return cmd_kms_compare(argc, argv);
+    fprintf(stderr, "usage: fovea-hil v4l2|gpio|kms|kms-compare ... (see tests/hil/guest.c)\n");
+    return 2;
+}
