@@ -158,10 +158,9 @@ test: deps
 # bochs-drm; the guest program is linked statically (busybox initramfs). tools/hil/prepare.sh
 # installs what it needs and caches the kernel and the gpio-sim module under $(BUILD)/hil.
 HIL_GUEST := $(BUILD)/hil/fovea-hil
-HIL_SRC := tests/hil/guest.c tests/hil/hil_vsync.c tests/hil/hil_display.c
-$(HIL_GUEST): $(HIL_SRC) tests/hil/hil_vsync.h tests/hil/hil_display.h tests/hil/pattern.h $(PLIB) $(LIB)
+$(HIL_GUEST): tests/hil/guest.c tests/hil/pattern.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -Itests/hil -I/usr/include/libdrm $(HIL_SRC) $(PLIB) $(LIB) -static $(ALL_LDFLAGS) \
+	$(CC) $(ALL_CFLAGS) -Itests/hil $< $(PLIB) $(LIB) -static $(ALL_LDFLAGS) \
 		-lgpiod -ldrm -lstb -ljpeg -lm -o $@
 
 test-hil:

@@ -16,12 +16,15 @@ TIMEOUT=${HIL_TIMEOUT:-240}
 FRAMES=${HIL_FRAMES:-60}
 GPIO_SECONDS=${HIL_GPIO_SECONDS:-4}
 SMP=${HIL_SMP:-2}
+# extra QEMU options, e.g. HIL_QEMU_EXTRA="-icount shift=auto"
+QEMU_EXTRA=${HIL_QEMU_EXTRA:-}
 guest_bin=$BUILD/hil/fovea-hil
 say() { echo "hil: $*"; }
 die() { echo "hil: error: $*" >&2; exit 1; }
 
 [ -x "$guest_bin" ] || die "$guest_bin missing (make test-hil builds it)"
-[ -f assets/eye_synth.y4m ] && [ -f assets/eye_synth.csv ] || die "assets/eye_synth.{y4m,csv} missing (make builds them)"
+[ -f assets/eye_synth.y4m ] && [ -f assets/eye_synth.csv ] ||
+    die "assets/eye_synth.{y4m,csv} missing (make builds them)"
 t_start=$(date +%s.%N)
 tools/hil/prepare.sh "$HIL_DIR"
 # shellcheck disable=SC1091
@@ -72,7 +75,8 @@ mkfifo "$run/ctl.in" "$run/ctl.out" "$run/mon.in" "$run/mon.out"
 exec 3<>"$run/ctl.in" 4<>"$run/ctl.out" 5<>"$run/mon.in" 6<>"$run/mon.out"
 console=$run/console.log
 : > "$console"
-qemu_args=(-accel tcg -cpu max -m 512 -smp "$SMP" -nodefaults -no-reboot -display none -vga none
+# shellcheck disable=SC2206,SC2054
+qemu_args=(-accel tcg -cpu max -m 512 -smp "$SMP" $QEMU_EXTRA -nodefaults -no-reboot -display none -vga none
     -device bochs-display
     -chardev "file,id=con,path=$console" -serial chardev:con
     -chardev "pipe,id=ctl,path=$run/ctl" -serial chardev:ctl
@@ -84,14 +88,13 @@ t_boot=$(date +%s.%N)
 timeout --kill-after=5 "$TIMEOUT" qemu-system-x86_64 "${qemu_args[@]}" > "$run/qemu.log" 2>&1 &
 qpid=$!
 shot_done=0
-kms_w= kms_h=
+kms_w='' kms_h=''
 while kill -0 "$qpid" 2>/dev/null; do
     if [ $shot_done = 0 ] && line=$(grep -m1 '^HIL-READY kms ' "$console" 2>/dev/null); then
         read -r _ _ kms_w kms_h <<< "$line"
         kms_h=${kms_h%$'\r'}
         rm -f "$run/shot.ppm"
         echo "screendump $run/shot.ppm" >&5
-        want=$((15 + ${#kms_w} + ${#kms_h} + kms_w * kms_h * 3)) # "P6\nW H\n255\n" + pixels
         for _ in $(seq 100); do
             [ -f "$run/shot.ppm" ] && [ "$(stat -c %s "$run/shot.ppm")" -ge $((kms_w * kms_h * 3)) ] && break
             sleep 0.1
@@ -120,6 +123,7 @@ for c in $checks; do
         echo "  FAIL $c (no result line)"
         fail=$((fail + 1))
     else
+        # shellcheck disable=SC2086
         set -- $line
         st=$3
         shift 3

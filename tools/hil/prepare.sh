@@ -55,7 +55,7 @@ done
 if [ -n "$missing" ]; then
     [ "$sudo" = no ] && die "missing packages:$missing (run as root: apt-get install$missing)"
     say "installing$missing"
-    apt-cache show $hdr_pkg >/dev/null 2>&1 || apt_update
+    apt-cache show "$hdr_pkg" >/dev/null 2>&1 || apt_update
     # shellcheck disable=SC2086
     $sudo apt-get install -y -qq --no-install-recommends $missing >/dev/null ||
         { apt_update; $sudo apt-get install -y -qq --no-install-recommends $missing >/dev/null; } ||
@@ -77,7 +77,7 @@ if [ ! -f "$kdir/unpacked.stamp" ]; then
     rm -rf "$kdir/dl" "$root"
     mkdir -p "$kdir/dl"
     chmod 777 "$kdir/dl" # apt's download sandbox user writes here
-    (cd "$kdir/dl" && apt-get download -qq "$img_pkg=$img_ver" 2>&1 | grep -v 'unsandboxed as root' || true)
+    (cd "$kdir/dl" && { apt-get download -qq "$img_pkg=$img_ver" 2>&1 | grep -v 'unsandboxed as root' || true; })
     deb=$(ls "$kdir/dl/${img_pkg}_"*.deb 2>/dev/null | head -n1)
     [ -n "$deb" ] || die "apt-get download $img_pkg=$img_ver fetched nothing"
     dpkg -x "$deb" "$root"
