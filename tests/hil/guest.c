@@ -444,6 +444,7 @@ typedef struct toggler {
     long n;                /* periods */
     volatile int stop;
     long edges, dropped, late_skipped;
+    long after_drop;       /* edges written right after a left-out one */
     double *late_us;       /* write time minus schedule, per written rising edge */
     int fail;
 } toggler;
@@ -483,6 +484,7 @@ static void *toggle_main(void *arg)
                 break;
             }
             tg->late_us[tg->edges++] = (double)(w - t) / 1e3;
+            tg->after_drop += vs_dropped(k - 1);
         } else {
             tg->dropped++;
         }
@@ -592,10 +594,11 @@ static int cmd_gpio(int argc, char **argv)
            pred.spurious, fv_vsync_pred_jitter_ns(&pred) / 1e3, late50, late99, path50, path99);
     /* Dropped edges: the predictor counted them as missed and the edge after each gap was
      * predicted as well as the others (it kept the lock instead of starting over). */
-    int pass_d = pass && tg.dropped > 0 && pred.missed >= tg.dropped && n_after >= tg.dropped - 1 &&
-                 d50 < 1000.0;
-    result("gpio-dropped", pass_d, "dropped=%ld missed_counted=%ld after_gap_n=%d after_gap_abs_p50_us=%.1f max_us=%.1f",
-           tg.dropped, pred.missed, n_after, d50, dmax);
+    int pass_d = pass && tg.dropped > 0 && pred.missed >= tg.dropped && tg.after_drop > 0 &&
+                 n_after == tg.after_drop && d50 < 1000.0;
+    result("gpio-dropped", pass_d,
+           "dropped=%ld missed_counted=%ld after_gap_written=%ld after_gap_seen=%d after_gap_abs_p50_us=%.1f max_us=%.1f",
+           tg.dropped, pred.missed, tg.after_drop, n_after, d50, dmax);
     free(lock);
     free(lock_abs);
     free(after_drop);
