@@ -255,6 +255,55 @@ static void vout_close(vout *o)
     o->fd = -1;
 }
 
+/* Unplug: vivid's "Disconnect" button unregisters its nodes until every handle is closed, then
+ * they come back (a USB camera pulled and plugged again). The project's capture must report
+ * FV_V4L2_GONE, close its handle, and reopen the device on its back-off schedule. */
+static int check_reopen(fv_v4l2 *cam, vout *o, const char *cap_dev)
+{
+    char err[512];
+    int fd = open(cap_dev, O_RDWR | O_NONBLOCK);
+    uint32_t id = 0;
+    if (fd >= 0) {
+        struct v4l2_queryctrl q = {.id = V4L2_CTRL_FLAG_NEXT_CTRL};
+        while (!xioctl(fd, VIDIOC_QUERYCTRL, &q)) {
+            if (!strcmp((const char *)q.name, "Disconnect")) {
+                id = q.id;
+                break;
+            }
+            q.id |= V4L2_CTRL_FLAG_NEXT_CTRL;
+        }
+    }
+    struct v4l2_control c = {.id = id, .value = 1};
+    if (fd < 0 || !id || xioctl(fd, VIDIOC_S_CTRL, &c)) {
+        result("v4l2-reopen", 0, "reason=\"no Disconnect control on %s or setting it failed: %s\"", cap_dev,
+               strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return 0;
+    }
+    close(fd);
+    vout_close(o); /* vivid comes back once its last user has gone: the output's handle too */
+    int64_t t0 = now_ns(), t_gone = 0, t_back = 0;
+    long gone = 0;
+    while (now_ns() - t0 < 10000000000LL && !t_back) {
+        fv_v4l2_frame f;
+        fv_v4l2_status st = fv_v4l2_next(cam, 200, &f, err, sizeof err);
+        if (st == FV_V4L2_GONE) {
+            gone++;
+            if (!t_gone)
+                t_gone = now_ns();
+        } else if (st == FV_V4L2_FRAME && t_gone) {
+            t_back = now_ns();
+        } else if (st == FV_V4L2_ERROR) {
+            break;
+        }
+    }
+    int ok = t_gone && t_back && cam->reopens >= 1;
+    result("v4l2-reopen", ok, "gone_calls=%ld reopens=%ld back_after_ms=%.0f last=\"%s\"", gone, cam->reopens,
+           t_back ? (double)(t_back - t_gone) / 1e6 : -1.0, ok ? "frame" : err);
+    return ok;
+}
+
 static int cmd_v4l2(int argc, char **argv)
 {
     if (argc != 7) {
@@ -400,6 +449,7 @@ static int cmd_v4l2(int argc, char **argv)
     }
     double secs = (double)(now_ns() - t0) / 1e9;
     fv_eye_destroy(trk);
+    int reopen_ok = check_reopen(&cam, &o, cap_dev);
     fv_v4l2_close(&cam);
     vout_close(&o);
     fv_eyesrc_close(src);
@@ -418,7 +468,7 @@ static int cmd_v4l2(int argc, char **argv)
     free(errs);
     free(truth);
     free(img);
-    return matched == frames && rate >= 0.95 && p50 <= 0.5 ? 0 : 1;
+    return matched == frames && rate >= 0.95 && p50 <= 0.5 && reopen_ok ? 0 : 1;
 }
 
 /* ---------------------------------------------------------------------------------------------
