@@ -77,10 +77,10 @@ int64_t fv_frameloop_budget_ns(const fv_frameloop *l)
     return (int64_t)((double)worst * l->p.budget_scale) + l->p.budget_margin_ns;
 }
 
-/* Waits for edges until deadline, feeding the predictor. Returns 1 when an edge at or after
- * `want_after` came (its time in *t), else 0. A failing source is dropped; the rest of the
- * wait is then a sleep. */
-static int take_edges(fv_frameloop *l, int64_t deadline, int64_t want_after, int64_t *t)
+/* Waits for edges until deadline, feeding the predictor. Returns 1 when an edge in [lo, hi]
+ * came (its time in *t); an edge after hi ends the wait with 0 (that vsync has passed without
+ * its edge). A failing source is dropped; the rest of the wait is then a sleep. */
+static int take_edges(fv_frameloop *l, int64_t deadline, int64_t lo, int64_t hi, int64_t *t)
 {
     for (;;) {
         if (l->source_dead) {
@@ -98,19 +98,21 @@ static int take_edges(fv_frameloop *l, int64_t deadline, int64_t want_after, int
             return 0;
         l->edges++;
         fv_vsync_pred_edge(&l->pred, te);
-        if (want_after != INT64_MAX && te >= want_after) {
+        if (te >= lo && te <= hi) {
             *t = te;
             return 1;
         }
+        if (te > hi)
+            return 0;
     }
 }
 
-/* Waits for the edge of vsync v (within the grace window); the edge time, or v predicted. */
+/* Waits for the edge of vsync v (within half a period of it); the edge time, or v predicted. */
 static int64_t wait_vsync(fv_frameloop *l, int64_t v, int *measured)
 {
     int64_t te;
     const int64_t half = l->p.nominal_period_ns / 2;
-    *measured = take_edges(l, v + l->p.edge_grace_ns, v - half, &te);
+    *measured = take_edges(l, v + l->p.edge_grace_ns, v - half, v + half, &te);
     return *measured ? te : v;
 }
 
@@ -120,13 +122,13 @@ int fv_frameloop_frame(fv_frameloop *l, fv_frame_record *rec)
     rec->frame = l->frames;
     int64_t now = l->ops.now_ns(l->ops.ctx);
     int64_t dummy;
-    take_edges(l, now, INT64_MAX, &dummy); /* whatever came in meanwhile */
+    take_edges(l, now, INT64_MAX, INT64_MAX, &dummy); /* whatever came in meanwhile */
     const int64_t budget = fv_frameloop_budget_ns(l);
     rec->budget_ns = budget;
     int64_t target = fv_vsync_pred_next(&l->pred, now + budget, now);
     const int64_t wake = target - budget;
     if (now < wake) {
-        take_edges(l, wake, INT64_MAX, &dummy);
+        take_edges(l, wake, INT64_MAX, INT64_MAX, &dummy);
         now = l->ops.now_ns(l->ops.ctx);
         /* the new edges refine the phase: the same vsync, predicted better */
         target = fv_vsync_pred_next(&l->pred, target - l->p.nominal_period_ns / 2, now);

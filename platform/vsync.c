@@ -153,11 +153,10 @@ int fv_vsync_wait(fv_vsync *v, int64_t timeout_ns, int64_t *t_ns, char *err, siz
         return fv_vsync_gpio_wait(v->gpio, timeout_ns, t_ns, err, err_len);
     int64_t now = fv_clock_now_ns(), deadline = now + timeout_ns, t;
     if (v->kind == K_TIMER) {
-        /* like a line read late: the last tick already passed is still reported, older ones
-         * are gone (the kernel's event queue is short too) */
+        /* like a GPIO line read late: the kernel queues 16 events, older ones are lost */
         int64_t passed = (now - v->t0_ns) / v->period_ns;
-        if (now >= v->t0_ns && passed > v->next_k)
-            v->next_k = passed;
+        if (now >= v->t0_ns && passed - 15 > v->next_k)
+            v->next_k = passed - 15;
         t = v->t0_ns + v->next_k * v->period_ns;
     } else {
         if (v->next_edge >= v->n_edges) { /* silent after the recording */
