@@ -7,7 +7,7 @@
 #
 # Environment: HIL_DIR (cache, default $BUILD/hil), HIL_TIMEOUT (seconds for the whole guest run,
 # default 240), HIL_FRAMES (eye frames through the V4L2 loop, default 60), HIL_GPIO_SECONDS
-# (default 4), HIL_SMP (guest CPUs, default 2). Exit 0 when every check passed, 1 otherwise.
+# (default 4), HIL_SMP (guest CPUs, default 1). Exit 0 when every check passed, 1 otherwise.
 set -eu
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
@@ -15,7 +15,7 @@ HIL_DIR=${HIL_DIR:-$BUILD/hil}
 TIMEOUT=${HIL_TIMEOUT:-240}
 FRAMES=${HIL_FRAMES:-60}
 GPIO_SECONDS=${HIL_GPIO_SECONDS:-4}
-SMP=${HIL_SMP:-2}
+SMP=${HIL_SMP:-1}
 # extra QEMU options, e.g. HIL_QEMU_EXTRA="-icount shift=auto"
 QEMU_EXTRA=${HIL_QEMU_EXTRA:-}
 guest_bin=$BUILD/hil/fovea-hil
