@@ -255,33 +255,68 @@ static void vout_close(vout *o)
     o->fd = -1;
 }
 
+/* Presses vivid's button control NAME (found by name: the ids are driver-private) through a
+ * second handle on dev. 0, or -1 with errno. */
+static int press_button(const char *dev, const char *name)
+{
+    int fd = open(dev, O_RDWR | O_NONBLOCK);
+    if (fd < 0)
+        return -1;
+    struct v4l2_queryctrl q = {.id = V4L2_CTRL_FLAG_NEXT_CTRL};
+    uint32_t id = 0;
+    while (!xioctl(fd, VIDIOC_QUERYCTRL, &q)) {
+        if (!strcmp((const char *)q.name, name)) {
+            id = q.id;
+            break;
+        }
+        q.id |= V4L2_CTRL_FLAG_NEXT_CTRL;
+    }
+    struct v4l2_control c = {.id = id, .value = 1};
+    int r = id ? xioctl(fd, VIDIOC_S_CTRL, &c) : (errno = ENOENT, -1);
+    int e = errno;
+    close(fd);
+    errno = e;
+    return r;
+}
+
+/* A corrupt buffer: vivid's "Inject V4L2_BUF_FLAG_ERROR" flags the next capture buffer; the
+ * project's capture must hand it back, count it in cam.skipped, and go on delivering frames. */
+static int check_buf_error(fv_v4l2 *cam, const char *cap_dev)
+{
+    char err[512];
+    long skipped0 = cam->skipped;
+    if (press_button(cap_dev, "Inject V4L2_BUF_FLAG_ERROR")) {
+        result("v4l2-buf-error", 0, "reason=\"no 'Inject V4L2_BUF_FLAG_ERROR' control on %s or setting it failed: %s\"",
+               cap_dev, strerror(errno));
+        return 0;
+    }
+    int frames = 0;
+    int64_t t0 = now_ns();
+    while (now_ns() - t0 < 5000000000LL && (frames < 3 || cam->skipped == skipped0)) {
+        fv_v4l2_frame f;
+        fv_v4l2_status st = fv_v4l2_next(cam, 200, &f, err, sizeof err);
+        if (st == FV_V4L2_FRAME)
+            frames++;
+        else if (st != FV_V4L2_TIMEOUT)
+            break;
+    }
+    int ok = cam->skipped == skipped0 + 1 && frames >= 3;
+    result("v4l2-buf-error", ok, "skipped=%ld frames_after=%d last_skip=\"%s\"", cam->skipped - skipped0, frames,
+           cam->last_err);
+    return ok;
+}
+
 /* Unplug: vivid's "Disconnect" button unregisters its nodes until every handle is closed, then
  * they come back (a USB camera pulled and plugged again). The project's capture must report
  * FV_V4L2_GONE, close its handle, and reopen the device on its back-off schedule. */
 static int check_reopen(fv_v4l2 *cam, vout *o, const char *cap_dev)
 {
     char err[512];
-    int fd = open(cap_dev, O_RDWR | O_NONBLOCK);
-    uint32_t id = 0;
-    if (fd >= 0) {
-        struct v4l2_queryctrl q = {.id = V4L2_CTRL_FLAG_NEXT_CTRL};
-        while (!xioctl(fd, VIDIOC_QUERYCTRL, &q)) {
-            if (!strcmp((const char *)q.name, "Disconnect")) {
-                id = q.id;
-                break;
-            }
-            q.id |= V4L2_CTRL_FLAG_NEXT_CTRL;
-        }
-    }
-    struct v4l2_control c = {.id = id, .value = 1};
-    if (fd < 0 || !id || xioctl(fd, VIDIOC_S_CTRL, &c)) {
+    if (press_button(cap_dev, "Disconnect")) {
         result("v4l2-reopen", 0, "reason=\"no Disconnect control on %s or setting it failed: %s\"", cap_dev,
                strerror(errno));
-        if (fd >= 0)
-            close(fd);
         return 0;
     }
-    close(fd);
     vout_close(o); /* vivid comes back once its last user has gone: the output's handle too */
     int64_t t0 = now_ns(), t_gone = 0, t_back = 0;
     long gone = 0;
@@ -449,7 +484,8 @@ static int cmd_v4l2(int argc, char **argv)
     }
     double secs = (double)(now_ns() - t0) / 1e9;
     fv_eye_destroy(trk);
-    int reopen_ok = check_reopen(&cam, &o, cap_dev);
+    int buferr_ok = check_buf_error(&cam, cap_dev);
+    int reopen_ok = check_reopen(&cam, &o, cap_dev) && buferr_ok;
     fv_v4l2_close(&cam);
     vout_close(&o);
     fv_eyesrc_close(src);

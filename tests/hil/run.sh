@@ -115,7 +115,7 @@ tr -d '\r' < "$console" > "$run/console.txt"
 if [ $shot_done = 1 ]; then
     "$guest_bin" kms-compare "$run/shot.ppm" "$kms_w" "$kms_h" >> "$run/console.txt" || true
 fi
-checks="boot modules v4l2-loop v4l2-track v4l2-reopen gpio-lock gpio-dropped kms-flip kms-readback"
+checks="boot modules v4l2-loop v4l2-track v4l2-buf-error v4l2-reopen gpio-lock gpio-dropped kms-flip kms-readback"
 pass=0 fail=0
 for c in $checks; do
     line=$(grep -m1 "^HIL $c " "$run/console.txt" || true)
