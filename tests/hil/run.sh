@@ -87,6 +87,7 @@ say "booting: qemu-system-x86_64 ${qemu_args[*]}"
 t_boot=$(date +%s.%N)
 timeout --kill-after=5 "$TIMEOUT" qemu-system-x86_64 "${qemu_args[@]}" > "$run/qemu.log" 2>&1 &
 qpid=$!
+trap 'kill "$qpid" 2>/dev/null || true' EXIT INT TERM # no QEMU left behind if this script is stopped
 shot_done=0
 kms_w='' kms_h=''
 while kill -0 "$qpid" 2>/dev/null; do
