@@ -149,7 +149,7 @@ static int a_present(void *c, int which, int64_t vsync_ns)
 {
     (void)vsync_ns;
     app *a = c;
-    if (which == FV_PRESENT_PREVIOUS)
+    if (which == FV_PRESENT_PREVIOUS || !a->disp)
         return 0; /* the front image stays on screen: nothing to do, no tearing */
     char err[512];
     if (fv_display_present(a->disp, a->img[a->back], 2 * a->W, a->H, (ptrdiff_t)a->W * 6, err, sizeof err)) {
@@ -157,7 +157,8 @@ static int a_present(void *c, int which, int64_t vsync_ns)
                 err);
         fv_display_close(a->disp, NULL, 0);
         char e2[64];
-        fv_display_open(&a->disp, "none", 2 * a->W, a->H, 90, e2, sizeof e2);
+        if (fv_display_open(&a->disp, "none", 2 * a->W, a->H, 90, e2, sizeof e2))
+            a->disp = NULL; /* out of memory: present nothing */
         a->display_failures++;
         return -1;
     }
@@ -347,7 +348,7 @@ int main(int argc, char **argv)
     fv_latency_summarise(rec + skip, nrec - skip, &s);
     const double run_s = (double)(fv_clock_now_ns() - a.t_start_ns) * 1e-9;
     printf("fovea-headset: %ld frames in %.2f s, %dx%d per eye, vsync %s (%.2f Hz nominal), display %s\n", nrec,
-           run_s, a.W, a.H, vsync_spec, 1e9 / (double)period, fv_display_kind(a.disp));
+           run_s, a.W, a.H, vsync_spec, 1e9 / (double)period, a.disp ? fv_display_kind(a.disp) : "none");
     printf("  frame rate %.2f fps; late %ld of %ld (%.1f %%)\n", s.fps, s.late, s.frames,
            s.frames ? 100.0 * (double)s.late / (double)s.frames : 0.0);
     printf("  gaze-to-photon p50 %.2f ms, p99 %.2f ms, max %.2f ms; render p50 %.2f ms, p99 %.2f ms\n", s.p50_ms,

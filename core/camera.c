@@ -93,7 +93,10 @@ int fv_camera_setup(fv_camera *c, const fv_camera_desc *d, const fv_pose *head)
     c->tan_top = ty;
     c->px_tan = 2.0f * ty / (float)d->height;
     c->focal_px = 1.0f / c->px_tan;
+    /* every field set, lens or not: reprojection compares whole cameras (memcmp) */
     c->lens_on = d->lens != NULL;
+    c->lens_k1 = c->lens_k2 = c->lens_cx = c->lens_cy = 0.0f;
+    c->lens_scale = 1.0f;
     if (d->lens) {
         const float *ctr = d->lens->center[d->eye == FV_EYE_RIGHT ? 1 : 0];
         c->lens_k1 = d->lens->k1;

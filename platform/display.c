@@ -88,7 +88,15 @@ int fv_display_open(fv_display **out, const char *spec, int w, int h, int fps, c
         rc = fv_kms_open(&d->kms, spec[3] ? spec + 4 : NULL, NULL, err, err_len);
     } else if (!strcmp(spec, "fbdev") || !strncmp(spec, "fbdev:", 6)) {
         d->kind = D_FBDEV;
-        rc = fbdev_open(d, spec[5] ? spec + 6 : "/dev/fb0", err, err_len);
+        char dev[256];
+        const char *a = spec[5] ? spec + 6 : "0";
+        if (a[0] >= '0' && a[0] <= '9') /* "1" */
+            snprintf(dev, sizeof dev, "/dev/fb%s", a);
+        else if (!strchr(a, '/')) /* "fb1" */
+            snprintf(dev, sizeof dev, "/dev/%s", a);
+        else
+            snprintf(dev, sizeof dev, "%s", a);
+        rc = fbdev_open(d, dev, err, err_len);
     } else if (!strcmp(spec, "window")) {
         d->kind = D_WINDOW;
         rc = fv_window_open(&d->win, w, h, err, err_len);

@@ -2,8 +2,8 @@
  * and shows or stores them; none blocks longer than its timeout.
  *  - kms[:CARD]: DRM/KMS through libdrm: the first connected connector and its preferred mode
  *    (or the first), two dumb buffers, a page flip per frame with its event (platform/display_kms.c);
- *  - fbdev[:DEV]: the Linux framebuffer (/dev/fb0), 16 or 32 bits per pixel, fallback for boards
- *    without KMS;
+ *  - fbdev[:DEV]: the Linux framebuffer (/dev/fb0; DEV "1", "fb1" or a path), 16 or 32 bits per
+ *    pixel, fallback for boards without KMS;
  *  - window: an SDL2 window on a PC; its mouse position can stand in for the gaze;
  *  - png:DIR (DIR/frame_NNNNN.png), y4m:FILE (YUV4MPEG2), none.
  * An image larger than the screen is cropped around its centre, a smaller one centred (no
@@ -16,7 +16,7 @@
 
 /* ---- DRM/KMS (-ldrm) ---- */
 typedef struct fv_kms fv_kms;
-/* card: a path ("/dev/dri/card0"), a number ("0"), or NULL for card0; mode: "WxH" or NULL for
+/* card: a path ("/dev/dri/card0"), a name ("card0"), a number ("0"), or NULL for card0; mode: "WxH" or NULL for
  * the connector's preferred mode. Sets the mode showing a black buffer. 0, or -1 with the
  * failing call and reason in err. Without libdrm at build time: always -1. */
 int fv_kms_open(fv_kms **k, const char *card, const char *mode, char *err, size_t err_len);

@@ -102,8 +102,10 @@ int fv_kms_open(fv_kms **out, const char *card, const char *mode, char *err, siz
     char path[256];
     if (!card || !*card)
         card = "/dev/dri/card0";
-    if (card[0] >= '0' && card[0] <= '9')
+    if (card[0] >= '0' && card[0] <= '9') /* "1" */
         snprintf(path, sizeof path, "/dev/dri/card%s", card);
+    else if (!strchr(card, '/')) /* "card1" */
+        snprintf(path, sizeof path, "/dev/dri/%s", card);
     else
         snprintf(path, sizeof path, "%s", card);
     int mw = 0, mh = 0;

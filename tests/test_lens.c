@@ -90,8 +90,13 @@ static void test_camera(void **st)
     d.height = 360;
     d.eye = FV_EYE_RIGHT;
     const fv_pose head = {{0.1f, 1.6f, 2.0f}, {0, 0.258819f, 0, 0.9659258f}};
-    fv_camera plain, lensed;
+    fv_camera plain, lensed, again;
+    /* every field is set whatever the memory held (reprojection memcmp()s whole cameras) */
+    memset(&plain, 0xaa, sizeof plain);
+    memset(&again, 0x55, sizeof again);
     assert_int_equal(fv_camera_setup(&plain, &d, &head), 0);
+    assert_int_equal(fv_camera_setup(&again, &d, &head), 0);
+    assert_memory_equal(&plain, &again, sizeof plain);
     fv_lens lens;
     fv_lens_default(&lens);
     lens.k1 = 0.2f;
