@@ -100,7 +100,7 @@ TSAN_BUILD := build-tsan
 CROSS_BUILD := build-aarch64
 endif
 
-.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin
+.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin test-hil
 all: $(LIB) $(PLIB) $(APPS) $(TOOLS)
 
 $(BUILD)/%.o: %.c
@@ -153,6 +153,20 @@ test-bin: $(LIB) $(PLIB) $(APPS) $(TOOLS) $(TESTS) $(RANGE) $(EYE_SYNTH)
 test: deps
 	@$(MAKE) --no-print-directory test-bin
 	@BUILD=$(BUILD) SHARED=$(SHARED) tests/run.sh
+
+# Hardware in the loop (docs/hil.md): Debian's kernel under QEMU (TCG) with vivid, gpio-sim and
+# bochs-drm; the guest program is linked statically (busybox initramfs). tools/hil/prepare.sh
+# installs what it needs and caches the kernel and the gpio-sim module under $(BUILD)/hil.
+HIL_GUEST := $(BUILD)/hil/fovea-hil
+$(HIL_GUEST): tests/hil/guest.c tests/hil/pattern.h $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests/hil $< $(PLIB) $(LIB) -static $(ALL_LDFLAGS) \
+		-lgpiod -ldrm -lstb -ljpeg -lm -o $@
+
+test-hil:
+	@tools/deps.sh
+	@$(MAKE) --no-print-directory $(HIL_GUEST) $(EYE_SYNTH)
+	@BUILD=$(BUILD) tests/hil/run.sh
 
 # Cross leg: build everything for aarch64 and run the core's tests under qemu-aarch64.
 check-aarch64:
