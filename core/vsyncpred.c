@@ -40,6 +40,10 @@ static void restart(fv_vsync_pred *v, int64_t t_ns)
     v->n = 1;
     v->head = 1 % v->p.window;
     v->rejects_in_row = 0;
+    /* a re-lock starts from the nominal period: a period fitted to edges that no longer fit is
+     * exactly what must not survive (a wrong one would keep every third edge "in phase") */
+    v->period_ns = (double)v->p.nominal_period_ns;
+    v->tentative = 0;
     v->last_innovation_ns = 0.0;
 }
 
@@ -86,7 +90,7 @@ int fv_vsync_pred_edge(fv_vsync_pred *v, int64_t t_ns)
          * (a 60 Hz panel when 90 was assumed) sets the period */
         const double dt = (double)(t_ns - v->last_t), nom = (double)v->p.nominal_period_ns;
         if (dt >= 0.6 * nom && dt <= 1.6 * nom && fabs(dt - nom) > v->p.tolerance * nom)
-            v->period_ns = dt;
+            v->period_ns = dt, v->tentative = 2; /* this edge and the next must agree */
     }
     const double pred_k = (double)(t_ns - v->ref_t) - v->a_ns;
     const double kf = (double)v->ref_k + pred_k / v->period_ns;
@@ -102,6 +106,14 @@ int fv_vsync_pred_edge(fv_vsync_pred *v, int64_t t_ns)
             v->spurious++;
         else
             v->doubled++;
+        if (v->tentative) {
+            /* the one interval that set the period was not the line's (a late or early edge at
+             * acquisition): the next one disagrees, so acquire again from this edge */
+            v->relocks++;
+            v->accepted++;
+            restart(v, t_ns);
+            return FV_EDGE_RELOCK;
+        }
         if (++v->rejects_in_row >= v->p.relock_after) {
             v->relocks++;
             v->accepted++;
@@ -111,6 +123,8 @@ int fv_vsync_pred_edge(fv_vsync_pred *v, int64_t t_ns)
         return verdict;
     }
     v->rejects_in_row = 0;
+    if (v->tentative)
+        v->tentative--; /* 0 once a second interval agreed */
     v->accepted++;
     if (k > v->last_k + 1)
         v->missed += k - v->last_k - 1;

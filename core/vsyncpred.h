@@ -38,6 +38,7 @@ typedef struct fv_vsync_pred {
     double a_ns, period_ns;
     int64_t last_t, last_k;           /* newest accepted edge */
     int rejects_in_row;
+    int tentative;                    /* > 0: period_ns is one interval's guess, not confirmed yet */
     double last_innovation_ns;        /* newest accepted edge minus its prediction */
     long edges, accepted, missed, spurious, doubled, relocks;
 } fv_vsync_pred;

@@ -179,6 +179,38 @@ static void test_phase_jump_and_other_rate(void **st)
     assert_true(fabs((double)fv_vsync_pred_next(&v, (int64_t)now, (int64_t)now) - (t1 + 20 * P90)) < 2000.0);
 }
 
+/* Found by the QEMU GPIO test (docs/hil.md): one short first interval after (re-)acquisition
+ * (a late edge, then an on-time one) used to set the period to 8.3 ms for good, and at 3/4 of
+ * the true period every third edge fits: "locked" at 120 Hz on a 90 Hz line forever. */
+static void test_short_first_interval(void **st)
+{
+    (void)st;
+    fv_vsync_pred v;
+    init90(&v);
+    int64_t t = 1000000000;
+    fv_vsync_pred_edge(&v, t);
+    t += 8300000;
+    fv_vsync_pred_edge(&v, t);
+    for (int i = 0; i < 900; i++) { /* 10 s of a perfect 90 Hz line */
+        t += 11111111;
+        fv_vsync_pred_edge(&v, t);
+    }
+    assert_true(fabs(fv_vsync_pred_period_ns(&v) - P90) < 1000.0);
+    assert_int_equal(fv_vsync_pred_state(&v, t + 1000), FV_VSYNC_LOCKED);
+    assert_true(v.spurious <= 2);
+    assert_true(fabs((double)fv_vsync_pred_next(&v, t + 1000, t + 1000) - (double)(t + 11111111)) < 2000.0);
+    /* the same after a re-lock from silence: the old period does not survive it */
+    t += 2000000000;
+    fv_vsync_pred_edge(&v, t);
+    t += 8300000;
+    fv_vsync_pred_edge(&v, t);
+    for (int i = 0; i < 90; i++) {
+        t += 11111111;
+        fv_vsync_pred_edge(&v, t);
+    }
+    assert_true(fabs(fv_vsync_pred_period_ns(&v) - P90) < 1000.0);
+}
+
 static void test_no_edges(void **st)
 {
     (void)st;
@@ -197,6 +229,7 @@ int main(void)
         cmocka_unit_test(test_clean_and_jitter), cmocka_unit_test(test_missed_edges),
         cmocka_unit_test(test_doubled_and_spurious), cmocka_unit_test(test_drift),
         cmocka_unit_test(test_silence), cmocka_unit_test(test_phase_jump_and_other_rate),
+        cmocka_unit_test(test_short_first_interval),
         cmocka_unit_test(test_no_edges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
