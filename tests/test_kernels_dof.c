@@ -460,10 +460,10 @@ static void run_pyrblur1(const fv_dsp *d, const char *isa, int w, int x0, int n,
     for (int i = 0; i < w; i++) {
         static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, -1.4e-45f, 64.0f, -64.0f, 64.0625f,
                                     100.0f, -1000.0f, 1e6f, -1.25e8f, 1.25e8f, 0.125f, -0.0625f};
-        const float u = rnd();
+        const float u = rnd(), sg = rndi(2) ? 1.0f : -1.0f; /* (one draw a statement: the same inputs whatever the compiler) */
         coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? 20.0f * rnd() : cmode == 2 ? -12.0f * rnd() :
-                   cmode == 3 ? (rndi(2) ? 80.0f : -80.0f) * rnd() :
-                   u < 0.25f ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : (rndi(2) ? 1.0f : -1.0f) * 70.0f * rnd();
+                   cmode == 3 ? sg * 80.0f * rnd() :
+                   u < 0.25f ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : sg * 70.0f * rnd();
         if (tmode == 0)
             t.p[i] = 1.0f;
         else if (tmode == 1)
@@ -519,12 +519,12 @@ static void run_pyrblur(const fv_dsp *d, const char *isa)
 {
     for (int n = 1; n <= 70; n++)
         for (int rep = 0; rep < 8; rep++) {
-            const int w = n + (rndi(3) == 0 ? 0 : rndi(40));
-            run_pyrblur1(d, isa, w, rndi(w - n + 1), n, rndi(4));
+            const int w = n + (rndi(3) == 0 ? 0 : rndi(40)), x0 = rndi(w - n + 1);
+            run_pyrblur1(d, isa, w, x0, n, rndi(4));
         }
     for (int k = 0; k < 12; k++) { /* whole production rows, as core/dof/weier.c calls it, and offset ones */
-        const int x0 = k < 6 ? 0 : 1 + rndi(9);
-        run_pyrblur1(d, isa, 1280 + x0 + (k & 1) * rndi(7), x0, 1280, rndi(4));
+        const int x0 = k < 6 ? 0 : 1 + rndi(9), w = 1280 + x0 + (k & 1) * rndi(7);
+        run_pyrblur1(d, isa, w, x0, 1280, rndi(4));
     }
 }
 
