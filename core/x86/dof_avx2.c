@@ -187,27 +187,51 @@ static inline __m256 ld2(const float *lo, const float *hi)
 #define PAIR(v, p) _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(2 * (p), 2 * (p), 2 * (p), 2 * (p), 2 * (p) + 1, \
                                                                  2 * (p) + 1, 2 * (p) + 1, 2 * (p) + 1))
 
-/* 8 pixels at a time as 4 pairs, the rest with the 128-bit version */
+/* pixels xp, xp + 1 (pair p of the 8 whose weights are a8) */
+static inline void up_pair(float *dst, const float *tmp, const int32_t *i0, const int32_t *i1, __m256 a8, int xp,
+                           int p)
+{
+    const __m256 p0 = ld2(tmp + 4 * (ptrdiff_t)i0[xp], tmp + 4 * (ptrdiff_t)i0[xp + 1]);
+    const __m256 p1 = ld2(tmp + 4 * (ptrdiff_t)i1[xp], tmp + 4 * (ptrdiff_t)i1[xp + 1]);
+    _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
+}
+
+/* 8 pixels at a time as 4 pairs (unrolled by hand: the pairs' lane indices are constants), the
+ * rest with the 128-bit version */
 static void upsample_row_avx2(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                               const float *ax, int n)
 {
     int x = 0;
     for (; x + 8 <= n; x += 8) {
         const __m256 a8 = _mm256_loadu_ps(ax + x);
-        for (int p = 0; p < 4; p++) {
-            const int xp = x + 2 * p;
-            const __m256 p0 = ld2(tmp + 4 * (ptrdiff_t)i0[xp], tmp + 4 * (ptrdiff_t)i0[xp + 1]);
-            const __m256 p1 = ld2(tmp + 4 * (ptrdiff_t)i1[xp], tmp + 4 * (ptrdiff_t)i1[xp + 1]);
-            _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
-        }
+        up_pair(dst, tmp, i0, i1, a8, x, 0);
+        up_pair(dst, tmp, i0, i1, a8, x + 2, 1);
+        up_pair(dst, tmp, i0, i1, a8, x + 4, 2);
+        up_pair(dst, tmp, i0, i1, a8, x + 6, 3);
     }
     if (x < n)
         dof_upsample_row_x86(dst + 4 * x, tmp, i0 + x, i1 + x, ax + x, n - x);
 }
 
+/* pair p of the 8 pixels from i: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0), kept where act */
+static inline void pb_pair(float *blur, const float *const *up, const int32_t *L0, const int32_t *L1, __m256 f,
+                           __m256 t, __m256 mix, __m256 act, int i, int p)
+{
+    const int k = 2 * p;
+    const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
+    float *b = blur + o;
+    const __m256 bv = _mm256_loadu_ps(b);
+    const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    const __m256 r =
+        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+}
+
 /* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_x86.h has why the clamped LUT
- * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs,
- * each computed for both pixels and kept per pixel by selects; the rest 128-bit. */
+ * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs
+ * (unrolled by hand), each computed for both pixels and kept per pixel by selects; the rest
+ * 128-bit. */
 static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
     const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
@@ -231,19 +255,14 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         _mm256_store_si256((__m256i *)L0, l0);
         _mm256_store_si256((__m256i *)L1, _mm256_sub_epi32(l0, _mm256_cmpgt_epi32(needi, l0))); /* + 1 if L0 < need */
         const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
-        for (int p = 0; p < 4; p++) {
-            if (!((bits >> 2 * p) & 3))
-                continue;
-            const int k = 2 * p;
-            const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
-            float *b = blur + o;
-            const __m256 bv = _mm256_loadu_ps(b);
-            const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
-            const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
-            const __m256 r = _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))),
-                                              PAIR(mix, p));
-            _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
-        }
+        if (bits & 3)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0);
+        if (bits & 12)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1);
+        if (bits & 48)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2);
+        if (bits & 192)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3);
     }
     if (i < x0 + n)
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
