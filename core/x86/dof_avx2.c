@@ -213,16 +213,21 @@ static void upsample_row_avx2(float *restrict dst, const float *tmp, const int32
         dof_upsample_row_x86(dst + 4 * x, tmp, i0 + x, i1 + x, ax + x, n - x);
 }
 
-/* pair p of the 8 pixels from i: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0), kept where act */
+/* pair p of the 8 pixels from i: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0), kept where
+ * act; sel = 0 (a constant) where all 8 are blended and none mixes: no selects needed. */
 static inline void pb_pair(float *blur, const float *const *up, const int32_t *L0, const int32_t *L1, __m256 f,
-                           __m256 t, __m256 mix, __m256 act, int i, int p)
+                           __m256 t, __m256 mix, __m256 act, int i, int p, int sel)
 {
     const int k = 2 * p;
     const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
     float *b = blur + o;
-    const __m256 bv = _mm256_loadu_ps(b);
     const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
     const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    if (!sel) {
+        _mm256_storeu_ps(b, pv);
+        return;
+    }
+    const __m256 bv = _mm256_loadu_ps(b);
     const __m256 r =
         _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
     _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
@@ -255,14 +260,21 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         _mm256_store_si256((__m256i *)L0, l0);
         _mm256_store_si256((__m256i *)L1, _mm256_sub_epi32(l0, _mm256_cmpgt_epi32(needi, l0))); /* + 1 if L0 < need */
         const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        if (bits == 255 && !_mm256_movemask_ps(mix)) { /* the periphery */
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 0);
+            continue;
+        }
         if (bits & 3)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 1);
         if (bits & 12)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 1);
         if (bits & 48)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 1);
         if (bits & 192)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 1);
     }
     if (i < x0 + n)
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);

@@ -252,17 +252,34 @@ static inline dof_pb_k dof_pb_setup(const fv_dof_pyrblur_args *a)
     return k;
 }
 
-/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act (all lanes broadcast) */
+/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act (all lanes broadcast).
+ * domix = 0: no pixel of the block both mixes and is blended (r = pv is then right for every
+ * blended one); doact = 0: every pixel of the block is blended. Constants at each call. */
 static inline __m128 dof_pb1(__m128 b, const float *u0p, const float *u1p, __m128 f, __m128 t, __m128 mix,
-                             __m128 act)
+                             __m128 act, int domix, int doact)
 {
     const __m128 u0 = _mm_loadu_ps(u0p), u1 = _mm_loadu_ps(u1p);
     const __m128 pv = _mm_add_ps(u0, _mm_mul_ps(f, _mm_sub_ps(u1, u0)));
-    const __m128 r = _mm_blendv_ps(pv, _mm_add_ps(b, _mm_mul_ps(t, _mm_sub_ps(pv, b))), mix);
-    return _mm_blendv_ps(b, r, act);
+    const __m128 r = domix ? _mm_blendv_ps(pv, _mm_add_ps(b, _mm_mul_ps(t, _mm_sub_ps(pv, b))), mix) : pv;
+    return doact ? _mm_blendv_ps(b, r, act) : r;
 }
 
 #define DOF_BC(v, k) _mm_shuffle_ps(v, v, _MM_SHUFFLE(k, k, k, k))
+
+/* the 4 pixels of a block from pixel i (b = blur + 4 i) */
+static inline void dof_pb4(float *b, const float *const *up, const int32_t *L0, const int32_t *L1, __m128 f,
+                           __m128 t, __m128 mix, __m128 act, int i, int domix, int doact)
+{
+    const ptrdiff_t o = 4 * (ptrdiff_t)i;
+    _mm_storeu_ps(b, dof_pb1(_mm_loadu_ps(b), up[L0[0]] + o, up[L1[0]] + o, DOF_BC(f, 0), DOF_BC(t, 0),
+                             DOF_BC(mix, 0), DOF_BC(act, 0), domix, doact));
+    _mm_storeu_ps(b + 4, dof_pb1(_mm_loadu_ps(b + 4), up[L0[1]] + o + 4, up[L1[1]] + o + 4, DOF_BC(f, 1),
+                                 DOF_BC(t, 1), DOF_BC(mix, 1), DOF_BC(act, 1), domix, doact));
+    _mm_storeu_ps(b + 8, dof_pb1(_mm_loadu_ps(b + 8), up[L0[2]] + o + 8, up[L1[2]] + o + 8, DOF_BC(f, 2),
+                                 DOF_BC(t, 2), DOF_BC(mix, 2), DOF_BC(act, 2), domix, doact));
+    _mm_storeu_ps(b + 12, dof_pb1(_mm_loadu_ps(b + 12), up[L0[3]] + o + 12, up[L1[3]] + o + 12, DOF_BC(f, 3),
+                                  DOF_BC(t, 3), DOF_BC(mix, 3), DOF_BC(act, 3), domix, doact));
+}
 
 static inline void dof_pyrblur_row_x86(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
@@ -285,16 +302,12 @@ static inline void dof_pyrblur_row_x86(float *restrict blur, const fv_dof_pyrblu
         _mm_store_si128((__m128i *)L1, _mm_sub_epi32(l0, _mm_cmplt_epi32(l0, k.needi))); /* + 1 where L0 < need */
         const __m128 mix = _mm_and_ps(_mm_cmpgt_ps(c, k.zero), _mm_cmplt_ps(t, k.one));
         float *b = blur + 4 * i;
-        const float *const *up = a->up;
-        const ptrdiff_t o = 4 * (ptrdiff_t)i;
-        _mm_storeu_ps(b, dof_pb1(_mm_loadu_ps(b), up[L0[0]] + o, up[L1[0]] + o, DOF_BC(f, 0), DOF_BC(t, 0),
-                                 DOF_BC(mix, 0), DOF_BC(act, 0)));
-        _mm_storeu_ps(b + 4, dof_pb1(_mm_loadu_ps(b + 4), up[L0[1]] + o + 4, up[L1[1]] + o + 4, DOF_BC(f, 1),
-                                     DOF_BC(t, 1), DOF_BC(mix, 1), DOF_BC(act, 1)));
-        _mm_storeu_ps(b + 8, dof_pb1(_mm_loadu_ps(b + 8), up[L0[2]] + o + 8, up[L1[2]] + o + 8, DOF_BC(f, 2),
-                                     DOF_BC(t, 2), DOF_BC(mix, 2), DOF_BC(act, 2)));
-        _mm_storeu_ps(b + 12, dof_pb1(_mm_loadu_ps(b + 12), up[L0[3]] + o + 12, up[L1[3]] + o + 12, DOF_BC(f, 3),
-                                      DOF_BC(t, 3), DOF_BC(mix, 3), DOF_BC(act, 3)));
+        const int domix = _mm_movemask_ps(_mm_and_ps(mix, act)) != 0, doact = _mm_movemask_ps(act) != 15;
+        /* the common blocks (all blended, none mixing: the periphery) without the selects */
+        if (!domix && !doact)
+            dof_pb4(b, a->up, L0, L1, f, t, mix, act, i, 0, 0);
+        else
+            dof_pb4(b, a->up, L0, L1, f, t, mix, act, i, 1, 1);
     }
     for (; i < x0 + n; i++) { /* the reference's control flow, channels as a vector */
         const float c = a->coc[i], t = a->t[i], m = c < 0.0f ? -c : c;
@@ -308,7 +321,7 @@ static inline void dof_pyrblur_row_x86(float *restrict blur, const fv_dof_pyrblu
         const __m128 mix = c > 0.0f && t < 1.0f ? all : k.zero;
         float *b = blur + 4 * i;
         _mm_storeu_ps(b, dof_pb1(_mm_loadu_ps(b), a->up[L0] + 4 * i, a->up[L1] + 4 * i, _mm_set1_ps(l - (float)L0),
-                                 _mm_set1_ps(t), mix, all));
+                                 _mm_set1_ps(t), mix, all, 1, 0));
     }
 }
 
