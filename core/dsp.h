@@ -113,7 +113,11 @@ struct fv_dof_pyrblur_args;
  * dof_pyrblur_row: for x in [x0, x0+n) with coc != 0 and t > 0: the continuous level
  *   l = min(lambda[min(int(|coc| steps), max)], need), pv = up[L0] + f (up[L1] - up[L0])
  *   (L0 = int l, L1 = min(L0 + 1, need), f = l - L0), blur[x] = coc > 0 && t < 1 ?
- *   blur + t (pv - blur) : pv (4 channels); other pixels untouched. */
+ *   blur + t (pv - blur) : pv (4 channels); other pixels keep their bits. |coc| lambda_steps must
+ *   stay below 2^31 (the reference's int conversion); lambda holds levels >= 0. The ISA versions
+ *   compute several pixels at once and keep each by a select on the reference's condition: they
+ *   may read (never use) up[0..need] and blur at pixels of [x0, x0+n) the reference skips, and
+ *   store a skipped pixel's blur back unchanged. */
 typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                                        const float *ax, int n);
 typedef void (*fv_dof_pyrblur_row_fn)(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);

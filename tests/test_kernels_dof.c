@@ -365,6 +365,178 @@ static void test_combine_row(void **state)
            comb_far, comb_lnear, comb_near, comb_enh);
 }
 
+/* ------------------------------------------------------------------ upsample_row */
+
+static const float below1 = 0x1.fffffep-1f; /* the largest float < 1 */
+
+/* n output pixels from a tmp row of sw texels. tmode 0: core/dof/weier.c's taps (by 2^L, borders
+ * clamped); 1: random taps, i0 / i1 often at the row's ends or equal; 2: all taps equal. */
+static void run_upsample1(const fv_dsp *d, const char *isa, int n, int tmode, int off)
+{
+    const int L = 1 + rndi(5);
+    const int sw = tmode == 0 ? ((n + (1 << L) - 1) >> L) + rndi(2) : 1 + rndi(rndi(2) ? 4 : n + 8);
+    buf tmp = buf_new(4 * (size_t)sw, off);
+    for (int i = 0; i < 4 * sw; i++)
+        tmp.p[i] = colour();
+    int32_t *i0 = malloc(sizeof(int32_t) * (size_t)n), *i1 = malloc(sizeof(int32_t) * (size_t)n);
+    buf ax = buf_new((size_t)n, off);
+    assert_non_null(i0), assert_non_null(i1);
+    for (int x = 0; x < n; x++) {
+        if (tmode == 0) { /* as xtaps_init */
+            const float u = ((float)x + 0.5f) * (1.0f / (float)(1 << L)) - 0.5f, fu = floorf(u);
+            const int a = (int)fu;
+            i0[x] = a < 0 ? 0 : a > sw - 1 ? sw - 1 : a;
+            i1[x] = a + 1 < 0 ? 0 : a + 1 > sw - 1 ? sw - 1 : a + 1;
+            ax.p[x] = u - fu;
+        } else {
+            const int e = rndi(6);
+            i0[x] = e == 0 ? 0 : e == 1 ? sw - 1 : rndi(sw);
+            i1[x] = tmode == 2 || rndi(4) == 0 ? i0[x] : rndi(3) == 0 ? (rndi(2) ? 0 : sw - 1) : rndi(sw);
+            const int k = rndi(6);
+            ax.p[x] = k == 0 ? 0.0f : k == 1 ? below1 : k == 2 ? 0.5f : rnd();
+        }
+    }
+    buf r = out_new(4 * (size_t)n, off), t = out_new(4 * (size_t)n, off);
+    fv_dof_upsample_row_c(r.p, tmp.p, i0, i1, ax.p, n);
+    d->dof_upsample_row(t.p, tmp.p, i0, i1, ax.p, n);
+    compare(r.p, t.p, 4 * (size_t)n + CANARY, 4, isa, "upsample_row", "row + canaries");
+    free(tmp.base), free(i0), free(i1), free(ax.base), free(r.base), free(t.base);
+}
+
+static void run_upsample(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70; n++)
+        for (int tmode = 0; tmode < 3; tmode++)
+            for (int rep = 0; rep < 2; rep++)
+                run_upsample1(d, isa, n, tmode, rndi(4));
+    for (int k = 0; k < 6; k++)
+        run_upsample1(d, isa, 1280, k % 3, rndi(4));
+}
+
+static void test_upsample_row(void **state)
+{
+    (void)state;
+    run_all("dof_upsample_row", run_upsample, offsetof(fv_dsp, dof_upsample_row));
+}
+
+/* ------------------------------------------------------------------ pyrblur_row */
+
+static long pb_active, pb_mix, pb_beyond, pb_frac; /* how often (reference, all ISAs) */
+
+/* Rows of w pixels; the span [x0, x0 + n). The level table: core/dof/weier.c's (steps 8, 512
+ * entries) or a short random one (levels >= 0, some whole, some above need), so CoCs run past
+ * its end. What the reference does not read (blur and the up rows where it skips a pixel, blur
+ * where it does not mix) holds NaN / Inf sometimes: an ISA version may read it but must not let
+ * it through; skipped pixels must keep their bits. */
+static void run_pyrblur1(const fv_dsp *d, const char *isa, int w, int x0, int n, int off)
+{
+    const size_t w4 = 4 * (size_t)w;
+    const int need = rndi(6), prod = rndi(2);
+    const int steps = prod ? 8 : 1 + rndi(16), lmax = prod ? 512 : rndi(40);
+    float *lambda = malloc(sizeof(float) * (size_t)(lmax + 1));
+    assert_non_null(lambda);
+    for (int i = 0; i <= lmax; i++) {
+        if (prod) { /* as core/dof/weier.c */
+            const float c = (float)i / 8.0f, var = c * c * (1.0f / 16.0f);
+            float lo = 0.0f, l = 0.0f;
+            for (int L = 1; L <= 5; L++) {
+                const float hi = (3.0f * (float)(1 << (2 * L)) - 1.0f) / 12.0f;
+                if (var < hi) {
+                    l = (float)(L - 1) + (var - lo) / (hi - lo);
+                    break;
+                }
+                lo = hi, l = (float)L;
+            }
+            lambda[i] = l;
+        } else
+            lambda[i] = rndi(4) == 0 ? (float)rndi(7) : rndi(8) == 0 ? below1 * (float)(1 + rndi(5)) : 6.0f * rnd();
+    }
+    buf coc = buf_new((size_t)w, off), t = buf_new((size_t)w, off);
+    buf up[6];
+    for (int L = 0; L <= need; L++)
+        up[L] = buf_new(w4, off);
+    const int cmode = rndi(6), tmode = rndi(5);
+    float run_t = 0.0f;
+    for (int i = 0; i < w; i++) {
+        static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, -1.4e-45f, 64.0f, -64.0f, 64.0625f,
+                                    100.0f, -1000.0f, 1e6f, -1.25e8f, 1.25e8f, 0.125f, -0.0625f};
+        const float u = rnd(), sg = rndi(2) ? 1.0f : -1.0f; /* (one draw a statement: the same inputs whatever the compiler) */
+        coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? 20.0f * rnd() : cmode == 2 ? -12.0f * rnd() :
+                   cmode == 3 ? sg * 80.0f * rnd() :
+                   u < 0.25f ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : sg * 70.0f * rnd();
+        if (tmode == 0)
+            t.p[i] = 1.0f;
+        else if (tmode == 1)
+            t.p[i] = rndi(3) ? rnd() : rndi(2) ? 0.0f : -0.0f;
+        else { /* runs of 0, 1 and in between (the transition), as along a real row */
+            if (rndi(6) == 0)
+                run_t = rndi(3) == 0 ? 0.0f : rndi(2) ? 1.0f : rndi(8) == 0 ? below1 : rndi(8) == 0 ? 1e-30f : rnd();
+            t.p[i] = tmode == 2 ? (rndi(8) == 0 ? -rnd() : rnd()) : run_t;
+        }
+        const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
+        const int act = m > 0.0f && tt > 0.0f;
+        for (int L = 0; L <= need; L++)
+            for (int k = 0; k < 4; k++)
+                up[L].p[4 * i + k] = !act && rndi(3) == 0 ? (rndi(2) ? NAN : -INFINITY) : colour();
+    }
+    buf r = buf_new(w4 + CANARY, off), o = buf_new(w4 + CANARY, off);
+    for (int i = 0; i < w; i++) {
+        const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
+        const int mix = m > 0.0f && tt > 0.0f && c > 0.0f && tt < 1.0f;
+        for (int k = 0; k < 4; k++)
+            r.p[4 * i + k] = !mix && rndi(3) == 0 ? (rndi(2) ? NAN : INFINITY) : colour();
+    }
+    for (size_t i = w4; i < w4 + CANARY; i++)
+        memcpy(r.p + i, &canary_bits, 4);
+    memcpy(o.p, r.p, (w4 + CANARY) * sizeof(float));
+    const float *ups[6];
+    for (int L = 0; L <= need; L++)
+        ups[L] = up[L].p;
+    const fv_dof_pyrblur_args a = {.coc = coc.p, .t = t.p, .up = ups, .need = need, .lambda = lambda,
+                                   .lambda_steps = steps, .lambda_max = lmax};
+    fv_dof_pyrblur_row_c(r.p, &a, x0, n);
+    d->dof_pyrblur_row(o.p, &a, x0, n);
+    compare(r.p, o.p, w4 + CANARY, 4, isa, "pyrblur_row", "whole row + canaries");
+    for (int i = x0; i < x0 + n; i++) {
+        const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
+        if (!(m > 0.0f && tt > 0.0f))
+            continue;
+        pb_active++;
+        pb_mix += c > 0.0f && tt < 1.0f;
+        pb_beyond += m * (float)steps >= (float)lmax;
+        const int li = (int)(m * (float)steps);
+        const float l = lambda[li < lmax ? li : lmax];
+        pb_frac += l < (float)need && l != floorf(l);
+        for (int k = 0; k < 4; k++)
+            assert_true(isfinite(r.p[4 * i + k]));
+    }
+    for (int L = 0; L <= need; L++)
+        free(up[L].base);
+    free(lambda), free(coc.base), free(t.base), free(r.base), free(o.base);
+}
+
+static void run_pyrblur(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70; n++)
+        for (int rep = 0; rep < 8; rep++) {
+            const int w = n + (rndi(3) == 0 ? 0 : rndi(40)), x0 = rndi(w - n + 1);
+            run_pyrblur1(d, isa, w, x0, n, rndi(4));
+        }
+    for (int k = 0; k < 12; k++) { /* whole production rows, as core/dof/weier.c calls it, and offset ones */
+        const int x0 = k < 6 ? 0 : 1 + rndi(9), w = 1280 + x0 + (k & 1) * rndi(7);
+        run_pyrblur1(d, isa, w, x0, 1280, rndi(4));
+    }
+}
+
+static void test_pyrblur_row(void **state)
+{
+    (void)state;
+    run_all("dof_pyrblur_row", run_pyrblur, offsetof(fv_dsp, dof_pyrblur_row));
+    printf("[ kernels  ] pyrblur pixels blended (all ISAs): %ld, mixed into the blur %ld, past the LUT's end %ld, "
+           "between two levels %ld\n",
+           pb_active, pb_mix, pb_beyond, pb_frac);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -380,6 +552,8 @@ int main(void)
         cmocka_unit_test(test_hgauss_row),
         cmocka_unit_test(test_vgauss_row),
         cmocka_unit_test(test_combine_row),
+        cmocka_unit_test(test_upsample_row),
+        cmocka_unit_test(test_pyrblur_row),
     };
     return cmocka_run_group_tests_name("kernels_dof", tests, setup, NULL);
 }

@@ -1,7 +1,8 @@
 /* bench_dof: times the layered depth-of-field kernels (dsp.h dof_*) of every ISA this CPU runs on
  * production-sized rows (1280 pixels; far CoCs of 2..16 px, so Gaussian sigmas of 0.5..4 px and
  * radii 2..12), single thread, data in cache as in the pipeline's bands, the Gaussians called on
- * spans of 128 pixels and the combine on whole rows as core/dof/weier.c calls them. Each run times one pass of every ISA back
+ * spans of 128 pixels and the combine, the up-sampling and the periphery's level blend on whole
+ * rows as core/dof/weier.c calls them. Each run times one pass of every ISA back
  * to back in this thread's CPU time; printed: ns per output pixel (the median of --reps runs, at
  * most 256) and the speed-up over C (the median of the runs' ratios). The outputs are also
  * compared with the C reference's (bit-identity; tests/test_kernels_dof checks it in depth).
@@ -21,6 +22,8 @@
 #define SPAN 128 /* TILE * 8, the span of core/dof/weier.c's Gaussian calls */
 #define ROWS 8   /* rows cycled through per timed pass (in cache) */
 #define VROWS 48 /* rows of the vertical pass's source plane */
+#define UPL 5    /* pyramid levels up-sampled (MAX_UP_LEVEL of core/dof/weier.c) */
+#define LSTEPS 8 /* the level LUT's steps per pixel of CoC (LAMBDA_STEPS) */
 
 static uint64_t rng = 0xbe4c4d0full;
 static float rnd(void)
@@ -59,10 +62,15 @@ typedef struct {
     float *plane;                   /* VROWS rows of far_h */
     float *dst;                     /* ROWS output rows */
     float *near, *lnear, *far, *enh, *t; /* one row each */
+    float *tmp;                     /* a row of level-1 texels (the up-sampling's source) */
+    int32_t *i0[UPL + 1], *i1[UPL + 1]; /* up-sampling taps by 2^L, L = 1..UPL */
+    float *ax[UPL + 1];
+    float *up[UPL + 1];             /* up-sampled level rows (up[0] = the row's level 0) */
+    float lambda[LSTEPS * 64 + 1];  /* CoC -> continuous level, as core/dof/weier.c */
 } bench;
 
-enum { K_COC, K_HG, K_VG, K_COMB, K_N };
-static const char *kname[K_N] = {"coc_row", "hgauss_row", "vgauss_row", "combine_row"};
+enum { K_COC, K_HG, K_VG, K_COMB, K_UP, K_PB, K_N };
+static const char *kname[K_N] = {"coc_row", "hgauss_row", "vgauss_row", "combine_row", "upsample_row", "pyrblur_row"};
 
 /* One timed pass of kernel k over ROWS rows; returns ns per output pixel. */
 static double pass(const bench *b, const fv_dsp *d, int k)
@@ -84,6 +92,17 @@ static double pass(const bench *b, const fv_dsp *d, int k)
                 d->dof_vgauss_row(dst, b->plane, W, 16 + r, 0, VROWS, xs, W - xs < SPAN ? W - xs : SPAN, sigv + xs,
                                   &b->tab);
             break;
+        case K_UP: /* levels 1..4 by turns */
+            d->dof_upsample_row(dst, b->tmp, b->i0[1 + r % 4], b->i1[1 + r % 4], b->ax[1 + r % 4], W);
+            break;
+        case K_PB: {
+            /* the row's own CoCs and t (the periphery beyond 320 px of the middle), all 5 levels */
+            const float *ups[UPL + 1] = {rgbd, b->up[1], b->up[2], b->up[3], b->up[4], b->up[5]};
+            const fv_dof_pyrblur_args pa = {.coc = coc, .t = b->t, .up = ups, .need = UPL, .lambda = b->lambda,
+                                            .lambda_steps = LSTEPS, .lambda_max = 64 * LSTEPS};
+            d->dof_pyrblur_row(dst, &pa, 0, W);
+            break;
+        }
         default: {
             /* as core/dof/weier.c: the whole row at once; near layers and enhancement on
              * odd rows only (tiles no near sample reaches; contrast enhancement off by default) */
@@ -166,8 +185,15 @@ int main(int argc, char **argv)
     b.enh = malloc(4 * sizeof(float) * (size_t)W);
     b.lnear = malloc(4 * sizeof(float) * (size_t)W);
     b.t = malloc(sizeof(float) * (size_t)W);
-    if (!b.rgbd || !b.coc || !b.sigh || !b.sigv || !b.plane || !b.dst || !ref || !b.near || !b.far || !b.enh ||
-        !b.lnear || !b.t) {
+    b.tmp = malloc(4 * sizeof(float) * (size_t)W);
+    int oom = !b.tmp;
+    for (int L = 0; L <= UPL; L++) {
+        b.i0[L] = malloc(sizeof(int32_t) * (size_t)W), b.i1[L] = malloc(sizeof(int32_t) * (size_t)W);
+        b.ax[L] = malloc(sizeof(float) * (size_t)W), b.up[L] = malloc(4 * sizeof(float) * (size_t)W);
+        oom |= !b.i0[L] || !b.i1[L] || !b.ax[L] || !b.up[L];
+    }
+    if (oom || !b.rgbd || !b.coc || !b.sigh || !b.sigv || !b.plane || !b.dst || !ref || !b.near || !b.far ||
+        !b.enh || !b.lnear || !b.t) {
         fprintf(stderr, "bench_dof: out of memory\n");
         return 1;
     }
@@ -178,6 +204,32 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < 4 * (size_t)W * VROWS; i++)
         b.plane[i] = rnd();
+    for (size_t i = 0; i < 4 * (size_t)W; i++) {
+        b.tmp[i] = rnd();
+        for (int L = 0; L <= UPL; L++)
+            b.up[L][i] = rnd();
+    }
+    for (int L = 1; L <= UPL; L++) /* taps as core/dof/weier.c's xtaps_init, level L of width W >> L */
+        for (int x = 0; x < W; x++) {
+            const int sw = (W + (1 << L) - 1) >> L;
+            const float u = ((float)x + 0.5f) / (float)(1 << L) - 0.5f, fu = floorf(u);
+            b.i0[L][x] = (int)fu < 0 ? 0 : (int)fu > sw - 1 ? sw - 1 : (int)fu;
+            b.i1[L][x] = (int)fu + 1 > sw - 1 ? sw - 1 : (int)fu + 1;
+            b.ax[L][x] = u - fu;
+        }
+    for (int i = 0; i <= 64 * LSTEPS; i++) { /* as core/dof/weier.c */
+        const float c = (float)i / LSTEPS, var = c * c * (1.0f / 16.0f);
+        float lo = 0.0f, l = 0.0f;
+        for (int L = 1; L <= UPL; L++) {
+            const float hi = (3.0f * (float)(1 << (2 * L)) - 1.0f) / 12.0f;
+            if (var < hi) {
+                l = (float)(L - 1) + (var - lo) / (hi - lo);
+                break;
+            }
+            lo = hi, l = (float)L;
+        }
+        b.lambda[i] = l;
+    }
     /* near layer in runs (objects), t: 0 within 200 px of the row's middle (the fovea), 1
      * beyond 320 px (the periphery), the transition between */
     float nw = 0.0f;
@@ -220,8 +272,8 @@ int main(int argc, char **argv)
                 nd++;
         }
         for (int kk = 0; kk < K_N; kk++) {
-            if (noisy && kk == K_COC)
-                continue; /* the CoC does not depend on the profile */
+            if (noisy && (kk == K_COC || kk == K_UP))
+                continue; /* the CoC and the up-sampling do not depend on the profile */
             /* each run times every ISA back to back, so a ratio compares runs under the same load */
             double ns[4][256], ratio[4][256];
             const int reps = b.reps < 256 ? b.reps : 256;
@@ -251,6 +303,8 @@ int main(int argc, char **argv)
     if (bad)
         printf("bench_dof: ! marks an ISA whose output differs from the C reference's\n");
     free(b.rgbd), free(b.coc), free(b.sigh), free(b.sigv), free(b.plane), free(b.dst), free(ref);
-    free(b.near), free(b.far), free(b.enh), free(b.lnear), free(b.t);
+    free(b.near), free(b.far), free(b.enh), free(b.lnear), free(b.t), free(b.tmp);
+    for (int L = 0; L <= UPL; L++)
+        free(b.i0[L]), free(b.i1[L]), free(b.ax[L]), free(b.up[L]);
     return bad;
 }

@@ -3,7 +3,8 @@
  * by channel in the same order); true division (FDIV), multiply then add (no FMLA: the tree is
  * built with -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the
  * depths); the Gaussians 4 output pixels at a time so 4 independent add chains overlap; the
- * combine 4 pixels at a time as channel vectors.
+ * combine 4 pixels at a time as channel vectors; the up-sampling and the periphery's level blend
+ * one pixel a vector (the latter's per-pixel scalars 4 at a time).
  *
  * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
  * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
@@ -198,8 +199,90 @@ static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, 
         fv_dof_combine_row_c(out, a, x, x0 + n - x);
 }
 
+/* one pixel a vector: dst = p0 + a (p1 - p0), 4 weights a load */
+static inline float32x4_t up1(const float *tmp, int32_t i0, int32_t i1, float a)
+{
+    const float32x4_t p0 = vld1q_f32(tmp + 4 * (ptrdiff_t)i0), p1 = vld1q_f32(tmp + 4 * (ptrdiff_t)i1);
+    return vaddq_f32(p0, vmulq_n_f32(vsubq_f32(p1, p0), a));
+}
+
+static void upsample_row_neon(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                              const float *ax, int n)
+{
+    int x = 0;
+    for (; x + 4 <= n; x += 4) {
+        const float32x4_t a4 = vld1q_f32(ax + x);
+        float *d = dst + 4 * x;
+        vst1q_f32(d, up1(tmp, i0[x], i1[x], vgetq_lane_f32(a4, 0)));
+        vst1q_f32(d + 4, up1(tmp, i0[x + 1], i1[x + 1], vgetq_lane_f32(a4, 1)));
+        vst1q_f32(d + 8, up1(tmp, i0[x + 2], i1[x + 2], vgetq_lane_f32(a4, 2)));
+        vst1q_f32(d + 12, up1(tmp, i0[x + 3], i1[x + 3], vgetq_lane_f32(a4, 3)));
+    }
+    for (; x < n; x++)
+        vst1q_f32(dst + 4 * x, up1(tmp, i0[x], i1[x], ax[x]));
+}
+
+/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act */
+static inline float32x4_t pb1(float32x4_t b, const float *u0p, const float *u1p, float f, float t, uint32_t mix,
+                              uint32_t act)
+{
+    const float32x4_t u0 = vld1q_f32(u0p), u1 = vld1q_f32(u1p);
+    const float32x4_t pv = vaddq_f32(u0, vmulq_n_f32(vsubq_f32(u1, u0), f));
+    const float32x4_t r = sel(vdupq_n_u32(mix), vaddq_f32(b, vmulq_n_f32(vsubq_f32(pv, b), t)), pv);
+    return sel(vdupq_n_u32(act), r, b);
+}
+
+/* 4 pixels at a time: their scalars as lanes, then one pixel a vector, each kept by selects (a
+ * pixel the reference skips gets its own bits back). The LUT index: the reference's
+ * min((int)(m steps), max) is, for m steps in [0, 2^31), (int) of min(m steps, max) (max an
+ * integer); clamping the float first (NaN to 0) keeps every lane's index in [0, max], skipped
+ * ones too, so the lookup stays in the table and L0, L1 in [0, need] (the table holds levels
+ * >= 0): a skipped pixel's loads stay in the rows up[0..need] at the call's pixels. */
+static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f), lmax = vdupq_n_f32((float)a->lambda_max);
+    const float32x4_t need = vdupq_n_f32((float)a->need);
+    const int32x4_t needi = vdupq_n_s32(a->need);
+    const float steps = (float)a->lambda_steps;
+    const float *const *up = a->up;
+    int i = x0;
+    for (; i + 4 <= x0 + n; i += 4) {
+        const float32x4_t c = vld1q_f32(a->coc + i), t = vld1q_f32(a->t + i);
+        const float32x4_t m = vabsq_f32(c); /* -0 -> +0: skipped either way */
+        const uint32x4_t act = vandq_u32(vcgtq_f32(m, zero), vcgtq_f32(t, zero));
+        if (!vmaxvq_u32(act))
+            continue;
+        float32x4_t v = vmulq_n_f32(m, steps);
+        v = sel(vcgtq_f32(v, zero), v, zero); /* NaN -> 0 */
+        v = sel(vcltq_f32(v, lmax), v, lmax);
+        int32_t li[4], L0[4], L1[4];
+        uint32_t mk[4], ak[4];
+        float fk[4], tk[4];
+        vst1q_s32(li, vcvtq_s32_f32(v));
+        const float32_t lv[4] = {a->lambda[li[0]], a->lambda[li[1]], a->lambda[li[2]], a->lambda[li[3]]};
+        float32x4_t l = vld1q_f32(lv);
+        l = sel(vcltq_f32(l, need), l, need); /* l < need ? l : need */
+        const int32x4_t l0 = vcvtq_s32_f32(l);
+        vst1q_f32(fk, vsubq_f32(l, vcvtq_f32_s32(l0)));
+        vst1q_s32(L0, l0);
+        vst1q_s32(L1, vsubq_s32(l0, vreinterpretq_s32_u32(vcltq_s32(l0, needi)))); /* + 1 where L0 < need */
+        vst1q_u32(mk, vandq_u32(vcgtq_f32(c, zero), vcltq_f32(t, one)));
+        vst1q_u32(ak, act);
+        vst1q_f32(tk, t);
+        for (int k = 0; k < 4; k++) {
+            const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
+            float *b = blur + o;
+            vst1q_f32(b, pb1(vld1q_f32(b), up[L0[k]] + o, up[L1[k]] + o, fk[k], tk[k], mk[k], ak[k]));
+        }
+    }
+    if (i < x0 + n)
+        fv_dof_pyrblur_row_c(blur, a, i, x0 + n - i);
+}
+
 void fv_dof_init_neon(fv_dsp *d)
 {
+    d->dof_upsample_row = upsample_row_neon;
+    d->dof_pyrblur_row = pyrblur_row_neon;
     d->dof_coc_row = coc_row_neon;
     d->dof_hgauss_row = hgauss_row_neon;
     d->dof_vgauss_row = vgauss_row_neon;

@@ -2,7 +2,8 @@
  * intrinsics). The CoC takes 8 pixels at a time; the Gaussians 8 output pixels at a time as four
  * 256-bit accumulators of two pixels each (each 128-bit half with its own pixel's weights), the
  * rest with the 128-bit pieces of core/x86/dof_x86.h, which also has why the bits are the
- * references'. The combine takes 8 pixels at a time without branches (see there). */
+ * references'. The combine takes 8 pixels at a time without branches (see there); the
+ * up-sampling and the periphery's level blend 8 at a time as 4 pixel pairs. */
 #include <immintrin.h>
 
 #include "x86/dof_x86.h"
@@ -176,8 +177,113 @@ static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, 
         dof_combine_row_x86(out, a, x, x0 + n - x);
 }
 
+/* two pixels' 128-bit vectors as one */
+static inline __m256 ld2(const float *lo, const float *hi)
+{
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1);
+}
+
+/* lanes 2p (low half) and 2p + 1 (high half) of an 8-lane vector, each spread over its half */
+#define PAIR(v, p) _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(2 * (p), 2 * (p), 2 * (p), 2 * (p), 2 * (p) + 1, \
+                                                                 2 * (p) + 1, 2 * (p) + 1, 2 * (p) + 1))
+
+/* pixels xp, xp + 1 (pair p of the 8 whose weights are a8) */
+static inline void up_pair(float *dst, const float *tmp, const int32_t *i0, const int32_t *i1, __m256 a8, int xp,
+                           int p)
+{
+    const __m256 p0 = ld2(tmp + 4 * (ptrdiff_t)i0[xp], tmp + 4 * (ptrdiff_t)i0[xp + 1]);
+    const __m256 p1 = ld2(tmp + 4 * (ptrdiff_t)i1[xp], tmp + 4 * (ptrdiff_t)i1[xp + 1]);
+    _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
+}
+
+/* 8 pixels at a time as 4 pairs (unrolled by hand: the pairs' lane indices are constants), the
+ * rest with the 128-bit version */
+static void upsample_row_avx2(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                              const float *ax, int n)
+{
+    int x = 0;
+    for (; x + 8 <= n; x += 8) {
+        const __m256 a8 = _mm256_loadu_ps(ax + x);
+        up_pair(dst, tmp, i0, i1, a8, x, 0);
+        up_pair(dst, tmp, i0, i1, a8, x + 2, 1);
+        up_pair(dst, tmp, i0, i1, a8, x + 4, 2);
+        up_pair(dst, tmp, i0, i1, a8, x + 6, 3);
+    }
+    if (x < n)
+        dof_upsample_row_x86(dst + 4 * x, tmp, i0 + x, i1 + x, ax + x, n - x);
+}
+
+/* pair p of the 8 pixels from i: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0), kept where
+ * act; sel = 0 (a constant) where all 8 are blended and none mixes: no selects needed. */
+static inline void pb_pair(float *blur, const float *const *up, const int32_t *L0, const int32_t *L1, __m256 f,
+                           __m256 t, __m256 mix, __m256 act, int i, int p, int sel)
+{
+    const int k = 2 * p;
+    const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
+    float *b = blur + o;
+    const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    if (!sel) {
+        _mm256_storeu_ps(b, pv);
+        return;
+    }
+    const __m256 bv = _mm256_loadu_ps(b);
+    const __m256 r =
+        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+}
+
+/* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_x86.h has why the clamped LUT
+ * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs
+ * (unrolled by hand), each computed for both pixels and kept per pixel by selects; the rest
+ * 128-bit. */
+static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
+    const __m256 need = _mm256_set1_ps((float)a->need), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    const __m256 msign = _mm256_set1_ps(-0.0f);
+    const __m256i needi = _mm256_set1_epi32(a->need);
+    const float *const *up = a->up;
+    int i = x0;
+    for (; i + 8 <= x0 + n; i += 8) {
+        const __m256 c = _mm256_loadu_ps(a->coc + i), t = _mm256_loadu_ps(a->t + i);
+        const __m256 m = _mm256_andnot_ps(msign, c); /* |c| (-0 -> +0: skipped either way) */
+        const __m256 act = _mm256_and_ps(_mm256_cmp_ps(m, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
+        const int bits = _mm256_movemask_ps(act);
+        if (!bits)
+            continue;
+        const __m256 v = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(m, steps), zero), lmax); /* NaN -> 0 */
+        const __m256 l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, _mm256_cvttps_epi32(v), 4), need);
+        const __m256i l0 = _mm256_cvttps_epi32(l);
+        const __m256 f = _mm256_sub_ps(l, _mm256_cvtepi32_ps(l0));
+        _Alignas(32) int32_t L0[8], L1[8];
+        _mm256_store_si256((__m256i *)L0, l0);
+        _mm256_store_si256((__m256i *)L1, _mm256_sub_epi32(l0, _mm256_cmpgt_epi32(needi, l0))); /* + 1 if L0 < need */
+        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        if (bits == 255 && !_mm256_movemask_ps(mix)) { /* the periphery */
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 0);
+            continue;
+        }
+        if (bits & 3)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 1);
+        if (bits & 12)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 1);
+        if (bits & 48)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 1);
+        if (bits & 192)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 1);
+    }
+    if (i < x0 + n)
+        dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
+}
+
 void fv_dof_init_avx2(fv_dsp *d)
 {
+    d->dof_upsample_row = upsample_row_avx2;
+    d->dof_pyrblur_row = pyrblur_row_avx2;
     d->dof_coc_row = coc_row_avx2;
     d->dof_hgauss_row = hgauss_row_avx2;
     d->dof_vgauss_row = vgauss_row_avx2;

@@ -1,7 +1,8 @@
 /* fovea: depth-of-field kernels, SSE4.1 (core/x86/dof_x86.h has the pieces and why they give
  * the bits of the C references in core/dof/kernels.c). The CoC takes 4 pixels at a time (true
  * division, the reference's selects); the Gaussians 4 output pixels at a time, one pixel per
- * vector, so 4 independent add chains overlap where the reference waits on one. */
+ * vector, so 4 independent add chains overlap where the reference waits on one. The up-sampling
+ * and the periphery's level blend take one pixel a vector (their per-pixel scalars 4 at a time). */
 #include "x86/dof_x86.h"
 
 static void coc_row_sse41(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
@@ -42,8 +43,21 @@ static void combine_row_sse41(float *restrict out, const fv_dof_combine_args *a,
     dof_combine_row_x86(out, a, x0, n);
 }
 
+static void upsample_row_sse41(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                               const float *ax, int n)
+{
+    dof_upsample_row_x86(dst, tmp, i0, i1, ax, n);
+}
+
+static void pyrblur_row_sse41(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    dof_pyrblur_row_x86(blur, a, x0, n);
+}
+
 void fv_dof_init_sse41(fv_dsp *d)
 {
+    d->dof_upsample_row = upsample_row_sse41;
+    d->dof_pyrblur_row = pyrblur_row_sse41;
     d->dof_coc_row = coc_row_sse41;
     d->dof_hgauss_row = hgauss_row_sse41;
     d->dof_vgauss_row = vgauss_row_sse41;

@@ -199,4 +199,130 @@ static inline void dof_combine_row_x86(float *restrict out, const fv_dof_combine
     }
 }
 
+/* ---- upsample_row, one pixel a vector: dst = p0 + a (p1 - p0), the reference's per-channel
+ * operations (the SSE4.1 version; the AVX2 one's tail) ---- */
+
+static inline __m128 dof_up1(const float *tmp, int32_t i0, int32_t i1, __m128 a)
+{
+    const __m128 p0 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)i0), p1 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)i1);
+    return _mm_add_ps(p0, _mm_mul_ps(a, _mm_sub_ps(p1, p0)));
+}
+
+static inline void dof_upsample_row_x86(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                                        const float *ax, int n)
+{
+    int x = 0;
+    for (; x + 4 <= n; x += 4) { /* 4 weights a load, spread by shuffles */
+        const __m128 a4 = _mm_loadu_ps(ax + x);
+        float *d = dst + 4 * x;
+        _mm_storeu_ps(d, dof_up1(tmp, i0[x], i1[x], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(0, 0, 0, 0))));
+        _mm_storeu_ps(d + 4, dof_up1(tmp, i0[x + 1], i1[x + 1], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(1, 1, 1, 1))));
+        _mm_storeu_ps(d + 8, dof_up1(tmp, i0[x + 2], i1[x + 2], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(2, 2, 2, 2))));
+        _mm_storeu_ps(d + 12, dof_up1(tmp, i0[x + 3], i1[x + 3], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(3, 3, 3, 3))));
+    }
+    for (; x < n; x++)
+        _mm_storeu_ps(dst + 4 * x, dof_up1(tmp, i0[x], i1[x], _mm_set1_ps(ax[x])));
+}
+
+/* ---- pyrblur_row ----
+ * The per-pixel scalars (active, level LUT index, l, L0, L1, f, mix) of 4 pixels at once, then
+ * one pixel a vector: the reference's operations on its 4 channels, kept by selects (a pixel the
+ * reference skips gets its own bits back; its garbage levels are valid ones, see below).
+ *   The LUT index: the reference's min((int)(m steps), max) is, for m steps in [0, 2^31),
+ * (int) of min(m steps, max) (max an integer: trunc(v) < max iff v < max). Clamping the float
+ * first (and NaN to 0: x86 max returns its second operand on NaN) keeps every lane's index in
+ * [0, max], skipped ones too, so the lookup never leaves the table; then min(l, need) and its
+ * (int) are in [0, need] (the table holds levels >= 0) and so are L0 and L1: the loads of a
+ * skipped pixel stay in the rows up[0..need] at the call's pixels. */
+typedef struct {
+    __m128 steps, lmax, need, zero, one, msign;
+    __m128i needi;
+} dof_pb_k;
+
+static inline dof_pb_k dof_pb_setup(const fv_dof_pyrblur_args *a)
+{
+    dof_pb_k k;
+    k.steps = _mm_set1_ps((float)a->lambda_steps);
+    k.lmax = _mm_set1_ps((float)a->lambda_max);
+    k.need = _mm_set1_ps((float)a->need);
+    k.zero = _mm_setzero_ps();
+    k.one = _mm_set1_ps(1.0f);
+    k.msign = _mm_set1_ps(-0.0f);
+    k.needi = _mm_set1_epi32(a->need);
+    return k;
+}
+
+/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act (all lanes broadcast).
+ * domix = 0: no pixel of the block both mixes and is blended (r = pv is then right for every
+ * blended one); doact = 0: every pixel of the block is blended. Constants at each call. */
+static inline __m128 dof_pb1(__m128 b, const float *u0p, const float *u1p, __m128 f, __m128 t, __m128 mix,
+                             __m128 act, int domix, int doact)
+{
+    const __m128 u0 = _mm_loadu_ps(u0p), u1 = _mm_loadu_ps(u1p);
+    const __m128 pv = _mm_add_ps(u0, _mm_mul_ps(f, _mm_sub_ps(u1, u0)));
+    const __m128 r = domix ? _mm_blendv_ps(pv, _mm_add_ps(b, _mm_mul_ps(t, _mm_sub_ps(pv, b))), mix) : pv;
+    return doact ? _mm_blendv_ps(b, r, act) : r;
+}
+
+#define DOF_BC(v, k) _mm_shuffle_ps(v, v, _MM_SHUFFLE(k, k, k, k))
+
+/* the 4 pixels of a block from pixel i (b = blur + 4 i) */
+static inline void dof_pb4(float *b, const float *const *up, const int32_t *L0, const int32_t *L1, __m128 f,
+                           __m128 t, __m128 mix, __m128 act, int i, int domix, int doact)
+{
+    const ptrdiff_t o = 4 * (ptrdiff_t)i;
+    _mm_storeu_ps(b, dof_pb1(_mm_loadu_ps(b), up[L0[0]] + o, up[L1[0]] + o, DOF_BC(f, 0), DOF_BC(t, 0),
+                             DOF_BC(mix, 0), DOF_BC(act, 0), domix, doact));
+    _mm_storeu_ps(b + 4, dof_pb1(_mm_loadu_ps(b + 4), up[L0[1]] + o + 4, up[L1[1]] + o + 4, DOF_BC(f, 1),
+                                 DOF_BC(t, 1), DOF_BC(mix, 1), DOF_BC(act, 1), domix, doact));
+    _mm_storeu_ps(b + 8, dof_pb1(_mm_loadu_ps(b + 8), up[L0[2]] + o + 8, up[L1[2]] + o + 8, DOF_BC(f, 2),
+                                 DOF_BC(t, 2), DOF_BC(mix, 2), DOF_BC(act, 2), domix, doact));
+    _mm_storeu_ps(b + 12, dof_pb1(_mm_loadu_ps(b + 12), up[L0[3]] + o + 12, up[L1[3]] + o + 12, DOF_BC(f, 3),
+                                  DOF_BC(t, 3), DOF_BC(mix, 3), DOF_BC(act, 3), domix, doact));
+}
+
+static inline void dof_pyrblur_row_x86(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const dof_pb_k k = dof_pb_setup(a);
+    int i = x0;
+    for (; i + 4 <= x0 + n; i += 4) {
+        const __m128 c = _mm_loadu_ps(a->coc + i), t = _mm_loadu_ps(a->t + i);
+        const __m128 m = _mm_andnot_ps(k.msign, c); /* |c| (-0 -> +0: skipped either way) */
+        const __m128 act = _mm_and_ps(_mm_cmpgt_ps(m, k.zero), _mm_cmpgt_ps(t, k.zero));
+        if (!_mm_movemask_ps(act))
+            continue;
+        const __m128 v = _mm_min_ps(_mm_max_ps(_mm_mul_ps(m, k.steps), k.zero), k.lmax);
+        _Alignas(16) int32_t li[4], L0[4], L1[4];
+        _mm_store_si128((__m128i *)li, _mm_cvttps_epi32(v));
+        const __m128 l = _mm_min_ps(_mm_setr_ps(a->lambda[li[0]], a->lambda[li[1]], a->lambda[li[2]], a->lambda[li[3]]),
+                                    k.need); /* l < need ? l : need */
+        const __m128i l0 = _mm_cvttps_epi32(l);
+        const __m128 f = _mm_sub_ps(l, _mm_cvtepi32_ps(l0));
+        _mm_store_si128((__m128i *)L0, l0);
+        _mm_store_si128((__m128i *)L1, _mm_sub_epi32(l0, _mm_cmplt_epi32(l0, k.needi))); /* + 1 where L0 < need */
+        const __m128 mix = _mm_and_ps(_mm_cmpgt_ps(c, k.zero), _mm_cmplt_ps(t, k.one));
+        float *b = blur + 4 * i;
+        const int domix = _mm_movemask_ps(_mm_and_ps(mix, act)) != 0, doact = _mm_movemask_ps(act) != 15;
+        /* the common blocks (all blended, none mixing: the periphery) without the selects */
+        if (!domix && !doact)
+            dof_pb4(b, a->up, L0, L1, f, t, mix, act, i, 0, 0);
+        else
+            dof_pb4(b, a->up, L0, L1, f, t, mix, act, i, 1, 1);
+    }
+    for (; i < x0 + n; i++) { /* the reference's control flow, channels as a vector */
+        const float c = a->coc[i], t = a->t[i], m = c < 0.0f ? -c : c;
+        if (!(m > 0.0f && t > 0.0f))
+            continue;
+        const float v = m * (float)a->lambda_steps;
+        float l = a->lambda[v < (float)a->lambda_max ? (int)v : a->lambda_max];
+        l = l < (float)a->need ? l : (float)a->need;
+        const int L0 = (int)l, L1 = L0 < a->need ? L0 + 1 : L0;
+        const __m128 all = _mm_castsi128_ps(_mm_set1_epi32(-1));
+        const __m128 mix = c > 0.0f && t < 1.0f ? all : k.zero;
+        float *b = blur + 4 * i;
+        _mm_storeu_ps(b, dof_pb1(_mm_loadu_ps(b), a->up[L0] + 4 * i, a->up[L1] + 4 * i, _mm_set1_ps(l - (float)L0),
+                                 _mm_set1_ps(t), mix, all, 1, 0));
+    }
+}
+
 #endif
