@@ -197,8 +197,10 @@ static void run_hgauss1(const fv_dsp *d, const char *isa, int w, int x0, int n, 
                    u < 0.15f ? 0.0f : u < 0.2f ? -0.0f : u < 0.4f ? -8.0f * rnd() : u < 0.45f ? 1e-30f : 16.0f * rnd();
         for (int c = 0; c < 4; c++)
             rgbd.p[4 * i + c] = colour();
-        if (!(coc.p[i] > 0.0f) && rndi(2)) /* colours of near / focused samples are never used */
-            rgbd.p[4 * i + rndi(3)] = rndi(2) ? NAN : INFINITY;
+        if (!(coc.p[i] > 0.0f) && rndi(2)) { /* colours of near / focused samples are never used */
+            const int ch = rndi(3);
+            rgbd.p[4 * i + ch] = rndi(2) ? NAN : INFINITY;
+        }
     }
     uint8_t *sig = malloc((size_t)n + 1);
     assert_non_null(sig);
@@ -222,8 +224,11 @@ static void run_hgauss(const fv_dsp *d, const char *isa)
         }
     for (int k = 0; k < 40; k++) { /* production spans (TILE * 8) and tiny rows */
         const int w = k < 20 ? 128 + rndi(1200) : 1 + rndi(8);
-        const int n = k < 20 ? (w < 128 ? w : 128 - rndi(2) * rndi(128)) : 1 + rndi(w);
-        run_hgauss1(d, isa, w, rndi(w - n + 1), n, rndi(5), rndi(4));
+        const int cut = k < 20 && w >= 128 && rndi(2) ? rndi(128) : 0; /* one draw after the other */
+        const int n = k < 20 ? (w < 128 ? w : 128 - cut) : 1 + rndi(w);
+        /* draws in a fixed order (argument evaluation order is unspecified) */
+        const int x0 = rndi(w - n + 1), sm = rndi(5), off = rndi(4);
+        run_hgauss1(d, isa, w, x0, n, sm, off);
     }
     run_hgauss1(d, isa, 1281, 0, 1281, 4, 1); /* longer than one chunk */
 }
@@ -259,11 +264,13 @@ static void run_vgauss(const fv_dsp *d, const char *isa)
     for (int n = 1; n <= 70; n++)
         for (int smode = 0; smode < 5; smode++) {
             const int w = n + rndi(20), h = 1 + rndi(rndi(2) ? 8 : 70);
-            run_vgauss1(d, isa, w, h, rndi(w - n + 1), n, smode, rndi(4));
+            const int x0 = rndi(w - n + 1), off = rndi(4);
+            run_vgauss1(d, isa, w, h, x0, n, smode, off);
         }
     for (int k = 0; k < 10; k++) {
         const int w = 128 + rndi(400);
-        run_vgauss1(d, isa, w, 16 + rndi(60), rndi(w - 127), 128, rndi(5), rndi(4));
+        const int hh = 16 + rndi(60), x0 = rndi(w - 127), sm = rndi(5), off = rndi(4);
+        run_vgauss1(d, isa, w, hh, x0, 128, sm, off);
     }
 }
 
@@ -349,7 +356,8 @@ static void run_combine(const fv_dsp *d, const char *isa)
     for (int n = 1; n <= 70; n++)
         for (int rep = 0; rep < 6; rep++) {
             const int w = n + (rndi(3) == 0 ? 0 : rndi(40));
-            run_combine1(d, isa, w, rndi(w - n + 1), n, rndi(4));
+            const int x0 = rndi(w - n + 1), off = rndi(4);
+            run_combine1(d, isa, w, x0, n, off);
         }
     for (int k = 0; k < 10; k++) { /* whole production rows, as core/dof/weier.c calls it */
         const int w = 1200 + rndi(200);
