@@ -44,8 +44,9 @@ static void usage(FILE *f)
             "  --kernels          time every hand-vectorised kernel (fv_dsp) against its C\n"
             "                     reference and each ISA this CPU runs at production sizes, print\n"
             "                     speed-ups (median of --kernel-reps runs, default 7; no scene)\n"
-            "  --kernel NAME --calls N   with --kernels: only set NAME up and call it N times with\n"
-            "                     the kernels of --isa (for instruction counts under qemu:\n"
+            "  --kernel NAME      with --kernels: only that kernel\n"
+            "  --calls N          with --kernel: no timing; set NAME up and call it N times with the\n"
+            "                     kernels of --isa (instruction counts under qemu:\n"
             "                     tools/kernel_icount.sh)\n"
             FV_COMMON_HELP "  --help             this text\n");
 }
@@ -247,10 +248,10 @@ typedef struct {
 
 static int run_kernels(const char *json_path, int reps, const char *only, long calls, unsigned isa_mask)
 {
-    if (only) { /* instruction counting: one kernel, one ISA, `calls` calls after the set-up */
+    if (only && !fv_kbench_find(only))
+        fv_usage_error(prog, "--kernel: '%s' is not a kernel of the table (see --kernels)", only);
+    if (only && calls > 0) { /* instruction counting: one kernel, one ISA, `calls` calls after the set-up */
         const fv_kbench_kernel *k = fv_kbench_find(only);
-        if (!k)
-            fv_usage_error(prog, "--kernel: '%s' is not a kernel of the table (see --kernels)", only);
         fv_dsp d;
         fv_dsp_init(&d, isa_mask);
         void *st = k->setup();
@@ -285,6 +286,8 @@ static int run_kernels(const char *json_path, int reps, const char *only, long c
     int nout = 0;
     for (int i = 0; i < fv_kbench_count; i++) {
         const fv_kbench_kernel *k = &fv_kbench_kernels[i];
+        if (only && strcmp(k->name, only))
+            continue;
         /* the ISAs with their own version (not the C one, not the same as a lower ISA's) */
         int use[NM];
         for (int m = 0; m < NM; m++) {
@@ -603,8 +606,8 @@ int main(int argc, char **argv)
     if (kernels) {
         if (optind < argc)
             fv_usage_error(prog, "unexpected argument '%s' (see --help)", argv[optind]);
-        if ((kernel != NULL) != (calls > 0))
-            fv_usage_error(prog, "--kernel NAME and --calls N go together");
+        if (calls > 0 && !kernel)
+            fv_usage_error(prog, "--calls N needs --kernel NAME");
         return run_kernels(json_path, kreps, kernel, calls, cfg.isa_mask);
     }
     if (kernel || calls)
