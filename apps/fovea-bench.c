@@ -461,6 +461,13 @@ static void print_table(const run_result *res, int nres, int frames)
     printf("(ms per frame, means over %d frames; one eye)\n", frames);
 }
 
+/* the fraction of pixels pull-push fills: those without a ray this frame */
+static double holes_of(const run_result *r, int w, int h)
+{
+    const double f = 1.0 - (double)r->samples / ((double)w * (double)h);
+    return f > 0.0 ? f : 0.0;
+}
+
 static void print_roofline(const run_result *res, int nres, int w, int h, double gbps)
 {
     printf("roofline (compulsory bytes per frame / stage time, against the measured copy bandwidth %.2f GB/s):\n",
@@ -471,7 +478,7 @@ static void print_roofline(const run_result *res, int nres, int w, int h, double
             const int s = roof_stages[k];
             double rd, wr;
             const double ms = res[i].stage_mean[s];
-            if (fv_prof_stage_bytes(s, w, h, strcmp(res[i].mode, "full") != 0, &rd, &wr) || isnan(ms) || ms <= 0.0 ||
+            if (fv_prof_stage_bytes(s, w, h, holes_of(&res[i], w, h), &rd, &wr) || isnan(ms) || ms <= 0.0 ||
                 rd + wr <= 0.0) {
                 printf(" %s -", fv_stage_names[s]);
                 continue;
@@ -517,7 +524,7 @@ static void json_run(FILE *f, const run_result *r, int w, int h, double gbps)
         double rd = 0.0, wr = 0.0;
         const double ms = r->stage_mean[s];
         fprintf(f, "%s\"%s\": ", k ? ", " : "", fv_stage_names[s]);
-        if (fv_prof_stage_bytes(s, w, h, strcmp(r->mode, "full") != 0, &rd, &wr) || isnan(ms) || ms <= 0.0 ||
+        if (fv_prof_stage_bytes(s, w, h, holes_of(r, w, h), &rd, &wr) || isnan(ms) || ms <= 0.0 ||
             rd + wr <= 0.0) {
             fputs("null", f);
             continue;

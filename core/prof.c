@@ -140,7 +140,7 @@ size_t fv_prof_dropped(const fv_prof *p, int slot)
     return p->r[slot].n - fv_prof_count(p, slot);
 }
 
-int fv_prof_stage_bytes(int stage, int w, int h, int foveated, double *rd, double *wr)
+int fv_prof_stage_bytes(int stage, int w, int h, double holes, double *rd, double *wr)
 {
     const double N = (double)w * (double)h;
     const double px = 16.0, wt = 4.0; /* a pixel: r, g, b, depth floats; a weight: one float */
@@ -148,8 +148,9 @@ int fv_prof_stage_bytes(int stage, int w, int h, int foveated, double *rd, doubl
     switch (stage) {
     case FV_STAGE_RECONSTRUCT: {
         /* levels above the tiles' pulls are pulled (fine level read, coarse level written), then
-         * every level but the top is pushed: fine colour + weight read, coarse colour read, fine
-         * colour written */
+         * every level but the top is pushed: fine weights read; where a pixel is a hole (the
+         * fraction `holes`, taken for every level), its colour and the coarse colour above it
+         * read and its colour written */
         int lw[32], lh[32], L = 0;
         for (int cw = w, ch = h; L < 32; L++) {
             lw[L] = cw, lh[L] = ch;
@@ -164,13 +165,13 @@ int fv_prof_stage_bytes(int stage, int w, int h, int foveated, double *rd, doubl
             *wr += (px + wt) * lw[l + 1] * (double)lh[l + 1];
         }
         for (int l = 0; l + 1 < levels; l++) {
-            *rd += (px + wt) * lw[l] * (double)lh[l] + px * lw[l + 1] * (double)lh[l + 1];
-            *wr += px * lw[l] * (double)lh[l];
+            *rd += wt * lw[l] * (double)lh[l] + holes * (px * lw[l] * (double)lh[l] + px * lw[l + 1] * (double)lh[l + 1]);
+            *wr += holes * px * lw[l] * (double)lh[l];
         }
         return 0;
     }
     case FV_STAGE_REPROJECT:
-        if (!foveated)
+        if (!(holes > 0.0))
             return 0; /* full sampling has no reprojection */
         /* level 0 colour + weight read and written; the history's level 0 and, for holes, its
          * coarser levels (a third more) read */
