@@ -261,7 +261,17 @@ static int run_kernels(const char *json_path, int reps, const char *only, long c
             k->reset(st);
         k->run(st, &d, 0, (int)calls);
         k->free(st);
-        printf("%s: %s %s x %ld calls\n", prog, k->name, fv_isa_name(d.isa), calls);
+        /* where the kernels' code is (tools/kernel_icount.py counts the instructions run there) */
+        printf("%s: %s %s x %ld calls; code at", prog, k->name, fv_isa_name(d.isa), calls);
+        for (int i = 0; i < FV_KBENCH_MAX_FIELDS; i++)
+            if (k->field[i]) {
+                void (*fn)(void);
+                uintptr_t a;
+                memcpy(&fn, (const char *)&d + k->field[i], sizeof fn);
+                memcpy(&a, &fn, sizeof a);
+                printf(" 0x%llx", (unsigned long long)a);
+            }
+        printf("\n");
         return FV_EXIT_OK;
     }
     static const unsigned masks[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_SSE41 | FV_ISA_AVX2, FV_ISA_NEON};
