@@ -44,6 +44,21 @@ BASE_CXXFLAGS := -std=c++17 $(OPT) $(WARN) -Wno-unused-parameter -pthread -Icore
 LIBS := -lembree3 -ltinygltf -lstb -ljpeg -lstdc++ -lm -lpthread
 TEST_LIBS := -lcmocka
 
+# Hardware back ends of platform/ (GPIO vsync: libgpiod 1.6, KMS: libdrm, window: SDL2), native
+# builds only: the cross leg runs the core's tests and has none of them. A back end whose
+# library is missing compiles to a stub whose open() says so. Linked --as-needed, so only the
+# programs that use a back end depend on its library.
+PKG_CONFIG ?= pkg-config
+ifeq ($(CROSS),)
+HW_PKGS := $(foreach p,libgpiod libdrm sdl2,$(if $(shell $(PKG_CONFIG) --exists $(p) 2>/dev/null && echo y),$(p)))
+endif
+HW_DEFS := $(if $(filter libgpiod,$(HW_PKGS)),-DFV_HAVE_GPIOD) $(if $(filter libdrm,$(HW_PKGS)),-DFV_HAVE_DRM) \
+           $(if $(filter sdl2,$(HW_PKGS)),-DFV_HAVE_SDL2)
+HW_CFLAGS := $(HW_DEFS) $(if $(HW_PKGS),$(shell $(PKG_CONFIG) --cflags $(HW_PKGS)))
+AS_NEEDED := -Wl,--push-state,--as-needed
+AS_NEEDED_END := -Wl,--pop-state
+HW_LIBS := $(if $(HW_PKGS),$(AS_NEEDED) $(shell $(PKG_CONFIG) --libs $(HW_PKGS)) $(AS_NEEDED_END))
+
 ALL_CFLAGS = $(BASE_CFLAGS) $(CFLAGS)
 ALL_CXXFLAGS = $(BASE_CXXFLAGS) $(CXXFLAGS)
 ALL_LDFLAGS = $(SANFLAGS) -pthread $(LDFLAGS)
@@ -85,7 +100,7 @@ TSAN_BUILD := build-tsan
 CROSS_BUILD := build-aarch64
 endif
 
-.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin
+.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin test-hil
 all: $(LIB) $(PLIB) $(APPS) $(TOOLS)
 
 $(BUILD)/%.o: %.c
@@ -104,19 +119,20 @@ $(BUILD)/%.o: %.cpp
 $(LIB): $(CORE_OBJ)
 	@rm -f $@
 	$(AR) rcs $@ $^
+$(PLATFORM_OBJ): ALL_CFLAGS += $(HW_CFLAGS)
 $(PLIB): $(PLATFORM_OBJ)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
 $(BUILD)/bin/%: apps/%.c $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) -o $@
+	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) -o $@
 $(BUILD)/tools/%: tools/%.c $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) -o $@
+	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) -o $@
 $(BUILD)/tests/%: tests/%.c tests/testutil.h tests/testscene.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -Itests $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(TEST_LIBS) -o $@
+	$(CC) $(ALL_CFLAGS) -Itests $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) $(TEST_LIBS) -o $@
 
 $(RANGE): tools/gen_range.c
 	$(MAKE) --no-print-directory $(BUILD)/tools/gen_range
@@ -137,6 +153,20 @@ test-bin: $(LIB) $(PLIB) $(APPS) $(TOOLS) $(TESTS) $(RANGE) $(EYE_SYNTH)
 test: deps
 	@$(MAKE) --no-print-directory test-bin
 	@BUILD=$(BUILD) SHARED=$(SHARED) tests/run.sh
+
+# Hardware in the loop (docs/hil.md): Debian's kernel under QEMU (TCG) with vivid, gpio-sim and
+# bochs-drm; the guest program is linked statically (busybox initramfs). tools/hil/prepare.sh
+# installs what it needs and caches the kernel and the gpio-sim module under $(BUILD)/hil.
+HIL_GUEST := $(BUILD)/hil/fovea-hil
+$(HIL_GUEST): tests/hil/guest.c tests/hil/pattern.h $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests/hil $< $(PLIB) $(LIB) -static $(ALL_LDFLAGS) \
+		-lgpiod -ldrm -lstb -ljpeg -lm -o $@
+
+test-hil:
+	@tools/deps.sh
+	@$(MAKE) --no-print-directory $(HIL_GUEST) $(EYE_SYNTH)
+	@BUILD=$(BUILD) tests/hil/run.sh
 
 # Cross leg: build everything for aarch64 and run the core's tests under qemu-aarch64.
 check-aarch64:

@@ -12,6 +12,7 @@ void fv_camera_desc_default(fv_camera_desc *d)
     d->ipd_m = 0.063f;
     d->eye = FV_EYE_CENTER;
     d->axis_shift = 0.0f;
+    d->lens = NULL;
 }
 
 void fv_quat_rotate(const float q[4], const float v[3], float out[3])
@@ -92,6 +93,18 @@ int fv_camera_setup(fv_camera *c, const fv_camera_desc *d, const fv_pose *head)
     c->tan_top = ty;
     c->px_tan = 2.0f * ty / (float)d->height;
     c->focal_px = 1.0f / c->px_tan;
+    /* every field set, lens or not: reprojection compares whole cameras (memcmp) */
+    c->lens_on = d->lens != NULL;
+    c->lens_k1 = c->lens_k2 = c->lens_cx = c->lens_cy = 0.0f;
+    c->lens_scale = 1.0f;
+    if (d->lens) {
+        const float *ctr = d->lens->center[d->eye == FV_EYE_RIGHT ? 1 : 0];
+        c->lens_k1 = d->lens->k1;
+        c->lens_k2 = d->lens->k2;
+        c->lens_scale = d->lens->scale[FV_LENS_G];
+        c->lens_cx = c->tan_left + ctr[0] * (float)d->width * c->px_tan;
+        c->lens_cy = c->tan_top - ctr[1] * (float)d->height * c->px_tan;
+    }
 
     float q[4] = {head->quat[0], head->quat[1], head->quat[2], head->quat[3]};
     fv_quat_normalize(q);
@@ -116,8 +129,11 @@ float fv_camera_project(const fv_camera *c, const float p[3], float *px, float *
     float y = v[0] * c->up[0] + v[1] * c->up[1] + v[2] * c->up[2];
     float z = -(v[0] * c->back[0] + v[1] * c->back[1] + v[2] * c->back[2]);
     if (z > 0.0f) {
-        *px = (x / z - c->tan_left) / c->px_tan;
-        *py = (c->tan_top - y / z) / c->px_tan;
+        float tx = x / z, ty = y / z;
+        if (c->lens_on && fv_lens_undistort(c->lens_k1, c->lens_k2, c->lens_scale, c->lens_cx, c->lens_cy, tx, ty, &tx, &ty))
+            return 0.0f; /* beyond what the lens shows */
+        *px = (tx - c->tan_left) / c->px_tan;
+        *py = (c->tan_top - ty) / c->px_tan;
     }
     return z;
 }

@@ -4,6 +4,8 @@
 #ifndef FOVEA_CAMERA_H
 #define FOVEA_CAMERA_H
 
+#include "lens.h"
+
 typedef struct fv_pose {
     float pos[3];  /* metres, world */
     float quat[4]; /* x, y, z, w: rotates head/eye space into world space */
@@ -19,6 +21,10 @@ typedef struct fv_camera {
     float right[3], up[3], back[3]; /* world axes of eye space (+X, +Y, +Z) */
     float px_tan;               /* tan-space size of one pixel (square pixels) */
     float focal_px;             /* pixels per unit tan at the optical axis */
+    /* lens distortion (fv_camera_desc.lens): rays go along the distorted directions */
+    int lens_on;
+    float lens_k1, lens_k2, lens_scale; /* the green channel's */
+    float lens_cx, lens_cy;             /* lens centre, tangent units */
 } fv_camera;
 
 typedef struct fv_camera_desc {
@@ -29,6 +35,9 @@ typedef struct fv_camera_desc {
     /* Horizontal offset of the optical axis as a fraction of the half-width, signed toward
      * the nose for the left eye; 0 = symmetric. Negated for the right eye (mirror image). */
     float axis_shift;
+    /* HMD lens (core/lens.h), NULL = none (the default): each eye uses its own lens centre.
+     * Must outlive the cameras set up from this description. */
+    const fv_lens *lens;
 } fv_camera_desc;
 
 void fv_camera_desc_default(fv_camera_desc *d);
@@ -41,11 +50,14 @@ static inline void fv_camera_ray(const fv_camera *c, float px, float py, float d
 {
     float tx = c->tan_left + px * c->px_tan;
     float ty = c->tan_top - py * c->px_tan;
+    if (c->lens_on)
+        fv_lens_distort(c->lens_k1, c->lens_k2, c->lens_scale, c->lens_cx, c->lens_cy, tx, ty, &tx, &ty);
     for (int i = 0; i < 3; i++)
         dir[i] = tx * c->right[i] + ty * c->up[i] - c->back[i];
 }
 
-/* Projects a world point to pixel coordinates; returns its view depth (<= 0: behind the eye). */
+/* Projects a world point to pixel coordinates (through the inverse lens mapping when there is a
+ * lens); returns its view depth (<= 0: behind the eye). */
 float fv_camera_project(const fv_camera *c, const float p[3], float *px, float *py);
 
 void fv_quat_rotate(const float q[4], const float v[3], float out[3]);

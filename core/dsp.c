@@ -32,12 +32,14 @@ void fv_dsp_init(fv_dsp *d, unsigned isa_mask)
         fv_pullpush_init_sse41(d);
         fv_reproject_init_sse41(d);
         fv_eyetrack_init_sse41(d);
+        fv_dof_init_sse41(d);
         d->isa = FV_ISA_SSE41;
     }
     if (avail & FV_ISA_AVX2) {
         fv_pullpush_init_avx2(d);
         fv_reproject_init_avx2(d);
         fv_eyetrack_init_avx2(d);
+        fv_dof_init_avx2(d);
         d->isa = FV_ISA_AVX2;
     }
 #elif defined(__aarch64__)
@@ -45,6 +47,7 @@ void fv_dsp_init(fv_dsp *d, unsigned isa_mask)
         fv_pullpush_init_neon(d);
         fv_reproject_init_neon(d);
         fv_eyetrack_init_neon(d);
+        fv_dof_init_neon(d);
         d->isa = FV_ISA_NEON;
     }
 #else

@@ -92,14 +92,35 @@ typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, in
  *   (coc > 0), taps clamped to [0, w): dst[x] = (sum g rgb, sum g) * inv[sig] (premultiplied).
  * dof_vgauss_row: for x in [x0, x0+n): dst[x] = sum_j g_j src[clamp(y + j, ylo, yhi - 1)][x]
  *   (4 channels; src rows stride pixels apart).
+ *   The ISA versions of both Gaussians run blocks of neighbouring pixels to the block's largest
+ *   radius, adding w = 0 taps (the table's zeros) beyond a pixel's own: same bits (an
+ *   accumulator starting at +0 is never -0, so + (+-0) changes nothing), but they read (not
+ *   use) those extra taps, in the row's [0, w) / the rows [ylo, yhi) at columns [x0, x0+n),
+ *   which must hold finite values there (far samples' colours; far_h).
  * dof_combine_row: out[x] for x in [x0, x0+n): o = sharp; towards far by min(1, coc) where
  *   coc > 0, by t min(1, -coc) where coc < 0; near n = near (or 0), blended by t towards
  *   s * lnear where t > 0 (s = 0 for near pixels, else 1); towards n.rgb / n.w by min(1, n.w)
  *   where n.w > 0; with enh,
  *   o = max(0, o + gain t (o - enh)) where gain t > 0; depth copied (fv_dof_combine_row_c has
- *   the order of operations). */
+ *   the order of operations). The ISA versions may read (never use) far, lnear and enh pixels of
+ *   [x0, x0+n) the reference skips: they compute a step for several pixels and keep it by a
+ *   select on the reference's condition. */
 struct fv_dof_gauss_tab;
 struct fv_dof_combine_args;
+struct fv_dof_pyrblur_args;
+/* dof_upsample_row: dst[x] = tmp[i0[x]] + ax[x] (tmp[i1[x]] - tmp[i0[x]]) for x in [0, n)
+ *   (4 channels; the horizontal half of a separable bilinear up-sampling).
+ * dof_pyrblur_row: for x in [x0, x0+n) with coc != 0 and t > 0: the continuous level
+ *   l = min(lambda[min(int(|coc| steps), max)], need), pv = up[L0] + f (up[L1] - up[L0])
+ *   (L0 = int l, L1 = min(L0 + 1, need), f = l - L0), blur[x] = coc > 0 && t < 1 ?
+ *   blur + t (pv - blur) : pv (4 channels); other pixels keep their bits. |coc| lambda_steps must
+ *   stay below 2^31 (the reference's int conversion); lambda holds levels >= 0. The ISA versions
+ *   compute several pixels at once and keep each by a select on the reference's condition: they
+ *   may read (never use) up[0..need] and blur at pixels of [x0, x0+n) the reference skips, and
+ *   store a skipped pixel's blur back unchanged. */
+typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                                       const float *ax, int n);
+typedef void (*fv_dof_pyrblur_row_fn)(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
 typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);
 typedef void (*fv_dof_hgauss_row_fn)(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
                                      const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
@@ -118,6 +139,8 @@ typedef struct fv_dsp {
     fv_dof_hgauss_row_fn dof_hgauss_row;
     fv_dof_vgauss_row_fn dof_vgauss_row;
     fv_dof_combine_row_fn dof_combine_row;
+    fv_dof_upsample_row_fn dof_upsample_row;
+    fv_dof_pyrblur_row_fn dof_pyrblur_row;
     /* eye tracker */
     fv_et_down2_row_fn et_down2_row;
     fv_et_integral_row_fn et_integral_row;
@@ -160,6 +183,9 @@ void fv_dof_hgauss_row_c(float *restrict dst, const float *rgbd, const float *co
 void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi, int x0,
                          int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
 void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
+void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                           const float *ax, int n);
+void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
 void fv_dof_init_c(fv_dsp *d);
 #if defined(__x86_64__)
 void fv_dof_init_sse41(fv_dsp *d);

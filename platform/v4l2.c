@@ -796,6 +796,10 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, ch
             return FV_V4L2_ERROR;
         }
         int bad = !buffer_ok(cam, &b);
+        if (bad) /* say why, as last_err promises for skipped frames */
+            fv_err(cam->last_err, sizeof cam->last_err, "%s: frame %u skipped: %s", cam->path, b.sequence,
+                   (b.flags & V4L2_BUF_FLAG_ERROR) ? "the driver flagged the buffer bad (V4L2_BUF_FLAG_ERROR)"
+                                                   : "shorter than a whole frame");
         if (!bad && cam->cfg.latest_only)
             drain_to_newest(cam, &b);
         int64_t t_deq = mono_ns();

@@ -368,5 +368,83 @@ if $K --images "$T/lab.txt" --quiet >"$T/out" 2>"$T/err"; then
 else
     bad "track labelled run failed: $(cat "$T/err")"
 fi
+# ---- fovea-headset: start-up faults exit 2 with one line; mid-run faults fall back and go on
+HS=$B/fovea-headset
+HO="--scene $SCENE --size 64x72 --threads 2"
+expect_usage "headset bad gpio chip" 'gpiod_chip_open_lookup\(nochip\)' $HS $HO --vsync gpio:nochip:3
+expect_usage "headset bad gpio line" 'gpio:gpiochip0:x.*LINE must be' $HS $HO --vsync gpio:gpiochip0:x
+expect_usage "headset bad gpio edge" 'LINE must be.*EDGE' $HS $HO --vsync gpio:gpiochip0:3:sideways
+if [ -e /dev/gpiochip0 ]; then
+    expect_usage "headset gpio line out of range" 'line 65535 out of range' $HS $HO --vsync gpio:gpiochip0:65535
+fi
+expect_usage "headset bad vsync" '--vsync sync:1: want gpio' $HS $HO --vsync sync:1
+expect_usage "headset bad timer rate" '--vsync timer:0: HZ' $HS $HO --vsync timer:0
+expect_usage "headset missing vsync replay" 'nope.txt: No such file' $HS $HO --vsync replay:"$T/nope.txt"
+expect_usage "headset missing camera" '/dev/video99' $HS $HO --camera /dev/video99
+expect_usage "headset missing camera replay" 'nope.y4m' $HS $HO --camera replay:"$T/nope.y4m"
+expect_usage "headset kms cannot open" 'open\(/dev/dri/card99\)' $HS $HO --display kms:/dev/dri/card99
+expect_usage "headset fbdev cannot open" "open\\($T/nofb\\)" $HS $HO --display fbdev:"$T/nofb"
+expect_usage "headset png dir cannot be made" '/proc/fovea-no' $HS $HO --display png:/proc/fovea-no/dir
+expect_usage "headset bad display" '--display tv: want kms' $HS $HO --display tv
+expect_usage "headset calibration without camera" '--calibration only applies with --camera' $HS $HO --calibration x
+printf 'k1 0.1\nk9 1\n' >"$T/bad.lens"
+expect_usage "headset bad lens" 'bad.lens:2: unknown key' $HS $HO --lens "$T/bad.lens"
+expect_usage "headset no scene" '--scene FILE is required' $HS --size 64x72
+
+# good runs: a summary, a latency CSV with one row per frame
+if $HS $HO --seconds 1 --trace assets/gaze_sweep.csv --latency-csv "$T/lat.csv" >"$T/out" 2>"$T/err"; then
+    grep -q 'gaze-to-photon p50' "$T/out" && ok || bad "headset summary: $(cat "$T/out")"
+    n=$(sed -n 's/^fovea-headset: \([0-9]*\) frames.*/\1/p' "$T/out")
+    [ -n "$n" ] && [ "$n" -gt 5 ] && [ "$(($(wc -l <"$T/lat.csv") - 1))" -eq "$n" ] && ok \
+        || bad "headset latency csv: $n frames, $(wc -l <"$T/lat.csv") lines"
+    head -n 1 "$T/lat.csv" | grep -q '^frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms' && ok \
+        || bad "headset csv header: $(head -n 1 "$T/lat.csv")"
+else
+    bad "headset good run failed: $(cat "$T/err")"
+fi
+if $HS $HO --seconds 1 --camera replay:$V --lens assets/hmd_example.lens --display png:"$T/hpng" >"$T/out" 2>"$T/err"; then
+    ls "$T/hpng"/frame_00000.png >/dev/null 2>&1 && ok || bad "headset png display wrote nothing"
+    grep -Eq 'camera: [1-9][0-9]* frames tracked$' "$T/out" && ok || bad "headset camera replay: $(cat "$T/out")"
+else
+    bad "headset camera + png run failed: $(cat "$T/err")"
+fi
+# mid-run: the eye video breaks off (truncated frame): last good gaze, frames go on
+hl=$(head -n 1 $V | wc -c)
+head -c $((hl + 30 * (6 + 320 * 240) + 100)) $V >"$T/cut.y4m"
+if $HS $HO --seconds 1.5 --camera replay:"$T/cut.y4m" --camera-fps 240 >"$T/out" 2>"$T/err"; then
+    grep -q 'camera failed (.*cut.y4m.*); keeping the last good gaze' "$T/err" && ok || bad "headset camera fault: $(cat "$T/err")"
+    grep -q 'failed mid-run' "$T/out" && ok || bad "headset camera fault summary: $(cat "$T/out")"
+else
+    bad "headset run with a camera failing mid-run exited: $(cat "$T/err")"
+fi
+# mid-run: the vsync line goes silent after 30 edges: predictor, then the timer; frames go on
+awk 'BEGIN { for (i = 0; i < 30; i++) printf "%d\n", 5000000000 + i * 11111111 }' >"$T/edges.txt"
+if $HS $HO --seconds 1.5 --vsync replay:"$T/edges.txt" --latency-csv "$T/sil.csv" >"$T/out" 2>"$T/err"; then
+    grep -q 'state timer' "$T/out" && ok || bad "headset silent vsync: $(cat "$T/out")"
+    n=$(grep -c ',timer,' "$T/sil.csv")
+    [ "$n" -ge 3 ] && ok || bad "headset stopped presenting when the line went silent: $n frames on the timer"
+else
+    bad "headset silent vsync run failed: $(cat "$T/err")"
+fi
+# mid-run: the PNG display's folder vanishes: falls back to none, keeps presenting; SIGINT ends
+# the run cleanly with the summary (polls: slow under the sanitizers)
+mkdir -p "$T/vanish"
+$HS $HO --display png:"$T/vanish/png" >"$T/out" 2>"$T/err" &
+hp=$!
+i=0
+while [ ! -e "$T/vanish/png/frame_00001.png" ] && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
+rm -rf "$T/vanish"
+i=0
+while ! grep -q 'continuing without a display' "$T/err" && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
+sleep 0.3
+kill -INT $hp
+wait $hp
+rc=$?
+[ "$rc" -eq 0 ] && ok || bad "headset SIGINT: exit $rc: $(cat "$T/err")"
+grep -q 'display png failed (.*); continuing without a display' "$T/err" && ok || bad "headset display fault: $(cat "$T/err")"
+grep -q 'display none' "$T/out" && grep -q 'gaze-to-photon p50' "$T/out" && ok || bad "headset summary after SIGINT: $(cat "$T/out")"
+n=$(sed -n 's/^fovea-headset: \([0-9]*\) frames.*/\1/p' "$T/out")
+[ -n "$n" ] && [ "$n" -gt 2 ] && ok || bad "headset frames after the display fault: $n"
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

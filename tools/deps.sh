@@ -4,7 +4,8 @@
 # (through dpkg multiarch) for the cross leg; --bench adds gnuplot for the charts of `make bench`
 # (not needed by `make test`).
 set -eu
-native="g++ make pkg-config libembree-dev libtinygltf-dev libstb-dev libcmocka-dev libjpeg62-turbo-dev"
+native="g++ make pkg-config libembree-dev libtinygltf-dev libstb-dev libcmocka-dev libjpeg62-turbo-dev
+        libgpiod-dev libdrm-dev libsdl2-dev"
 cross="gcc-aarch64-linux-gnu g++-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user
        libembree-dev:arm64 libtinygltf-dev:arm64 libstb-dev:arm64 libcmocka-dev:arm64 libjpeg62-turbo-dev:arm64"
 want=$native

@@ -24,9 +24,12 @@ echo "|---|---|---|---|---|" >> "$OUT/table.md"
 echo "$cases" | while read -r name file fnear ffar; do
     for focus in "$fnear" "$ffar"; do
         tag="$name-$focus"
-        echo "measure_dof: $tag: reference ($SPP lens samples per pixel)" >&2
-        $R --scene "$file" --frames 1 --size "$SIZE" --quiet --reference "$SPP" --focus-m "$focus" \
-            --pupil-mm "$PUPIL" --out "$OUT/$tag-ref"
+        # the reference is kept between runs (same SPP, size and pupil: delete OUT to redo it)
+        if [ ! -f "$OUT/$tag-ref/frame_00000.png" ]; then
+            echo "measure_dof: $tag: reference ($SPP lens samples per pixel)" >&2
+            $R --scene "$file" --frames 1 --size "$SIZE" --quiet --reference "$SPP" --focus-m "$focus" \
+                --pupil-mm "$PUPIL" --out "$OUT/$tag-ref"
+        fi
         for model in none $MODELS; do
             if [ "$model" = none ]; then dof="--dof none"; else dof="--dof weak --dof-model $model"; fi
             # shellcheck disable=SC2086

@@ -120,8 +120,41 @@ void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args 
     }
 }
 
+void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                           const float *ax, int n)
+{
+    for (int x = 0; x < n; x++) {
+        const float *p0 = tmp + 4 * (ptrdiff_t)i0[x], *p1 = tmp + 4 * (ptrdiff_t)i1[x], a = ax[x];
+        for (int c = 0; c < 4; c++)
+            dst[4 * x + c] = p0[c] + a * (p1[c] - p0[c]);
+    }
+}
+
+void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n)
+{
+    for (int i = x0; i < x0 + n; i++) {
+        const float c = a->coc[i], t = a->t[i], m = c < 0.0f ? -c : c;
+        if (!(m > 0.0f && t > 0.0f))
+            continue;
+        const int li = (int)(m * (float)a->lambda_steps);
+        float l = a->lambda[li < a->lambda_max ? li : a->lambda_max];
+        l = l < (float)a->need ? l : (float)a->need;
+        const int L0 = (int)l, L1 = L0 < a->need ? L0 + 1 : L0;
+        const float f = l - (float)L0, *u0 = a->up[L0] + 4 * i, *u1 = a->up[L1] + 4 * i;
+        float *b = blur + 4 * i;
+        /* far pixels in the transition blend into the centre's Gaussian already in blur */
+        const int mix = c > 0.0f && t < 1.0f;
+        for (int k = 0; k < 4; k++) {
+            const float pv = u0[k] + f * (u1[k] - u0[k]);
+            b[k] = mix ? b[k] + t * (pv - b[k]) : pv;
+        }
+    }
+}
+
 void fv_dof_init_c(fv_dsp *d)
 {
+    d->dof_upsample_row = fv_dof_upsample_row_c;
+    d->dof_pyrblur_row = fv_dof_pyrblur_row_c;
     d->dof_coc_row = fv_dof_coc_row_c;
     d->dof_hgauss_row = fv_dof_hgauss_row_c;
     d->dof_vgauss_row = fv_dof_vgauss_row_c;

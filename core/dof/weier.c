@@ -111,8 +111,8 @@ static void xtaps_init(xtaps *t, int L, int w, int src_w)
 /* Image `src` (2^L level-0 pixels a texel) bilinearly up-sampled to level-0 row y, columns
  * [0, w). Separable: the two source rows are blended once into tmp, then each pixel reads two
  * texels. */
-static void upsample_row(const img4 *src, int L, const xtaps *xt, int y, int w, float *restrict tmp,
-                         float *restrict dst)
+static void upsample_row(const fv_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w,
+                         float *restrict tmp, float *restrict dst)
 {
     const float sc = 1.0f / (float)(1 << L);
     const float v = ((float)y + 0.5f) * sc - 0.5f, fv = floorf(v), ay = v - fv;
@@ -120,11 +120,7 @@ static void upsample_row(const img4 *src, int L, const xtaps *xt, int y, int w, 
     const float *rb = src->px + 4 * (ptrdiff_t)clampi((int)fv + 1, 0, src->h - 1) * src->stride;
     for (int i = 0; i < 4 * src->w; i++)
         tmp[i] = ra[i] + ay * (rb[i] - ra[i]);
-    for (int x = 0; x < w; x++) {
-        const float *p0 = tmp + 4 * xt->i0[x], *p1 = tmp + 4 * xt->i1[x], ax = xt->ax[x];
-        for (int c = 0; c < 4; c++)
-            dst[4 * x + c] = p0[c] + ax * (p1[c] - p0[c]);
-    }
+    dsp->dof_upsample_row(dst, tmp, xt->i0, xt->i1, xt->ax, w);
 }
 
 /* ---- passes ---- */
@@ -375,21 +371,11 @@ static void blur_periphery(const wctx *x, int tid, int y, const float *coc, cons
         const fv_pyr_level *lv = &pyr->lv[L];
         const img4 im = {lv->rgbd, lv->w, lv->h, lv->stride};
         up[L] = slot(x, tid, 2 + L);
-        upsample_row(&im, L, &x->xt[L], y, x->w, tmp, up[L]);
+        upsample_row(x->dsp, &im, L, &x->xt[L], y, x->w, tmp, up[L]);
     }
-    for (int i = 0; i < x->w; i++) {
-        const float t = trow[i], a = coc[i] < 0.0f ? -coc[i] : coc[i];
-        if (!(a > 0.0f && t > 0.0f))
-            continue;
-        float l = x->lambda[mini((int)(a * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
-        l = l < (float)need ? l : (float)need;
-        const int L0 = (int)l, L1 = L0 < need ? L0 + 1 : L0;
-        const float f = l - (float)L0;
-        for (int k = 0; k < 3; k++) {
-            const float pv = up[L0][4 * i + k] + f * (up[L1][4 * i + k] - up[L0][4 * i + k]);
-            blur[4 * i + k] = coc[i] > 0.0f && t < 1.0f ? blur[4 * i + k] + t * (pv - blur[4 * i + k]) : pv;
-        }
-    }
+    const fv_dof_pyrblur_args pa = {.coc = coc, .t = trow, .up = (const float *const *)up, .need = need,
+                                    .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS, .lambda_max = 64 * LAMBDA_STEPS};
+    x->dsp->dof_pyrblur_row(blur, &pa, 0, x->w);
 }
 
 /* The fused vertical pass and combine of one band. */
@@ -477,12 +463,12 @@ static void vcombine_band(void *ctx, int band, int tid)
         if (x->l_reach >= 0) {
             lup = slot(x, tid, 3);
             const img4 im = {x->l_v, x->lw, x->lh, x->lw};
-            upsample_row(&im, 2, &x->xt[2], y, x->w, slot(x, tid, 4), lup); /* LOW = 2^2 */
+            upsample_row(x->dsp, &im, 2, &x->xt[2], y, x->w, slot(x, tid, 4), lup); /* LOW = 2^2 */
         }
         if (enh) {
             const fv_pyr_level *lv = &v->pyr->lv[x->enh_level];
             const img4 im = {lv->rgbd, lv->w, lv->h, lv->stride};
-            upsample_row(&im, x->enh_level, &x->xt[x->enh_level], y, x->w, slot(x, tid, 6), enh);
+            upsample_row(x->dsp, &im, x->enh_level, &x->xt[x->enh_level], y, x->w, slot(x, tid, 6), enh);
         }
         const int64_t tb = fv_time_ns();
         fv_dof_combine_args a = {.sharp = sharp, .coc = coc, .far = far, .near = nfull, .lnear = lup, .t = trow,

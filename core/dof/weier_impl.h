@@ -35,4 +35,14 @@ typedef struct fv_dof_combine_args {
     float gain;         /* contrast enhancement gain (used with enh) */
 } fv_dof_combine_args;
 
+/* One row of the periphery's own-pixel blur (dsp dof_pyrblur_row). */
+typedef struct fv_dof_pyrblur_args {
+    const float *coc;          /* signed CoC row, px */
+    const float *t;            /* transition weight row */
+    const float *const *up;    /* up[L], L = 0..need: pyramid level L up-sampled to the row (up[0] sharp) */
+    int need;                  /* the deepest level read */
+    const float *lambda;       /* |c| * lambda_steps (clamped to lambda_max) -> continuous level */
+    int lambda_steps, lambda_max;
+} fv_dof_pyrblur_args;
+
 #endif

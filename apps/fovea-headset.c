@@ -1,0 +1,393 @@
+/* fovea-headset: the live headset runtime. Wires a vsync source, the gaze (eye camera, trace
+ * or mouse), the stereo pipeline and a display to the vsync-locked frame loop
+ * (core/frameloop.h), and accounts gaze-to-photon latency. */
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "calibfile.h"
+#include "cli.h"
+#include "display.h"
+#include "eyetrack/gazefilter.h"
+#include "frameloop.h"
+#include "gazesrc.h"
+#include "lensfile.h"
+#include "output.h"
+#include "pipeline.h"
+#include "scene.h"
+#include "trace.h"
+#include "vsync.h"
+
+static const char *prog = "fovea-headset";
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: fovea-headset --scene FILE [--camera /dev/videoN|replay:FILE.y4m|none]\n"
+            "                     [--vsync gpio:CHIP:LINE[:rising|falling]|timer:HZ|replay:FILE]\n"
+            "                     [--display kms[:CARD]|fbdev[:DEV]|window|png:DIR|y4m:FILE|none]\n"
+            "                     [--calibration FILE] [--seconds S] [options]\n"
+            "Renders both eyes locked to vsync with the newest gaze; prints a latency summary at exit.\n"
+            "  --scene FILE        glTF 2.0 scene\n"
+            "  --camera SRC        eye camera (V4L2 device or a Y4M replayed at --camera-fps); default\n"
+            "                      none: gaze from --trace, the mouse (--display window) or the centre\n"
+            "  --vsync SRC         vsync source (default timer:90)\n"
+            "  --display DST       where frames go (default none)\n"
+            "  --calibration FILE  gaze calibration (fovea-calibration text); without it the camera's\n"
+            "                      pupil position maps linearly over the field of view (uncalibrated)\n"
+            "  --seconds S         run time (default: until SIGINT)\n"
+            "  --trace FILE        gaze/head trace (CSV, looped); head pose from it with a camera too\n"
+            "  --lens FILE         HMD lens profile: rays along the distorted directions (turns\n"
+            "                      reprojection off: it does not model the lens yet)\n"
+            "  --latency-csv FILE  per-frame gaze/ray/done/photon times\n"
+            "  --hz HZ             nominal refresh for gpio/replay vsync (default 90)\n"
+            "  --camera-fps F      frame rate of a replayed eye video (default 120)\n" FV_COMMON_HELP
+            "  --help              this text\n");
+}
+
+enum { OPT_SCENE = 1, OPT_CAMERA, OPT_VSYNC, OPT_DISPLAY, OPT_CALIB, OPT_SECONDS, OPT_TRACE, OPT_LENS, OPT_CSV,
+       OPT_HZ, OPT_CAMFPS, OPT_HELP };
+
+static volatile sig_atomic_t stop_requested;
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_requested = 1;
+}
+
+typedef struct app {
+    fv_pipeline *pl;
+    fv_vsync *vsync;
+    fv_display *disp;
+    fv_gazesrc *cam;
+    const fv_trace *trace;
+    fv_pose view;
+    int W, H;
+    uint8_t *img[2]; /* front (on screen) and back (being rendered), side by side */
+    int back;
+    int64_t t_start_ns, end_ns;
+    fv_gaze_ring *ring;
+    int reported_vsync, reported_cam;
+    long display_failures;
+} app;
+
+static int64_t a_now(void *c)
+{
+    (void)c;
+    return fv_clock_now_ns();
+}
+static void a_sleep(void *c, int64_t t)
+{
+    (void)c;
+    fv_clock_sleep_until_ns(t);
+}
+static int a_wait_edge(void *c, int64_t deadline, int64_t *t)
+{
+    app *a = c;
+    char err[512];
+    int rc = fv_vsync_wait(a->vsync, deadline - fv_clock_now_ns(), t, err, sizeof err);
+    if (rc < 0 && !a->reported_vsync) {
+        fprintf(stderr, "%s: vsync %s failed (%s); running on the predictor and the timer\n", prog,
+                fv_vsync_kind(a->vsync), err);
+        a->reported_vsync = 1;
+    }
+    return rc;
+}
+static double trace_t_ms(const app *a, int64_t t_ns)
+{
+    const fv_trace *tr = a->trace;
+    double t = (double)(t_ns - a->t_start_ns) * 1e-6;
+    const double span = tr->s[tr->n - 1].t_ms - tr->s[0].t_ms;
+    return tr->s[0].t_ms + (span > 0 ? fmod(t, span) : 0.0); /* looped */
+}
+static void a_sample_gaze(void *c, int64_t now)
+{
+    app *a = c;
+    if (a->cam) {
+        const char *why = fv_gazesrc_failed(a->cam);
+        if (why && !a->reported_cam) {
+            fprintf(stderr, "%s: camera failed (%s); keeping the last good gaze\n", prog, why);
+            a->reported_cam = 1;
+        }
+        return; /* the camera thread pushes its own samples */
+    }
+    fv_gaze_sample s = {.t_ns = now, .x = 0.5f, .y = 0.5f, .confidence = 1.0f};
+    if (a->disp && fv_display_mouse_gaze(a->disp, &s.x, &s.y)) {
+    } else if (a->trace) {
+        fv_trace_sample ts;
+        fv_trace_at(a->trace, trace_t_ms(a, now), &ts);
+        s.x = ts.gaze_x;
+        s.y = ts.gaze_y;
+    }
+    fv_gaze_ring_push(a->ring, &s);
+}
+static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
+{
+    app *a = c;
+    if (stop_requested || fv_clock_now_ns() >= a->end_ns || (a->disp && fv_display_quit_requested(a->disp)))
+        return -1;
+    fv_pose head = a->view;
+    if (a->trace && a->trace->has_head) {
+        fv_trace_sample ts;
+        fv_trace_at(a->trace, trace_t_ms(a, t_ns), &ts); /* the head where it will be at the photon time */
+        head = ts.head;
+    }
+    const float gx = g ? g->x : 0.5f, gy = g ? g->y : 0.5f;
+    /* the focus filter accommodates in photon time; a doubtful gaze widens the fovea */
+    fv_pipeline_set_time_ns(a->pl, t_ns);
+    fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(g ? g->confidence : 0.0f));
+    uint8_t *dst = a->img[a->back];
+    for (int e = 0; e < 2; e++) {
+        const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
+        fv_frame_stats st;
+        if (fv_pipeline_render(a->pl, eye, &head, gx, gy, &st))
+            return -1;
+        fv_pipeline_to_rgb8(a->pl, eye, dst + (size_t)e * a->W * 3, (ptrdiff_t)a->W * 6);
+    }
+    return 0;
+}
+static int a_present(void *c, int which, int64_t vsync_ns)
+{
+    (void)vsync_ns;
+    app *a = c;
+    if (which == FV_PRESENT_PREVIOUS || !a->disp)
+        return 0; /* the front image stays on screen: nothing to do, no tearing */
+    char err[512];
+    if (fv_display_present(a->disp, a->img[a->back], 2 * a->W, a->H, (ptrdiff_t)a->W * 6, err, sizeof err)) {
+        fprintf(stderr, "%s: display %s failed (%s); continuing without a display\n", prog, fv_display_kind(a->disp),
+                err);
+        fv_display_close(a->disp, NULL, 0);
+        char e2[64];
+        if (fv_display_open(&a->disp, "none", 2 * a->W, a->H, 90, e2, sizeof e2))
+            a->disp = NULL; /* out of memory: present nothing */
+        a->display_failures++;
+        return -1;
+    }
+    a->back ^= 1;
+    return 0;
+}
+
+static void write_csv(const char *path, const fv_frame_record *r, long n, int64_t t0, char *err, size_t err_len,
+                      int *ok)
+{
+    fv_afile f;
+    *ok = 0;
+    if (fv_afile_open(&f, path, err, err_len))
+        return;
+    fprintf(f.f, "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,render_ms,late,"
+                 "photon_edge,vsync_state,budget_ms,gaze_x,gaze_y\n");
+#define MS(t) ((double)((t) - t0) * 1e-6)
+    for (long i = 0; i < n; i++) {
+        const fv_frame_record *q = &r[i];
+        fprintf(f.f, "%ld,", q->frame);
+        if (q->has_gaze)
+            fprintf(f.f, "%.3f", MS(q->gaze_t_ns));
+        fprintf(f.f, ",%.3f,%.3f,%.3f,%.3f,", MS(q->ray_start_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
+        if (q->has_gaze)
+            fprintf(f.f, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
+        fprintf(f.f, ",%.3f,%d,%d,%s,%.3f,", (double)(q->done_ns - q->ray_start_ns) * 1e-6, q->late, q->photon_edge,
+                fv_vsync_state_name(q->vsync_state), (double)q->budget_ns * 1e-6);
+        if (q->has_gaze)
+            fprintf(f.f, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
+        else
+            fputc(',', f.f);
+        fputc('\n', f.f);
+    }
+#undef MS
+    *ok = !fv_afile_commit(&f, err, err_len);
+}
+
+int main(int argc, char **argv)
+{
+    fv_pipeline_config cfg;
+    fv_pipeline_config_default(&cfg);
+    const char *scene_path = NULL, *camera = "none", *vsync_spec = "timer:90", *display_spec = "none";
+    const char *calib_path = NULL, *trace_path = NULL, *lens_path = NULL, *csv_path = NULL;
+    double seconds = 0.0;
+    float hz = 90.0f, cam_fps = 120.0f;
+    int reproject_given = 0;
+    static const struct option opts[] = {
+        {"scene", required_argument, 0, OPT_SCENE}, {"camera", required_argument, 0, OPT_CAMERA},
+        {"vsync", required_argument, 0, OPT_VSYNC}, {"display", required_argument, 0, OPT_DISPLAY},
+        {"calibration", required_argument, 0, OPT_CALIB}, {"seconds", required_argument, 0, OPT_SECONDS},
+        {"trace", required_argument, 0, OPT_TRACE}, {"lens", required_argument, 0, OPT_LENS},
+        {"latency-csv", required_argument, 0, OPT_CSV}, {"hz", required_argument, 0, OPT_HZ},
+        {"camera-fps", required_argument, 0, OPT_CAMFPS}, {"help", no_argument, 0, OPT_HELP},
+        FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
+    opterr = 0;
+    int o;
+    while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        switch (o) {
+        case OPT_SCENE: scene_path = optarg; break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_VSYNC: vsync_spec = optarg; break;
+        case OPT_DISPLAY: display_spec = optarg; break;
+        case OPT_CALIB: calib_path = optarg; break;
+        case OPT_SECONDS: seconds = fv_arg_float(prog, "--seconds", optarg, 0.01f, 1e7f); break;
+        case OPT_TRACE: trace_path = optarg; break;
+        case OPT_LENS: lens_path = optarg; break;
+        case OPT_CSV: csv_path = optarg; break;
+        case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
+        case OPT_CAMFPS: cam_fps = fv_arg_float(prog, "--camera-fps", optarg, 1.0f, 1000.0f); break;
+        case OPT_HELP: usage(stdout); return FV_EXIT_OK;
+        case '?': fv_bad_option(prog, argv);
+        default:
+            if (o == FV_OPT_REPROJECT)
+                reproject_given = 1;
+            if (!fv_common_option(prog, o, optarg, &cfg))
+                fv_usage_error(prog, "unhandled option (see --help)");
+        }
+    }
+    fv_common_validate(prog, argc, argv, scene_path, &cfg);
+    const int have_camera = strcmp(camera, "none") != 0;
+    if (calib_path && !have_camera)
+        fv_usage_error(prog, "--calibration only applies with --camera");
+
+    /* from here on SIGINT ends the run cleanly (start-up included: the loop stops at once) */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    char err[1024];
+    /* every input is checked before anything opens hardware */
+    fv_calib calib;
+    if (calib_path && fv_calib_load(&calib, calib_path, err, sizeof err))
+        fv_usage_error(prog, "--calibration %s", err);
+    fv_trace tr = {0};
+    if (trace_path && fv_trace_load(&tr, trace_path, err, sizeof err))
+        fv_usage_error(prog, "%s", err);
+    fv_lens lens;
+    if (lens_path) {
+        const float r_max = 3.0f * tanf(cfg.cam.fov_y_deg * 3.14159265f / 360.0f); /* beyond any corner */
+        if (fv_lens_load(&lens, lens_path, r_max, err, sizeof err))
+            fv_usage_error(prog, "--lens %s", err);
+        cfg.cam.lens = &lens;
+        if (reproject_given && cfg.taa.enabled)
+            fv_usage_error(prog, "--lens: reprojection does not model the lens yet; drop --reproject on");
+        cfg.taa.enabled = 0;
+    }
+    app a = {0};
+    a.trace = trace_path ? &tr : NULL;
+    a.W = cfg.cam.width;
+    a.H = cfg.cam.height;
+    if (fv_vsync_open(&a.vsync, vsync_spec, err, sizeof err))
+        fv_usage_error(prog, "%s", err);
+    if (fv_display_open(&a.disp, display_spec, 2 * a.W, a.H, (int)lrintf(hz), err, sizeof err)) {
+        fv_vsync_close(a.vsync);
+        fv_usage_error(prog, "%s", err);
+    }
+    fv_scene *scene = fv_scene_load(scene_path, err, sizeof err);
+    if (!scene) {
+        fv_display_close(a.disp, NULL, 0);
+        fv_vsync_close(a.vsync);
+        fv_usage_error(prog, "%s", err);
+    }
+    fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)a.W / (float)a.H, a.view.pos, a.view.quat);
+    a.pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
+    fv_gaze_ring ring;
+    fv_gaze_ring_init(&ring);
+    a.ring = &ring;
+    if (a.pl && have_camera) {
+        /* gaze maps to the left eye's image (the one the trace format describes) */
+        fv_camera_desc cd = cfg.cam;
+        cd.eye = FV_EYE_LEFT;
+        fv_camera lc;
+        fv_camera_setup(&lc, &cd, &a.view);
+        if (fv_gazesrc_start(&a.cam, camera, calib_path ? &calib : NULL, &lc, cam_fps, &ring, err, sizeof err)) {
+            fv_pipeline_destroy(a.pl);
+            a.pl = NULL;
+        }
+    }
+    if (!a.pl) {
+        fv_gaze_ring_destroy(&ring);
+        fv_scene_free(scene);
+        fv_display_close(a.disp, NULL, 0);
+        fv_vsync_close(a.vsync);
+        fv_trace_free(&tr);
+        fv_usage_error(prog, "%s", err);
+    }
+    int status = FV_EXIT_FAIL;
+    fv_frame_record *rec = NULL;
+    long nrec = 0, caprec = 0;
+    a.img[0] = calloc((size_t)a.W * 2 * a.H, 3);
+    a.img[1] = calloc((size_t)a.W * 2 * a.H, 3);
+    if (!a.img[0] || !a.img[1]) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        goto done;
+    }
+
+    int64_t period = fv_vsync_nominal_period_ns(a.vsync);
+    if (period <= 0)
+        period = (int64_t)(1e9 / hz + 0.5);
+    fv_frameloop_params lp;
+    fv_frameloop_default_params(&lp, period);
+    fv_frameloop_ops ops = {&a, a_now, a_sleep, a_wait_edge, a_sample_gaze, a_render, a_present};
+    a.t_start_ns = fv_clock_now_ns();
+    a.end_ns = seconds > 0 ? a.t_start_ns + (int64_t)(seconds * 1e9) : INT64_MAX;
+    fv_frameloop loop;
+    fv_frameloop_init(&loop, &lp, &ops, &ring);
+    for (;;) {
+        if (nrec == caprec) {
+            caprec = caprec ? 2 * caprec : 1024;
+            fv_frame_record *n = realloc(rec, (size_t)caprec * sizeof *n);
+            if (!n) {
+                fprintf(stderr, "%s: out of memory for frame records\n", prog);
+                goto done;
+            }
+            rec = n;
+        }
+        if (fv_frameloop_frame(&loop, &rec[nrec]))
+            break;
+        nrec++;
+    }
+    status = FV_EXIT_OK;
+    /* the summary: the first frames (acquiring the line, the first renders' cold caches still in
+     * the 16-frame budget) left out */
+    const long skip = nrec > 40 ? 20 : 0;
+    fv_latency_summary s;
+    fv_latency_summarise(rec + skip, nrec - skip, &s);
+    const double run_s = (double)(fv_clock_now_ns() - a.t_start_ns) * 1e-9;
+    printf("fovea-headset: %ld frames in %.2f s, %dx%d per eye, vsync %s (%.2f Hz nominal), display %s\n", nrec,
+           run_s, a.W, a.H, vsync_spec, 1e9 / (double)period, a.disp ? fv_display_kind(a.disp) : "none");
+    printf("  frame rate %.2f fps; late %ld of %ld (%.1f %%)\n", s.fps, s.late, s.frames,
+           s.frames ? 100.0 * (double)s.late / (double)s.frames : 0.0);
+    printf("  gaze-to-photon p50 %.2f ms, p99 %.2f ms, max %.2f ms; render p50 %.2f ms, p99 %.2f ms\n", s.p50_ms,
+           s.p99_ms, s.max_ms, s.render_p50_ms, s.render_p99_ms);
+    printf("  vsync: %ld edges, missed %ld, spurious %ld, doubled %ld, relocks %ld, jitter %.1f us, period %.1f us, "
+           "state %s%s\n",
+           loop.pred.edges, loop.pred.missed, loop.pred.spurious, loop.pred.doubled, loop.pred.relocks,
+           fv_vsync_pred_jitter_ns(&loop.pred) * 1e-3, fv_vsync_pred_period_ns(&loop.pred) * 1e-3,
+           fv_vsync_state_name(fv_vsync_pred_state(&loop.pred, fv_clock_now_ns())),
+           loop.source_dead ? " (source failed)" : "");
+    if (a.cam)
+        printf("  camera: %ld frames tracked%s\n", fv_gazesrc_frames(a.cam),
+               fv_gazesrc_failed(a.cam) ? " (failed mid-run)" : "");
+    if (csv_path) {
+        int ok;
+        write_csv(csv_path, rec, nrec, a.t_start_ns, err, sizeof err, &ok);
+        if (!ok) {
+            fprintf(stderr, "%s: %s\n", prog, err);
+            status = FV_EXIT_FAIL;
+        }
+    }
+done:
+    fv_gazesrc_stop(a.cam);
+    if (fv_display_close(a.disp, err, sizeof err)) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        status = FV_EXIT_FAIL;
+    }
+    fv_vsync_close(a.vsync);
+    fv_pipeline_destroy(a.pl);
+    fv_gaze_ring_destroy(&ring);
+    fv_scene_free(scene);
+    fv_trace_free(&tr);
+    free(a.img[0]);
+    free(a.img[1]);
+    free(rec);
+    return status;
+}

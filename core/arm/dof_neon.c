@@ -1,0 +1,290 @@
+/* fovea: depth-of-field kernels, AArch64 Advanced SIMD. Bit-identical to the C references in
+ * core/dof/kernels.c: in the Gaussians one pixel = one float32x4_t (the references add channel
+ * by channel in the same order); true division (FDIV), multiply then add (no FMLA: the tree is
+ * built with -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the
+ * depths); the Gaussians 4 output pixels at a time so 4 independent add chains overlap; the
+ * combine 4 pixels at a time as channel vectors; the up-sampling and the periphery's level blend
+ * one pixel a vector (the latter's per-pixel scalars 4 at a time).
+ *
+ * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
+ * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
+ * it (the table holds 0 there, core/dof/weier_impl.h), and an accumulator that starts at +0 is
+ * never -0 (x + y is -0 only if both are -0), so adding +-0 leaves its bits unchanged. The same
+ * argument lets the horizontal pass add +0 (a masked tap) for a near sample instead of skipping
+ * it. The values read for those extra taps lie in the rows / columns the call covers and must be
+ * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
+#include <arm_neon.h>
+
+#include "dof/weier_impl.h"
+#include "dsp.h"
+
+#define CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
+
+static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+static inline int maxi(int a, int b) { return a > b ? a : b; }
+
+static inline float32x4_t sel(uint32x4_t m, float32x4_t a, float32x4_t b) { return vbslq_f32(m, a, b); }
+
+static void coc_row_neon(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
+{
+    const float32x4_t idn = vdupq_n_f32(1.0f / dn), idf = vdupq_n_f32(1.0f / df);
+    const float32x4_t vdn = vdupq_n_f32(dn), vdf = vdupq_n_f32(df), lo = vdupq_n_f32(FV_DOF_MIN_DEPTH_M);
+    const float32x4_t one = vdupq_n_f32(1.0f), zero = vdupq_n_f32(0.0f);
+    int x = 0;
+    for (; x + 4 <= n; x += 4) {
+        const float32x4_t d = vld4q_f32(rgbd + 4 * x).val[3];
+        const float32x4_t g = sel(vcgtq_f32(d, lo), d, lo);
+        const float32x4_t ig = vdivq_f32(one, g);
+        const float32x4_t nr = vmulq_n_f32(vsubq_f32(idn, ig), K);
+        const float32x4_t fr = vmulq_n_f32(vsubq_f32(idf, ig), K);
+        vst1q_f32(coc + x, sel(vcltq_f32(g, vdn), nr, sel(vcgtq_f32(g, vdf), fr, zero)));
+    }
+    if (x < n)
+        fv_dof_coc_row_c(coc + x, rgbd + 4 * x, n - x, K, dn, df);
+}
+
+/* (r, g, b, 1) for a far sample (coc > 0), +0 otherwise, positions base .. base+len-1 clamped
+ * into [0, w). */
+static inline void mask_row(float *restrict m, const float *rgbd, const float *coc, int w, int base, int len)
+{
+    for (int k = 0; k < len; k++) {
+        const int q = clampi(base + k, 0, w - 1);
+        const float32x4_t p = vsetq_lane_f32(1.0f, vld1q_f32(rgbd + 4 * q), 3);
+        const uint32x4_t far = vcgtq_f32(vdupq_n_f32(coc[q]), vdupq_n_f32(0.0f));
+        vst1q_f32(m + 4 * k, vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(p), far)));
+    }
+}
+
+static inline float32x4_t g1(const float *m, const float *wt, int R)
+{
+    float32x4_t a = vdupq_n_f32(0.0f);
+    for (int j = -R; j <= R; j++)
+        a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(m + 4 * j), wt[j < 0 ? -j : j]));
+    return a;
+}
+
+static void hgauss_row_neon(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                            const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    float m[4 * (CH + 2 * FV_DOF_RMAX)];
+    for (int c0 = 0; c0 < n; c0 += CH) {
+        const int cn = n - c0 < CH ? n - c0 : CH;
+        const uint8_t *sg = sig + c0;
+        int Rc = 0;
+        for (int i = 0; i < cn; i++)
+            Rc = maxi(Rc, tab->rad[sg[i]]);
+        mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
+        const float *mc = m + 4 * Rc; /* output pixel c0 + i at mc + 4 i */
+        float *d = dst + 4 * (ptrdiff_t)(x0 + c0);
+        int i = 0;
+        for (; i + 4 <= cn; i += 4) {
+            const uint8_t *s = sg + i;
+            const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
+            const int R = maxi(maxi(tab->rad[s[0]], tab->rad[s[1]]), maxi(tab->rad[s[2]], tab->rad[s[3]]));
+            float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
+            for (int j = -R; j <= R; j++) {
+                const int k = j < 0 ? -j : j;
+                const float *p = mc + 4 * (i + j);
+                a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
+                a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
+                a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
+                a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
+            }
+            vst1q_f32(d + 4 * i, vmulq_n_f32(a0, tab->inv[s[0]]));
+            vst1q_f32(d + 4 * i + 4, vmulq_n_f32(a1, tab->inv[s[1]]));
+            vst1q_f32(d + 4 * i + 8, vmulq_n_f32(a2, tab->inv[s[2]]));
+            vst1q_f32(d + 4 * i + 12, vmulq_n_f32(a3, tab->inv[s[3]]));
+        }
+        for (; i < cn; i++)
+            vst1q_f32(d + 4 * i, vmulq_n_f32(g1(mc + 4 * i, tab->w[sg[i]], tab->rad[sg[i]]), tab->inv[sg[i]]));
+    }
+}
+
+static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
+                            int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const uint8_t *s = sig + i;
+        const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
+        const int R = maxi(maxi(tab->rad[s[0]], tab->rad[s[1]]), maxi(tab->rad[s[2]], tab->rad[s[3]]));
+        const float *col = src + 4 * (ptrdiff_t)(x0 + i);
+        float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
+        for (int j = -R; j <= R; j++) {
+            const int k = j < 0 ? -j : j;
+            const float *p = col + 4 * (ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride;
+            a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
+            a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
+            a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
+            a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
+        }
+        float *o = dst + 4 * (ptrdiff_t)(x0 + i);
+        vst1q_f32(o, a0);
+        vst1q_f32(o + 4, a1);
+        vst1q_f32(o + 8, a2);
+        vst1q_f32(o + 12, a3);
+    }
+    for (; i < n; i++) {
+        const float *wt = tab->w[sig[i]], *col = src + 4 * (ptrdiff_t)(x0 + i);
+        const int R = tab->rad[sig[i]];
+        float32x4_t a = vdupq_n_f32(0.0f);
+        for (int j = -R; j <= R; j++)
+            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + 4 * (ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride),
+                                         wt[j < 0 ? -j : j]));
+        vst1q_f32(dst + 4 * (ptrdiff_t)(x0 + i), a);
+    }
+}
+
+/* a + s (b - a) */
+static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float32x4_t s)
+{
+    return vaddq_f32(a, vmulq_f32(s, vsubq_f32(b, a)));
+}
+
+/* 4 pixels at a time without branches: LD4 splits them into channel vectors, so the per-pixel
+ * scalars (coc, t, coverage) are plain lanes; each step is computed for the 4 and kept per pixel
+ * by a select on the reference's condition (a pixel whose step the reference skips keeps its
+ * bits; the skipped step may read and compute garbage, which the select drops). */
+static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
+{
+    const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f);
+    int x = x0;
+    for (; x + 4 <= x0 + n; x += 4) {
+        const float32x4x4_t s = vld4q_f32(a->sharp + 4 * x);
+        float32x4_t o[3] = {s.val[0], s.val[1], s.val[2]};
+        const float32x4_t c = vld1q_f32(a->coc + x), t = vld1q_f32(a->t + x);
+        const uint32x4_t cneg = vcltq_f32(c, zero), tp = vcgtq_f32(t, zero);
+        /* towards the pixel's own blur by ab = c > 0 ? min(c, 1) : c < 0 && t > 0 ? t min(-c, 1) : 0 */
+        const float32x4_t nc = vnegq_f32(c);
+        const float32x4_t abn = sel(vandq_u32(cneg, tp), vmulq_f32(t, sel(vcltq_f32(nc, one), nc, one)), zero);
+        const float32x4_t ab = sel(vcgtq_f32(c, zero), sel(vcltq_f32(c, one), c, one), abn);
+        const uint32x4_t far = vcgtq_f32(ab, zero);
+        if (vmaxvq_u32(far)) {
+            const float32x4x4_t f = vld4q_f32(a->far + 4 * x);
+            for (int k = 0; k < 3; k++)
+                o[k] = sel(far, lerp(o[k], f.val[k], ab), o[k]);
+        }
+        float32x4x4_t nv = {{zero, zero, zero, zero}};
+        if (a->near)
+            nv = vld4q_f32(a->near + 4 * x);
+        if (a->lnear && vmaxvq_u32(tp)) {
+            const float32x4_t sc = sel(cneg, zero, one); /* c < 0 ? 0 : 1 */
+            const float32x4x4_t q = vld4q_f32(a->lnear + 4 * x);
+            for (int k = 0; k < 4; k++)
+                nv.val[k] = sel(tp, vaddq_f32(nv.val[k], vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q.val[k]), nv.val[k]))),
+                                nv.val[k]);
+        }
+        const float32x4_t n3 = nv.val[3];
+        const uint32x4_t pos = vcgtq_f32(n3, zero);
+        if (vmaxvq_u32(pos)) {
+            const float32x4_t cov = sel(vcltq_f32(n3, one), n3, one);
+            for (int k = 0; k < 3; k++)
+                o[k] = sel(pos, lerp(o[k], vdivq_f32(nv.val[k], n3), cov), o[k]);
+        }
+        if (a->enh) {
+            const float32x4_t g = vmulq_n_f32(t, a->gain);
+            const uint32x4_t gp = vcgtq_f32(g, zero);
+            if (vmaxvq_u32(gp)) {
+                const float32x4x4_t b = vld4q_f32(a->enh + 4 * x);
+                for (int k = 0; k < 3; k++) {
+                    const float32x4_t v = vaddq_f32(o[k], vmulq_f32(g, vsubq_f32(o[k], b.val[k])));
+                    o[k] = sel(gp, sel(vcgtq_f32(v, zero), v, zero), o[k]); /* v > 0 ? v : +0 */
+                }
+            }
+        }
+        const float32x4x4_t r = {{o[0], o[1], o[2], s.val[3]}};
+        vst4q_f32(out + 4 * x, r);
+    }
+    if (x < x0 + n)
+        fv_dof_combine_row_c(out, a, x, x0 + n - x);
+}
+
+/* one pixel a vector: dst = p0 + a (p1 - p0), 4 weights a load */
+static inline float32x4_t up1(const float *tmp, int32_t i0, int32_t i1, float a)
+{
+    const float32x4_t p0 = vld1q_f32(tmp + 4 * (ptrdiff_t)i0), p1 = vld1q_f32(tmp + 4 * (ptrdiff_t)i1);
+    return vaddq_f32(p0, vmulq_n_f32(vsubq_f32(p1, p0), a));
+}
+
+static void upsample_row_neon(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                              const float *ax, int n)
+{
+    int x = 0;
+    for (; x + 4 <= n; x += 4) {
+        const float32x4_t a4 = vld1q_f32(ax + x);
+        float *d = dst + 4 * x;
+        vst1q_f32(d, up1(tmp, i0[x], i1[x], vgetq_lane_f32(a4, 0)));
+        vst1q_f32(d + 4, up1(tmp, i0[x + 1], i1[x + 1], vgetq_lane_f32(a4, 1)));
+        vst1q_f32(d + 8, up1(tmp, i0[x + 2], i1[x + 2], vgetq_lane_f32(a4, 2)));
+        vst1q_f32(d + 12, up1(tmp, i0[x + 3], i1[x + 3], vgetq_lane_f32(a4, 3)));
+    }
+    for (; x < n; x++)
+        vst1q_f32(dst + 4 * x, up1(tmp, i0[x], i1[x], ax[x]));
+}
+
+/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act */
+static inline float32x4_t pb1(float32x4_t b, const float *u0p, const float *u1p, float f, float t, uint32_t mix,
+                              uint32_t act)
+{
+    const float32x4_t u0 = vld1q_f32(u0p), u1 = vld1q_f32(u1p);
+    const float32x4_t pv = vaddq_f32(u0, vmulq_n_f32(vsubq_f32(u1, u0), f));
+    const float32x4_t r = sel(vdupq_n_u32(mix), vaddq_f32(b, vmulq_n_f32(vsubq_f32(pv, b), t)), pv);
+    return sel(vdupq_n_u32(act), r, b);
+}
+
+/* 4 pixels at a time: their scalars as lanes, then one pixel a vector, each kept by selects (a
+ * pixel the reference skips gets its own bits back). The LUT index: the reference's
+ * min((int)(m steps), max) is, for m steps in [0, 2^31), (int) of min(m steps, max) (max an
+ * integer); clamping the float first (NaN to 0) keeps every lane's index in [0, max], skipped
+ * ones too, so the lookup stays in the table and L0, L1 in [0, need] (the table holds levels
+ * >= 0): a skipped pixel's loads stay in the rows up[0..need] at the call's pixels. */
+static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f), lmax = vdupq_n_f32((float)a->lambda_max);
+    const float32x4_t need = vdupq_n_f32((float)a->need);
+    const int32x4_t needi = vdupq_n_s32(a->need);
+    const float steps = (float)a->lambda_steps;
+    const float *const *up = a->up;
+    int i = x0;
+    for (; i + 4 <= x0 + n; i += 4) {
+        const float32x4_t c = vld1q_f32(a->coc + i), t = vld1q_f32(a->t + i);
+        const float32x4_t m = vabsq_f32(c); /* -0 -> +0: skipped either way */
+        const uint32x4_t act = vandq_u32(vcgtq_f32(m, zero), vcgtq_f32(t, zero));
+        if (!vmaxvq_u32(act))
+            continue;
+        float32x4_t v = vmulq_n_f32(m, steps);
+        v = sel(vcgtq_f32(v, zero), v, zero); /* NaN -> 0 */
+        v = sel(vcltq_f32(v, lmax), v, lmax);
+        int32_t li[4], L0[4], L1[4];
+        uint32_t mk[4], ak[4];
+        float fk[4], tk[4];
+        vst1q_s32(li, vcvtq_s32_f32(v));
+        const float32_t lv[4] = {a->lambda[li[0]], a->lambda[li[1]], a->lambda[li[2]], a->lambda[li[3]]};
+        float32x4_t l = vld1q_f32(lv);
+        l = sel(vcltq_f32(l, need), l, need); /* l < need ? l : need */
+        const int32x4_t l0 = vcvtq_s32_f32(l);
+        vst1q_f32(fk, vsubq_f32(l, vcvtq_f32_s32(l0)));
+        vst1q_s32(L0, l0);
+        vst1q_s32(L1, vsubq_s32(l0, vreinterpretq_s32_u32(vcltq_s32(l0, needi)))); /* + 1 where L0 < need */
+        vst1q_u32(mk, vandq_u32(vcgtq_f32(c, zero), vcltq_f32(t, one)));
+        vst1q_u32(ak, act);
+        vst1q_f32(tk, t);
+        for (int k = 0; k < 4; k++) {
+            const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
+            float *b = blur + o;
+            vst1q_f32(b, pb1(vld1q_f32(b), up[L0[k]] + o, up[L1[k]] + o, fk[k], tk[k], mk[k], ak[k]));
+        }
+    }
+    if (i < x0 + n)
+        fv_dof_pyrblur_row_c(blur, a, i, x0 + n - i);
+}
+
+void fv_dof_init_neon(fv_dsp *d)
+{
+    d->dof_upsample_row = upsample_row_neon;
+    d->dof_pyrblur_row = pyrblur_row_neon;
+    d->dof_coc_row = coc_row_neon;
+    d->dof_hgauss_row = hgauss_row_neon;
+    d->dof_vgauss_row = vgauss_row_neon;
+    d->dof_combine_row = combine_row_neon;
+}

@@ -1,0 +1,65 @@
+#include "lens.h"
+
+#include <math.h>
+
+#include "err.h"
+
+void fv_lens_default(fv_lens *l)
+{
+    l->k1 = l->k2 = 0.0f;
+    for (int c = 0; c < 3; c++)
+        l->scale[c] = 1.0f;
+    for (int e = 0; e < 2; e++)
+        l->center[e][0] = l->center[e][1] = 0.5f;
+}
+
+int fv_lens_validate(const fv_lens *l, float r_max, char *err, size_t err_len)
+{
+    if (!isfinite(l->k1) || !isfinite(l->k2) || fabsf(l->k1) > 10.0f || fabsf(l->k2) > 10.0f)
+        return fv_err(err, err_len, "lens: k1 and k2 must be in [-10, 10]");
+    for (int c = 0; c < 3; c++)
+        if (!(l->scale[c] > 0.5f && l->scale[c] < 2.0f))
+            return fv_err(err, err_len, "lens: channel scales must be in (0.5, 2)");
+    for (int e = 0; e < 2; e++)
+        for (int i = 0; i < 2; i++)
+            if (!(l->center[e][i] >= 0.0f && l->center[e][i] <= 1.0f))
+                return fv_err(err, err_len, "lens: centres must be in [0, 1] (normalised image coordinates)");
+    /* d/dr [r (1 + k1 r^2 + k2 r^4)] = 1 + 3 k1 r^2 + 5 k2 r^4 must stay positive */
+    for (int i = 0; i <= 1000; i++) {
+        const float r = r_max * (float)i / 1000.0f, r2 = r * r;
+        if (1.0f + 3.0f * l->k1 * r2 + 5.0f * l->k2 * r2 * r2 <= 0.0f)
+            return fv_err(err, err_len, "lens: k1 %g, k2 %g fold the image over at r = %.3f (not invertible)",
+                          (double)l->k1, (double)l->k2, (double)r);
+    }
+    return 0;
+}
+
+int fv_lens_undistort(float k1, float k2, float scale, float cx, float cy, float dx, float dy, float *tx, float *ty)
+{
+    /* radial only: solve g(r) = scale r (1 + k1 r^2 + k2 r^4) = |d - c| for r, in double */
+    const double vx = (double)dx - cx, vy = (double)dy - cy;
+    const double rd = sqrt(vx * vx + vy * vy);
+    if (rd == 0.0) {
+        *tx = cx;
+        *ty = cy;
+        return 0;
+    }
+    double r = rd / scale;
+    for (int it = 0; it < 30; it++) {
+        const double r2 = r * r;
+        const double g = scale * r * (1.0 + k1 * r2 + k2 * r2 * r2) - rd;
+        const double dg = scale * (1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2 * r2);
+        if (!(dg > 0.0))
+            return -1;
+        const double step = g / dg;
+        r -= step;
+        if (fabs(step) < 1e-12 * (1.0 + r))
+            break;
+    }
+    if (!(r >= 0.0) || !isfinite(r))
+        return -1;
+    const double s = r / rd;
+    *tx = (float)(cx + vx * s);
+    *ty = (float)(cy + vy * s);
+    return 0;
+}

@@ -1,0 +1,42 @@
+/* fovea: HMD lens distortion model. A panel point at tangent-space offset u from the lens centre
+ * (tangent units of the camera's undistorted frustum, r = |u|) is seen through the lens along
+ *     centre + u * scale_c * (1 + k1 r^2 + k2 r^4)
+ * (radial polynomial; scale_c per colour channel c models lateral chromatic aberration).
+ * Rendering rays along that direction pre-distorts the image, so no resampling pass is needed.
+ * Rays are cast for the green channel (one ray per pixel); the red and blue scales are kept in
+ * the model for a per-channel pass (not built: see docs/headset.md). */
+#ifndef FOVEA_LENS_H
+#define FOVEA_LENS_H
+
+#include <stddef.h>
+
+enum { FV_LENS_R = 0, FV_LENS_G = 1, FV_LENS_B = 2 };
+
+typedef struct fv_lens {
+    float k1, k2;
+    float scale[3];        /* per channel, R G B */
+    float center[2][2];    /* lens centre per eye [left, right][x, y], normalised image coordinates */
+} fv_lens;
+
+/* No distortion: k = 0, scales 1, centres at the image centre. */
+void fv_lens_default(fv_lens *l);
+/* 0 when the radial mapping is monotonic (invertible) out to r_max tangent units and the
+ * numbers are sane; -1 with a reason otherwise. */
+int fv_lens_validate(const fv_lens *l, float r_max, char *err, size_t err_len);
+
+/* The direction (tangent space) seen through the lens for panel point (tx, ty); (cx, cy) = lens
+ * centre in tangent units. */
+static inline void fv_lens_distort(float k1, float k2, float scale, float cx, float cy, float tx, float ty, float *ox,
+                                   float *oy)
+{
+    const float ux = tx - cx, uy = ty - cy;
+    const float r2 = ux * ux + uy * uy;
+    const float f = scale * (1.0f + r2 * (k1 + k2 * r2));
+    *ox = cx + ux * f;
+    *oy = cy + uy * f;
+}
+/* The inverse: the panel point that is seen along (dx, dy). 0, or -1 when Newton's method did
+ * not converge (outside the invertible range). */
+int fv_lens_undistort(float k1, float k2, float scale, float cx, float cy, float dx, float dy, float *tx, float *ty);
+
+#endif

@@ -1,0 +1,291 @@
+/* fovea: depth-of-field kernels, AVX2 (built with -mavx2 -mfma but -ffp-contract=off and no FMA
+ * intrinsics). The CoC takes 8 pixels at a time; the Gaussians 8 output pixels at a time as four
+ * 256-bit accumulators of two pixels each (each 128-bit half with its own pixel's weights), the
+ * rest with the 128-bit pieces of core/x86/dof_x86.h, which also has why the bits are the
+ * references'. The combine takes 8 pixels at a time without branches (see there); the
+ * up-sampling and the periphery's level blend 8 at a time as 4 pixel pairs. */
+#include <immintrin.h>
+
+#include "x86/dof_x86.h"
+
+static void coc_row_avx2(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
+{
+    const __m256 vK = _mm256_set1_ps(K), idn = _mm256_set1_ps(1.0f / dn), idf = _mm256_set1_ps(1.0f / df);
+    const __m256 vdn = _mm256_set1_ps(dn), vdf = _mm256_set1_ps(df), one = _mm256_set1_ps(1.0f);
+    const __m256 lo = _mm256_set1_ps(FV_DOF_MIN_DEPTH_M);
+    const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+    int x = 0;
+    for (; x + 8 <= n; x += 8) {
+        const float *p = rgbd + 4 * x;
+        /* depths: (d0 d2 d4 d6 | d1 d3 d5 d7), then in order */
+        const __m256 h0 = _mm256_unpackhi_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8));
+        const __m256 h1 = _mm256_unpackhi_ps(_mm256_loadu_ps(p + 16), _mm256_loadu_ps(p + 24));
+        const __m256 d = _mm256_permutevar8x32_ps(_mm256_shuffle_ps(h0, h1, _MM_SHUFFLE(3, 2, 3, 2)), order);
+        const __m256 g = _mm256_max_ps(d, lo); /* d > min ? d : min */
+        const __m256 ig = _mm256_div_ps(one, g);
+        const __m256 nr = _mm256_mul_ps(vK, _mm256_sub_ps(idn, ig));
+        const __m256 fr = _mm256_and_ps(_mm256_mul_ps(vK, _mm256_sub_ps(idf, ig)), _mm256_cmp_ps(g, vdf, _CMP_GT_OQ));
+        _mm256_storeu_ps(coc + x, _mm256_blendv_ps(fr, nr, _mm256_cmp_ps(g, vdn, _CMP_LT_OQ)));
+    }
+    if (x + 4 <= n) {
+        const dof_coc4_k k = dof_coc4_setup(K, dn, df);
+        _mm_storeu_ps(coc + x, dof_coc4(dof_depth4(rgbd + 4 * x), &k));
+        x += 4;
+    }
+    if (x < n)
+        fv_dof_coc_row_c(coc + x, rgbd + 4 * x, n - x, K, dn, df);
+}
+
+/* weights of a pixel pair: wa[k] in the low half, wb[k] in the high half */
+static inline __m256 wpair(const float *wa, const float *wb, int k)
+{
+    return _mm256_blend_ps(_mm256_broadcast_ss(wa + k), _mm256_broadcast_ss(wb + k), 0xf0);
+}
+
+/* 8 neighbouring pixels (pairs in the halves of 4 accumulators), the block's largest radius R. */
+static inline void g8(__m256 a[4], const float *p, const ptrdiff_t *off, const float *const wt[8], int R)
+{
+    __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
+    int one = 1;
+    for (int k = 1; k < 8; k++)
+        one &= wt[k] == wt[0];
+    if (one) { /* one sigma: one broadcast a tap */
+        for (int j = -R; j <= R; j++) {
+            const float *q = p + off[j];
+            const __m256 g = _mm256_broadcast_ss(wt[0] + (j < 0 ? -j : j));
+            a0 = _mm256_add_ps(a0, _mm256_mul_ps(g, _mm256_loadu_ps(q)));
+            a1 = _mm256_add_ps(a1, _mm256_mul_ps(g, _mm256_loadu_ps(q + 8)));
+            a2 = _mm256_add_ps(a2, _mm256_mul_ps(g, _mm256_loadu_ps(q + 16)));
+            a3 = _mm256_add_ps(a3, _mm256_mul_ps(g, _mm256_loadu_ps(q + 24)));
+        }
+    } else {
+        for (int j = -R; j <= R; j++) {
+            const int k = j < 0 ? -j : j;
+            const float *q = p + off[j];
+            a0 = _mm256_add_ps(a0, _mm256_mul_ps(wpair(wt[0], wt[1], k), _mm256_loadu_ps(q)));
+            a1 = _mm256_add_ps(a1, _mm256_mul_ps(wpair(wt[2], wt[3], k), _mm256_loadu_ps(q + 8)));
+            a2 = _mm256_add_ps(a2, _mm256_mul_ps(wpair(wt[4], wt[5], k), _mm256_loadu_ps(q + 16)));
+            a3 = _mm256_add_ps(a3, _mm256_mul_ps(wpair(wt[6], wt[7], k), _mm256_loadu_ps(q + 24)));
+        }
+    }
+    a[0] = a0, a[1] = a1, a[2] = a2, a[3] = a3;
+}
+
+/* n pixels from p (output d), 8 at a time, then 4 and 1; norm: times inv[s]. */
+static inline void gauss_8(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
+                           const fv_dof_gauss_tab *tab, int norm)
+{
+    int i = 0;
+    for (; i + 8 <= n; i += 8) {
+        const uint8_t *s = sig + i;
+        const float *const wt[8] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]],
+                                    tab->w[s[4]], tab->w[s[5]], tab->w[s[6]], tab->w[s[7]]};
+        __m256 a[4];
+        g8(a, p + 4 * i, off, wt, dof_span_rad(s, 8, tab));
+        for (int k = 0; k < 4; k++) {
+            const __m256 inv = _mm256_setr_m128(_mm_set1_ps(tab->inv[s[2 * k]]), _mm_set1_ps(tab->inv[s[2 * k + 1]]));
+            _mm256_storeu_ps(d + 4 * (i + 2 * k), norm ? _mm256_mul_ps(a[k], inv) : a[k]);
+        }
+    }
+    if (i < n)
+        dof_gauss_4(d + 4 * i, p + 4 * i, off, n - i, sig + i, tab, norm);
+}
+
+static void hgauss_row_avx2(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                            const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    _Alignas(32) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    dof_offsets_h(off, FV_DOF_RMAX);
+    for (int c0 = 0; c0 < n; c0 += DOF_CH) {
+        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);
+        dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
+        /* output pixel c0 + i from m + 4 (Rc + i) */
+        gauss_8(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);
+    }
+}
+
+static void vgauss_row_avx2(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
+                            int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    const int R = dof_span_rad(sig, n, tab);
+    dof_offsets_v(off, R, stride, y, ylo, yhi);
+    gauss_8(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
+}
+
+/* a + s (b - a) */
+static inline __m256 lerp8(__m256 a, __m256 b, __m256 s)
+{
+    return _mm256_add_ps(a, _mm256_mul_ps(s, _mm256_sub_ps(b, a)));
+}
+
+/* 8 pixels at a time without branches: two pixels a 256-bit vector, each step computed for both
+ * and kept per pixel by a select on the reference's condition (so a pixel whose step the
+ * reference skips keeps its bits; the skipped step may read and compute garbage, which the
+ * select drops). The per-pixel scalars (coc, t and what follows from them) are computed for the
+ * 8 pixels at once, then spread over the pairs' halves. */
+static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
+{
+    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps(), gain = _mm256_set1_ps(a->gain);
+    const __m256 msign = _mm256_set1_ps(-0.0f);
+    int x = x0;
+    for (; x + 8 <= x0 + n; x += 8) {
+        const __m256 c8 = _mm256_loadu_ps(a->coc + x), t8 = _mm256_loadu_ps(a->t + x);
+        const __m256 cneg = _mm256_cmp_ps(c8, zero, _CMP_LT_OQ), tpos = _mm256_cmp_ps(t8, zero, _CMP_GT_OQ);
+        /* towards the pixel's own blur by ab = c > 0 ? min(c, 1) : c < 0 && t > 0 ? t min(-c, 1) : 0 */
+        const __m256 abn = _mm256_and_ps(_mm256_mul_ps(t8, _mm256_min_ps(_mm256_xor_ps(c8, msign), one)),
+                                         _mm256_and_ps(cneg, tpos));
+        const __m256 ab8 = _mm256_blendv_ps(abn, _mm256_min_ps(c8, one), _mm256_cmp_ps(c8, zero, _CMP_GT_OQ));
+        const int anyfar = _mm256_movemask_ps(_mm256_cmp_ps(ab8, zero, _CMP_GT_OQ));
+        const __m256 sc8 = _mm256_blendv_ps(one, zero, cneg); /* lnear's scale: c < 0 ? 0 : 1 */
+        const int anyl = a->lnear && _mm256_movemask_ps(tpos);
+        const __m256 g8 = _mm256_mul_ps(gain, t8);
+        const int anyg = a->enh && _mm256_movemask_ps(_mm256_cmp_ps(g8, zero, _CMP_GT_OQ));
+        for (int p = 0; p < 4; p++) {
+            const int xp = x + 2 * p;
+            const int l = 2 * p, h = 2 * p + 1; /* the pair's pixels within the 8 */
+            const __m256i idx = _mm256_setr_epi32(l, l, l, l, h, h, h, h);
+            const __m256 s = _mm256_loadu_ps(a->sharp + 4 * xp);
+            __m256 o = s;
+            if (anyfar) {
+                const __m256 ab = _mm256_permutevar8x32_ps(ab8, idx);
+                o = _mm256_blendv_ps(o, lerp8(o, _mm256_loadu_ps(a->far + 4 * xp), ab),
+                                     _mm256_cmp_ps(ab, zero, _CMP_GT_OQ));
+            }
+            __m256 nv = a->near ? _mm256_loadu_ps(a->near + 4 * xp) : zero;
+            if (anyl) {
+                const __m256 t = _mm256_permutevar8x32_ps(t8, idx), sc = _mm256_permutevar8x32_ps(sc8, idx);
+                const __m256 q = _mm256_mul_ps(sc, _mm256_loadu_ps(a->lnear + 4 * xp));
+                nv = _mm256_blendv_ps(nv, _mm256_add_ps(nv, _mm256_mul_ps(t, _mm256_sub_ps(q, nv))),
+                                      _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
+            }
+            const __m256 n3 = _mm256_permute_ps(nv, _MM_SHUFFLE(3, 3, 3, 3));
+            const __m256 pos = _mm256_cmp_ps(n3, zero, _CMP_GT_OQ);
+            if (_mm256_movemask_ps(pos))
+                o = _mm256_blendv_ps(o, lerp8(o, _mm256_div_ps(nv, n3), _mm256_min_ps(n3, one)), pos);
+            if (anyg) {
+                const __m256 g = _mm256_permutevar8x32_ps(g8, idx);
+                const __m256 v = _mm256_add_ps(o, _mm256_mul_ps(g, _mm256_sub_ps(o, _mm256_loadu_ps(a->enh + 4 * xp))));
+                /* max: v > 0 ? v : +0 */
+                o = _mm256_blendv_ps(o, _mm256_max_ps(v, zero), _mm256_cmp_ps(g, zero, _CMP_GT_OQ));
+            }
+            _mm256_storeu_ps(out + 4 * xp, _mm256_blend_ps(o, s, 0x88));
+        }
+    }
+    if (x < x0 + n)
+        dof_combine_row_x86(out, a, x, x0 + n - x);
+}
+
+/* two pixels' 128-bit vectors as one */
+static inline __m256 ld2(const float *lo, const float *hi)
+{
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1);
+}
+
+/* lanes 2p (low half) and 2p + 1 (high half) of an 8-lane vector, each spread over its half */
+#define PAIR(v, p) _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(2 * (p), 2 * (p), 2 * (p), 2 * (p), 2 * (p) + 1, \
+                                                                 2 * (p) + 1, 2 * (p) + 1, 2 * (p) + 1))
+
+/* pixels xp, xp + 1 (pair p of the 8 whose weights are a8) */
+static inline void up_pair(float *dst, const float *tmp, const int32_t *i0, const int32_t *i1, __m256 a8, int xp,
+                           int p)
+{
+    const __m256 p0 = ld2(tmp + 4 * (ptrdiff_t)i0[xp], tmp + 4 * (ptrdiff_t)i0[xp + 1]);
+    const __m256 p1 = ld2(tmp + 4 * (ptrdiff_t)i1[xp], tmp + 4 * (ptrdiff_t)i1[xp + 1]);
+    _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
+}
+
+/* 8 pixels at a time as 4 pairs (unrolled by hand: the pairs' lane indices are constants), the
+ * rest with the 128-bit version */
+static void upsample_row_avx2(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                              const float *ax, int n)
+{
+    int x = 0;
+    for (; x + 8 <= n; x += 8) {
+        const __m256 a8 = _mm256_loadu_ps(ax + x);
+        up_pair(dst, tmp, i0, i1, a8, x, 0);
+        up_pair(dst, tmp, i0, i1, a8, x + 2, 1);
+        up_pair(dst, tmp, i0, i1, a8, x + 4, 2);
+        up_pair(dst, tmp, i0, i1, a8, x + 6, 3);
+    }
+    if (x < n)
+        dof_upsample_row_x86(dst + 4 * x, tmp, i0 + x, i1 + x, ax + x, n - x);
+}
+
+/* pair p of the 8 pixels from i: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0), kept where
+ * act; sel = 0 (a constant) where all 8 are blended and none mixes: no selects needed. */
+static inline void pb_pair(float *blur, const float *const *up, const int32_t *L0, const int32_t *L1, __m256 f,
+                           __m256 t, __m256 mix, __m256 act, int i, int p, int sel)
+{
+    const int k = 2 * p;
+    const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
+    float *b = blur + o;
+    const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    if (!sel) {
+        _mm256_storeu_ps(b, pv);
+        return;
+    }
+    const __m256 bv = _mm256_loadu_ps(b);
+    const __m256 r =
+        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+}
+
+/* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_x86.h has why the clamped LUT
+ * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs
+ * (unrolled by hand), each computed for both pixels and kept per pixel by selects; the rest
+ * 128-bit. */
+static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
+    const __m256 need = _mm256_set1_ps((float)a->need), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    const __m256 msign = _mm256_set1_ps(-0.0f);
+    const __m256i needi = _mm256_set1_epi32(a->need);
+    const float *const *up = a->up;
+    int i = x0;
+    for (; i + 8 <= x0 + n; i += 8) {
+        const __m256 c = _mm256_loadu_ps(a->coc + i), t = _mm256_loadu_ps(a->t + i);
+        const __m256 m = _mm256_andnot_ps(msign, c); /* |c| (-0 -> +0: skipped either way) */
+        const __m256 act = _mm256_and_ps(_mm256_cmp_ps(m, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
+        const int bits = _mm256_movemask_ps(act);
+        if (!bits)
+            continue;
+        const __m256 v = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(m, steps), zero), lmax); /* NaN -> 0 */
+        const __m256 l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, _mm256_cvttps_epi32(v), 4), need);
+        const __m256i l0 = _mm256_cvttps_epi32(l);
+        const __m256 f = _mm256_sub_ps(l, _mm256_cvtepi32_ps(l0));
+        _Alignas(32) int32_t L0[8], L1[8];
+        _mm256_store_si256((__m256i *)L0, l0);
+        _mm256_store_si256((__m256i *)L1, _mm256_sub_epi32(l0, _mm256_cmpgt_epi32(needi, l0))); /* + 1 if L0 < need */
+        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        if (bits == 255 && !_mm256_movemask_ps(mix)) { /* the periphery */
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 0);
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 0);
+            continue;
+        }
+        if (bits & 3)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 1);
+        if (bits & 12)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 1);
+        if (bits & 48)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 1);
+        if (bits & 192)
+            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 1);
+    }
+    if (i < x0 + n)
+        dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
+}
+
+void fv_dof_init_avx2(fv_dsp *d)
+{
+    d->dof_upsample_row = upsample_row_avx2;
+    d->dof_pyrblur_row = pyrblur_row_avx2;
+    d->dof_coc_row = coc_row_avx2;
+    d->dof_hgauss_row = hgauss_row_avx2;
+    d->dof_vgauss_row = vgauss_row_avx2;
+    d->dof_combine_row = combine_row_avx2;
+}

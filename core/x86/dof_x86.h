@@ -1,0 +1,328 @@
+/* fovea: the 128-bit pieces of the depth-of-field kernels shared by the SSE4.1 and AVX2 versions
+ * (each .c file includes this and is built with its own ISA flags). One pixel = one __m128
+ * (r, g, b, depth or weight): the references (core/dof/kernels.c) add channel by channel in the
+ * same order, so a vector of 4 channel accumulators gives their bits.
+ *
+ * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
+ * largest radius R: a pixel whose own radius is smaller adds w[s][|j|] * v = +-0 for |j| beyond
+ * it (the table holds 0 there, core/dof/weier_impl.h), and an accumulator that starts at +0 is
+ * never -0 (x + y is -0 only if both are -0), so adding +-0 leaves its bits unchanged. The same
+ * argument lets the horizontal pass add +0 (a masked tap) for a near sample instead of skipping
+ * it. The values read for those extra taps lie in the rows / columns the call covers and must be
+ * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
+#ifndef FOVEA_DOF_X86_H
+#define FOVEA_DOF_X86_H
+
+#include <smmintrin.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dof/weier_impl.h"
+#include "dsp.h"
+
+#define DOF_CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
+
+static inline int dof_clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+static inline int dof_maxi(int a, int b) { return a > b ? a : b; }
+
+/* ---- coc_row: 4 pixels ---- */
+typedef struct {
+    __m128 K, idn, idf, dn, df;
+} dof_coc4_k;
+
+static inline dof_coc4_k dof_coc4_setup(float K, float dn, float df)
+{
+    dof_coc4_k k;
+    k.K = _mm_set1_ps(K);
+    k.idn = _mm_set1_ps(1.0f / dn);
+    k.idf = _mm_set1_ps(1.0f / df);
+    k.dn = _mm_set1_ps(dn);
+    k.df = _mm_set1_ps(df);
+    return k;
+}
+
+/* depths of 4 pixels -> their CoCs: g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 */
+static inline __m128 dof_coc4(__m128 d, const dof_coc4_k *k)
+{
+    const __m128 g = _mm_max_ps(d, _mm_set1_ps(FV_DOF_MIN_DEPTH_M)); /* d > min ? d : min */
+    const __m128 ig = _mm_div_ps(_mm_set1_ps(1.0f), g);
+    const __m128 nr = _mm_mul_ps(k->K, _mm_sub_ps(k->idn, ig));
+    const __m128 fr = _mm_and_ps(_mm_mul_ps(k->K, _mm_sub_ps(k->idf, ig)), _mm_cmpgt_ps(g, k->df));
+    return _mm_blendv_ps(fr, nr, _mm_cmplt_ps(g, k->dn));
+}
+
+/* lane 3 of 4 consecutive pixels */
+static inline __m128 dof_depth4(const float *rgbd)
+{
+    const __m128 h01 = _mm_unpackhi_ps(_mm_loadu_ps(rgbd), _mm_loadu_ps(rgbd + 4));       /* z0 z1 d0 d1 */
+    const __m128 h23 = _mm_unpackhi_ps(_mm_loadu_ps(rgbd + 8), _mm_loadu_ps(rgbd + 12));  /* z2 z3 d2 d3 */
+    return _mm_movehl_ps(h23, h01);
+}
+
+/* ---- hgauss_row ---- */
+
+/* The row as the far layer sees it, positions base .. base+len-1 clamped into [0, w):
+ * (r, g, b, 1) for a far sample (coc > 0), +0 otherwise (so g * m adds exactly what the
+ * reference adds, or +-0 for a skipped tap). 16-byte aligned m. */
+static inline void dof_mask_row(float *restrict m, const float *rgbd, const float *coc, int w, int base, int len)
+{
+    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+    for (int k = 0; k < len; k++) {
+        const int q = dof_clampi(base + k, 0, w - 1);
+        const __m128 p = _mm_blend_ps(_mm_loadu_ps(rgbd + 4 * q), one, 8);
+        _mm_store_ps(m + 4 * k, _mm_and_ps(p, _mm_cmpgt_ps(_mm_set1_ps(coc[q]), zero)));
+    }
+}
+
+/* ---- the Gaussians' taps: tap j of the pixel at p is at p + off[j] (off points at the entry of
+ * j = 0 and holds the span's largest radius either way): the masked row's neighbours for the
+ * horizontal pass, the clamped rows for the vertical one. Pixel k of a block is at p + 4 k. */
+
+/* One pixel, its own radius. */
+static inline __m128 dof_g1(const float *p, const ptrdiff_t *off, const float *wt, int R)
+{
+    __m128 a = _mm_setzero_ps();
+    for (int j = -R; j <= R; j++)
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(wt[j < 0 ? -j : j]), _mm_loadu_ps(p + off[j])));
+    return a;
+}
+
+/* Four neighbouring pixels, the block's largest radius R (see the top of this file). */
+static inline void dof_g4(__m128 a[4], const float *p, const ptrdiff_t *off, const float *const wt[4], int R)
+{
+    __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
+    if (wt[0] == wt[1] && wt[0] == wt[2] && wt[0] == wt[3]) { /* one sigma: one broadcast a tap */
+        for (int j = -R; j <= R; j++) {
+            const float *q = p + off[j];
+            const __m128 g = _mm_set1_ps(wt[0][j < 0 ? -j : j]);
+            a0 = _mm_add_ps(a0, _mm_mul_ps(g, _mm_loadu_ps(q)));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(g, _mm_loadu_ps(q + 4)));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(g, _mm_loadu_ps(q + 8)));
+            a3 = _mm_add_ps(a3, _mm_mul_ps(g, _mm_loadu_ps(q + 12)));
+        }
+    } else {
+        for (int j = -R; j <= R; j++) {
+            const int k = j < 0 ? -j : j;
+            const float *q = p + off[j];
+            a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(wt[0][k]), _mm_loadu_ps(q)));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(wt[1][k]), _mm_loadu_ps(q + 4)));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_set1_ps(wt[2][k]), _mm_loadu_ps(q + 8)));
+            a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_set1_ps(wt[3][k]), _mm_loadu_ps(q + 12)));
+        }
+    }
+    a[0] = a0, a[1] = a1, a[2] = a2, a[3] = a3;
+}
+
+/* n pixels from p (output d), 4 at a time; norm: times inv[s] (the horizontal pass). */
+static inline void dof_gauss_4(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
+                               const fv_dof_gauss_tab *tab, int norm)
+{
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const uint8_t *s = sig + i;
+        const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
+        const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
+        __m128 a[4];
+        dof_g4(a, p + 4 * i, off, wt, R);
+        for (int k = 0; k < 4; k++)
+            _mm_storeu_ps(d + 4 * (i + k), norm ? _mm_mul_ps(a[k], _mm_set1_ps(tab->inv[s[k]])) : a[k]);
+    }
+    for (; i < n; i++) {
+        const __m128 a = dof_g1(p + 4 * i, off, tab->w[sig[i]], tab->rad[sig[i]]);
+        _mm_storeu_ps(d + 4 * i, norm ? _mm_mul_ps(a, _mm_set1_ps(tab->inv[sig[i]])) : a);
+    }
+}
+
+/* The offsets of the taps j in [-R, R]: the horizontal pass's (neighbours in the masked row)
+ * and the vertical pass's (rows clamped into [ylo, yhi), relative to row 0). off points at j = 0. */
+static inline void dof_offsets_h(ptrdiff_t *off, int R)
+{
+    for (int j = -R; j <= R; j++)
+        off[j] = 4 * (ptrdiff_t)j;
+}
+static inline void dof_offsets_v(ptrdiff_t *off, int R, ptrdiff_t stride, int y, int ylo, int yhi)
+{
+    for (int j = -R; j <= R; j++)
+        off[j] = 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
+}
+
+static inline int dof_span_rad(const uint8_t *sig, int n, const fv_dof_gauss_tab *tab)
+{
+    int R = 0;
+    for (int i = 0; i < n; i++)
+        R = dof_maxi(R, tab->rad[sig[i]]);
+    return R;
+}
+
+/* ---- combine_row, one pixel at a time: the reference's control flow, colours as vectors (the
+ * SSE4.1 version; the AVX2 one's tail) ---- */
+
+static inline __m128 dof_bcast3(__m128 v) { return _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 3, 3)); }
+
+/* a + s (b - a), s broadcast */
+static inline __m128 dof_lerp(__m128 a, __m128 b, float s)
+{
+    return _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(s), _mm_sub_ps(b, a)));
+}
+
+static inline void dof_combine_row_x86(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
+{
+    for (int x = x0; x < x0 + n; x++) {
+        const __m128 s = _mm_loadu_ps(a->sharp + 4 * x);
+        __m128 o = s; /* lane 3 is carried along unused and replaced by the depth at the end */
+        const float c = a->coc[x], t = a->t[x];
+        float ab = 0.0f;
+        if (c > 0.0f)
+            ab = c < 1.0f ? c : 1.0f;
+        else if (c < 0.0f && t > 0.0f)
+            ab = t * (-c < 1.0f ? -c : 1.0f);
+        if (ab > 0.0f)
+            o = dof_lerp(o, _mm_loadu_ps(a->far + 4 * x), ab);
+        __m128 nv = a->near ? _mm_loadu_ps(a->near + 4 * x) : _mm_setzero_ps();
+        if (a->lnear && t > 0.0f) {
+            const float sc = c < 0.0f ? 0.0f : 1.0f;
+            const __m128 q = _mm_mul_ps(_mm_set1_ps(sc), _mm_loadu_ps(a->lnear + 4 * x));
+            nv = _mm_add_ps(nv, _mm_mul_ps(_mm_set1_ps(t), _mm_sub_ps(q, nv)));
+        }
+        const float n3 = _mm_cvtss_f32(dof_bcast3(nv));
+        if (n3 > 0.0f)
+            o = dof_lerp(o, _mm_div_ps(nv, dof_bcast3(nv)), n3 < 1.0f ? n3 : 1.0f);
+        if (a->enh) {
+            const float g = a->gain * t;
+            if (g > 0.0f) {
+                const __m128 b = _mm_loadu_ps(a->enh + 4 * x);
+                const __m128 v = _mm_add_ps(o, _mm_mul_ps(_mm_set1_ps(g), _mm_sub_ps(o, b)));
+                o = _mm_max_ps(v, _mm_setzero_ps()); /* v > 0 ? v : +0 */
+            }
+        }
+        _mm_storeu_ps(out + 4 * x, _mm_blend_ps(o, s, 8));
+    }
+}
+
+/* ---- upsample_row, one pixel a vector: dst = p0 + a (p1 - p0), the reference's per-channel
+ * operations (the SSE4.1 version; the AVX2 one's tail) ---- */
+
+static inline __m128 dof_up1(const float *tmp, int32_t i0, int32_t i1, __m128 a)
+{
+    const __m128 p0 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)i0), p1 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)i1);
+    return _mm_add_ps(p0, _mm_mul_ps(a, _mm_sub_ps(p1, p0)));
+}
+
+static inline void dof_upsample_row_x86(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                                        const float *ax, int n)
+{
+    int x = 0;
+    for (; x + 4 <= n; x += 4) { /* 4 weights a load, spread by shuffles */
+        const __m128 a4 = _mm_loadu_ps(ax + x);
+        float *d = dst + 4 * x;
+        _mm_storeu_ps(d, dof_up1(tmp, i0[x], i1[x], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(0, 0, 0, 0))));
+        _mm_storeu_ps(d + 4, dof_up1(tmp, i0[x + 1], i1[x + 1], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(1, 1, 1, 1))));
+        _mm_storeu_ps(d + 8, dof_up1(tmp, i0[x + 2], i1[x + 2], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(2, 2, 2, 2))));
+        _mm_storeu_ps(d + 12, dof_up1(tmp, i0[x + 3], i1[x + 3], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(3, 3, 3, 3))));
+    }
+    for (; x < n; x++)
+        _mm_storeu_ps(dst + 4 * x, dof_up1(tmp, i0[x], i1[x], _mm_set1_ps(ax[x])));
+}
+
+/* ---- pyrblur_row ----
+ * The per-pixel scalars (active, level LUT index, l, L0, L1, f, mix) of 4 pixels at once, then
+ * one pixel a vector: the reference's operations on its 4 channels, kept by selects (a pixel the
+ * reference skips gets its own bits back; its garbage levels are valid ones, see below).
+ *   The LUT index: the reference's min((int)(m steps), max) is, for m steps in [0, 2^31),
+ * (int) of min(m steps, max) (max an integer: trunc(v) < max iff v < max). Clamping the float
+ * first (and NaN to 0: x86 max returns its second operand on NaN) keeps every lane's index in
+ * [0, max], skipped ones too, so the lookup never leaves the table; then min(l, need) and its
+ * (int) are in [0, need] (the table holds levels >= 0) and so are L0 and L1: the loads of a
+ * skipped pixel stay in the rows up[0..need] at the call's pixels. */
+typedef struct {
+    __m128 steps, lmax, need, zero, one, msign;
+    __m128i needi;
+} dof_pb_k;
+
+static inline dof_pb_k dof_pb_setup(const fv_dof_pyrblur_args *a)
+{
+    dof_pb_k k;
+    k.steps = _mm_set1_ps((float)a->lambda_steps);
+    k.lmax = _mm_set1_ps((float)a->lambda_max);
+    k.need = _mm_set1_ps((float)a->need);
+    k.zero = _mm_setzero_ps();
+    k.one = _mm_set1_ps(1.0f);
+    k.msign = _mm_set1_ps(-0.0f);
+    k.needi = _mm_set1_epi32(a->need);
+    return k;
+}
+
+/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act (all lanes broadcast).
+ * domix = 0: no pixel of the block both mixes and is blended (r = pv is then right for every
+ * blended one); doact = 0: every pixel of the block is blended. Constants at each call. */
+static inline __m128 dof_pb1(__m128 b, const float *u0p, const float *u1p, __m128 f, __m128 t, __m128 mix,
+                             __m128 act, int domix, int doact)
+{
+    const __m128 u0 = _mm_loadu_ps(u0p), u1 = _mm_loadu_ps(u1p);
+    const __m128 pv = _mm_add_ps(u0, _mm_mul_ps(f, _mm_sub_ps(u1, u0)));
+    const __m128 r = domix ? _mm_blendv_ps(pv, _mm_add_ps(b, _mm_mul_ps(t, _mm_sub_ps(pv, b))), mix) : pv;
+    return doact ? _mm_blendv_ps(b, r, act) : r;
+}
+
+#define DOF_BC(v, k) _mm_shuffle_ps(v, v, _MM_SHUFFLE(k, k, k, k))
+
+/* the 4 pixels of a block from pixel i (b = blur + 4 i) */
+static inline void dof_pb4(float *b, const float *const *up, const int32_t *L0, const int32_t *L1, __m128 f,
+                           __m128 t, __m128 mix, __m128 act, int i, int domix, int doact)
+{
+    const ptrdiff_t o = 4 * (ptrdiff_t)i;
+    _mm_storeu_ps(b, dof_pb1(_mm_loadu_ps(b), up[L0[0]] + o, up[L1[0]] + o, DOF_BC(f, 0), DOF_BC(t, 0),
+                             DOF_BC(mix, 0), DOF_BC(act, 0), domix, doact));
+    _mm_storeu_ps(b + 4, dof_pb1(_mm_loadu_ps(b + 4), up[L0[1]] + o + 4, up[L1[1]] + o + 4, DOF_BC(f, 1),
+                                 DOF_BC(t, 1), DOF_BC(mix, 1), DOF_BC(act, 1), domix, doact));
+    _mm_storeu_ps(b + 8, dof_pb1(_mm_loadu_ps(b + 8), up[L0[2]] + o + 8, up[L1[2]] + o + 8, DOF_BC(f, 2),
+                                 DOF_BC(t, 2), DOF_BC(mix, 2), DOF_BC(act, 2), domix, doact));
+    _mm_storeu_ps(b + 12, dof_pb1(_mm_loadu_ps(b + 12), up[L0[3]] + o + 12, up[L1[3]] + o + 12, DOF_BC(f, 3),
+                                  DOF_BC(t, 3), DOF_BC(mix, 3), DOF_BC(act, 3), domix, doact));
+}
+
+static inline void dof_pyrblur_row_x86(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const dof_pb_k k = dof_pb_setup(a);
+    int i = x0;
+    for (; i + 4 <= x0 + n; i += 4) {
+        const __m128 c = _mm_loadu_ps(a->coc + i), t = _mm_loadu_ps(a->t + i);
+        const __m128 m = _mm_andnot_ps(k.msign, c); /* |c| (-0 -> +0: skipped either way) */
+        const __m128 act = _mm_and_ps(_mm_cmpgt_ps(m, k.zero), _mm_cmpgt_ps(t, k.zero));
+        if (!_mm_movemask_ps(act))
+            continue;
+        const __m128 v = _mm_min_ps(_mm_max_ps(_mm_mul_ps(m, k.steps), k.zero), k.lmax);
+        _Alignas(16) int32_t li[4], L0[4], L1[4];
+        _mm_store_si128((__m128i *)li, _mm_cvttps_epi32(v));
+        const __m128 l = _mm_min_ps(_mm_setr_ps(a->lambda[li[0]], a->lambda[li[1]], a->lambda[li[2]], a->lambda[li[3]]),
+                                    k.need); /* l < need ? l : need */
+        const __m128i l0 = _mm_cvttps_epi32(l);
+        const __m128 f = _mm_sub_ps(l, _mm_cvtepi32_ps(l0));
+        _mm_store_si128((__m128i *)L0, l0);
+        _mm_store_si128((__m128i *)L1, _mm_sub_epi32(l0, _mm_cmplt_epi32(l0, k.needi))); /* + 1 where L0 < need */
+        const __m128 mix = _mm_and_ps(_mm_cmpgt_ps(c, k.zero), _mm_cmplt_ps(t, k.one));
+        float *b = blur + 4 * i;
+        const int domix = _mm_movemask_ps(_mm_and_ps(mix, act)) != 0, doact = _mm_movemask_ps(act) != 15;
+        /* the common blocks (all blended, none mixing: the periphery) without the selects */
+        if (!domix && !doact)
+            dof_pb4(b, a->up, L0, L1, f, t, mix, act, i, 0, 0);
+        else
+            dof_pb4(b, a->up, L0, L1, f, t, mix, act, i, 1, 1);
+    }
+    for (; i < x0 + n; i++) { /* the reference's control flow, channels as a vector */
+        const float c = a->coc[i], t = a->t[i], m = c < 0.0f ? -c : c;
+        if (!(m > 0.0f && t > 0.0f))
+            continue;
+        const float v = m * (float)a->lambda_steps;
+        float l = a->lambda[v < (float)a->lambda_max ? (int)v : a->lambda_max];
+        l = l < (float)a->need ? l : (float)a->need;
+        const int L0 = (int)l, L1 = L0 < a->need ? L0 + 1 : L0;
+        const __m128 all = _mm_castsi128_ps(_mm_set1_epi32(-1));
+        const __m128 mix = c > 0.0f && t < 1.0f ? all : k.zero;
+        float *b = blur + 4 * i;
+        _mm_storeu_ps(b, dof_pb1(_mm_loadu_ps(b), a->up[L0] + 4 * i, a->up[L1] + 4 * i, _mm_set1_ps(l - (float)L0),
+                                 _mm_set1_ps(t), mix, all, 1, 0));
+    }
+}
+
+#endif

@@ -1,0 +1,150 @@
+#!/bin/bash
+# make test-hil: boots Debian's kernel in QEMU (TCG) from a small initramfs and runs the
+# hardware-in-the-loop checks of tests/hil/guest.c against real kernel drivers (vivid, gpio-sim,
+# bochs-drm). docs/hil.md says what runs and how.
+#
+#   BUILD=build tests/hil/run.sh      (make test-hil builds $BUILD/hil/fovea-hil first)
+#
+# Environment: HIL_DIR (cache, default $BUILD/hil), HIL_TIMEOUT (seconds for the whole guest run,
+# default 240), HIL_FRAMES (eye frames through the V4L2 loop, default 60), HIL_GPIO_SECONDS
+# (default 4), HIL_SMP (guest CPUs, default 1). Exit 0 when every check passed, 1 otherwise.
+set -eu
+cd "$(dirname "$0")/../.."
+BUILD=${BUILD:-build}
+HIL_DIR=${HIL_DIR:-$BUILD/hil}
+TIMEOUT=${HIL_TIMEOUT:-240}
+FRAMES=${HIL_FRAMES:-60}
+GPIO_SECONDS=${HIL_GPIO_SECONDS:-4}
+SMP=${HIL_SMP:-1}
+# extra QEMU options, e.g. HIL_QEMU_EXTRA="-icount shift=auto"
+QEMU_EXTRA=${HIL_QEMU_EXTRA:-}
+guest_bin=$BUILD/hil/fovea-hil
+say() { echo "hil: $*"; }
+die() { echo "hil: error: $*" >&2; exit 1; }
+
+[ -x "$guest_bin" ] || die "$guest_bin missing (make test-hil builds it)"
+[ -f assets/eye_synth.y4m ] && [ -f assets/eye_synth.csv ] ||
+    die "assets/eye_synth.{y4m,csv} missing (make builds them)"
+t_start=$(date +%s.%N)
+tools/hil/prepare.sh "$HIL_DIR"
+# shellcheck disable=SC1091
+. "$HIL_DIR/env"
+t_prep=$(date +%s.%N)
+
+# --- initramfs: busybox, the modules (load order from modprobe --show-depends), the guest program
+run=$HIL_DIR/run
+rm -rf "$run"
+mkdir -p "$run/initrd/bin" "$run/initrd/lib/modules" "$run/initrd/data" "$run/initrd/dev" "$run/initrd/proc" \
+    "$run/initrd/sys"
+cp /bin/busybox "$run/initrd/bin/busybox"
+file_type=$(od -An -c -N4 "$run/initrd/bin/busybox" | tr -d ' ')
+[ "$file_type" = '177ELF' ] || die "/bin/busybox is not an ELF (busybox-static)"
+cp "$guest_bin" "$run/initrd/bin/fovea-hil"
+cp tests/hil/init "$run/initrd/init"
+chmod 755 "$run/initrd/init"
+# the first FRAMES frames of the eye video (header line + FRAMES x ("FRAME\n" + 320x240 luma))
+head -n1 assets/eye_synth.y4m | grep -q '^YUV4MPEG2 W320 H240 .*Cmono' ||
+    die "assets/eye_synth.y4m is not the 320x240 Cmono video the V4L2 check expects"
+hdr=$(head -n1 assets/eye_synth.y4m | wc -c)
+head -c $((hdr + FRAMES * (6 + 320 * 240))) assets/eye_synth.y4m > "$run/initrd/data/eye_synth.y4m"
+head -n $((FRAMES + 1)) assets/eye_synth.csv > "$run/initrd/data/eye_synth.csv"
+: > "$run/initrd/modules.list"
+mods=$(for m in vivid bochs gpio-sim; do
+    modprobe -d "$HIL_ROOT" -S "$HIL_KVER" --show-depends "$m" || die "modprobe --show-depends $m failed"
+done | awk '$1 == "insmod" && !seen[$2]++ { print $2 }')
+[ -n "$mods" ] || die "no modules resolved"
+for p in $mods; do
+    b=$(basename "$p")
+    case "$b" in
+        *.ko) cp "$p" "$run/initrd/lib/modules/$b" ;;
+        *.ko.xz) xz -dc "$p" > "$run/initrd/lib/modules/${b%.xz}"; b=${b%.xz} ;;
+        *) die "unexpected module file $p" ;;
+    esac
+    case "$b" in
+        vivid.ko) echo "$b n_devs=1 node_types=0x101" ;;
+        *) echo "$b" ;;
+    esac >> "$run/initrd/modules.list"
+done
+(cd "$run/initrd" && find . | LC_ALL=C sort | cpio -o -H newc --quiet | gzip -1 > ../initrd.gz)
+say "kernel $HIL_KVER ($HIL_IMG_PKG $HIL_IMG_VER), initramfs $(($(stat -c %s "$run/initrd.gz") / 1024)) KiB," \
+    "$(wc -l < "$run/initrd/modules.list") modules: $(awk '{printf "%s%s", sep, $1; sep=" "}' "$run/initrd/modules.list")"
+t_initrd=$(date +%s.%N)
+
+# --- QEMU: console on ttyS0 (a file), the host's answers on ttyS1, the monitor on a pipe
+mkfifo "$run/ctl.in" "$run/ctl.out" "$run/mon.in" "$run/mon.out"
+exec 3<>"$run/ctl.in" 4<>"$run/ctl.out" 5<>"$run/mon.in" 6<>"$run/mon.out"
+console=$run/console.log
+: > "$console"
+# shellcheck disable=SC2206,SC2054
+qemu_args=(-accel tcg -cpu max -m 512 -smp "$SMP" $QEMU_EXTRA -nodefaults -no-reboot -display none -vga none
+    -device bochs-display
+    -chardev "file,id=con,path=$console" -serial chardev:con
+    -chardev "pipe,id=ctl,path=$run/ctl" -serial chardev:ctl
+    -chardev "pipe,id=mon,path=$run/mon" -mon chardev=mon,mode=readline
+    -kernel "$HIL_VMLINUX" -initrd "$run/initrd.gz"
+    -append "console=ttyS0 quiet panic=-1 rdinit=/init HIL_FRAMES=$FRAMES HIL_GPIO_SECONDS=$GPIO_SECONDS")
+say "booting: qemu-system-x86_64 ${qemu_args[*]}"
+t_boot=$(date +%s.%N)
+timeout --kill-after=5 "$TIMEOUT" qemu-system-x86_64 "${qemu_args[@]}" > "$run/qemu.log" 2>&1 &
+qpid=$!
+trap 'kill "$qpid" 2>/dev/null || true' EXIT INT TERM # no QEMU left behind if this script is stopped
+shot_done=0
+kms_w='' kms_h=''
+while kill -0 "$qpid" 2>/dev/null; do
+    if [ $shot_done = 0 ] && line=$(grep -m1 '^HIL-READY kms ' "$console" 2>/dev/null); then
+        read -r _ _ kms_w kms_h <<< "$line"
+        kms_h=${kms_h%$'\r'}
+        rm -f "$run/shot.ppm"
+        echo "screendump $run/shot.ppm" >&5
+        for _ in $(seq 100); do
+            [ -f "$run/shot.ppm" ] && [ "$(stat -c %s "$run/shot.ppm")" -ge $((kms_w * kms_h * 3)) ] && break
+            sleep 0.1
+        done
+        sleep 0.2
+        echo >&3 # the guest may tear down its framebuffers now
+        shot_done=1
+    fi
+    sleep 0.1
+done
+qrc=0
+wait "$qpid" || qrc=$?
+t_end=$(date +%s.%N)
+exec 3>&- 4>&- 5>&- 6>&-
+
+# --- results
+tr -d '\r' < "$console" > "$run/console.txt"
+if [ $shot_done = 1 ]; then
+    "$guest_bin" kms-compare "$run/shot.ppm" "$kms_w" "$kms_h" >> "$run/console.txt" || true
+fi
+checks="boot modules v4l2-loop v4l2-track v4l2-buf-error v4l2-reopen gpio-lock gpio-dropped kms-flip kms-readback"
+pass=0 fail=0
+for c in $checks; do
+    line=$(grep -m1 "^HIL $c " "$run/console.txt" || true)
+    if [ -z "$line" ]; then
+        echo "  FAIL $c (no result line)"
+        fail=$((fail + 1))
+    else
+        # shellcheck disable=SC2086
+        set -- $line
+        st=$3
+        shift 3
+        echo "  $st $c $*"
+        if [ "$st" = PASS ]; then pass=$((pass + 1)); else fail=$((fail + 1)); fi
+    fi
+done
+if [ $qrc = 124 ] || [ $qrc = 137 ]; then
+    echo "  FAIL guest timed out after ${TIMEOUT}s (killed); console: $run/console.txt"
+    fail=$((fail + 1))
+elif ! grep -q '^HIL done' "$run/console.txt"; then
+    echo "  FAIL guest did not finish (qemu exit $qrc); console: $run/console.txt, qemu: $run/qemu.log"
+    fail=$((fail + 1))
+fi
+secs() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.1f", b - a }'; }
+say "times: prepare $(secs "$t_start" "$t_prep") s, initramfs $(secs "$t_prep" "$t_initrd") s," \
+    "guest run $(secs "$t_boot" "$t_end") s (guest uptime at boot line $(sed -n 's/^HIL boot PASS uptime_s=\([0-9.]*\).*/\1/p' "$run/console.txt") s)"
+if [ $fail -gt 0 ]; then
+    say "console:"
+    sed 's/^/    /' "$run/console.txt" | tail -n 60
+fi
+echo "hil: $pass passed, $fail failed"
+[ $fail = 0 ]

@@ -1,0 +1,567 @@
+/* fovea: checkasm-style tests of the depth-of-field kernels (dsp.h dof_*): every ISA this machine
+ * runs against the plain-C references of core/dof/kernels.c on random and edge-case inputs, bit
+ * for bit (so -0 vs +0 counts). Inputs live in exact-size heap buffers starting at odd offsets
+ * (ASan catches over-reads); outputs are whole rows pre-filled with canary NaNs, so a write
+ * outside [x0, x0 + n) or past the row shows. Deterministic: a fixed-seed PRNG. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "testutil.h"
+
+#include "dof/weier_impl.h"
+#include "dsp.h"
+
+static const uint32_t canary_bits = 0x7fc0dead; /* a NaN no kernel computes */
+#define CANARY 16
+
+static const unsigned isa_list[] = {
+#if defined(__x86_64__)
+    FV_ISA_SSE41, FV_ISA_AVX2,
+#elif defined(__aarch64__)
+    FV_ISA_NEON,
+#endif
+    0 /* sentinel */
+};
+
+static uint64_t rng = 0xd0f5eed2026ull;
+static float rnd(void) { return fv_test_randf(&rng); }
+static int rndi(int n) { return (int)(fv_test_rand(&rng) % (uint64_t)n); }
+
+static fv_dof_gauss_tab tab;
+
+/* a colour channel: mostly ordinary, sometimes signed zeros, tiny or large values, negatives */
+static float colour(void)
+{
+    static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, 1e4f, 0.5f, 1.0f, -0.25f, 65504.0f};
+    return rndi(8) == 0 ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : 2.0f * rnd() - 0.25f;
+}
+
+/* exact-size buffer of count floats, `off` floats into its allocation */
+typedef struct {
+    float *base, *p;
+} buf;
+static buf buf_new(size_t count, int off)
+{
+    buf b;
+    b.base = malloc((count + (size_t)off) * sizeof(float));
+    assert_non_null(b.base);
+    b.p = b.base + off;
+    return b;
+}
+/* an output of count floats + CANARY, all canaries */
+static buf out_new(size_t count, int off)
+{
+    buf b = buf_new(count + CANARY, off);
+    for (size_t i = 0; i < count + CANARY; i++)
+        memcpy(b.p + i, &canary_bits, 4);
+    return b;
+}
+
+static unsigned long compared; /* floats compared, all ISAs */
+
+static void compare(const float *ref, const float *got, size_t count, size_t per_px, const char *isa,
+                    const char *kernel, const char *what)
+{
+    for (size_t i = 0; i < count; i++) {
+        uint32_t a, b;
+        memcpy(&a, ref + i, 4);
+        memcpy(&b, got + i, 4);
+        if (a != b)
+            fail_msg("%s %s (%s): float %zu (pixel %zu channel %zu): c=%.9g (%a) %s=%.9g (%a)", isa, kernel, what, i,
+                     i / per_px, i % per_px, (double)ref[i], (double)ref[i], isa, (double)got[i], (double)got[i]);
+    }
+    compared += count;
+}
+
+typedef void (*runner)(const fv_dsp *d, const char *isa);
+
+static void run_all(const char *kernel, runner fn, size_t member)
+{
+    int tested = 0;
+    for (int k = 0; isa_list[k]; k++) {
+        const unsigned isa = isa_list[k];
+        if (!(fv_cpu_isas() & isa)) {
+            printf("[ kernels  ] %s: %-7s not on this CPU, skipped\n", kernel, fv_isa_name(isa));
+            continue;
+        }
+        fv_dsp d, c;
+        fv_dsp_init(&d, isa);
+        fv_dsp_init(&c, FV_ISA_C);
+        assert_int_equal(d.isa, isa);
+        void *f, *fc;
+        memcpy(&f, (const char *)&d + member, sizeof f);
+        memcpy(&fc, (const char *)&c + member, sizeof fc);
+        if (f == fc) {
+            printf("[ kernels  ] %s: %-7s has no version of its own, skipped\n", kernel, fv_isa_name(isa));
+            continue;
+        }
+        const unsigned long before = compared;
+        fn(&d, fv_isa_name(isa));
+        printf("[ kernels  ] %s: %-7s bit-identical to C (%lu floats)\n", kernel, fv_isa_name(isa), compared - before);
+        tested++;
+    }
+    if (!tested)
+        printf("[ kernels  ] %s: no ISA version on this machine\n", kernel);
+}
+
+/* ------------------------------------------------------------------ coc_row */
+
+static float depth(int mode, float dn, float df)
+{
+    switch (mode == 0 ? rndi(9) : mode) {
+    case 1: return 0.05f * rnd();                  /* below the 0.05 m floor */
+    case 2: return 1000.0f;                        /* a miss */
+    case 3: return dn;                             /* exactly at a bound: CoC 0 */
+    case 4: return df;
+    case 5: return dn + (df - dn) * rnd();         /* in focus: CoC 0 */
+    case 6: return 0.05f;
+    case 7: return -1.0f;
+    default: return 0.01f + 60.0f * rnd() * rnd();
+    }
+}
+
+static void run_coc(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70 + 2; n++) {
+        const int nn = n <= 70 ? n : n == 71 ? 640 : 1281;
+        for (int mode = 0; mode < 8; mode++) {
+            const int off = rndi(4);
+            const float dn = 0.3f + 2.0f * rnd(), df = dn + (rndi(4) == 0 ? 0.0f : 5.0f * rnd());
+            const float K = rndi(5) == 0 ? 0.0f : 1.0f + 40.0f * rnd();
+            buf in = buf_new(4 * (size_t)nn, off);
+            for (int i = 0; i < nn; i++) {
+                for (int c = 0; c < 3; c++)
+                    in.p[4 * i + c] = colour();
+                in.p[4 * i + 3] = depth(mode, dn, df);
+            }
+            buf r = out_new((size_t)nn, off), t = out_new((size_t)nn, off);
+            fv_dof_coc_row_c(r.p, in.p, nn, K, dn, df);
+            d->dof_coc_row(t.p, in.p, nn, K, dn, df);
+            compare(r.p, t.p, (size_t)nn + CANARY, 1, isa, "coc_row", "coc + canaries");
+            for (int i = 0; i < nn; i++)
+                assert_true(isfinite(r.p[i]));
+            free(in.base), free(r.base), free(t.base);
+        }
+    }
+}
+
+static void test_coc_row(void **state)
+{
+    (void)state;
+    run_all("dof_coc_row", run_coc, offsetof(fv_dsp, dof_coc_row));
+}
+
+/* ------------------------------------------------------------------ sigma indices */
+
+static void gen_sig(uint8_t *sig, int n, int mode)
+{
+    const int m = FV_DOF_NSIG - 1;
+    int run = 0, s = 0;
+    for (int i = 0; i < n; i++) {
+        switch (mode) {
+        case 0: sig[i] = (uint8_t)rndi(FV_DOF_NSIG); break;     /* every pixel its own */
+        case 1: sig[i] = 0; break;                              /* in focus (radius 1, w = 1 0) */
+        case 2: sig[i] = (uint8_t)m; break;                     /* the largest kernel */
+        case 3: sig[i] = (uint8_t)(rndi(2) ? 0 : m); break;     /* extremes mixed */
+        default:                                                /* runs, as along a real row */
+            if (run-- <= 0)
+                run = rndi(9), s = rndi(4) ? 8 + rndi(25) : rndi(FV_DOF_NSIG);
+            sig[i] = (uint8_t)s;
+        }
+    }
+}
+
+static void test_gauss_tab(void **state)
+{
+    (void)state;
+    /* the ISA versions run blocks of pixels to the block's largest radius and rely on this */
+    for (int s = 0; s < FV_DOF_NSIG; s++) {
+        assert_true(tab.rad[s] >= 1 && tab.rad[s] <= FV_DOF_RMAX);
+        for (int j = tab.rad[s] + 1; j <= FV_DOF_RMAX; j++)
+            assert_true(tab.w[s][j] == 0.0f && !signbit(tab.w[s][j]));
+        for (int j = 0; j <= FV_DOF_RMAX; j++)
+            assert_true(tab.w[s][j] >= 0.0f);
+    }
+}
+
+/* ------------------------------------------------------------------ hgauss_row */
+
+static void run_hgauss1(const fv_dsp *d, const char *isa, int w, int x0, int n, int smode, int off)
+{
+    buf rgbd = buf_new(4 * (size_t)w, off), coc = buf_new((size_t)w, off);
+    const int cmode = rndi(5);
+    for (int i = 0; i < w; i++) {
+        const float u = rnd();
+        coc.p[i] = cmode == 0 ? 1.0f + rnd() : cmode == 1 ? -2.0f : /* all far / all near */
+                   u < 0.15f ? 0.0f : u < 0.2f ? -0.0f : u < 0.4f ? -8.0f * rnd() : u < 0.45f ? 1e-30f : 16.0f * rnd();
+        for (int c = 0; c < 4; c++)
+            rgbd.p[4 * i + c] = colour();
+        if (!(coc.p[i] > 0.0f) && rndi(2)) { /* colours of near / focused samples are never used */
+            const int ch = rndi(3);
+            rgbd.p[4 * i + ch] = rndi(2) ? NAN : INFINITY;
+        }
+    }
+    uint8_t *sig = malloc((size_t)n + 1);
+    assert_non_null(sig);
+    gen_sig(sig, n, smode);
+    buf r = out_new(4 * (size_t)w, off), t = out_new(4 * (size_t)w, off);
+    fv_dof_hgauss_row_c(r.p, rgbd.p, coc.p, w, x0, n, sig, &tab);
+    d->dof_hgauss_row(t.p, rgbd.p, coc.p, w, x0, n, sig, &tab);
+    compare(r.p, t.p, 4 * (size_t)w + CANARY, 4, isa, "hgauss_row", "whole row + canaries");
+    for (int i = 4 * x0; i < 4 * (x0 + n); i++)
+        assert_true(isfinite(r.p[i]));
+    free(sig), free(rgbd.base), free(coc.base), free(r.base), free(t.base);
+}
+
+static void run_hgauss(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70; n++)
+        for (int smode = 0; smode < 5; smode++) {
+            const int w = n + (rndi(3) == 0 ? 0 : rndi(60)); /* span reaching both edges or not */
+            const int x0 = rndi(w - n + 1);
+            run_hgauss1(d, isa, w, x0, n, smode, rndi(4));
+        }
+    for (int k = 0; k < 40; k++) { /* production spans (TILE * 8) and tiny rows */
+        const int w = k < 20 ? 128 + rndi(1200) : 1 + rndi(8);
+        const int cut = k < 20 && w >= 128 && rndi(2) ? rndi(128) : 0; /* one draw after the other */
+        const int n = k < 20 ? (w < 128 ? w : 128 - cut) : 1 + rndi(w);
+        /* draws in a fixed order (argument evaluation order is unspecified) */
+        const int x0 = rndi(w - n + 1), sm = rndi(5), off = rndi(4);
+        run_hgauss1(d, isa, w, x0, n, sm, off);
+    }
+    run_hgauss1(d, isa, 1281, 0, 1281, 4, 1); /* longer than one chunk */
+}
+
+static void test_hgauss_row(void **state)
+{
+    (void)state;
+    run_all("dof_hgauss_row", run_hgauss, offsetof(fv_dsp, dof_hgauss_row));
+}
+
+/* ------------------------------------------------------------------ vgauss_row */
+
+static void run_vgauss1(const fv_dsp *d, const char *isa, int w, int h, int x0, int n, int smode, int off)
+{
+    const ptrdiff_t stride = w + rndi(3);
+    const size_t count = 4 * (size_t)(stride * (h - 1) + w);
+    buf src = buf_new(count, off);
+    for (size_t i = 0; i < count; i++)
+        src.p[i] = colour();
+    const int ylo = rndi(h), yhi = ylo + 1 + rndi(h - ylo), y = ylo + rndi(yhi - ylo);
+    uint8_t *sig = malloc((size_t)n + 1);
+    assert_non_null(sig);
+    gen_sig(sig, n, smode);
+    buf r = out_new(4 * (size_t)w, off), t = out_new(4 * (size_t)w, off);
+    fv_dof_vgauss_row_c(r.p, src.p, stride, y, ylo, yhi, x0, n, sig, &tab);
+    d->dof_vgauss_row(t.p, src.p, stride, y, ylo, yhi, x0, n, sig, &tab);
+    compare(r.p, t.p, 4 * (size_t)w + CANARY, 4, isa, "vgauss_row", "whole row + canaries");
+    free(sig), free(src.base), free(r.base), free(t.base);
+}
+
+static void run_vgauss(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70; n++)
+        for (int smode = 0; smode < 5; smode++) {
+            const int w = n + rndi(20), h = 1 + rndi(rndi(2) ? 8 : 70);
+            const int x0 = rndi(w - n + 1), off = rndi(4);
+            run_vgauss1(d, isa, w, h, x0, n, smode, off);
+        }
+    for (int k = 0; k < 10; k++) {
+        const int w = 128 + rndi(400);
+        const int hh = 16 + rndi(60), x0 = rndi(w - 127), sm = rndi(5), off = rndi(4);
+        run_vgauss1(d, isa, w, hh, x0, 128, sm, off);
+    }
+}
+
+static void test_vgauss_row(void **state)
+{
+    (void)state;
+    run_all("dof_vgauss_row", run_vgauss, offsetof(fv_dsp, dof_vgauss_row));
+}
+
+/* ------------------------------------------------------------------ combine_row */
+
+static long comb_far, comb_lnear, comb_near, comb_enh; /* how often the steps ran (reference) */
+
+/* Rows of w pixels; the span [x0, x0 + n). What the reference does not read (far unless coc > 0
+ * or coc < 0 < t, lnear where t <= 0, enh where gain t <= 0) holds NaN / Inf: an ISA version may
+ * read it but must not let it through. */
+static void run_combine1(const fv_dsp *d, const char *isa, int w, int x0, int n, int off)
+{
+    const size_t w4 = 4 * (size_t)w;
+    buf sharp = buf_new(w4, off), coc = buf_new((size_t)w, off), far = buf_new(w4, off), near = buf_new(w4, off);
+    buf lnear = buf_new(w4, off), t = buf_new((size_t)w, off), enh = buf_new(w4, off);
+    const int cmode = rndi(5), tmode = rndi(5);
+    const float gain = rndi(4) ? 2.0f * rnd() : 0.0f;
+    float run_t = 0.0f;
+    for (int i = 0; i < w; i++) {
+        const float u = rnd();
+        coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? 20.0f * rnd() : cmode == 2 ? -12.0f * rnd() :
+                   u < 0.15f ? 0.0f : u < 0.2f ? -0.0f : u < 0.3f ? -4.0f : u < 0.45f ? -12.0f * rnd() :
+                   u < 0.55f ? rnd() : u < 0.6f ? 1.0f : 20.0f * rnd();
+        if (tmode == 0)
+            t.p[i] = 0.0f;
+        else if (tmode == 1)
+            t.p[i] = 1.0f;
+        else { /* runs of 0, 1 and in between (the transition), as along a real row */
+            if (rndi(6) == 0)
+                run_t = rndi(3) == 0 ? 0.0f : rndi(2) ? 1.0f : rnd();
+            t.p[i] = tmode == 2 ? rnd() : run_t;
+        }
+        const float nw = rndi(3) ? 0.05f + 1.5f * rnd() : 0.0f, lw = rndi(3) ? 0.05f + 1.5f * rnd() : 0.0f;
+        for (int c = 0; c < 4; c++) {
+            sharp.p[4 * i + c] = colour();
+            far.p[4 * i + c] = colour();
+            near.p[4 * i + c] = c < 3 ? nw * colour() : nw;
+            lnear.p[4 * i + c] = c < 3 ? lw * colour() : lw;
+            enh.p[4 * i + c] = colour();
+        }
+        const float bad = rndi(2) ? NAN : -INFINITY;
+        if (!(coc.p[i] > 0.0f) && !(coc.p[i] < 0.0f && t.p[i] > 0.0f))
+            far.p[4 * i + rndi(4)] = bad;
+        if (!(t.p[i] > 0.0f))
+            lnear.p[4 * i + rndi(4)] = bad;
+        if (!(gain * t.p[i] > 0.0f))
+            enh.p[4 * i + rndi(4)] = bad;
+    }
+    const fv_dof_combine_args a = {
+        .sharp = sharp.p,
+        .coc = coc.p,
+        .far = far.p,
+        .near = rndi(4) ? near.p : NULL,
+        .lnear = rndi(4) ? lnear.p : NULL,
+        .t = t.p,
+        .enh = rndi(3) ? enh.p : NULL,
+        .gain = gain,
+    };
+    buf r = out_new(w4, off), o = out_new(w4, off);
+    fv_dof_combine_row_c(r.p, &a, x0, n);
+    d->dof_combine_row(o.p, &a, x0, n);
+    compare(r.p, o.p, w4 + CANARY, 4, isa, "combine_row", "whole row + canaries");
+    for (int x = x0; x < x0 + n; x++) {
+        for (int c = 0; c < 4; c++)
+            assert_true(isfinite(r.p[4 * x + c]));
+        comb_far += coc.p[x] > 0.0f || (coc.p[x] < 0.0f && t.p[x] > 0.0f);
+        comb_lnear += a.lnear && t.p[x] > 0.0f;
+        comb_near += a.near && near.p[4 * x + 3] > 0.0f;
+        comb_enh += a.enh && gain * t.p[x] > 0.0f;
+    }
+    free(sharp.base), free(coc.base), free(far.base), free(near.base), free(lnear.base), free(t.base);
+    free(enh.base), free(r.base), free(o.base);
+}
+
+static void run_combine(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70; n++)
+        for (int rep = 0; rep < 6; rep++) {
+            const int w = n + (rndi(3) == 0 ? 0 : rndi(40));
+            const int x0 = rndi(w - n + 1), off = rndi(4);
+            run_combine1(d, isa, w, x0, n, off);
+        }
+    for (int k = 0; k < 10; k++) { /* whole production rows, as core/dof/weier.c calls it */
+        const int w = 1200 + rndi(200);
+        run_combine1(d, isa, w, 0, w, rndi(4));
+    }
+}
+
+static void test_combine_row(void **state)
+{
+    (void)state;
+    run_all("dof_combine_row", run_combine, offsetof(fv_dsp, dof_combine_row));
+    printf("[ kernels  ] combine steps run (all ISAs): far %ld, lnear %ld, near coverage %ld, enhancement %ld\n",
+           comb_far, comb_lnear, comb_near, comb_enh);
+}
+
+/* ------------------------------------------------------------------ upsample_row */
+
+static const float below1 = 0x1.fffffep-1f; /* the largest float < 1 */
+
+/* n output pixels from a tmp row of sw texels. tmode 0: core/dof/weier.c's taps (by 2^L, borders
+ * clamped); 1: random taps, i0 / i1 often at the row's ends or equal; 2: all taps equal. */
+static void run_upsample1(const fv_dsp *d, const char *isa, int n, int tmode, int off)
+{
+    const int L = 1 + rndi(5);
+    const int sw = tmode == 0 ? ((n + (1 << L) - 1) >> L) + rndi(2) : 1 + rndi(rndi(2) ? 4 : n + 8);
+    buf tmp = buf_new(4 * (size_t)sw, off);
+    for (int i = 0; i < 4 * sw; i++)
+        tmp.p[i] = colour();
+    int32_t *i0 = malloc(sizeof(int32_t) * (size_t)n), *i1 = malloc(sizeof(int32_t) * (size_t)n);
+    buf ax = buf_new((size_t)n, off);
+    assert_non_null(i0), assert_non_null(i1);
+    for (int x = 0; x < n; x++) {
+        if (tmode == 0) { /* as xtaps_init */
+            const float u = ((float)x + 0.5f) * (1.0f / (float)(1 << L)) - 0.5f, fu = floorf(u);
+            const int a = (int)fu;
+            i0[x] = a < 0 ? 0 : a > sw - 1 ? sw - 1 : a;
+            i1[x] = a + 1 < 0 ? 0 : a + 1 > sw - 1 ? sw - 1 : a + 1;
+            ax.p[x] = u - fu;
+        } else {
+            const int e = rndi(6);
+            i0[x] = e == 0 ? 0 : e == 1 ? sw - 1 : rndi(sw);
+            i1[x] = tmode == 2 || rndi(4) == 0 ? i0[x] : rndi(3) == 0 ? (rndi(2) ? 0 : sw - 1) : rndi(sw);
+            const int k = rndi(6);
+            ax.p[x] = k == 0 ? 0.0f : k == 1 ? below1 : k == 2 ? 0.5f : rnd();
+        }
+    }
+    buf r = out_new(4 * (size_t)n, off), t = out_new(4 * (size_t)n, off);
+    fv_dof_upsample_row_c(r.p, tmp.p, i0, i1, ax.p, n);
+    d->dof_upsample_row(t.p, tmp.p, i0, i1, ax.p, n);
+    compare(r.p, t.p, 4 * (size_t)n + CANARY, 4, isa, "upsample_row", "row + canaries");
+    free(tmp.base), free(i0), free(i1), free(ax.base), free(r.base), free(t.base);
+}
+
+static void run_upsample(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70; n++)
+        for (int tmode = 0; tmode < 3; tmode++)
+            for (int rep = 0; rep < 2; rep++)
+                run_upsample1(d, isa, n, tmode, rndi(4));
+    for (int k = 0; k < 6; k++)
+        run_upsample1(d, isa, 1280, k % 3, rndi(4));
+}
+
+static void test_upsample_row(void **state)
+{
+    (void)state;
+    run_all("dof_upsample_row", run_upsample, offsetof(fv_dsp, dof_upsample_row));
+}
+
+/* ------------------------------------------------------------------ pyrblur_row */
+
+static long pb_active, pb_mix, pb_beyond, pb_frac; /* how often (reference, all ISAs) */
+
+/* Rows of w pixels; the span [x0, x0 + n). The level table: core/dof/weier.c's (steps 8, 512
+ * entries) or a short random one (levels >= 0, some whole, some above need), so CoCs run past
+ * its end. What the reference does not read (blur and the up rows where it skips a pixel, blur
+ * where it does not mix) holds NaN / Inf sometimes: an ISA version may read it but must not let
+ * it through; skipped pixels must keep their bits. */
+static void run_pyrblur1(const fv_dsp *d, const char *isa, int w, int x0, int n, int off)
+{
+    const size_t w4 = 4 * (size_t)w;
+    const int need = rndi(6), prod = rndi(2);
+    const int steps = prod ? 8 : 1 + rndi(16), lmax = prod ? 512 : rndi(40);
+    float *lambda = malloc(sizeof(float) * (size_t)(lmax + 1));
+    assert_non_null(lambda);
+    for (int i = 0; i <= lmax; i++) {
+        if (prod) { /* as core/dof/weier.c */
+            const float c = (float)i / 8.0f, var = c * c * (1.0f / 16.0f);
+            float lo = 0.0f, l = 0.0f;
+            for (int L = 1; L <= 5; L++) {
+                const float hi = (3.0f * (float)(1 << (2 * L)) - 1.0f) / 12.0f;
+                if (var < hi) {
+                    l = (float)(L - 1) + (var - lo) / (hi - lo);
+                    break;
+                }
+                lo = hi, l = (float)L;
+            }
+            lambda[i] = l;
+        } else
+            lambda[i] = rndi(4) == 0 ? (float)rndi(7) : rndi(8) == 0 ? below1 * (float)(1 + rndi(5)) : 6.0f * rnd();
+    }
+    buf coc = buf_new((size_t)w, off), t = buf_new((size_t)w, off);
+    buf up[6];
+    for (int L = 0; L <= need; L++)
+        up[L] = buf_new(w4, off);
+    const int cmode = rndi(6), tmode = rndi(5);
+    float run_t = 0.0f;
+    for (int i = 0; i < w; i++) {
+        static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, -1.4e-45f, 64.0f, -64.0f, 64.0625f,
+                                    100.0f, -1000.0f, 1e6f, -1.25e8f, 1.25e8f, 0.125f, -0.0625f};
+        const float u = rnd(), sg = rndi(2) ? 1.0f : -1.0f; /* (one draw a statement: the same inputs whatever the compiler) */
+        coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? 20.0f * rnd() : cmode == 2 ? -12.0f * rnd() :
+                   cmode == 3 ? sg * 80.0f * rnd() :
+                   u < 0.25f ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : sg * 70.0f * rnd();
+        if (tmode == 0)
+            t.p[i] = 1.0f;
+        else if (tmode == 1)
+            t.p[i] = rndi(3) ? rnd() : rndi(2) ? 0.0f : -0.0f;
+        else { /* runs of 0, 1 and in between (the transition), as along a real row */
+            if (rndi(6) == 0)
+                run_t = rndi(3) == 0 ? 0.0f : rndi(2) ? 1.0f : rndi(8) == 0 ? below1 : rndi(8) == 0 ? 1e-30f : rnd();
+            t.p[i] = tmode == 2 ? (rndi(8) == 0 ? -rnd() : rnd()) : run_t;
+        }
+        const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
+        const int act = m > 0.0f && tt > 0.0f;
+        for (int L = 0; L <= need; L++)
+            for (int k = 0; k < 4; k++)
+                up[L].p[4 * i + k] = !act && rndi(3) == 0 ? (rndi(2) ? NAN : -INFINITY) : colour();
+    }
+    buf r = buf_new(w4 + CANARY, off), o = buf_new(w4 + CANARY, off);
+    for (int i = 0; i < w; i++) {
+        const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
+        const int mix = m > 0.0f && tt > 0.0f && c > 0.0f && tt < 1.0f;
+        for (int k = 0; k < 4; k++)
+            r.p[4 * i + k] = !mix && rndi(3) == 0 ? (rndi(2) ? NAN : INFINITY) : colour();
+    }
+    for (size_t i = w4; i < w4 + CANARY; i++)
+        memcpy(r.p + i, &canary_bits, 4);
+    memcpy(o.p, r.p, (w4 + CANARY) * sizeof(float));
+    const float *ups[6];
+    for (int L = 0; L <= need; L++)
+        ups[L] = up[L].p;
+    const fv_dof_pyrblur_args a = {.coc = coc.p, .t = t.p, .up = ups, .need = need, .lambda = lambda,
+                                   .lambda_steps = steps, .lambda_max = lmax};
+    fv_dof_pyrblur_row_c(r.p, &a, x0, n);
+    d->dof_pyrblur_row(o.p, &a, x0, n);
+    compare(r.p, o.p, w4 + CANARY, 4, isa, "pyrblur_row", "whole row + canaries");
+    for (int i = x0; i < x0 + n; i++) {
+        const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
+        if (!(m > 0.0f && tt > 0.0f))
+            continue;
+        pb_active++;
+        pb_mix += c > 0.0f && tt < 1.0f;
+        pb_beyond += m * (float)steps >= (float)lmax;
+        const int li = (int)(m * (float)steps);
+        const float l = lambda[li < lmax ? li : lmax];
+        pb_frac += l < (float)need && l != floorf(l);
+        for (int k = 0; k < 4; k++)
+            assert_true(isfinite(r.p[4 * i + k]));
+    }
+    for (int L = 0; L <= need; L++)
+        free(up[L].base);
+    free(lambda), free(coc.base), free(t.base), free(r.base), free(o.base);
+}
+
+static void run_pyrblur(const fv_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 70; n++)
+        for (int rep = 0; rep < 8; rep++) {
+            const int w = n + (rndi(3) == 0 ? 0 : rndi(40)), x0 = rndi(w - n + 1);
+            run_pyrblur1(d, isa, w, x0, n, rndi(4));
+        }
+    for (int k = 0; k < 12; k++) { /* whole production rows, as core/dof/weier.c calls it, and offset ones */
+        const int x0 = k < 6 ? 0 : 1 + rndi(9), w = 1280 + x0 + (k & 1) * rndi(7);
+        run_pyrblur1(d, isa, w, x0, 1280, rndi(4));
+    }
+}
+
+static void test_pyrblur_row(void **state)
+{
+    (void)state;
+    run_all("dof_pyrblur_row", run_pyrblur, offsetof(fv_dsp, dof_pyrblur_row));
+    printf("[ kernels  ] pyrblur pixels blended (all ISAs): %ld, mixed into the blur %ld, past the LUT's end %ld, "
+           "between two levels %ld\n",
+           pb_active, pb_mix, pb_beyond, pb_frac);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    fv_dof_gauss_tab_init(&tab);
+    return 0;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_gauss_tab),
+        cmocka_unit_test(test_coc_row),
+        cmocka_unit_test(test_hgauss_row),
+        cmocka_unit_test(test_vgauss_row),
+        cmocka_unit_test(test_combine_row),
+        cmocka_unit_test(test_upsample_row),
+        cmocka_unit_test(test_pyrblur_row),
+    };
+    return cmocka_run_group_tests_name("kernels_dof", tests, setup, NULL);
+}

@@ -1,0 +1,151 @@
+/* Lens profiles: parsing and its errors; the distortion against its formula, its inverse, and
+ * the camera's rays and projection with and without a lens. */
+#include <math.h>
+#include <string.h>
+
+#include "camera.h"
+#include "lensfile.h"
+#include "testutil.h"
+
+static void test_parse(void **st)
+{
+    (void)st;
+    fv_lens l;
+    char err[256];
+    assert_int_equal(fv_lens_parse(&l,
+                                   "# test HMD\n\nk1 0.12\nk2 0.03 # comment\r\nchroma 0.99 1.0 1.01\n"
+                                   "left_center 0.53 0.48\n  right_center\t0.47 0.52\n",
+                                   "p.txt", 2.0f, err, sizeof err),
+                     0);
+    assert_float_equal(l.k1, 0.12f, 0);
+    assert_float_equal(l.k2, 0.03f, 0);
+    assert_float_equal(l.scale[0], 0.99f, 0);
+    assert_float_equal(l.scale[2], 1.01f, 0);
+    assert_float_equal(l.center[0][0], 0.53f, 0);
+    assert_float_equal(l.center[1][1], 0.52f, 0);
+    /* empty: no distortion */
+    assert_int_equal(fv_lens_parse(&l, "# nothing\n", "e.txt", 2.0f, err, sizeof err), 0);
+    assert_float_equal(l.k1, 0.0f, 0);
+    assert_float_equal(l.scale[1], 1.0f, 0);
+    assert_float_equal(l.center[1][0], 0.5f, 0);
+
+    static const struct {
+        const char *text, *why;
+    } bad[] = {
+        {"k3 0.1\n", "b.txt:1: unknown key 'k3'"},
+        {"k1\n", "b.txt:1: k1 wants 1 number"},
+        {"\nk1 0.1 0.2\n", "b.txt:2: k1 wants 1 number"},
+        {"chroma 1 1\n", "b.txt:1: chroma wants 3 numbers"},
+        {"left_center 0.5 abc\n", "b.txt:1: left_center wants 2 numbers"},
+        {"left_center 1.5 0.5\n", "b.txt: lens: centres"},
+        {"chroma 1 3 1\n", "b.txt: lens: channel scales"},
+        {"k1 -0.5\n", "not invertible"}, /* 1 - 1.5 r^2 < 0 before r = 2 */
+        {"k2 nan\n", "k2 wants 1 number"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        err[0] = 0;
+        assert_int_equal(fv_lens_parse(&l, bad[i].text, "b.txt", 2.0f, err, sizeof err), -1);
+        if (!strstr(err, bad[i].why))
+            fail_msg("'%s': got '%s', want '%s'", bad[i].text, err, bad[i].why);
+    }
+    assert_int_equal(fv_lens_load(&l, "/nonexistent/hmd.lens", 2.0f, err, sizeof err), -1);
+    assert_non_null(strstr(err, "/nonexistent/hmd.lens: No such file"));
+}
+
+static void test_formula_and_round_trip(void **st)
+{
+    (void)st;
+    const float k1 = 0.22f, k2 = 0.05f, cx = 0.07f, cy = -0.03f;
+    uint64_t rng = 11;
+    double worst = 0.0;
+    for (int i = 0; i < 2000; i++) {
+        const float tx = 2.4f * fv_test_randf(&rng) - 1.2f, ty = 2.4f * fv_test_randf(&rng) - 1.2f;
+        for (int c = 0; c < 3; c++) {
+            const float s = c == 0 ? 0.994f : c == 1 ? 1.0f : 1.008f;
+            float dx, dy;
+            fv_lens_distort(k1, k2, s, cx, cy, tx, ty, &dx, &dy);
+            /* the formula, in double */
+            const double ux = (double)tx - cx, uy = (double)ty - cy, r2 = ux * ux + uy * uy;
+            const double f = s * (1.0 + k1 * r2 + k2 * r2 * r2);
+            assert_true(fabs(dx - (cx + ux * f)) < 2e-6 && fabs(dy - (cy + uy * f)) < 2e-6);
+            /* barrel-correcting: farther out than the panel point (k > 0) */
+            if (c == 1 && r2 > 1e-4)
+                assert_true((dx - cx) * (dx - cx) + (dy - cy) * (dy - cy) > r2);
+            float bx, by;
+            assert_int_equal(fv_lens_undistort(k1, k2, s, cx, cy, dx, dy, &bx, &by), 0);
+            const double e = fmax(fabs(bx - tx), fabs(by - ty));
+            if (e > worst)
+                worst = e;
+        }
+    }
+    assert_true(worst < 2e-6);
+}
+
+static void test_camera(void **st)
+{
+    (void)st;
+    fv_camera_desc d;
+    fv_camera_desc_default(&d);
+    d.width = 320;
+    d.height = 360;
+    d.eye = FV_EYE_RIGHT;
+    const fv_pose head = {{0.1f, 1.6f, 2.0f}, {0, 0.258819f, 0, 0.9659258f}};
+    fv_camera plain, lensed, again;
+    /* every field is set whatever the memory held (reprojection memcmp()s whole cameras) */
+    memset(&plain, 0xaa, sizeof plain);
+    memset(&again, 0x55, sizeof again);
+    assert_int_equal(fv_camera_setup(&plain, &d, &head), 0);
+    assert_int_equal(fv_camera_setup(&again, &d, &head), 0);
+    assert_memory_equal(&plain, &again, sizeof plain);
+    fv_lens lens;
+    fv_lens_default(&lens);
+    lens.k1 = 0.2f;
+    lens.k2 = 0.04f;
+    lens.center[1][0] = 0.45f; /* right eye: centre toward the nose */
+    lens.center[1][1] = 0.55f;
+    d.lens = &lens;
+    assert_int_equal(fv_camera_setup(&lensed, &d, &head), 0);
+    assert_false(plain.lens_on);
+    assert_true(lensed.lens_on);
+
+    /* without a lens the ray is the plain pinhole formula, bit for bit */
+    float dir[3];
+    fv_camera_ray(&plain, 17.5f, 200.5f, dir);
+    const float tx = plain.tan_left + 17.5f * plain.px_tan, ty = plain.tan_top - 200.5f * plain.px_tan;
+    for (int i = 0; i < 3; i++)
+        assert_true(dir[i] == tx * plain.right[i] + ty * plain.up[i] - plain.back[i]);
+
+    /* the lens centre pixel looks along the same direction either way */
+    float a[3], b[3];
+    const float px0 = 0.45f * 320, py0 = 0.55f * 360;
+    fv_camera_ray(&plain, px0, py0, a);
+    fv_camera_ray(&lensed, px0, py0, b);
+    for (int i = 0; i < 3; i++)
+        assert_float_equal(a[i], b[i], 1e-6);
+
+    /* elsewhere: along the distorted tangent; projecting the point seen returns the pixel */
+    for (int y = 10; y < 360; y += 50)
+        for (int x = 5; x < 320; x += 45) {
+            const float px = (float)x + 0.5f, py = (float)y + 0.5f;
+            fv_camera_ray(&lensed, px, py, b);
+            float ux = lensed.tan_left + px * lensed.px_tan, uy = lensed.tan_top - py * lensed.px_tan, ex, ey;
+            fv_lens_distort(0.2f, 0.04f, 1.0f, lensed.lens_cx, lensed.lens_cy, ux, uy, &ex, &ey);
+            for (int i = 0; i < 3; i++)
+                assert_float_equal(b[i], ex * lensed.right[i] + ey * lensed.up[i] - lensed.back[i], 1e-5);
+            const float p[3] = {lensed.eye_pos[0] + 3 * b[0], lensed.eye_pos[1] + 3 * b[1], lensed.eye_pos[2] + 3 * b[2]};
+            float qx, qy;
+            assert_float_equal(fv_camera_project(&lensed, p, &qx, &qy), 3.0f, 1e-4);
+            assert_float_equal(qx, px, 2e-3);
+            assert_float_equal(qy, py, 2e-3);
+        }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_parse),
+        cmocka_unit_test(test_formula_and_round_trip),
+        cmocka_unit_test(test_camera),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
