@@ -1,5 +1,6 @@
 #include "kbench.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -193,12 +194,15 @@ typedef struct {
     float *rgbd, *coc, *a4, *b4, *c4, *out, *t;
     uint8_t *sig;
     fv_dof_gauss_tab *tab;
+    int32_t *i0, *i1; /* up-sampling by 2: taps into a 640-pixel coarse row */
+    float *ax, *lambda;
 } dof_st;
+#define LSTEPS 8 /* the level table's steps per pixel of CoC (core/dof/weier.c) */
 static void dof_free(void *st)
 {
     dof_st *t = st;
     free(t->rgbd), free(t->coc), free(t->a4), free(t->b4), free(t->c4), free(t->out), free(t->t), free(t->sig);
-    free(t->tab), free(t);
+    free(t->tab), free(t->i0), free(t->i1), free(t->ax), free(t->lambda), free(t);
 }
 static void *dof_setup(void)
 {
@@ -209,8 +213,19 @@ static void *dof_setup(void)
     t->rgbd = fplane(4 * n), t->coc = fplane(n), t->a4 = fplane(4 * n), t->b4 = fplane(4 * n);
     t->c4 = fplane(4 * n), t->out = fplane(4 * n), t->t = fplane(n), t->sig = malloc(n);
     t->tab = malloc(sizeof *t->tab);
-    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->tab)
+    t->i0 = malloc(W * sizeof *t->i0), t->i1 = malloc(W * sizeof *t->i1), t->ax = fplane(W);
+    t->lambda = fplane(64 * LSTEPS + 1);
+    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->tab || !t->i0 ||
+        !t->i1 || !t->ax || !t->lambda)
         return dof_free(t), NULL;
+    for (int x = 0; x < W; x++) { /* pixel centres: x = 2 X + 0.5 +- 0.25 */
+        const int X = x / 2;
+        t->i0[x] = x & 1 ? X : (X > 0 ? X - 1 : 0);
+        t->i1[x] = x & 1 ? (X + 1 < W / 2 ? X + 1 : X) : X;
+        t->ax[x] = x & 1 ? 0.25f : (X > 0 ? 0.75f : 0.0f);
+    }
+    for (int i = 0; i <= 64 * LSTEPS; i++) /* about log2 of the CoC */
+        t->lambda[i] = i < LSTEPS ? 0.0f : fminf(5.0f, log2f((float)i / LSTEPS));
     fv_dof_gauss_tab_init(t->tab);
     uint32_t s = 4;
     fill_rgbd(t->rgbd, n, &s, 0.3f, 20.0f);
@@ -246,6 +261,26 @@ static void vgauss_run(void *st, const fv_dsp *d, int row0, int rows)
     for (int k = 0; k < rows; k++) {
         const int y = (row0 + k) % H;
         d->dof_vgauss_row(t->out + 4 * (size_t)y * W, t->a4, W, y, 0, H, 0, W, t->sig + (size_t)y * W, t->tab);
+    }
+}
+static void upsample_run(void *st, const fv_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        d->dof_upsample_row(t->out + 4 * y * W, t->a4 + 4 * (y / 2) * W, t->i0, t->i1, t->ax, W);
+    }
+}
+static void pyrblur_run(void *st, const fv_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        const float *up[5] = {t->rgbd + 4 * y * W, t->a4 + 4 * y * W, t->b4 + 4 * y * W, t->c4 + 4 * y * W,
+                              t->a4 + 4 * ((y + 1) % H) * W};
+        const fv_dof_pyrblur_args a = {.coc = t->coc + y * W, .t = t->t + y * W, .up = up, .need = 4,
+                                       .lambda = t->lambda, .lambda_steps = LSTEPS, .lambda_max = 64 * LSTEPS};
+        d->dof_pyrblur_row(t->out + 4 * y * W, &a, 0, W);
     }
 }
 static void combine_run(void *st, const fv_dsp *d, int row0, int rows)
@@ -323,6 +358,10 @@ const fv_kbench_kernel fv_kbench_kernels[] = {
     {"dof_hgauss_row", "1280x1440, 1440 rows, sigma 1-4 px", {F(dof_hgauss_row), 0}, H, dof_setup, NULL, hgauss_run,
      dof_free},
     {"dof_vgauss_row", "1280x1440, 1440 rows, sigma 1-4 px", {F(dof_vgauss_row), 0}, H, dof_setup, NULL, vgauss_run,
+     dof_free},
+    {"dof_upsample_row", "1280x1440, 1440 rows, by 2 from 640", {F(dof_upsample_row), 0}, H, dof_setup, NULL,
+     upsample_run, dof_free},
+    {"dof_pyrblur_row", "1280x1440, 1440 rows, 5 levels", {F(dof_pyrblur_row), 0}, H, dof_setup, NULL, pyrblur_run,
      dof_free},
     {"dof_combine_row", "1280x1440, 1440 rows, all layers", {F(dof_combine_row), 0}, H, dof_setup, NULL, combine_run,
      dof_free},
