@@ -8,7 +8,8 @@ Each FILE is a scene bench (fovea-bench --json) or a kernel bench (--kernels --j
   scaling.png   per-stage scaling efficiency t(1) / (n t(n)) against threads (--sweep threads=...)
   sweep-P.png   per-stage time against each other swept parameter P (pmin, size, r0, r1)
   roofline.png  fraction of the measured copy bandwidth per post-processing stage
-  kernels.png   kernel speed-ups against the C reference per ISA
+  kernels.png   kernel speed-ups against the C reference per ISA (and, from
+                tools/kernel_icount.py --json, NEON's instruction ratio under qemu)
 Charts whose data is absent are skipped. Prints the files written.
 """
 import json
@@ -37,7 +38,7 @@ def scene_name(d):
 
 
 def head(out, w=1000, h=560):
-    return 'set terminal pngcairo size %d,%d font ",10"\nset output "%s"\nset grid ytics\nset key outside right\n' % (
+    return 'set terminal pngcairo noenhanced size %d,%d font ",10"\nset output "%s"\nset grid ytics\nset key outside right\n' % (
         w, h, out)
 
 
@@ -141,7 +142,12 @@ def roofline_chart(scenes, out):
 def kernels_chart(kern, out):
     isas, names, sp = [], [], {}
     for k in kern:
-        for r in k["kernels_bench"]["results"]:
+        for r in k.get("kernel_icount", {}).get("results", []):
+            if r["ratio"]:
+                if "neon (insn ratio, qemu)" not in isas:
+                    isas.append("neon (insn ratio, qemu)")
+                sp[(r["kernel"], "neon (insn ratio, qemu)")] = r["ratio"]
+        for r in k.get("kernels_bench", {}).get("results", []):
             if r["isa"] not in isas:
                 isas.append(r["isa"])
             if r["kernel"] not in names:
@@ -170,7 +176,7 @@ def main():
     for p in sys.argv[2:]:
         with open(p) as f:
             d = json.load(f)
-        (kern if "kernels_bench" in d else scenes).append(d)
+        (kern if "kernels_bench" in d or "kernel_icount" in d else scenes).append(d)
     outs = [stages_chart(scenes, os.path.join(outdir, "stages.png")),
             scaling_chart(scenes, os.path.join(outdir, "scaling.png")),
             roofline_chart(scenes, os.path.join(outdir, "roofline.png")),
