@@ -9,12 +9,14 @@ How (Debian's qemu-user 7.2 ships no TCG plugins, so no libinsn.so; valgrind is 
      inputs up, makes N calls and prints where the kernel's code is (guest addresses);
   2. the code's extent comes from `aarch64-linux-gnu-nm -S` (symbol sizes, the binary is PIE and
      qemu-user loads it at 0x5500000000); the taa entry also counts fv_taa_tile_run;
-  3. qemu-aarch64 runs it again with `-d in_asm,exec,nochain -dfilter RANGES`: in_asm logs every
+  3. qemu-aarch64 runs it twice (N and 3N calls) with `-d in_asm,exec,nochain -dfilter RANGES`: in_asm logs every
      translated block in those ranges with its instructions, exec (with chaining off) every
      execution of such a block; instructions = sum over executions of the block's length.
-Only instructions inside the kernel's own functions count (calls into libm or other helpers
-are not; the kernels make none). The set-up is outside the ranges, so it costs nothing in the
-log. Prints instructions per call and the C / NEON ratio (a proxy for the speed-up: it ignores
+The ranges are every function of the source files the kernel's code comes from (its static
+helpers, e.g. reproject's `tap`) and, for NEON, of the C reference's file too (the NEON kernels
+finish odd tails with the C reference); calls into libc / libm are not counted (the kernels make
+none). Set-up code in those files cancels out: each count is the difference between a run of N
+and one of 3N calls, over 2N. Prints instructions per call and the C / NEON ratio (a proxy for the speed-up: it ignores
 latencies, memory and issue width).
 """
 import json
@@ -41,38 +43,23 @@ def kernels(bench):
 
 
 def symbols(bench):
+    """(address, size, name, source file) of every function in the binary (nm -l: debug info)."""
     syms = []
-    out = subprocess.run(["aarch64-linux-gnu-nm", "-S", "--defined-only", bench], capture_output=True,
+    out = subprocess.run(["aarch64-linux-gnu-nm", "-S", "-l", "--defined-only", bench], capture_output=True,
                          text=True, check=True).stdout
     for line in out.splitlines():
-        p = line.split()
-        if len(p) == 4 and p[2] in "tTwW":
-            syms.append((int(p[0], 16), int(p[1], 16), p[3]))
+        p = line.split("\t")
+        q = p[0].split()
+        if len(q) == 4 and q[2] in "tTwW":
+            src = p[1].rsplit(":", 1)[0] if len(p) > 1 else ""
+            syms.append((int(q[0], 16), int(q[1], 16), q[3], src))
     return syms
 
 
-def count(bench, kernel, isa, calls, syms):
-    r = subprocess.run(["qemu-aarch64", bench, "--kernels", "--kernel", kernel, "--calls", str(calls), "--isa", isa],
-                       capture_output=True, text=True)
-    if r.returncode:
-        raise RuntimeError(r.stderr.strip())
-    addrs = [int(a, 16) for a in re.findall(r"0x[0-9a-f]+", r.stdout.split("code at")[1])]
-    ranges, fnames = [], []
-    for a in addrs:
-        for s, n, name in syms:
-            if s + BASE == a:
-                ranges.append((a, n))
-                fnames.append(name)
-    if kernel.startswith("taa"):
-        for s, n, name in syms:
-            if name == "fv_taa_tile_run":
-                ranges.append((s + BASE, n))
-                fnames.append(name)
-    if not ranges:
-        raise RuntimeError("no symbol at %s" % addrs)
+def run_logged(bench, kernel, isa, calls, dfilter):
+    """Instructions executed inside the dfilter ranges by one run."""
     with tempfile.TemporaryDirectory() as d:
         log = os.path.join(d, "q.log")
-        dfilter = ",".join("0x%x+0x%x" % (a, n) for a, n in ranges)
         subprocess.run(["qemu-aarch64", "-d", "in_asm,exec,nochain", "-dfilter", dfilter, "-D", log, bench,
                         "--kernels", "--kernel", kernel, "--calls", str(calls), "--isa", isa],
                        capture_output=True, check=True)
@@ -84,9 +71,8 @@ def count(bench, kernel, isa, calls, syms):
                     continue
                 m = re.match(r"^0x([0-9a-f]+):\s", line)
                 if m:
-                    pc = int(m.group(1), 16)
                     if cur is None:
-                        cur = pc
+                        cur = int(m.group(1), 16)
                         tb[cur] = 0
                     tb[cur] += 1
                     continue
@@ -96,7 +82,35 @@ def count(bench, kernel, isa, calls, syms):
                 m = re.match(r"^Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/", line)
                 if m:
                     total += tb.get(int(m.group(1), 16), 0)
-    return total / calls, fnames
+    return total
+
+
+def code_addrs(bench, kernel, isa):
+    r = subprocess.run(["qemu-aarch64", bench, "--kernels", "--kernel", kernel, "--calls", "1", "--isa", isa],
+                       capture_output=True, text=True)
+    if r.returncode:
+        raise RuntimeError(r.stderr.strip())
+    return [int(a, 16) for a in re.findall(r"0x[0-9a-f]+", r.stdout.split("code at")[1])]
+
+
+def count(bench, kernel, isa, calls, syms):
+    """Instructions per call: every function of the source files of the kernel's code (its
+    static helpers) and, for an ISA version, of the C reference's (its tails) are counted; the
+    set-up's share cancels between a run of `calls` and one of 3 `calls` calls."""
+    files, names = set(), []
+    for a in code_addrs(bench, kernel, isa) + (code_addrs(bench, kernel, "c") if isa != "c" else []):
+        for s, n, name, src in syms:
+            if s + BASE == a:
+                files.add(src)
+                names.append(name)
+    if kernel.startswith("taa"):
+        files |= {src for s, n, name, src in syms if name == "fv_taa_tile_run"}
+    if not files:
+        raise RuntimeError("no symbol at the kernel's address")
+    dfilter = ",".join("0x%x+0x%x" % (s + BASE, n) for s, n, name, src in syms if src in files and n > 0)
+    i1 = run_logged(bench, kernel, isa, calls, dfilter)
+    i3 = run_logged(bench, kernel, isa, 3 * calls, dfilter)
+    return (i3 - i1) / (2 * calls), names[:1]
 
 
 def main():
