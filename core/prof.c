@@ -95,6 +95,17 @@ void fv_prof_instant(fv_prof *p, int slot, int track, const char *name, int64_t 
     put(p, slot, track, name, t_ns, t_ns, arg, 'i');
 }
 
+void fv_prof_frame_markers(fv_prof *p, long frame, int64_t gaze_latch_ns, int64_t photon_ns, int late)
+{
+    if (!p)
+        return;
+    const int f = (int)(frame & 0x7fffffff);
+    put(p, 0, FV_PROF_TRACK_MARKERS, "gaze latch", gaze_latch_ns, gaze_latch_ns, f, 'i');
+    if (late)
+        put(p, 0, FV_PROF_TRACK_MARKERS, "late", photon_ns, photon_ns, f, 'i');
+    put(p, 0, FV_PROF_TRACK_MARKERS, "vsync", photon_ns, photon_ns, f, 'i');
+}
+
 void fv_prof_set_stage_hook(fv_prof *p, fv_prof_stage_hook fn, void *ctx)
 {
     p->hook = fn;

@@ -52,6 +52,13 @@ int64_t fv_prof_now(void); /* CLOCK_MONOTONIC, ns */
 void fv_prof_span(fv_prof *p, int slot, int track, const char *name, int64_t t0_ns, int64_t t1_ns, int arg);
 void fv_prof_instant(fv_prof *p, int slot, int track, const char *name, int64_t t_ns, int arg);
 
+/* The frame loop's markers (core/frameloop.h's fv_frame_record, CLOCK_MONOTONIC times), for the
+ * headset: instants "gaze latch" (the newest gaze sample taken, just before the rays) and "vsync"
+ * (the photon time: the edge the frame was shown from) on the markers track, "late" when the
+ * frame missed its target vsync; arg = the frame number. Records on slot 0: call it from the
+ * thread that renders (the pipeline pool's worker 0). p may be NULL. */
+void fv_prof_frame_markers(fv_prof *p, long frame, int64_t gaze_latch_ns, int64_t photon_ns, int late);
+
 /* Per-stage hook (hardware counters): called on the rendering thread at the start (end = 0) and
  * the end (end = 1) of each FV_PROF_* stage, with p NULL-checked by the caller's helper below. */
 typedef void (*fv_prof_stage_hook)(void *ctx, int stage, int end);

@@ -32,6 +32,13 @@ static void test_ring(void **state)
     assert_int_equal(fv_prof_count(p, 0), 1);
     assert_true(fv_prof_event_at(p, 0, 0)->kind == 'i');
     assert_int_equal(fv_prof_count(p, 2), 0);
+    fv_prof_frame_markers(p, 41, 1000, 2000, 1); /* the headset's markers: latch, late, vsync */
+    fv_prof_frame_markers(NULL, 41, 1000, 2000, 1);
+    assert_int_equal(fv_prof_count(p, 0), 4);
+    assert_string_equal(fv_prof_event_at(p, 0, 1)->name, "gaze latch");
+    assert_string_equal(fv_prof_event_at(p, 0, 3)->name, "vsync");
+    assert_true(fv_prof_event_at(p, 0, 3)->t0_ns == 2000 && fv_prof_event_at(p, 0, 3)->arg == 41);
+    assert_int_equal(fv_prof_event_at(p, 0, 2)->track, FV_PROF_TRACK_MARKERS);
     fv_prof_destroy(p);
 }
 
