@@ -34,7 +34,10 @@ def num(v):
 
 
 def scene_name(d):
-    return os.path.splitext(os.path.basename(d["scene"]))[0]
+    """The scene's name, and the JSON file's when it differs (two runs of one scene)."""
+    n = os.path.splitext(os.path.basename(d["scene"]))[0]
+    f = d.get("_file", n)
+    return n if f.lower() in n.lower() else "%s [%s]" % (n, f)
 
 
 def head(out, w=1000, h=560):
@@ -176,6 +179,7 @@ def main():
     for p in sys.argv[2:]:
         with open(p) as f:
             d = json.load(f)
+        d["_file"] = os.path.splitext(os.path.basename(p))[0]
         (kern if "kernels_bench" in d or "kernel_icount" in d else scenes).append(d)
     outs = [stages_chart(scenes, os.path.join(outdir, "stages.png")),
             scaling_chart(scenes, os.path.join(outdir, "scaling.png")),
