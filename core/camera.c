@@ -97,7 +97,10 @@ int fv_camera_setup(fv_camera *c, const fv_camera_desc *d, const fv_pose *head)
     c->lens_on = d->lens != NULL;
     c->lens_k1 = c->lens_k2 = c->lens_cx = c->lens_cy = 0.0f;
     c->lens_scale = 1.0f;
+    c->lens_scale_rgb[0] = c->lens_scale_rgb[1] = c->lens_scale_rgb[2] = 1.0f;
     if (d->lens) {
+        for (int i = 0; i < 3; i++)
+            c->lens_scale_rgb[i] = d->lens->scale[i];
         const float *ctr = d->lens->center[d->eye == FV_EYE_RIGHT ? 1 : 0];
         c->lens_k1 = d->lens->k1;
         c->lens_k2 = d->lens->k2;

@@ -24,6 +24,7 @@ typedef struct fv_camera {
     /* lens distortion (fv_camera_desc.lens): rays go along the distorted directions */
     int lens_on;
     float lens_k1, lens_k2, lens_scale; /* the green channel's */
+    float lens_scale_rgb[3];            /* all three (lateral chromatic aberration) */
     float lens_cx, lens_cy;             /* lens centre, tangent units */
 } fv_camera;
 

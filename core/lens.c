@@ -63,3 +63,23 @@ int fv_lens_undistort(float k1, float k2, float scale, float cx, float cy, float
     *ty = (float)(cy + vy * s);
     return 0;
 }
+
+void fv_lens_lca_init(fv_lens_lca *t, float k1, float k2, const float scale[3], float r_max)
+{
+    t->on = scale[FV_LENS_R] != scale[FV_LENS_G] || scale[FV_LENS_B] != scale[FV_LENS_G];
+    t->r_max = r_max > 0.0f ? r_max : 1.0f;
+    t->inv_step = (float)FV_LENS_LCA_STEPS / t->r_max;
+    for (int ch = 0; ch < 2; ch++) {
+        const float sc = scale[ch == 0 ? FV_LENS_R : FV_LENS_B];
+        for (int i = 0; i <= FV_LENS_LCA_STEPS; i++) {
+            /* r = 0: the limit of the ratio is sc / scale_g (the radial functions' slopes) */
+            const double r = i ? (double)t->r_max * i / FV_LENS_LCA_STEPS : 1e-6;
+            const double r2 = r * r, d = sc * r * (1.0 + k1 * r2 + k2 * r2 * r2); /* |D_c(P) - c| */
+            float qx = 0.0f, qy = 0.0f;
+            /* Q on the same ray from c: solve green's radial function for |d| */
+            if (fv_lens_undistort(k1, k2, scale[FV_LENS_G], 0.0f, 0.0f, (float)d, 0.0f, &qx, &qy))
+                qx = (float)r; /* beyond the invertible range: no correction */
+            t->ratio[ch][i] = (float)((double)qx / r);
+        }
+    }
+}

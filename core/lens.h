@@ -3,11 +3,15 @@
  *     centre + u * scale_c * (1 + k1 r^2 + k2 r^4)
  * (radial polynomial; scale_c per colour channel c models lateral chromatic aberration).
  * Rendering rays along that direction pre-distorts the image, so no resampling pass is needed.
- * Rays are cast for the green channel (one ray per pixel); the red and blue scales are kept in
- * the model for a per-channel pass (not built: see docs/headset.md). */
+ * Rays are cast for the green channel (one ray per pixel). Red and blue go along their own
+ * directions: where green's image shows direction D at panel point Q, red at panel point P must
+ * show D_r(P), so red at P is read from the rendered image at Q = D_g^-1(D_r(P)) (radial, so a
+ * 1-D table of |Q - c| / |P - c| against |P - c|), fused into the conversion to display bytes
+ * (fv_lens_lca_*): no extra pass over the image. */
 #ifndef FOVEA_LENS_H
 #define FOVEA_LENS_H
 
+#include <math.h>
 #include <stddef.h>
 
 enum { FV_LENS_R = 0, FV_LENS_G = 1, FV_LENS_B = 2 };
@@ -38,5 +42,30 @@ static inline void fv_lens_distort(float k1, float k2, float scale, float cx, fl
 /* The inverse: the panel point that is seen along (dx, dy). 0, or -1 when Newton's method did
  * not converge (outside the invertible range). */
 int fv_lens_undistort(float k1, float k2, float scale, float cx, float cy, float dx, float dy, float *tx, float *ty);
+
+/* Lateral chromatic aberration: per channel (R, B) the ratio |Q - c| / |P - c| against
+ * r = |P - c| in FV_LENS_LCA_STEPS steps up to r_max (tangent units). */
+#define FV_LENS_LCA_STEPS 1024
+typedef struct fv_lens_lca {
+    int on;                                   /* red or blue scale differs from green's */
+    float r_max, inv_step;
+    float ratio[2][FV_LENS_LCA_STEPS + 1];    /* [0] red, [1] blue */
+} fv_lens_lca;
+/* Builds the tables for radii up to r_max; on = 0 when there is nothing to correct. */
+void fv_lens_lca_init(fv_lens_lca *t, float k1, float k2, const float scale[3], float r_max);
+/* The panel point (tangent units) whose green ray carries channel ch's (0 red, 1 blue) direction
+ * at panel point (tx, ty); (cx, cy) = lens centre. */
+static inline void fv_lens_lca_source(const fv_lens_lca *t, int ch, float cx, float cy, float tx, float ty, float *qx,
+                                      float *qy)
+{
+    const float ux = tx - cx, uy = ty - cy;
+    float f = sqrtf(ux * ux + uy * uy) * t->inv_step;
+    f = f < (float)FV_LENS_LCA_STEPS ? f : (float)FV_LENS_LCA_STEPS;
+    int i = (int)f;
+    i = i < FV_LENS_LCA_STEPS ? i : FV_LENS_LCA_STEPS - 1;
+    const float a = f - (float)i, s = t->ratio[ch][i] + a * (t->ratio[ch][i + 1] - t->ratio[ch][i]);
+    *qx = cx + ux * s;
+    *qy = cy + uy * s;
+}
 
 #endif

@@ -263,6 +263,36 @@ static void test_far_gaussian_profile(void **st)
     rig_free(&r);
 }
 
+/* Patney's contrast enhancement, in focus (only it acts): a flat area is left exactly as it is
+ * (the blur of a constant is that constant); across a step edge in the periphery the bright
+ * side overshoots and the dark side clamps at 0; far from the edge nothing changes. */
+static void step_in_focus(int x, int y, float px[4])
+{
+    (void)y;
+    px[0] = px[1] = px[2] = x >= 100 ? 0.8f : 0.2f;
+    px[3] = 2.0f;
+}
+
+static void test_contrast_enhancement(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, step_in_focus, FV_DOF_WEAK, 2.0f, -300.0f, 80.0f); /* all in the periphery */
+    r.prm.contrast_gain = 0.5f;
+    static const float fp[4] = {3.0f, 3.0f, 3.0f, 3.0f};
+    r.v.enh_fp = fp, r.v.enh_n = 4, r.v.enh_step = 1000.0f;
+    rig_run(&r, NULL, ~0u);
+    for (int y = 0; y < H; y++) {
+        assert_memory_equal(out_px(&r, 10, y), in_px(&r, 10, y), 4 * sizeof(float));
+        assert_memory_equal(out_px(&r, 190, y), in_px(&r, 190, y), 4 * sizeof(float));
+    }
+    assert_true(out_px(&r, 100, 80)[0] > 0.85f);                 /* overshoot on the bright side */
+    assert_true(out_px(&r, 99, 80)[0] < 0.15f);                  /* undershoot on the dark side */
+    assert_true(out_px(&r, 99, 80)[0] >= 0.0f);
+    assert_true(out_px(&r, 100, 80)[0] > out_px(&r, 103, 80)[0]); /* fading away from the edge */
+    rig_free(&r);
+}
+
 /* The CoC row kernel against eq. (3) in double (core/dof/coc.c), every ISA. */
 static void test_coc_row_matches_eq3(void **st)
 {
@@ -336,6 +366,7 @@ int main(void)
         cmocka_unit_test(test_near_spreads_fovea),
         cmocka_unit_test(test_near_spreads_periphery),
         cmocka_unit_test(test_far_gaussian_profile),
+        cmocka_unit_test(test_contrast_enhancement),
         cmocka_unit_test(test_coc_row_matches_eq3),
         cmocka_unit_test(test_threads_and_isas_identical),
     };

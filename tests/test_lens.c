@@ -140,12 +140,48 @@ static void test_camera(void **st)
         }
 }
 
+/* Lateral chromatic aberration: the table's source point for red / blue at panel point P is the
+ * point Q whose green ray goes where P's red / blue ray goes, checked against the direct
+ * construction (distort with the channel's scale, undistort with green's, in double). */
+static void test_lca_source(void **st)
+{
+    (void)st;
+    const float k1 = 0.22f, k2 = 0.04f, scale[3] = {1.012f, 1.0f, 0.985f};
+    fv_lens_lca t;
+    fv_lens_lca_init(&t, k1, k2, scale, 1.6f);
+    assert_true(t.on);
+    uint64_t rng = 7;
+    for (int i = 0; i < 2000; i++) {
+        const float cx = 0.05f, cy = -0.02f;
+        const float tx = cx + 2.2f * (fv_test_randf(&rng) - 0.5f), ty = cy + 2.2f * (fv_test_randf(&rng) - 0.5f);
+        for (int ch = 0; ch < 2; ch++) {
+            float dx, dy, ex, ey, qx, qy;
+            fv_lens_distort(k1, k2, scale[ch ? 2 : 0], cx, cy, tx, ty, &dx, &dy);
+            assert_int_equal(fv_lens_undistort(k1, k2, scale[1], cx, cy, dx, dy, &ex, &ey), 0);
+            fv_lens_lca_source(&t, ch, cx, cy, tx, ty, &qx, &qy);
+            assert_float_equal(qx, ex, 2e-5f);
+            assert_float_equal(qy, ey, 2e-5f);
+        }
+    }
+    /* red spreads outwards of green, blue inwards, by about the scale ratio near the centre */
+    float qx, qy;
+    fv_lens_lca_source(&t, 0, 0.0f, 0.0f, 0.01f, 0.0f, &qx, &qy);
+    assert_float_equal(qx, 0.01f * 1.012f, 2e-6f);
+    fv_lens_lca_source(&t, 1, 0.0f, 0.0f, 0.01f, 0.0f, &qx, &qy);
+    assert_float_equal(qx, 0.01f * 0.985f, 2e-6f);
+    /* equal scales: nothing to do */
+    const float same[3] = {1.0f, 1.0f, 1.0f};
+    fv_lens_lca_init(&t, k1, k2, same, 1.6f);
+    assert_false(t.on);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse),
         cmocka_unit_test(test_formula_and_round_trip),
         cmocka_unit_test(test_camera),
+        cmocka_unit_test(test_lca_source),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

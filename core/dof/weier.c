@@ -29,8 +29,9 @@
  *
  * Combine (stage "combine"): sharp -> far layer by min(1, c) (a CoC of one pixel is fully
  * blurred), near layer alpha-blended with its coverage, then optionally Patney et al. 2016's
- * contrast enhancement in the transition and periphery: out + gain t (out - blur), the blur one
- * pyramid level (the sampling footprint 1 / sqrt(p) there) up-sampled.
+ * contrast enhancement in the transition and periphery: out + gain t (out - blur), the blur read
+ * from the pyramid like the periphery's own blur, its width following the sampling footprint
+ * 1 / sqrt(p) at the pixel's eccentricity (sigma = footprint / 2).
  *
  * The filter's vertical pass and the combine run fused per row (the layers never go to memory
  * as full images); their times are the workers' time in each, scaled to the pass's wall time.
@@ -48,7 +49,8 @@
 
 #define TILE 16
 #define LOW 4          /* the near layer's reduced resolution in the periphery: 4x4 blocks */
-#define NSLOT 9        /* per-thread row buffers of the fused vertical + combine pass */
+#define NSLOT 13       /* per-thread row buffers of the fused vertical + combine pass */
+#define ENH_LEVELS 3   /* contrast enhancement: levels 1..3 (footprints up to ~8 px) */
 #define MAX_UP_LEVEL 5 /* periphery far blur: levels 1..5 (CoC up to 64 px) */
 #define LAMBDA_STEPS 8 /* the level LUT's steps per pixel of CoC */
 
@@ -147,7 +149,7 @@ typedef struct {
     int l_reach;               /* the largest radius there */
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
     float lambda[64 * LAMBDA_STEPS + 1]; /* CoC -> continuous pyramid level */
-    int enh_level;             /* contrast enhancement: the pyramid level of its blur, 0 = off */
+    int enh_on;                /* contrast enhancement runs */
     float *band_ms;            /* per band: worker time (ms) in the filter and the combine (pairs) */
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
 } wctx;
@@ -387,9 +389,10 @@ static void vcombine_band(void *ctx, int band, int tid)
     const ptrdiff_t st = x->wk->stride;
     const int y0 = band * TILE, y1 = mini(y0 + TILE, x->h);
     /* slots: 0 far, 1 near, 2..7 the far periphery's temporary and up-sampled levels, reused
-     * afterwards by the near layer's up-sampling (3, 4) and the enhancement's (5, 6); 8 t */
+     * afterwards by the near layer's up-sampling (3, 4) and the enhancement's levels (5..7);
+     * 8 t; the enhancement's CoC-like width (9), result (10), temporary (11), ones (12) */
     float *far = slot(x, tid, 0), *near = slot(x, tid, 1), *trow = slot(x, tid, 8);
-    float *enh = x->enh_level > 0 ? slot(x, tid, 5) : NULL;
+    float *enh = x->enh_on ? slot(x, tid, 10) : NULL;
     uint8_t sig[TILE * 8];
     double filter_ns = 0.0, combine_ns = 0.0;
     for (int y = y0; y < y1; y++) {
@@ -466,9 +469,33 @@ static void vcombine_band(void *ctx, int band, int tid)
             upsample_row(x->dsp, &im, 2, &x->xt[2], y, x->w, slot(x, tid, 4), lup); /* LOW = 2^2 */
         }
         if (enh) {
-            const fv_pyr_level *lv = &v->pyr->lv[x->enh_level];
-            const img4 im = {lv->rgbd, lv->w, lv->h, lv->stride};
-            upsample_row(x->dsp, &im, x->enh_level, &x->xt[x->enh_level], y, x->w, slot(x, tid, 6), enh);
+            /* Patney's blur, its width following the sampling footprint fp(eccentricity): the
+             * periphery's own-blur kernel with a "CoC" of 2 fp (sigma fp / 2) */
+            float *ecoc = slot(x, tid, 9), *ones = slot(x, tid, 12), *up[ENH_LEVELS + 1];
+            float emax = 0.0f;
+            for (int i = 0; i < x->w; i++) {
+                ecoc[i] = 0.0f;
+                ones[i] = 1.0f;
+                if (!(trow[i] > 0.0f))
+                    continue;
+                const float dx = (float)i + 0.5f - v->gaze_x, ecc = sqrtf(dx * dx + dyr * dyr);
+                const int e = (int)(ecc / v->enh_step);
+                ecoc[i] = 2.0f * v->enh_fp[e < v->enh_n - 1 ? e : v->enh_n - 1];
+                emax = ecoc[i] > emax ? ecoc[i] : emax;
+            }
+            const float lm = x->lambda[mini((int)(emax * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
+            const int need = mini(mini((int)lm + (lm > (float)(int)lm), ENH_LEVELS), x->up_levels);
+            up[0] = (float *)sharp;
+            for (int L = 1; L <= need; L++) {
+                const fv_pyr_level *lv = &v->pyr->lv[L];
+                const img4 im = {lv->rgbd, lv->w, lv->h, lv->stride};
+                up[L] = slot(x, tid, 4 + L);
+                upsample_row(x->dsp, &im, L, &x->xt[L], y, x->w, slot(x, tid, 11), up[L]);
+            }
+            const fv_dof_pyrblur_args ea = {.coc = ecoc, .t = ones, .up = (const float *const *)up, .need = need,
+                                            .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS,
+                                            .lambda_max = 64 * LAMBDA_STEPS};
+            x->dsp->dof_pyrblur_row(enh, &ea, 0, x->w);
         }
         const int64_t tb = fv_time_ns();
         fv_dof_combine_args a = {.sharp = sharp, .coc = coc, .far = far, .near = nfull, .lnear = lup, .t = trow,
@@ -560,15 +587,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
         }
         x->lambda[i] = l;
     }
-    /* Patney's kernel follows the sampling footprint 1/sqrt(p): the level whose texel covers the
-     * periphery's footprint; its strength ramps with the transition weight t */
-    if (v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0) {
-        float fp = 1.0f;
-        for (int i = 0; i < v->enh_n; i++)
-            fp = v->enh_fp[i] > fp ? v->enh_fp[i] : fp;
-        x->enh_level = clampi((int)floorf(log2f(fp) + 0.5f), 0, mini(v->pyr->levels - 1, MAX_UP_LEVEL));
-    }
-
+    x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
     const int64_t t0 = fv_time_ns();
     fv_pool_run(pool, x->th, coc_band, x);
     dilate_tiles(x);
