@@ -208,7 +208,7 @@ bench:
 	    --json out/bench/range-sweeps.json
 	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 3 --warmup 1 --dof weak \
 	    --trace-out out/bench/range-trace.json >/dev/null
-	tools/plot_bench.py out/bench out/bench/range-dof.json out/bench/range-scaling.json out/bench/range-sweeps.json \
+	python3 tools/plot_bench.py out/bench out/bench/range-dof.json out/bench/range-scaling.json out/bench/range-sweeps.json \
 	    out/bench/kernels.json
 	@echo "charts: out/bench/*.png   trace (Perfetto / chrome://tracing): out/bench/range-trace.json"
 
