@@ -1,6 +1,7 @@
 #include "prof.h"
 
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "pipeline.h"
@@ -42,11 +43,14 @@ fv_prof *fv_prof_create(int slots, size_t capacity)
         free(p);
         return NULL;
     }
-    for (int s = 0; s < slots; s++)
+    for (int s = 0; s < slots; s++) {
         if (!(p->r[s].ev = malloc(cap * sizeof *p->r[s].ev))) {
             fv_prof_destroy(p);
             return NULL;
         }
+        /* touched now, so that no page fault lands in a recorded frame */
+        memset(p->r[s].ev, 0, cap * sizeof *p->r[s].ev);
+    }
     return p;
 }
 
