@@ -190,7 +190,8 @@ run: deps
 	$(BUILD)/bin/fovea-replay --scene $(RANGE) --trace assets/gaze_sweep.csv --frames 120 --out out/run
 	@echo "frames: out/run/frame_*.png   stats: out/run/stats.csv"
 
-bench: deps
+bench:
+	@tools/deps.sh --bench
 	@$(MAKE) --no-print-directory all $(RANGE)
 	@mkdir -p out/bench
 	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 30 --json out/bench/range.json
@@ -199,6 +200,17 @@ bench: deps
 	for m in hussain mantiuk konrad liu; do \
 	    $(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 5 --warmup 1 --dof weak --dof-model $$m \
 	        --json out/bench/range-dof-$$m.json || exit 1; done
+	$(BUILD)/bin/fovea-bench --kernels --json out/bench/kernels.json
+	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode both --frames 10 --warmup 2 --dof weak --sweep threads=1..$(shell nproc) \
+	    --json out/bench/range-scaling.json
+	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 5 --warmup 2 --dof weak \
+	    --sweep pmin=0.05,0.1,0.2,0.4 --sweep size=640x720,960x1080,1280x1440 --sweep r0=5,10,15 \
+	    --json out/bench/range-sweeps.json
+	$(BUILD)/bin/fovea-bench --scene $(RANGE) --mode foveated --frames 3 --warmup 1 --dof weak \
+	    --trace-out out/bench/range-trace.json >/dev/null
+	python3 tools/plot_bench.py out/bench out/bench/range-dof.json out/bench/range-scaling.json out/bench/range-sweeps.json \
+	    out/bench/kernels.json
+	@echo "charts: out/bench/*.png   trace (Perfetto / chrome://tracing): out/bench/range-trace.json"
 
 PREFIX ?= /usr/local
 install: all

@@ -13,6 +13,8 @@
 #include "reference.h"
 #include "scene.h"
 #include "trace.h"
+#include "prof.h"
+#include "proftrace.h"
 
 static const char *prog = "fovea-replay";
 
@@ -40,12 +42,14 @@ static void usage(FILE *f)
             "                     per pixel (every pixel; stage columns empty, total_ms its time)\n"
             "                     (--focus-m and --pupil-mm below set its lens; the default focus\n"
             "                     is the view depth at the point of regard)\n"
+            "  --trace-out FILE   write a Chrome trace-event JSON of the run (Perfetto,\n"
+            "                     chrome://tracing): worker, stage and ray-tile tracks, frame markers\n"
             "  --window           show frames in a window (not built yet)\n"
             "  --quiet            no progress output\n" FV_COMMON_HELP "  --help             this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_TRACE, OPT_FRAMES, OPT_OUT, OPT_FULL, OPT_STEREO, OPT_Y4M, OPT_REF, OPT_WINDOW, OPT_HZ,
-       OPT_QUIET, OPT_VS_FULL, OPT_HELP };
+       OPT_QUIET, OPT_VS_FULL, OPT_TRACE_OUT, OPT_HELP };
 
 /* --reference: the thin-lens ground truth (core/reference.h) of one eye into rgb8. The focus is
  * fixed by the caller for both eyes (they accommodate together). Progress counts tiles. */
@@ -101,7 +105,7 @@ int main(int argc, char **argv)
 {
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
-    const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL;
+    const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0;
     fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
@@ -113,6 +117,7 @@ int main(int argc, char **argv)
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
         {"window", no_argument, 0, OPT_WINDOW}, {"hz", required_argument, 0, OPT_HZ},
         {"quiet", no_argument, 0, OPT_QUIET}, {"vs-full", no_argument, 0, OPT_VS_FULL},
+        {"trace-out", required_argument, 0, OPT_TRACE_OUT},
         {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -128,6 +133,7 @@ int main(int argc, char **argv)
         case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
         case OPT_QUIET: quiet = 1; break;
         case OPT_VS_FULL: vs_full = 1; break;
+        case OPT_TRACE_OUT: prof_path = optarg; break;
         case OPT_REF: refp.spp = (int)fv_arg_long(prog, "--reference", optarg, 1, 65536); break;
         case OPT_WINDOW: fv_usage_error(prog, "--window: the window display is not built yet; use --out / --y4m");
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
@@ -178,6 +184,18 @@ int main(int argc, char **argv)
     }
 
     int status = FV_EXIT_FAIL;
+    /* the trace recorder: one slot per worker of the (rendering) pipeline's pool */
+    fv_prof *prof = NULL;
+    if (prof_path) {
+        if (!(prof = fv_prof_create(fv_pool_threads(fv_pipeline_pool(pl)), (size_t)1 << 18))) {
+            fv_pipeline_destroy(ref);
+            fv_pipeline_destroy(pl);
+            fv_scene_free(scene);
+            fv_trace_free(&tr);
+            fv_fail(prog, FV_EXIT_FAIL, "out of memory for the trace recorder");
+        }
+        fv_pipeline_set_prof(pl, prof);
+    }
     int outw = stereo ? 2 * W : W;
     /* cur / prev: the (left) eye's image of this and the last frame, W * 3 bytes a row */
     uint8_t *rgb = malloc((size_t)outw * H * 3), *prev = malloc((size_t)W * H * 3), *cur = malloc((size_t)W * H * 3);
@@ -238,6 +256,7 @@ int main(int argc, char **argv)
         if (ref)
             fv_pipeline_set_time_ns(ref, (int64_t)llround(t_ms * 1e6));
         fv_pose head = tr.has_head ? smp.head : view;
+        fv_prof_instant(prof, 0, FV_PROF_TRACK_MARKERS, "frame", fv_prof_now(), (int)f);
         fv_frame_stats st[2], sum;
         memset(&sum, 0, sizeof sum);
         for (int e = 0; e < neyes; e++) {
@@ -342,6 +361,15 @@ int main(int argc, char **argv)
                    prog, mean_get(&m_all), mean_get(&m_fov), mean_get(&m_per), mean_get(&m_fl));
     }
     status = FV_EXIT_OK;
+    if (prof) {
+        char label[600];
+        snprintf(label, sizeof label, "fovea-replay %s", scene_path);
+        fv_pipeline_set_prof(pl, NULL);
+        if (fv_prof_write_json(prof, prof_path, label, err, sizeof err)) {
+            fprintf(stderr, "%s: %s\n", prog, err);
+            status = FV_EXIT_FAIL;
+        }
+    }
 done:
     fv_afile_abort(&csv);
     if (y4m_open)
@@ -355,6 +383,7 @@ done:
     free(refbuf);
     fv_pipeline_destroy(ref);
     fv_pipeline_destroy(pl);
+    fv_prof_destroy(prof);
     fv_scene_free(scene);
     fv_trace_free(&tr);
     return status;

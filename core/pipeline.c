@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "prof.h"
 #include "raycast.h"
 #include "err.h"
 
@@ -46,6 +47,7 @@ struct fv_pipeline {
     const fv_sampler *enh_for; /* the sampler enh_fp was computed for (the fovea may widen) */
     int64_t t_ns;            /* the frame time set by fv_pipeline_set_time_ns; INT64_MIN: none */
     eye_state eyes[2];
+    fv_prof *prof;           /* trace recorder (fv_pipeline_set_prof); NULL: off */
     uint8_t srgb[SRGB_LUT + 1]; /* linear [0,1] -> sRGB 8-bit */
 };
 
@@ -258,6 +260,21 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
     st->stage_ms[FV_STAGE_COMBINE] = t.combine_ms;
 }
 
+/* A stage's span on its own track (recorded by the rendering thread, slot 0). */
+static void prof_stage(fv_prof *prof, int stage, int64_t t0, fv_eye eye)
+{
+    if (prof) {
+        const int64_t t1 = fv_prof_stage_mark(prof, stage, 1);
+        fv_prof_span(prof, 0, FV_PROF_TRACK_STAGE + stage, fv_prof_stage_names[stage], t0, t1, (int)eye);
+    }
+}
+
+void fv_pipeline_set_prof(fv_pipeline *p, fv_prof *prof)
+{
+    p->prof = prof;
+    fv_pool_set_prof(p->pool, prof);
+}
+
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
                        fv_frame_stats *st)
 {
@@ -285,7 +302,9 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     const int dst = p->taa ? es->cur ^ 1 : 0;
     fv_pyramid *pyr = &es->pyr[dst];
     fv_taa_frame tf;
-    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa};
+    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa,
+                           .prof = p->prof};
+    const int64_t pf0 = fv_prof_stage_mark(p->prof, FV_PROF_FRAME, 0), pc0 = fv_prof_stage_mark(p->prof, FV_PROF_CAST, 0);
     int64_t t0 = fv_time_ns();
     if (p->taa && es->hist_valid) {
         fv_taa_frame_setup(&tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
@@ -296,13 +315,20 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     double taa_ms = NAN;
     st->samples = fv_raycast(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     int64_t t1 = fv_time_ns();
+    prof_stage(p->prof, FV_PROF_CAST, pc0, eye);
+    const int64_t pr0 = fv_prof_stage_mark(p->prof, FV_PROF_RECONSTRUCT, 0);
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
     fv_pullpush_from(pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(pyr));
     int64_t t2 = fv_time_ns();
+    prof_stage(p->prof, FV_PROF_RECONSTRUCT, pr0, eye);
     st->focus_m = NAN;
-    if (p->dof)
+    if (p->dof) {
+        const int64_t pd0 = fv_prof_stage_mark(p->prof, FV_PROF_DOF, 0);
         render_dof(p, es, pyr, gaze_x, gaze_y, st);
+        prof_stage(p->prof, FV_PROF_DOF, pd0, eye);
+    }
     int64_t t3 = fv_time_ns();
+    prof_stage(p->prof, FV_PROF_FRAME, pf0, eye);
     es->cur = dst;
     es->prev_cam = es->cam;
     es->hist_valid = 1;

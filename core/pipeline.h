@@ -75,6 +75,12 @@ const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p);
 int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale);
 float fv_pipeline_fovea_scale(const fv_pipeline *p); /* the step in force: 1 .. 2 */
 fv_pool *fv_pipeline_pool(fv_pipeline *p);
+/* Trace recorder (core/prof.h) for the following frames, NULL = off (the default): stage spans
+ * (frame, trace, reconstruct, dof) on the stage tracks, pool jobs and ray-casting tiles on the
+ * workers' tracks; its stage hook runs at every stage boundary. prof needs a slot per pool
+ * thread (fv_pool_threads(fv_pipeline_pool(p))) and must outlive its use. */
+struct fv_prof;
+void fv_pipeline_set_prof(fv_pipeline *p, struct fv_prof *prof);
 const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 
 /* The eye's last image (after depth of field, if on): 4 floats a pixel (linear r, g, b,

@@ -1,5 +1,6 @@
 #define _GNU_SOURCE
 #include "pool.h"
+#include "prof.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -23,6 +24,7 @@ struct fv_pool {
     int busy;                 /* workers still inside the current job */
     int quit;
     atomic_int next;          /* next item to claim */
+    fv_prof *prof;            /* trace recorder (NULL: off), published under mu with the job */
 };
 
 typedef struct { fv_pool *pool; int id; } worker_arg;
@@ -46,14 +48,17 @@ int fv_online_cpus(void)
     return n < 1 ? 1 : (int)n;
 }
 
-static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, int id)
+static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, int id, fv_prof *prof)
 {
+    const int64_t t0 = prof ? fv_prof_now() : 0;
     for (;;) {
         int i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed);
         if (i >= count)
             break;
         fn(ctx, i, id);
     }
+    if (prof) /* this worker's share of the job, on its own track */
+        fv_prof_span(prof, id, id, "pool job", t0, fv_prof_now(), count);
 }
 
 static void *worker_main(void *arg)
@@ -73,8 +78,9 @@ static void *worker_main(void *arg)
         fv_task_fn fn = p->fn;
         void *ctx = p->ctx;
         int count = p->count;
+        fv_prof *prof = p->prof;
         pthread_mutex_unlock(&p->mu);
-        drain(p, fn, ctx, count, wa.id);
+        drain(p, fn, ctx, count, wa.id, prof);
         pthread_mutex_lock(&p->mu);
         if (--p->busy == 0)
             pthread_cond_signal(&p->done_cv);
@@ -137,8 +143,12 @@ void fv_pool_run(fv_pool *p, int count, fv_task_fn fn, void *ctx)
     if (count <= 0)
         return;
     if (!p || p->threads == 1 || count == 1) {
+        fv_prof *prof = p ? p->prof : NULL;
+        const int64_t t0 = prof ? fv_prof_now() : 0;
         for (int i = 0; i < count; i++)
             fn(ctx, i, 0);
+        if (prof)
+            fv_prof_span(prof, 0, 0, "pool job", t0, fv_prof_now(), count);
         return;
     }
     pthread_mutex_lock(&p->mu);
@@ -150,9 +160,19 @@ void fv_pool_run(fv_pool *p, int count, fv_task_fn fn, void *ctx)
     p->generation++;
     pthread_cond_broadcast(&p->start_cv);
     pthread_mutex_unlock(&p->mu);
-    drain(p, fn, ctx, count, 0);
+    fv_prof *prof = p->prof; /* only the caller writes it (fv_pool_set_prof) */
+    drain(p, fn, ctx, count, 0, prof);
     pthread_mutex_lock(&p->mu);
     while (p->busy > 0)
         pthread_cond_wait(&p->done_cv, &p->mu);
+    pthread_mutex_unlock(&p->mu);
+}
+
+void fv_pool_set_prof(fv_pool *p, fv_prof *prof)
+{
+    if (!p)
+        return;
+    pthread_mutex_lock(&p->mu);
+    p->prof = prof;
     pthread_mutex_unlock(&p->mu);
 }

@@ -18,6 +18,12 @@ int fv_pool_threads(const fv_pool *pool); /* 1 for a NULL pool */
 /* Blocks until all items are done. pool may be NULL: runs serially on the caller. */
 void fv_pool_run(fv_pool *pool, int count, fv_task_fn fn, void *ctx);
 
+/* Trace recorder (core/prof.h) for the following jobs, NULL = off (the default): each worker
+ * records its share of every job ("pool job") on its own track, slot = thread_id, so prof needs
+ * at least fv_pool_threads slots. Call it between jobs, from the thread that runs them. */
+struct fv_prof;
+void fv_pool_set_prof(fv_pool *pool, struct fv_prof *prof);
+
 /* Flush-to-zero / denormals-are-zero for the calling thread (every pool worker sets it). */
 void fv_set_ftz(void);
 

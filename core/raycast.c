@@ -1,4 +1,5 @@
 #include "raycast.h"
+#include "prof.h"
 
 #include <math.h>
 #include <stdatomic.h>
@@ -20,6 +21,7 @@ typedef struct {
     const fv_taa_params *taa_prm;
     atomic_long rays;
     atomic_llong taa_ns;
+    struct fv_prof *prof; /* NULL: no trace recording */
 } rc_job;
 
 /* The history a tile will read lies around the tile moved by the head motion: guess the move
@@ -79,8 +81,8 @@ static const unsigned char *tile_order(void)
 
 static void trace_tile(void *ctx, int index, int thread_id)
 {
-    (void)thread_id;
     rc_job *j = ctx;
+    const int64_t tile_t0 = j->prof ? fv_prof_now() : 0;
     const fv_camera *cam = j->cam;
     const fv_pyr_level *l0 = &j->pyr->lv[0];
     int tx = index % j->tiles_x, ty = index / j->tiles_x;
@@ -150,7 +152,10 @@ static void trace_tile(void *ctx, int index, int thread_id)
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
         fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], j->dsp, x0, y0, tw, th);
-        atomic_fetch_add_explicit(&j->taa_ns, fv_time_ns() - t0, memory_order_relaxed);
+        const int64_t t1 = fv_time_ns();
+        atomic_fetch_add_explicit(&j->taa_ns, t1 - t0, memory_order_relaxed);
+        if (j->prof)
+            fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
     }
     /* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level
      * 4. Tiles start on multiples of 16, so every block starts on even coordinates. */
@@ -160,6 +165,8 @@ static void trace_tile(void *ctx, int index, int thread_id)
         xl >>= 1, yl >>= 1, wl = (wl + 1) >> 1, hl = (hl + 1) >> 1;
     }
     atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
+    if (j->prof)
+        fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_prof_now(), index);
 }
 
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
@@ -170,6 +177,7 @@ long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *s
         j.phase = opt->phase;
         j.taa = opt->taa;
         j.taa_prm = opt->taa_prm;
+        j.prof = opt->prof;
     }
     j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
     j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;

@@ -52,6 +52,8 @@ typedef struct fv_raycast_opts {
     int phase;                     /* sampling pattern phase (fv_sampler_row) */
     const fv_taa_frame *taa;       /* NULL: no temporal reprojection */
     const fv_taa_params *taa_prm;  /* with taa */
+    struct fv_prof *prof;          /* trace recorder (core/prof.h): a "tile" span per tile (arg: its
+                                    * index) on the worker's track, "reproject" inside; NULL = off */
 } fv_raycast_opts;
 
 /* opt may be NULL (phase 0, no reprojection). With opt->taa each tile reprojects the previous

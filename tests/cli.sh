@@ -233,6 +233,62 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
 else
     bad "bench failed: $(cat "$T/err")"
 fi
+# Profiling (issue 7): traces, bench JSON schema, counters, sweeps, kernel benchmarks.
+expect_usage "bench bad sweep param" '--sweep: .speed=1. is not P=VALUES' $B/fovea-bench --scene $SCENE --sweep speed=1
+expect_usage "bench bad sweep threads" '--sweep threads: 0 is out of range' $B/fovea-bench --scene $SCENE --sweep threads=0..2
+expect_usage "bench bad sweep size" '--sweep size: .64. is not WxH' $B/fovea-bench --scene $SCENE --sweep size=64
+expect_usage "bench sweep r0 > r1" '--sweep r0: r0 30 must not exceed r1 20' $B/fovea-bench --scene $SCENE --sweep r0=5,30
+expect_usage "bench bad counters" '--counters: .maybe. is not one of on, off' $B/fovea-bench --scene $SCENE --counters maybe
+expect_usage "bench unknown kernel" "--kernel: .nope. is not a kernel" $B/fovea-bench --kernels --kernel nope
+expect_usage "bench calls without kernel" '--calls N needs --kernel NAME' $B/fovea-bench --kernels --calls 3
+# the checkers themselves catch what they are for (so the checks below can fail)
+printf '{"traceEvents":[{"ph":"M","pid":1,"tid":0,"name":"thread_name","args":{"name":"w"}},{"ph":"B","pid":1,"tid":0,"ts":1,"name":"x"}]}' >"$T/open.json"
+python3 tools/check_trace.py "$T/open.json" 1 >/dev/null && bad "check_trace accepted an unclosed span" || ok
+printf '{"scene": "x", "runs": []}' >"$T/schema-bad.json"
+python3 tools/check_schema.py docs/bench.schema.json "$T/schema-bad.json" >/dev/null && bad "check_schema accepted a bad file" || ok
+# a real trace: matched B/E, one track per worker, stage tracks, tile spans; counters switched
+# off (as on a VM without a PMU): reported as unavailable with the reason, the bench succeeds;
+# the JSON (with two sweeps) validates against the documented schema
+if FOVEA_PERF=off $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --threads 2 --dof weak \
+    --trace-out "$T/trace.json" --sweep threads=1..2 --sweep pmin=0.1,0.3 --json "$T/p.json" >"$T/out" 2>"$T/err"; then
+    ok
+    out=$(python3 tools/check_trace.py "$T/trace.json" 2 --stages --tiles) && ok || bad "bench trace: $out"
+    out=$(python3 tools/check_schema.py docs/bench.schema.json "$T/p.json") && ok || bad "bench JSON schema: $out"
+    grep -q '"available": false, "reason": "switched off (FOVEA_PERF=off)"' "$T/p.json" && ok ||
+        bad "counters not reported unavailable in the JSON"
+    grep -q 'counters (foveated): unavailable: switched off' "$T/out" && ok || bad "counters not reported unavailable"
+    python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); s=d["sweeps"]; assert [p["threads"] for p in s[0]["points"]]==[1,2] and [p["pmin"] for p in s[1]["points"]]==[0.1,0.3] and all(len(p["runs"])==2 for p in s[0]["points"]) and d["runs"][0]["roofline"]["coc"]["gbps"]>0' "$T/p.json" &&
+        ok || bad "sweep points or roofline missing in $(head -c 400 "$T/p.json")"
+else
+    bad "profiling bench failed: $(cat "$T/err")"
+fi
+# counters on (whatever this machine has): the bench succeeds either way
+FOVEA_PERF= $B/fovea-bench --scene $SCENE --size 64x72 --frames 1 --warmup 0 --mode foveated --json "$T/c.json" \
+    >/dev/null 2>"$T/err" && grep -q '"counters": {"available": ' "$T/c.json" && ok || bad "bench with counters: $(cat "$T/err")"
+# a one-thread trace has exactly one worker track
+if $B/fovea-bench --scene $SCENE --size 64x72 --frames 1 --warmup 0 --threads 1 --mode full --trace-out "$T/t1.json" \
+    >/dev/null 2>"$T/err"; then
+    out=$(python3 tools/check_trace.py "$T/t1.json" 1 --stages --tiles) && ok || bad "1-thread trace: $out"
+else
+    bad "1-thread trace bench failed: $(cat "$T/err")"
+fi
+# the replay's trace, two eyes
+if $R --scene $SCENE --frames 2 --size 64x72 --threads 2 --stereo --out "$T/rt" --trace-out "$T/rt.json" --quiet \
+    2>"$T/err"; then
+    out=$(python3 tools/check_trace.py "$T/rt.json" 2 --stages --tiles) && ok || bad "replay trace: $out"
+else
+    bad "replay with --trace-out failed: $(cat "$T/err")"
+fi
+# one kernel timed at production size, and an instruction-count call run
+if $B/fovea-bench --kernels --kernel dof_coc_row --kernel-reps 1 --json "$T/k.json" >"$T/out" 2>"$T/err"; then
+    out=$(python3 tools/check_schema.py docs/bench.schema.json "$T/k.json") && ok || bad "kernels JSON schema: $out"
+    grep -q '"kernel": "dof_coc_row", .*"isa": "c"' "$T/k.json" && ok || bad "kernels JSON: $(cat "$T/k.json")"
+else
+    bad "--kernels failed: $(cat "$T/err")"
+fi
+$B/fovea-bench --kernels --kernel pull_row --calls 2 --isa c 2>"$T/err" | grep -q 'pull_row c x 2 calls' && ok ||
+    bad "--kernels --calls: $(cat "$T/err")"
+
 # fovea-track: bad eye input gets one line naming the problem, exit 2, and no CSV left behind
 K=$B/fovea-track
 V=assets/eye_synth.y4m

@@ -1,7 +1,8 @@
 #!/bin/sh
 # Installs the Debian (bookworm) packages fovea needs, only when missing. Idempotent; silent when
 # everything is present. --cross adds the aarch64 cross toolchain, qemu-user and arm64 libraries
-# (through dpkg multiarch) for the cross leg.
+# (through dpkg multiarch) for the cross leg; --bench adds gnuplot for the charts of `make bench`
+# (not needed by `make test`).
 set -eu
 native="g++ make pkg-config libembree-dev libtinygltf-dev libstb-dev libcmocka-dev libjpeg62-turbo-dev
         libgpiod-dev libdrm-dev libsdl2-dev"
@@ -9,6 +10,7 @@ cross="gcc-aarch64-linux-gnu g++-aarch64-linux-gnu libc6-dev-arm64-cross qemu-us
        libembree-dev:arm64 libtinygltf-dev:arm64 libstb-dev:arm64 libcmocka-dev:arm64 libjpeg62-turbo-dev:arm64"
 want=$native
 [ "${1:-}" = "--cross" ] && want="$native $cross"
+[ "${1:-}" = "--bench" ] && want="$native gnuplot-nox"
 
 arch=$(dpkg --print-architecture)
 missing=

@@ -1,0 +1,211 @@
+#include "prof.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "pipeline.h"
+#include "raycast.h"
+
+const char *const fv_prof_stage_names[FV_PROF_STAGES] = {"frame", "trace", "reconstruct", "dof"};
+
+/* One slot's ring: written by one thread only; padded so neighbours' counters do not share a
+ * cache line. */
+typedef struct {
+    fv_prof_event *ev;
+    size_t n; /* events ever recorded; the ring holds the last min(n, cap) */
+    char pad[64 - sizeof(fv_prof_event *) - sizeof(size_t)];
+} ring;
+
+struct fv_prof {
+    int slots;
+    size_t cap, mask;
+    ring *r;
+    fv_prof_stage_hook hook;
+    void *hook_ctx;
+};
+
+fv_prof *fv_prof_create(int slots, size_t capacity)
+{
+    if (slots < 1 || capacity < 1)
+        return NULL;
+    size_t cap = 1;
+    while (cap < capacity)
+        cap <<= 1;
+    fv_prof *p = calloc(1, sizeof *p);
+    if (!p)
+        return NULL;
+    p->slots = slots;
+    p->cap = cap;
+    p->mask = cap - 1;
+    p->r = calloc((size_t)slots, sizeof *p->r);
+    if (!p->r) {
+        free(p);
+        return NULL;
+    }
+    for (int s = 0; s < slots; s++) {
+        if (!(p->r[s].ev = malloc(cap * sizeof *p->r[s].ev))) {
+            fv_prof_destroy(p);
+            return NULL;
+        }
+        /* touched now, so that no page fault lands in a recorded frame */
+        memset(p->r[s].ev, 0, cap * sizeof *p->r[s].ev);
+    }
+    return p;
+}
+
+void fv_prof_destroy(fv_prof *p)
+{
+    if (!p)
+        return;
+    if (p->r)
+        for (int s = 0; s < p->slots; s++)
+            free(p->r[s].ev);
+    free(p->r);
+    free(p);
+}
+
+int fv_prof_slots(const fv_prof *p) { return p ? p->slots : 0; }
+
+int64_t fv_prof_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static inline void put(fv_prof *p, int slot, int track, const char *name, int64_t t0, int64_t t1, int arg, char kind)
+{
+    if (!p || slot < 0 || slot >= p->slots)
+        return;
+    ring *r = &p->r[slot];
+    fv_prof_event *e = &r->ev[r->n & p->mask];
+    e->t0_ns = t0;
+    e->t1_ns = t1 < t0 ? t0 : t1;
+    e->name = name;
+    e->track = track;
+    e->arg = arg;
+    e->kind = kind;
+    r->n++;
+}
+
+void fv_prof_span(fv_prof *p, int slot, int track, const char *name, int64_t t0_ns, int64_t t1_ns, int arg)
+{
+    put(p, slot, track, name, t0_ns, t1_ns, arg, 'X');
+}
+
+void fv_prof_instant(fv_prof *p, int slot, int track, const char *name, int64_t t_ns, int arg)
+{
+    put(p, slot, track, name, t_ns, t_ns, arg, 'i');
+}
+
+void fv_prof_frame_markers(fv_prof *p, long frame, int64_t gaze_latch_ns, int64_t photon_ns, int late)
+{
+    if (!p)
+        return;
+    const int f = (int)(frame & 0x7fffffff);
+    put(p, 0, FV_PROF_TRACK_MARKERS, "gaze latch", gaze_latch_ns, gaze_latch_ns, f, 'i');
+    if (late)
+        put(p, 0, FV_PROF_TRACK_MARKERS, "late", photon_ns, photon_ns, f, 'i');
+    put(p, 0, FV_PROF_TRACK_MARKERS, "vsync", photon_ns, photon_ns, f, 'i');
+}
+
+void fv_prof_set_stage_hook(fv_prof *p, fv_prof_stage_hook fn, void *ctx)
+{
+    p->hook = fn;
+    p->hook_ctx = ctx;
+}
+
+int64_t fv_prof_stage_mark(fv_prof *p, int stage, int end)
+{
+    if (!p)
+        return 0;
+    /* the counters are read outside the span: the hook's own cost is not in the stage's time */
+    if (end) {
+        const int64_t t = fv_prof_now();
+        if (p->hook)
+            p->hook(p->hook_ctx, stage, 1);
+        return t;
+    }
+    if (p->hook)
+        p->hook(p->hook_ctx, stage, 0);
+    return fv_prof_now();
+}
+
+size_t fv_prof_count(const fv_prof *p, int slot)
+{
+    if (!p || slot < 0 || slot >= p->slots)
+        return 0;
+    return p->r[slot].n < p->cap ? p->r[slot].n : p->cap;
+}
+
+const fv_prof_event *fv_prof_event_at(const fv_prof *p, int slot, size_t index)
+{
+    if (index >= fv_prof_count(p, slot))
+        return NULL;
+    const ring *r = &p->r[slot];
+    const size_t first = r->n - fv_prof_count(p, slot);
+    return &r->ev[(first + index) & p->mask];
+}
+
+size_t fv_prof_dropped(const fv_prof *p, int slot)
+{
+    if (!p || slot < 0 || slot >= p->slots)
+        return 0;
+    return p->r[slot].n - fv_prof_count(p, slot);
+}
+
+int fv_prof_stage_bytes(int stage, int w, int h, double holes, double *rd, double *wr)
+{
+    const double N = (double)w * (double)h;
+    const double px = 16.0, wt = 4.0; /* a pixel: r, g, b, depth floats; a weight: one float */
+    *rd = *wr = 0.0;
+    switch (stage) {
+    case FV_STAGE_RECONSTRUCT: {
+        /* levels above the tiles' pulls are pulled (fine level read, coarse level written), then
+         * every level but the top is pushed: fine weights read; where a pixel is a hole (the
+         * fraction `holes`, taken for every level), its colour and the coarse colour above it
+         * read and its colour written */
+        int lw[32], lh[32], L = 0;
+        for (int cw = w, ch = h; L < 32; L++) {
+            lw[L] = cw, lh[L] = ch;
+            if (cw == 1 && ch == 1)
+                break;
+            cw = (cw + 1) / 2, ch = (ch + 1) / 2;
+        }
+        const int levels = L + 1;
+        const int pulled = levels - 1 < FV_TILE_PULL_LEVELS ? levels - 1 : FV_TILE_PULL_LEVELS;
+        for (int l = pulled; l + 1 < levels; l++) {
+            *rd += (px + wt) * lw[l] * (double)lh[l];
+            *wr += (px + wt) * lw[l + 1] * (double)lh[l + 1];
+        }
+        for (int l = 0; l + 1 < levels; l++) {
+            *rd += wt * lw[l] * (double)lh[l] + holes * (px * lw[l] * (double)lh[l] + px * lw[l + 1] * (double)lh[l + 1]);
+            *wr += holes * px * lw[l] * (double)lh[l];
+        }
+        return 0;
+    }
+    case FV_STAGE_REPROJECT:
+        if (!(holes > 0.0))
+            return 0; /* full sampling has no reprojection */
+        /* level 0 colour + weight read and written; the history's level 0 and, for holes, its
+         * coarser levels (a third more) read */
+        *rd = (px + wt) * N + (px + wt) * N * (4.0 / 3.0);
+        *wr = (px + wt) * N;
+        return 0;
+    case FV_STAGE_COC: /* level 0 colour + depth read, the CoC plane written */
+        *rd = px * N;
+        *wr = wt * N;
+        return 0;
+    case FV_STAGE_DOF_FILTER: /* level 0 + CoC read; the horizontal pass's layer written, read back */
+        *rd = (px + wt) * N + px * N;
+        *wr = px * N;
+        return 0;
+    case FV_STAGE_COMBINE: /* sharp, CoC, the blurred layer read; the output written */
+        *rd = (px + wt + px) * N;
+        *wr = px * N;
+        return 0;
+    default:
+        return -1;
+    }
+}

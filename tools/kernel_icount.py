@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""NEON speed-ups without NEON hardware: counts the guest instructions each kernel of
+fovea-bench's kernel table runs under qemu-aarch64, C reference against NEON.
+
+usage: tools/kernel_icount.py [--build build-aarch64] [--calls 4] [--kernel NAME] [--json FILE]
+
+How (Debian's qemu-user 7.2 ships no TCG plugins, so no libinsn.so; valgrind is not used):
+  1. `fovea-bench --kernels --kernel K --calls N --isa I` sets the kernel's production-sized
+     inputs up, makes N calls and prints where the kernel's code is (guest addresses);
+  2. the code's extent comes from `aarch64-linux-gnu-nm -S` (symbol sizes, the binary is PIE and
+     qemu-user loads it at 0x5500000000); the taa entry also counts fv_taa_tile_run;
+  3. qemu-aarch64 runs it twice (N and 3N calls) with `-d in_asm,exec,nochain -dfilter RANGES`: in_asm logs every
+     translated block in those ranges with its instructions, exec (with chaining off) every
+     execution of such a block; instructions = sum over executions of the block's length.
+The ranges are every function of the source files the kernel's code comes from (its static
+helpers, e.g. reproject's `tap`) and, for NEON, of the C reference's file too (the NEON kernels
+finish odd tails with the C reference); calls into libc / libm are not counted (the kernels make
+none). Set-up code in those files cancels out: each count is the difference between a run of N
+and one of 3N calls, over 2N. Prints instructions per call and the C / NEON ratio (a proxy for the speed-up: it ignores
+latencies, memory and issue width).
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+BASE = 0x5500000000  # where qemu-user puts a PIE aarch64 executable
+
+
+def arg(name, default):
+    if name in sys.argv:
+        return sys.argv[sys.argv.index(name) + 1]
+    return default
+
+
+def kernels(bench):
+    # the table's names: from a one-rep timing listing would be slow under qemu; ask the source
+    src = open(os.path.join(os.path.dirname(__file__), "..", "core", "kbench.c")).read()
+    tab = src[src.index("const fv_kbench_kernel fv_kbench_kernels[]"):]
+    return re.findall(r'^\s*\{"([a-z0-9_+]+)",', tab, re.M)
+
+
+def symbols(bench):
+    """(address, size, name, source file) of every function in the binary (nm -l: debug info)."""
+    syms = []
+    out = subprocess.run(["aarch64-linux-gnu-nm", "-S", "-l", "--defined-only", bench], capture_output=True,
+                         text=True, check=True).stdout
+    for line in out.splitlines():
+        p = line.split("\t")
+        q = p[0].split()
+        if len(q) == 4 and q[2] in "tTwW":
+            src = p[1].rsplit(":", 1)[0] if len(p) > 1 else ""
+            syms.append((int(q[0], 16), int(q[1], 16), q[3], src))
+    return syms
+
+
+def run_logged(bench, kernel, isa, calls, dfilter):
+    """Instructions executed inside the dfilter ranges by one run."""
+    with tempfile.TemporaryDirectory() as d:
+        log = os.path.join(d, "q.log")
+        subprocess.run(["qemu-aarch64", "-d", "in_asm,exec,nochain", "-dfilter", dfilter, "-D", log, bench,
+                        "--kernels", "--kernel", kernel, "--calls", str(calls), "--isa", isa],
+                       capture_output=True, check=True)
+        tb, cur, total = {}, None, 0
+        with open(log, errors="replace") as f:
+            for line in f:
+                if line.startswith("IN:"):
+                    cur = None
+                    continue
+                m = re.match(r"^0x([0-9a-f]+):\s", line)
+                if m:
+                    if cur is None:
+                        cur = int(m.group(1), 16)
+                        tb[cur] = 0
+                    tb[cur] += 1
+                    continue
+                if not line.strip():
+                    cur = None
+                    continue
+                m = re.match(r"^Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/", line)
+                if m:
+                    total += tb.get(int(m.group(1), 16), 0)
+    return total
+
+
+def code_addrs(bench, kernel, isa):
+    r = subprocess.run(["qemu-aarch64", bench, "--kernels", "--kernel", kernel, "--calls", "1", "--isa", isa],
+                       capture_output=True, text=True)
+    if r.returncode:
+        raise RuntimeError(r.stderr.strip())
+    return [int(a, 16) for a in re.findall(r"0x[0-9a-f]+", r.stdout.split("code at")[1])]
+
+
+def count(bench, kernel, isa, calls, syms):
+    """Instructions per call: every function of the source files of the kernel's code (its
+    static helpers) and, for an ISA version, of the C reference's (its tails) are counted; the
+    set-up's share cancels between a run of `calls` and one of 3 `calls` calls."""
+    files, names = set(), []
+    for a in code_addrs(bench, kernel, isa) + (code_addrs(bench, kernel, "c") if isa != "c" else []):
+        for s, n, name, src in syms:
+            if s + BASE == a:
+                files.add(src)
+                names.append(name)
+    if kernel.startswith("taa"):
+        files |= {src for s, n, name, src in syms if name == "fv_taa_tile_run"}
+    if not files:
+        raise RuntimeError("no symbol at the kernel's address")
+    dfilter = ",".join("0x%x+0x%x" % (s + BASE, n) for s, n, name, src in syms if src in files and n > 0)
+    i1 = run_logged(bench, kernel, isa, calls, dfilter)
+    i3 = run_logged(bench, kernel, isa, 3 * calls, dfilter)
+    return (i3 - i1) / (2 * calls), names[:1]
+
+
+def main():
+    build = arg("--build", "build-aarch64")
+    calls = int(arg("--calls", "4"))
+    only = arg("--kernel", None)
+    bench = os.path.join(build, "bin", "fovea-bench")
+    syms = symbols(bench)
+    res = []
+    print("%-20s %14s %14s %8s   (instructions per call, qemu-aarch64, %d calls)" % ("kernel", "c", "neon", "c/neon",
+                                                                                     calls))
+    for k in kernels(bench):
+        if only and k != only:
+            continue
+        c, cf = count(bench, k, "c", calls, syms)
+        n, nf = count(bench, k, "neon", calls, syms)
+        same = cf == nf  # no NEON version: the C one twice
+        print("%-20s %14.0f %14s %8s   %s" % (k, c, "-" if same else "%.0f" % n, "-" if same else "%.2fx" % (c / n),
+                                            " ".join(nf)))
+        res.append({"kernel": k, "c_insns_per_call": c, "neon_insns_per_call": None if same else n,
+                    "ratio": None if same else c / n})
+    if "--json" in sys.argv:
+        with open(arg("--json", None), "w") as f:
+            json.dump({"kernel_icount": {"calls": calls, "results": res}}, f, indent=1)
+
+
+main()
