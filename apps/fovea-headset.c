@@ -17,6 +17,8 @@
 #include "lensfile.h"
 #include "output.h"
 #include "pipeline.h"
+#include "prof.h"
+#include "proftrace.h"
 #include "scene.h"
 #include "trace.h"
 #include "vsync.h"
@@ -44,12 +46,14 @@ static void usage(FILE *f)
             "                      reprojection off: it does not model the lens yet)\n"
             "  --latency-csv FILE  per-frame gaze/ray/done/photon times\n"
             "  --hz HZ             nominal refresh for gpio/replay vsync (default 90)\n"
-            "  --camera-fps F      frame rate of a replayed eye video (default 120)\n" FV_COMMON_HELP
+            "  --camera-fps F      frame rate of a replayed eye video (default 120)\n"
+            "  --trace-out FILE    write a Chrome trace-event JSON of the run (Perfetto): worker\n"
+            "                      and stage tracks, gaze-latch / vsync / late markers\n" FV_COMMON_HELP
             "  --help              this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_CAMERA, OPT_VSYNC, OPT_DISPLAY, OPT_CALIB, OPT_SECONDS, OPT_TRACE, OPT_LENS, OPT_CSV,
-       OPT_HZ, OPT_CAMFPS, OPT_HELP };
+       OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_HELP };
 
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig)
@@ -205,9 +209,10 @@ int main(int argc, char **argv)
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
     const char *scene_path = NULL, *camera = "none", *vsync_spec = "timer:90", *display_spec = "none";
-    const char *calib_path = NULL, *trace_path = NULL, *lens_path = NULL, *csv_path = NULL;
+    const char *calib_path = NULL, *trace_path = NULL, *lens_path = NULL, *csv_path = NULL, *prof_path = NULL;
     double seconds = 0.0;
     float hz = 90.0f, cam_fps = 120.0f;
+    fv_prof *prof = NULL; /* --trace-out's recorder */
     int reproject_given = 0;
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, {"camera", required_argument, 0, OPT_CAMERA},
@@ -215,7 +220,8 @@ int main(int argc, char **argv)
         {"calibration", required_argument, 0, OPT_CALIB}, {"seconds", required_argument, 0, OPT_SECONDS},
         {"trace", required_argument, 0, OPT_TRACE}, {"lens", required_argument, 0, OPT_LENS},
         {"latency-csv", required_argument, 0, OPT_CSV}, {"hz", required_argument, 0, OPT_HZ},
-        {"camera-fps", required_argument, 0, OPT_CAMFPS}, {"help", no_argument, 0, OPT_HELP},
+        {"camera-fps", required_argument, 0, OPT_CAMFPS}, {"trace-out", required_argument, 0, OPT_TRACE_OUT},
+        {"help", no_argument, 0, OPT_HELP},
         FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -232,6 +238,7 @@ int main(int argc, char **argv)
         case OPT_CSV: csv_path = optarg; break;
         case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
         case OPT_CAMFPS: cam_fps = fv_arg_float(prog, "--camera-fps", optarg, 1.0f, 1000.0f); break;
+        case OPT_TRACE_OUT: prof_path = optarg; break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
@@ -329,6 +336,15 @@ int main(int argc, char **argv)
     fv_frameloop_ops ops = {&a, a_now, a_sleep, a_wait_edge, a_sample_gaze, a_render, a_present};
     a.t_start_ns = fv_clock_now_ns();
     a.end_ns = seconds > 0 ? a.t_start_ns + (int64_t)(seconds * 1e9) : INT64_MAX;
+    /* the trace recorder (--trace-out): one slot per worker of the pipeline's pool; a 2^20-event
+     * ring per worker (40 MB) holds about 80 stereo frames at 1280x1440 (the newest are kept) */
+    if (prof_path) {
+        if (!(prof = fv_prof_create(fv_pool_threads(fv_pipeline_pool(a.pl)), (size_t)1 << 20))) {
+            fprintf(stderr, "%s: out of memory for the trace recorder\n", prog);
+            goto done;
+        }
+        fv_pipeline_set_prof(a.pl, prof);
+    }
     fv_frameloop loop;
     fv_frameloop_init(&loop, &lp, &ops, &ring);
     for (;;) {
@@ -343,6 +359,8 @@ int main(int argc, char **argv)
         }
         if (fv_frameloop_frame(&loop, &rec[nrec]))
             break;
+        if (prof) /* gaze latch, vsync (photon) and late markers of this frame */
+            fv_prof_frame_markers(prof, rec[nrec].frame, rec[nrec].ray_start_ns, rec[nrec].photon_ns, rec[nrec].late);
         nrec++;
     }
     status = FV_EXIT_OK;
@@ -375,7 +393,18 @@ int main(int argc, char **argv)
             status = FV_EXIT_FAIL;
         }
     }
+    if (prof) {
+        char label[600];
+        snprintf(label, sizeof label, "fovea-headset %s", scene_path);
+        fv_pipeline_set_prof(a.pl, NULL);
+        if (fv_prof_write_json(prof, prof_path, label, err, sizeof err)) {
+            fprintf(stderr, "%s: %s\n", prog, err);
+            status = FV_EXIT_FAIL;
+        }
+    }
 done:
+    fv_pipeline_set_prof(a.pl, NULL);
+    fv_prof_destroy(prof);
     fv_gazesrc_stop(a.cam);
     if (fv_display_close(a.disp, err, sizeof err)) {
         fprintf(stderr, "%s: %s\n", prog, err);

@@ -402,6 +402,13 @@ if $HS $HO --seconds 1 --trace assets/gaze_sweep.csv --latency-csv "$T/lat.csv" 
 else
     bad "headset good run failed: $(cat "$T/err")"
 fi
+# --trace-out: valid trace, one track per worker, the stage tracks and the loop's markers
+if $HS $HO --seconds 0.5 --trace-out "$T/hs.json" >"$T/out" 2>"$T/err"; then
+    out=$(python3 tools/check_trace.py "$T/hs.json" 2 --stages) && ok || bad "headset trace: $out"
+    for m in 'gaze latch' 'vsync'; do grep -q "\"name\": *\"$m\"" "$T/hs.json" && ok || bad "headset trace lacks $m markers"; done
+else
+    bad "headset --trace-out failed: $(cat "$T/err")"
+fi
 if $HS $HO --seconds 1 --camera replay:$V --lens assets/hmd_example.lens --display png:"$T/hpng" >"$T/out" 2>"$T/err"; then
     ls "$T/hpng"/frame_00000.png >/dev/null 2>&1 && ok || bad "headset png display wrote nothing"
     grep -Eq 'camera: [1-9][0-9]* frames tracked$' "$T/out" && ok || bad "headset camera replay: $(cat "$T/out")"
@@ -433,7 +440,9 @@ $HS $HO --display png:"$T/vanish/png" >"$T/out" 2>"$T/err" &
 hp=$!
 i=0
 while [ ! -e "$T/vanish/png/frame_00001.png" ] && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
-rm -rf "$T/vanish"
+# moved away in one step (rm -rf races with the frames still being written into it)
+mv "$T/vanish" "$T/vanished"
+rm -rf "$T/vanished"
 i=0
 while ! grep -q 'continuing without a display' "$T/err" && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
 sleep 0.3
