@@ -65,19 +65,7 @@ static float gen_value(int mode, int channel)
     return channel == 3 ? 0.1f + 100.0f * rnd() : rnd();
 }
 
-/* An exact-size input buffer of `count` floats, starting `off` floats into its allocation. */
-typedef struct {
-    float *base, *p;
-} buf;
-
-static buf buf_new(size_t count, int off)
-{
-    buf b;
-    b.base = malloc((count + (size_t)off) * sizeof(float));
-    assert_non_null(b.base);
-    b.p = b.base + off;
-    return b;
-}
+/* exact-size buffers: buf_new in testutil.h */
 
 /* An output row with 4 canaries before and CANARY after. */
 static buf out_new(size_t count, int off)

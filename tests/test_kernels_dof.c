@@ -37,18 +37,7 @@ static float colour(void)
     return rndi(8) == 0 ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : 2.0f * rnd() - 0.25f;
 }
 
-/* exact-size buffer of count floats, `off` floats into its allocation */
-typedef struct {
-    float *base, *p;
-} buf;
-static buf buf_new(size_t count, int off)
-{
-    buf b;
-    b.base = malloc((count + (size_t)off) * sizeof(float));
-    assert_non_null(b.base);
-    b.p = b.base + off;
-    return b;
-}
+/* exact-size buffers: buf_new in testutil.h */
 /* an output of count floats + CANARY, all canaries */
 static buf out_new(size_t count, int off)
 {

@@ -26,3 +26,17 @@ static inline float fv_test_randf(uint64_t *state) /* [0,1) */
 {
     return (float)(fv_test_rand(state) >> 40) * (1.0f / 16777216.0f);
 }
+
+/* An exact-size buffer of `count` floats, starting `off` floats into its allocation (so ASan
+ * catches over-reads and rows start unaligned). Free `base`. */
+typedef struct {
+    float *base, *p;
+} buf;
+static inline buf buf_new(size_t count, int off)
+{
+    buf b;
+    b.base = (float *)malloc((count + (size_t)off) * sizeof(float));
+    assert_non_null(b.base);
+    b.p = b.base + off;
+    return b;
+}
