@@ -403,7 +403,7 @@ else
     bad "headset good run failed: $(cat "$T/err")"
 fi
 # --trace-out: valid trace, one track per worker, the stage tracks and the loop's markers
-if $HS $HO --seconds 0.5 --trace-out "$T/hs.json" >"$T/out" 2>"$T/err"; then
+if $HS $HO --seconds 2 --trace-out "$T/hs.json" >"$T/out" 2>"$T/err"; then
     out=$(python3 tools/check_trace.py "$T/hs.json" 2 --stages) && ok || bad "headset trace: $out"
     for m in 'gaze latch' 'vsync'; do grep -q "\"name\": *\"$m\"" "$T/hs.json" && ok || bad "headset trace lacks $m markers"; done
 else
