@@ -28,7 +28,7 @@ static inline float32x4_t sel(uint32x4_t m, float32x4_t a, float32x4_t b) { retu
 static void coc_row_neon(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
 {
     const float32x4_t idn = vdupq_n_f32(1.0f / dn), idf = vdupq_n_f32(1.0f / df);
-    const float32x4_t vdn = vdupq_n_f32(dn), vdf = vdupq_n_f32(df), lo = vdupq_n_f32(FV_DOF_MIN_DEPTH_M);
+    const float32x4_t vdn = vdupq_n_f32(dn), vdf = vdupq_n_f32(df), lo = vdupq_n_f32(FV_COC_MIN_DEPTH_M);
     const float32x4_t one = vdupq_n_f32(1.0f), zero = vdupq_n_f32(0.0f);
     int x = 0;
     for (; x + 4 <= n; x += 4) {

@@ -12,7 +12,7 @@ void fv_dof_coc_row_c(float *restrict coc, const float *rgbd, int n, float K, fl
 {
     const float inv_dn = 1.0f / dn, inv_df = 1.0f / df;
     for (int x = 0; x < n; x++) {
-        const float g = rgbd[4 * x + 3] > FV_DOF_MIN_DEPTH_M ? rgbd[4 * x + 3] : FV_DOF_MIN_DEPTH_M;
+        const float g = rgbd[4 * x + 3] > FV_COC_MIN_DEPTH_M ? rgbd[4 * x + 3] : FV_COC_MIN_DEPTH_M;
         const float ig = 1.0f / g;
         /* near of d_n: K (1/g - 1/d_n) negated; far of d_f: K (1/d_f - 1/g); else 0 */
         coc[x] = g < dn ? K * (inv_dn - ig) : g > df ? K * (inv_df - ig) : 0.0f;

@@ -7,8 +7,7 @@
 #include <stdint.h>
 
 #include "../pullpush.h"
-
-#define FV_DOF_MIN_DEPTH_M 0.05f /* = FV_COC_MIN_DEPTH_M (core/dof/coc.h) */
+#include "coc.h" /* FV_COC_MIN_DEPTH_M */
 
 /* Gaussian weights for sigma = s / FV_DOF_SIG_STEPS px, s < FV_DOF_NSIG; w[s][j] for |offset| j
  * (0 beyond rad[s] = ceil(3 sigma)), inv[s] = 1 / (the full kernel's sum). */

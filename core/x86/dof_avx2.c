@@ -12,7 +12,7 @@ static void coc_row_avx2(float *restrict coc, const float *rgbd, int n, float K,
 {
     const __m256 vK = _mm256_set1_ps(K), idn = _mm256_set1_ps(1.0f / dn), idf = _mm256_set1_ps(1.0f / df);
     const __m256 vdn = _mm256_set1_ps(dn), vdf = _mm256_set1_ps(df), one = _mm256_set1_ps(1.0f);
-    const __m256 lo = _mm256_set1_ps(FV_DOF_MIN_DEPTH_M);
+    const __m256 lo = _mm256_set1_ps(FV_COC_MIN_DEPTH_M);
     const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
     int x = 0;
     for (; x + 8 <= n; x += 8) {
@@ -91,28 +91,7 @@ static inline void gauss_8(float *d, const float *p, const ptrdiff_t *off, int n
         dof_gauss_4(d + 4 * i, p + 4 * i, off, n - i, sig + i, tab, norm);
 }
 
-static void hgauss_row_avx2(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
-                            const uint8_t *sig, const fv_dof_gauss_tab *tab)
-{
-    _Alignas(32) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];
-    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
-    dof_offsets_h(off, FV_DOF_RMAX);
-    for (int c0 = 0; c0 < n; c0 += DOF_CH) {
-        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);
-        dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
-        /* output pixel c0 + i from m + 4 (Rc + i) */
-        gauss_8(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);
-    }
-}
-
-static void vgauss_row_avx2(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
-                            int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
-{
-    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
-    const int R = dof_span_rad(sig, n, tab);
-    dof_offsets_v(off, R, stride, y, ylo, yhi);
-    gauss_8(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
-}
+DOF_GAUSS_ROWS(avx2, gauss_8, 32)
 
 /* a + s (b - a) */
 static inline __m256 lerp8(__m256 a, __m256 b, __m256 s)

@@ -15,28 +15,7 @@ static void coc_row_sse41(float *restrict coc, const float *rgbd, int n, float K
         fv_dof_coc_row_c(coc + x, rgbd + 4 * x, n - x, K, dn, df);
 }
 
-static void hgauss_row_sse41(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
-                             const uint8_t *sig, const fv_dof_gauss_tab *tab)
-{
-    _Alignas(16) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];
-    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
-    dof_offsets_h(off, FV_DOF_RMAX);
-    for (int c0 = 0; c0 < n; c0 += DOF_CH) {
-        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);
-        dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
-        /* output pixel c0 + i from m + 4 (Rc + i) */
-        dof_gauss_4(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);
-    }
-}
-
-static void vgauss_row_sse41(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
-                             int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
-{
-    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
-    const int R = dof_span_rad(sig, n, tab);
-    dof_offsets_v(off, R, stride, y, ylo, yhi);
-    dof_gauss_4(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
-}
+DOF_GAUSS_ROWS(sse41, dof_gauss_4, 16)
 
 static void combine_row_sse41(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {

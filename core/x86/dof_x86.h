@@ -44,7 +44,7 @@ static inline dof_coc4_k dof_coc4_setup(float K, float dn, float df)
 /* depths of 4 pixels -> their CoCs: g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 */
 static inline __m128 dof_coc4(__m128 d, const dof_coc4_k *k)
 {
-    const __m128 g = _mm_max_ps(d, _mm_set1_ps(FV_DOF_MIN_DEPTH_M)); /* d > min ? d : min */
+    const __m128 g = _mm_max_ps(d, _mm_set1_ps(FV_COC_MIN_DEPTH_M)); /* d > min ? d : min */
     const __m128 ig = _mm_div_ps(_mm_set1_ps(1.0f), g);
     const __m128 nr = _mm_mul_ps(k->K, _mm_sub_ps(k->idn, ig));
     const __m128 fr = _mm_and_ps(_mm_mul_ps(k->K, _mm_sub_ps(k->idf, ig)), _mm_cmpgt_ps(g, k->df));
@@ -324,5 +324,31 @@ static inline void dof_pyrblur_row_x86(float *restrict blur, const fv_dof_pyrblu
                                  _mm_set1_ps(t), mix, all, 1, 0));
     }
 }
+
+
+/* The Gaussian row kernels' set-up (tap offsets, the masked far row of a chunk), shared by the
+ * SSE4.1 and AVX2 files; GAUSS is the ISA's block routine (dof_gauss_4 / gauss_8). */
+#define DOF_GAUSS_ROWS(SUFFIX, GAUSS, ALIGN)                                                                  \
+    static void hgauss_row_##SUFFIX(float *restrict dst, const float *rgbd, const float *coc, int w, int x0,   \
+                                    int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)                    \
+    {                                                                                                          \
+        _Alignas(ALIGN) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];                                               \
+        ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;                                        \
+        dof_offsets_h(off, FV_DOF_RMAX);                                                                       \
+        for (int c0 = 0; c0 < n; c0 += DOF_CH) {                                                               \
+            const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);            \
+            dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);                                          \
+            /* output pixel c0 + i from m + 4 (Rc + i) */                                                      \
+            GAUSS(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);                      \
+        }                                                                                                      \
+    }                                                                                                          \
+    static void vgauss_row_##SUFFIX(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo,   \
+                                    int yhi, int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)   \
+    {                                                                                                          \
+        ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;                                        \
+        const int R = dof_span_rad(sig, n, tab);                                                               \
+        dof_offsets_v(off, R, stride, y, ylo, yhi);                                                            \
+        GAUSS(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);                          \
+    }
 
 #endif
