@@ -53,6 +53,7 @@
 #define ENH_LEVELS 3   /* contrast enhancement: levels 1..3 (footprints up to ~8 px) */
 #define MAX_UP_LEVEL 5 /* periphery far blur: levels 1..5 (CoC up to 64 px) */
 #define LAMBDA_STEPS 8 /* the level LUT's steps per pixel of CoC */
+#define LAMBDA_N (64 * LAMBDA_STEPS + 1) /* CoCs 0 .. 64 px */
 
 static inline float clampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
 static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
@@ -148,7 +149,7 @@ typedef struct {
     float *l_v;                /* after the vertical pass */
     int l_reach;               /* the largest radius there */
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
-    float lambda[64 * LAMBDA_STEPS + 1]; /* CoC -> continuous pyramid level */
+    const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
     int enh_on;                /* contrast enhancement runs */
     float *band_ms;            /* per band: worker time (ms) in the filter and the combine (pairs) */
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
@@ -360,7 +361,7 @@ static void blur_periphery(const wctx *x, int tid, int y, const float *coc, cons
     for (int i = 0; i < x->w; i++) {
         const float a = coc[i] < 0.0f ? -coc[i] : coc[i];
         if (a > 0.0f && trow[i] > 0.0f) {
-            const float l = x->lambda[mini((int)(a * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
+            const float l = x->lambda[mini((int)(a * LAMBDA_STEPS), (LAMBDA_N - 1))];
             const int L = (int)l + (l > (float)(int)l);
             need = L > need ? L : need;
         }
@@ -376,7 +377,7 @@ static void blur_periphery(const wctx *x, int tid, int y, const float *coc, cons
         upsample_row(x->dsp, &im, L, &x->xt[L], y, x->w, tmp, up[L]);
     }
     const fv_dof_pyrblur_args pa = {.coc = coc, .t = trow, .up = (const float *const *)up, .need = need,
-                                    .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS, .lambda_max = 64 * LAMBDA_STEPS};
+                                    .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS, .lambda_max = (LAMBDA_N - 1)};
     x->dsp->dof_pyrblur_row(blur, &pa, 0, x->w);
 }
 
@@ -483,7 +484,7 @@ static void vcombine_band(void *ctx, int band, int tid)
                 ecoc[i] = 2.0f * v->enh_fp[e < v->enh_n - 1 ? e : v->enh_n - 1];
                 emax = ecoc[i] > emax ? ecoc[i] : emax;
             }
-            const float lm = x->lambda[mini((int)(emax * LAMBDA_STEPS), 64 * LAMBDA_STEPS)];
+            const float lm = x->lambda[mini((int)(emax * LAMBDA_STEPS), (LAMBDA_N - 1))];
             const int need = mini(mini((int)lm + (lm > (float)(int)lm), ENH_LEVELS), x->up_levels);
             up[0] = (float *)sharp;
             for (int L = 1; L <= need; L++) {
@@ -494,7 +495,7 @@ static void vcombine_band(void *ctx, int band, int tid)
             }
             const fv_dof_pyrblur_args ea = {.coc = ecoc, .t = ones, .up = (const float *const *)up, .need = need,
                                             .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS,
-                                            .lambda_max = 64 * LAMBDA_STEPS};
+                                            .lambda_max = (LAMBDA_N - 1)};
             x->dsp->dof_pyrblur_row(enh, &ea, 0, x->w);
         }
         const int64_t tb = fv_time_ns();
@@ -509,18 +510,61 @@ static void vcombine_band(void *ctx, int band, int tid)
     x->band_ms[2 * band + 1] = (float)(combine_ns * 1e-6);
 }
 
-/* Scratch beyond the planes: tiles, the quarter-resolution layer, band times, per-thread rows. */
-static int ensure_aux(fv_dof_work *wk, int w, int h, int threads)
+/* CoC -> continuous level: interpolating two levels mixes their variances, so match the
+ * variance c^2 / 16 of the disc. Level L up-sampled bilinearly to pixel centres has about the
+ * box's (4^L - 1) / 12 plus the tent's 4^L / 6 averaged over phases, (3 4^L - 1) / 12 per axis
+ * for L >= 1 (sigma ~ 2^L / 2); level 0 is the sharp image, variance 0. */
+static void lambda_init(float *lambda)
 {
+    for (int i = 0; i < LAMBDA_N; i++) {
+        const float c = (float)i / LAMBDA_STEPS, var = c * c * (1.0f / 16.0f);
+        float lo = 0.0f, l = 0.0f;
+        for (int L = 1; L <= MAX_UP_LEVEL; L++) {
+            const float hi = (3.0f * (float)(1 << (2 * L)) - 1.0f) / 12.0f;
+            if (var < hi) {
+                l = (float)(L - 1) + (var - lo) / (hi - lo);
+                break;
+            }
+            lo = hi, l = (float)L;
+        }
+        lambda[i] = l;
+    }
+}
+
+/* The constant tables at the start of aux (the level LUT, then the up-sampling taps of levels
+ * 1..MAX_UP_LEVEL for the work's width), followed by the per-frame scratch. */
+static size_t tables_len(int w) { return LAMBDA_N + 3 * (size_t)MAX_UP_LEVEL * (size_t)w; }
+
+static void tables_at(float *a, int w, const float **lambda, xtaps xt[MAX_UP_LEVEL + 1])
+{
+    *lambda = a, a += LAMBDA_N;
+    for (int L = 1; L <= MAX_UP_LEVEL; L++) {
+        xt[L].i0 = (int32_t *)(void *)a, a += w; /* int32 and float have the same size */
+        xt[L].i1 = (int32_t *)(void *)a, a += w;
+        xt[L].ax = a, a += w;
+    }
+}
+
+/* Scratch beyond the planes, allocated on first use and kept: the tables (built then), tiles,
+ * the quarter-resolution layer, band times, per-thread rows. */
+static int ensure_aux(fv_dof_work *wk, int threads)
+{
+    const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 2 * (size_t)th +
-                       3 * (size_t)MAX_UP_LEVEL * (size_t)w;
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 2 * (size_t)th;
     if (wk->aux_len < aux) {
         free(wk->aux);
         if (!(wk->aux = malloc(aux * sizeof(float))))
             return wk->aux_len = 0, -1;
         wk->aux_len = aux;
+        const float *lambda;
+        xtaps xt[MAX_UP_LEVEL + 1];
+        tables_at(wk->aux, w, &lambda, xt);
+        lambda_init(wk->aux);
+        for (int L = 1; L <= MAX_UP_LEVEL; L++) /* level L's width, ceil(w / 2^L): for L = 2 also
+                                                 * the quarter-resolution layer's */
+            xtaps_init(&xt[L], L, w, (w + (1 << L) - 1) >> L);
     }
     const size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
     if (wk->rows_len < rows) {
@@ -539,7 +583,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->v = v, x->wk = wk, x->dsp = dsp, x->out = out, x->out_stride = out_stride, x->tab = wk->gauss;
     x->w = v->pyr->lv[0].w, x->h = v->pyr->lv[0].h;
     x->tw = (x->w + TILE - 1) / TILE, x->th = (x->h + TILE - 1) / TILE;
-    if (ensure_aux(wk, x->w, x->h, fv_pool_threads(pool)))
+    if (x->w != wk->w || x->h != wk->h || ensure_aux(wk, fv_pool_threads(pool)))
         goto fail;
     x->K = v->prm->pupil_mm * 1e-3f * v->focal_px * v->blur_scale;
     x->dn = fmaxf(v->focus_m - v->prm->tolerance_m, FV_COC_MIN_DEPTH_M), x->df = v->focus_m + v->prm->tolerance_m;
@@ -548,6 +592,8 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->lw = (x->w + LOW - 1) / LOW, x->lh = (x->h + LOW - 1) / LOW;
     const ptrdiff_t nl = (ptrdiff_t)x->lw * x->lh;
     float *a = wk->aux;
+    tables_at(a, x->w, &x->lambda, x->xt);
+    a += tables_len(x->w);
     x->t_near = a, x->t_fsig = a + nt, x->t_near_own = a + 2 * nt, x->t_fsig_own = a + 3 * nt, a += 4 * nt;
     x->l_src = a, a += 4 * nl;
     x->l_r = a, a += nl;
@@ -557,36 +603,11 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_hw = a, a += nl;
     x->l_v = a, a += 4 * nl;
     x->band_ms = a, a += 2 * x->th;
-    for (int L = 1; L <= MAX_UP_LEVEL; L++) {
-        xtaps *t = &x->xt[L];
-        t->i0 = (int32_t *)(void *)a, a += x->w; /* int32 and float have the same size */
-        t->i1 = (int32_t *)(void *)a, a += x->w;
-        t->ax = a, a += x->w;
-        /* level L's width, ceil(w / 2^L): for L = 2 also the quarter-resolution layer's */
-        xtaps_init(t, L, x->w, (x->w + (1 << L) - 1) >> L);
-    }
     /* the centre rectangle: the transition disc plus the kernels' reach */
     const float reach = v->r1_px + 2.0f * FV_DOF_RMAX;
     x->cx0 = clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = clampi((int)ceilf(v->gaze_x + reach), 0, x->w);
     x->cy0 = clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
     x->up_levels = mini(MAX_UP_LEVEL, v->pyr->levels - 1);
-    /* CoC -> continuous level: interpolating two levels mixes their variances, so match the
-     * variance c^2 / 16 of the disc. Level L up-sampled bilinearly to pixel centres has about
-     * the box's (4^L - 1) / 12 plus the tent's 4^L / 6 averaged over phases, (3 4^L - 1) / 12
-     * per axis for L >= 1 (sigma ~ 2^L / 2); level 0 is the sharp image, variance 0. */
-    for (int i = 0; i <= 64 * LAMBDA_STEPS; i++) {
-        const float c = (float)i / LAMBDA_STEPS, var = c * c * (1.0f / 16.0f);
-        float lo = 0.0f, l = 0.0f;
-        for (int L = 1; L <= MAX_UP_LEVEL; L++) {
-            const float hi = (3.0f * (float)(1 << (2 * L)) - 1.0f) / 12.0f;
-            if (var < hi) {
-                l = (float)(L - 1) + (var - lo) / (hi - lo);
-                break;
-            }
-            lo = hi, l = (float)L;
-        }
-        x->lambda[i] = l;
-    }
     x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
     const int64_t t0 = fv_time_ns();
     fv_pool_run(pool, x->th, coc_band, x);
