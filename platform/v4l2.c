@@ -709,6 +709,16 @@ static int buffer_ok(const fv_v4l2 *cam, const struct v4l2_buffer *b)
     return !(b->flags & V4L2_BUF_FLAG_ERROR) && buffer_used(cam, b) >= frame_min_bytes(cam);
 }
 
+/* A frame handed back unused because the driver flagged it or it is short: counted, and
+ * last_err says why (for the caller's diagnostics). */
+static void note_skip(fv_v4l2 *cam, const struct v4l2_buffer *b)
+{
+    cam->skipped++;
+    fv_err(cam->last_err, sizeof cam->last_err, "%s: frame %u skipped: %s", cam->path, b->sequence,
+           (b->flags & V4L2_BUF_FLAG_ERROR) ? "the driver flagged the buffer bad (V4L2_BUF_FLAG_ERROR)"
+                                            : "shorter than a whole frame");
+}
+
 /* latest_only: while more frames are already waiting, hand the older one back and take the newer,
  * so the tracker sees the freshest eye image. Failures here are left for the next poll/DQBUF to
  * report (a vanished device fails those too); *b stays a good buffer throughout. */
@@ -725,7 +735,7 @@ static void drain_to_newest(fv_v4l2 *cam, struct v4l2_buffer *b)
         if (xioctl(cam, VIDIOC_DQBUF, &nb) < 0 || nb.index >= (uint32_t)cam->n_buffers)
             return;
         if (!buffer_ok(cam, &nb)) {
-            cam->skipped++;
+            note_skip(cam, &nb);
             if (requeue(cam, (int)nb.index) < 0)
                 return;
             continue;
@@ -795,11 +805,8 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, ch
             fv_err(err, err_len, "VIDIOC_DQBUF on %s: buffer index %u out of range", cam->path, b.index);
             return FV_V4L2_ERROR;
         }
-        int bad = !buffer_ok(cam, &b);
-        if (bad) /* say why, as last_err promises for skipped frames */
-            fv_err(cam->last_err, sizeof cam->last_err, "%s: frame %u skipped: %s", cam->path, b.sequence,
-                   (b.flags & V4L2_BUF_FLAG_ERROR) ? "the driver flagged the buffer bad (V4L2_BUF_FLAG_ERROR)"
-                                                   : "shorter than a whole frame");
+        const int bad_buf = !buffer_ok(cam, &b);
+        int bad = bad_buf;
         if (!bad && cam->cfg.latest_only)
             drain_to_newest(cam, &b);
         int64_t t_deq = mono_ns();
@@ -809,8 +816,12 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, ch
             bad = fv_mjpeg_to_luma8(src, used, cam->width, cam->height, cam->luma, (size_t)cam->width, cam->last_err,
                                     sizeof cam->last_err) != 0;
         if (bad) {
-            /* A corrupted or short frame (USB packet loss): hand it back and wait for the next. */
-            cam->skipped++;
+            /* A corrupted or short frame (USB packet loss): hand it back and wait for the next
+             * (an undecodable MJPEG frame's reason is already in last_err). */
+            if (bad_buf)
+                note_skip(cam, &b);
+            else
+                cam->skipped++;
             if (requeue(cam, (int)b.index) < 0) {
                 int e = errno;
                 if (errno_gone(e))

@@ -290,7 +290,7 @@ static int check_buf_error(fv_v4l2 *cam, const char *cap_dev)
                cap_dev, strerror(errno));
         return 0;
     }
-    int frames = 0;
+    int frames = 0, presses = 1;
     int64_t t0 = now_ns();
     while (now_ns() - t0 < 5000000000LL && (frames < 3 || cam->skipped == skipped0)) {
         fv_v4l2_frame f;
@@ -299,10 +299,17 @@ static int check_buf_error(fv_v4l2 *cam, const char *cap_dev)
             frames++;
         else if (st != FV_V4L2_TIMEOUT)
             break;
+        /* vivid marks a buffer it is filling; one it drops before delivering takes the flag with
+         * it (seen once in ~10 runs): press again after 30 good frames, at most 3 times */
+        if (cam->skipped == skipped0 && frames >= 30 * presses && presses < 3 &&
+            !press_button(cap_dev, "Inject V4L2_BUF_FLAG_ERROR"))
+            presses++;
     }
-    int ok = cam->skipped == skipped0 + 1 && frames >= 3 && strstr(cam->last_err, "flagged the buffer bad");
-    result("v4l2-buf-error", ok, "skipped=%ld frames_after=%d last_skip=\"%s\"", cam->skipped - skipped0, frames,
-           cam->last_err);
+    /* one skipped frame a press at most (a delayed flag and a second press can both land) */
+    int ok = cam->skipped > skipped0 && cam->skipped <= skipped0 + presses && frames >= 3 &&
+             strstr(cam->last_err, "flagged the buffer bad");
+    result("v4l2-buf-error", ok, "skipped=%ld frames_after=%d presses=%d last_skip=\"%s\"", cam->skipped - skipped0,
+           frames, presses, cam->last_err);
     return ok;
 }
 
