@@ -184,33 +184,62 @@ static void test_synthetic_noisy(void **state)
     free(img);
 }
 
-/* Pupils partly under the upper lid, low noise: the lid's edge must not flatten the fit.
- * Stated bound: 6 px with at least 75% of the pupil in view (measured 1.2-5.6 px: the weakest
- * part of the tracker); below that (55-69% in view: 2.5-11 px) printed, not bounded. */
+/* Pupils partly under the upper lid, and fully in view, over a seeded random set like a headset
+ * sees it: gaze +-20 deg, pupil 1.6-2.8 mm, 2-6 LEDs, sensor noise 2-14 grey levels, brightness
+ * 0.55-1; every other frame looks up (3-13 deg) into a lid opened 0.35-0.65. Stated bounds per
+ * visibility bin (measured when written, 320x240: full view median 0.09 px, p90 0.25 px; 70-99%
+ * in view median 0.58 px, 82% within 3 px; 50-70% median 6.1 px, printed, not bounded). The
+ * tracker before the lid work (no lid line, no gradient support, edges at a level's crossing)
+ * scored p90 1.76 px in full view and median 2.67 px, 54% within 3 px under the lid: these
+ * bounds fail it. */
 static void test_partial_occlusion(void **state)
 {
     (void)state;
-    static const fv_synth_state cases[] = {
-        { 10.1f, 6.2f, 2.25f, 0.5f }, { -5.6f, 5.8f, 2.06f, 0.5f }, { 4.5f, 7.4f, 1.93f, 0.5f },
-        { -10.0f, 10.0f, 2.4f, 0.55f }, { 5.0f, 12.0f, 2.2f, 0.6f }, { -12.0f, 8.0f, 2.8f, 0.5f },
-        { 0.0f, 8.0f, 2.5f, 0.45f }, { 0.0f, 3.0f, 2.5f, 0.35f },
-    };
+    rng = 0x1d1dull;
     fv_synth_params p;
     fv_synth_default_params(&p, W, H);
     p.supersample = 2;
-    p.noise_sigma = 3.0f;
     uint8_t *img = malloc(W * H);
     fv_eye_tracker *t = fv_eye_create(NULL);
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    enum { N = 160 };
+    float full[N], lid[N], deep[N];
+    int nf = 0, nl = 0, nd = 0;
+    for (int i = 0; i < N; i++) {
+        p.noise_sigma = 2.0f + 12.0f * rnd();
+        p.brightness = 0.55f + 0.45f * rnd();
+        p.n_leds = 2 + (int)(4.999f * rnd());
+        const int up = i % 2;
+        const float yaw = -20.0f + 40.0f * rnd(), pitch = up ? 3.0f + 10.0f * rnd() : -10.0f + 20.0f * rnd();
+        const float pupil = 1.6f + 1.2f * rnd(), open = up ? 0.35f + 0.3f * rnd() : 1.0f;
+        const fv_synth_state s = { yaw, pitch, pupil, open };
         fv_synth_truth gt;
-        fv_synth_truth_of(&p, &cases[i], &gt);
-        const frame_eval e = eval_frame(t, &p, &cases[i], 500u + (uint64_t)i, 0, img);
-        printf("[ eyetrack ] lid over the pupil: %.0f%% visible: error %.2f px%s\n", 100.0 * gt.pupil_visible,
-               (double)e.pupil_err, gt.pupil_visible >= 0.75f ? " (bound 6)" : "");
-        assert_true(e.found);
-        if (gt.pupil_visible >= 0.75f)
-            assert_true(e.pupil_err < 6.0f);
+        fv_synth_truth_of(&p, &s, &gt);
+        const frame_eval e = eval_frame(t, &p, &s, 700u + (uint64_t)i, 0, img);
+        const float err = e.found ? e.pupil_err : 1e3f;
+        if (gt.pupil_visible >= 0.99f)
+            full[nf++] = err;
+        else if (gt.pupil_visible >= 0.7f)
+            lid[nl++] = err;
+        else if (gt.pupil_visible >= 0.5f)
+            deep[nd++] = err;
     }
+    float *bins[3] = { full, lid, deep };
+    const int counts[3] = { nf, nl, nd };
+    const char *names[3] = { "full view", "70-99% in view", "50-70% in view" };
+    float med[3], p90[3], in3[3];
+    for (int b = 0; b < 3; b++) {
+        assert_true(counts[b] >= 10);
+        int k = 0;
+        for (int i = 0; i < counts[b]; i++)
+            k += bins[b][i] <= 3.0f;
+        in3[b] = (float)k / (float)counts[b];
+        med[b] = median(bins[b], counts[b]); /* sorts */
+        p90[b] = bins[b][counts[b] * 9 / 10];
+        printf("[ eyetrack ] lid set, %-14s %3d frames: median error %.2f px, p90 %.2f px, max %.2f px, %.0f%% within 3 px\n",
+               names[b], counts[b], (double)med[b], (double)p90[b], (double)bins[b][counts[b] - 1], 100.0 * in3[b]);
+    }
+    assert_true(med[0] < 0.3f && p90[0] < 0.6f);
+    assert_true(med[1] < 1.5f && in3[1] >= 0.7f);
     fv_eye_destroy(t);
     free(img);
 }

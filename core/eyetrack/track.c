@@ -27,7 +27,12 @@
 
 #define SEARCH_MAX_SIDE 160 /* search image F: min side at most this */
 #define SEARCH_C_SIDE 64    /* exhaustive search image C: min side at most this */
+#define REFINE_MAX_SIDE 320 /* headset frames: pupil refined on the frame halved down to this */
 #define NRAYS 48
+#define EDGE_SEARCH_PX 3.0f /* headset frames: steepest rise looked for this far either side of the crossing */
+/* RANSAC support on headset-sized pupils: an edge point counts only if its gradient is within
+ * 32 deg of the candidate ellipse's outward normal */
+#define GRAD_MINCOS 0.85
 #define SPOT_MIN 20 /* bright_spot: grey levels above the median of its surround */
 
 struct fv_eye_tracker {
@@ -207,6 +212,40 @@ static inline float sample(const uint8_t *img, int w, int h, float x, float y)
     return a + fy * (b - a);
 }
 
+/* One row of a 3x3 box filter, edges replicated: dst[x] = (S * 3641 + 16384) >> 15 (S / 9,
+ * rounded; the form a rounding high multiply gives) with S the sum of r0, r1, r2 over columns
+ * x - 1 .. x + 1, clamped to [0, n). */
+static void box3_row(uint8_t *restrict dst, const uint8_t *r0, const uint8_t *r1, const uint8_t *r2, int n)
+{
+    int prev = r0[0] + r1[0] + r2[0], cur = prev;
+    for (int x = 0; x < n; x++) {
+        const int next = x + 1 < n ? r0[x + 1] + r1[x + 1] + r2[x + 1] : cur;
+        dst[x] = (uint8_t)(((prev + cur + next) * 3641 + 16384) >> 15);
+        prev = cur, cur = next;
+    }
+}
+
+/* Distance along the ray (cx, cy) + d (dx, dy) of the steepest rise within +-span of d0:
+ * central differences 1 px wide every 0.5 px, the peak refined by a parabola through the
+ * differences 1 px either side of it. */
+static float steepest_rise(const uint8_t *img, int w, int h, float cx, float cy, float dx, float dy, float d0,
+                           float span)
+{
+#define AT(q) sample(img, w, h, cx + (q) * dx, cy + (q) * dy)
+    float best = -1e30f, bq = d0;
+    for (float q = fmaxf(0.5f, d0 - span); q <= d0 + span; q += 0.5f) {
+        const float g = AT(q + 0.5f) - AT(q - 0.5f);
+        if (g > best)
+            best = g, bq = q;
+    }
+    const float gm = AT(bq) - AT(bq - 1.0f), gp = AT(bq + 1.0f) - AT(bq);
+    const float den = gm - 2.0f * best + gp;
+    /* vertex of the parabola through (-1, gm), (0, best), (1, gp), in units of 1 px; the
+     * samples of the search were 0.5 px apart, so at most a quarter pixel either way */
+    return bq + (den < 0 ? fclampf(0.5f * (gm - gp) / den, -0.25f, 0.25f) : 0.0f);
+#undef AT
+}
+
 /* The ray stays at or above th for len pixels past dist (a pupil edge, not a glint's halo or
  * a stray bright pixel inside the pupil). */
 static int sustained(const uint8_t *win, int ww, int wh, float cx, float cy, float dx, float dy, float dist, float len,
@@ -372,7 +411,11 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
 /* ---------------------------------------------------------------- refinement */
 
 /* Points within tol of e (fv_ellipse_distance with the rotation computed once). */
-static int count_near(const fv_ellipse *e, const float *x, const float *y, int n, double tol)
+/* Points within tol of the ellipse; with gradients (gx, gy not NULL), only those whose image
+ * gradient points along the ellipse's outward normal (cos >= mincos): a lash or lid edge that
+ * happens to lie on a candidate ellipse runs across it, not along it. */
+static int count_near(const fv_ellipse *e, const float *x, const float *y, const float *gx, const float *gy, int n,
+                      double tol, double mincos)
 {
     const double c = cos(e->angle), s = sin(e->angle), ia = 1.0 / e->a, ib = 1.0 / e->b;
     int k = 0;
@@ -380,7 +423,16 @@ static int count_near(const fv_ellipse *e, const float *x, const float *y, int n
         const double u = (x[i] - e->cx) * c + (y[i] - e->cy) * s, v = -(x[i] - e->cx) * s + (y[i] - e->cy) * c;
         const double rho = sqrt((u * ia) * (u * ia) + (v * ib) * (v * ib));
         const double d = rho < 1e-12 ? e->b : fabs(rho - 1.0) * sqrt(u * u + v * v) / rho;
-        k += d <= tol;
+        if (d > tol)
+            continue;
+        if (gx) {
+            const double nu = u * ia * ia, nv = v * ib * ib;
+            const double nx = nu * c - nv * s, ny = nu * s + nv * c;
+            const double dot = nx * gx[i] + ny * gy[i], nn = sqrt((nx * nx + ny * ny) * (gx[i] * gx[i] + gy[i] * gy[i]));
+            if (!(dot >= mincos * nn))
+                continue;
+        }
+        k++;
     }
     return k;
 }
@@ -392,6 +444,48 @@ typedef struct {
     fv_ellipse e;
     float inliers; /* fraction of rays giving inlier edge points */
 } pupil;
+
+/* A lid across the pupil puts a run of edge points on a nearly straight line (its radius of
+ * curvature is several times the pupil's). Find the best line through pairs of points 2-8 rays
+ * apart (the points come in ray order, and a lid's are neighbours); if at least 5 points lie
+ * within tol of it, spread over >= 1.2 r along it (an arc of the pupil's own outline that long
+ * bends away from any line by more than tol even at b/a = 0.6), it runs within 40 deg of
+ * horizontal and it cuts the pupil, drop those points and everything beyond it (lashes).
+ * Returns the number of points kept (ex, ey, egx, egy compacted). */
+static int drop_lid_line(float *ex, float *ey, float *egx, float *egy, int ne, float cx, float cy, float r)
+{
+    const float tol = fmaxf(0.5f, 0.025f * r);
+    int best = 0;
+    float bnx = 0, bny = 0, bd = 0;
+    for (int i = 0; i < ne; i++)
+        for (int dj = 2; dj <= imin(8, ne - 1); dj++) {
+            const int j = (i + dj) % ne;
+            const float dx = ex[j] - ex[i], dy = ey[j] - ey[i], len = hypotf(dx, dy);
+            if (len < 0.3f * r || fabsf(dy) > 0.643f * len) /* sin 40 deg */
+                continue;
+            const float nx = -dy / len, ny = dx / len, d = nx * ex[i] + ny * ey[i];
+            if (fabsf(nx * cx + ny * cy - d) > 0.95f * r)
+                continue;
+            int cnt = 0;
+            float tmin = 1e30f, tmax = -1e30f;
+            for (int k = 0; k < ne; k++)
+                if (fabsf(nx * ex[k] + ny * ey[k] - d) <= tol) {
+                    const float tt = ny * ex[k] - nx * ey[k];
+                    cnt++, tmin = fminf(tmin, tt), tmax = fmaxf(tmax, tt);
+                }
+            if (cnt >= 5 && tmax - tmin >= 1.2f * r && cnt > best)
+                best = cnt, bnx = nx, bny = ny, bd = d;
+        }
+    if (!best)
+        return ne;
+    /* side of the line the centre is on: keep points on it, beyond tol */
+    const float sc = bnx * cx + bny * cy - bd > 0 ? 1.0f : -1.0f;
+    int m = 0;
+    for (int k = 0; k < ne; k++)
+        if (sc * (bnx * ex[k] + bny * ey[k] - bd) > tol)
+            ex[m] = ex[k], ey[m] = ey[k], egx[m] = egx[k], egy[m] = egy[k], m++;
+    return m;
+}
 
 static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
                   int inpainted, uint8_t *win, uint8_t *mask, int *idx, pupil *out)
@@ -411,13 +505,17 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     histogram(win, ww, wh, ww, hist);
     const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
     const int thr = imax(med + 40, med + (255 - med) / 2);
-    if (!inpainted && percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
+    int masked = 0;
+    if (!inpainted && percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr) {
         inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, (uint8_t)med);
+        masked = 1;
+    }
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
     float inner = c->inner, ring = c->ring;
     /* small frames only need the levels and size from this (their centre is the search's) */
     const int iters = inpainted ? 2 : 6;
+    int grown = 0;
     for (int it = 0; it < iters; it++) {
         /* blob and surround levels around the current estimate */
         double si = 0, so = 0;
@@ -438,6 +536,12 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             inner = (float)(si / ni);
         if (no)
             ring = (float)(so / no);
+        /* Headset-sized frames: the search's box can sit between reflections inside a much
+         * bigger pupil, with pupil all around it too; grow it until its surround is not pupil */
+        if (!inpainted && grown < 4 && ring < inner + 0.25f * (med - inner) && 1.7f * 1.4f * r < half) {
+            r *= 1.4f, grown++, it--;
+            continue;
+        }
         if (!(ring > inner))
             return -1;
         const float th = 0.5f * (inner + ring);
@@ -478,31 +582,70 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
 
     /* edge points along rays: first outward crossing of the mid level */
     const float th = 0.5f * (inner + ring);
+    const uint8_t *ew = win;
+    if (!inpainted) {
+        /* 3x3 box: sensor noise would otherwise break the sustained-crossing rule near the
+         * true edge and push crossings out into a dark iris (idx is free once inpainted) */
+        uint8_t *bl = (uint8_t *)idx;
+        for (int y = 0; y < wh; y++)
+            box3_row(bl + y * ww, win + imax(0, y - 1) * ww, win + y * ww, win + imin(wh - 1, y + 1) * ww, ww);
+        ew = bl;
+    }
     float ex[NRAYS], ey[NRAYS];
     int ne = 0;
     const float step = fmaxf(0.25f, r / 24.0f);
     const int nrays = r < 12.0f ? NRAYS / 2 : NRAYS; /* small pupils: fewer edge pixels anyway */
-    float evo[NRAYS];
+    float evo[NRAYS], egx[NRAYS], egy[NRAYS];
     const float lidf = 0.35f;
     for (int k = 0; k < nrays; k++) {
         const float a = (float)(2.0 * M_PI * k / nrays), dx = cosf(a), dy = sinf(a);
-        float prev = sample(win, ww, wh, cx, cy), pd = 0;
+        float prev = sample(ew, ww, wh, cx, cy), pd = 0;
         for (float dist = step; dist < 2.2f * r; dist += step) {
             const float px = cx + dist * dx, py = cy + dist * dy;
             if (px < 0.5f || py < 0.5f || px > ww - 0.5f || py > wh - 0.5f)
                 break;
-            const float v = sample(win, ww, wh, px, py);
-            if (v >= th && prev < th && sustained(win, ww, wh, cx, cy, dx, dy, dist, fmaxf(1.5f, 0.2f * r), th)) {
+            const float v = sample(ew, ww, wh, px, py);
+            if (v >= th && prev < th && sustained(ew, ww, wh, cx, cy, dx, dy, dist, fmaxf(1.5f, 0.2f * r), th)) {
                 const float f = (th - prev) / (v - prev);
-                const float de = pd + f * (dist - pd);
+                float de = pd + f * (dist - pd);
+                if (!inpainted) /* the level's crossing moves with the levels; the edge does not */
+                    de = steepest_rise(ew, ww, wh, cx, cy, dx, dy, de, EDGE_SEARCH_PX);
                 /* beyond a pupil edge lies iris; beyond a lid edge, much brighter skin: a ray
                  * that meets the lid gives no point (it would drag the fit) */
                 const float po = de + fmaxf(2.0f, 0.15f * r);
-                const float vo = sample(win, ww, wh, cx + po * dx, cy + po * dy);
-                if (vo <= ring + 0.6f * (ring - inner)) {
+                const float vo = sample(ew, ww, wh, cx + po * dx, cy + po * dy);
+                float vmax = vo;
+                if (!inpainted) {
+                    /* the brightest of the profile beyond: iris for a pupil edge, skin between
+                     * the lashes for a lid edge */
+                    const float pe = de + fmaxf(4.0f, 0.5f * r);
+                    for (float q = po + 1.0f; q <= pe; q += 1.0f) {
+                        const float qx = cx + q * dx, qy = cy + q * dy;
+                        if (qx < 0.5f || qy < 0.5f || qx > ww - 0.5f || qy > wh - 0.5f)
+                            break;
+                        vmax = fmaxf(vmax, sample(ew, ww, wh, qx, qy));
+                    }
+                }
+                /* an edge next to an inpainted reflection is made up, not seen */
+                const int ix = (int)(cx + de * dx), iy = (int)(cy + de * dy);
+                int near_mask = 0;
+                if (masked)
+                    for (int qy = imax(0, iy - 1); qy <= imin(wh - 1, iy + 1); qy++)
+                        for (int qx = imax(0, ix - 1); qx <= imin(ww - 1, ix + 1); qx++)
+                            near_mask |= mask[qy * ww + qx] != 0;
+                if (!near_mask && vo <= ring + 0.6f * (ring - inner)) {
                     ex[ne] = cx + de * dx + x0;
                     ey[ne] = cy + de * dy + y0;
-                    evo[ne] = vo;
+                    evo[ne] = vmax;
+                    /* Sobel gradient at the edge point (bilinear samples 1 px apart), for the
+                     * RANSAC support test */
+                    const float qx = cx + de * dx, qy = cy + de * dy;
+                    float g[3][3];
+                    for (int j = 0; j < 3; j++)
+                        for (int i = 0; i < 3; i++)
+                            g[j][i] = sample(ew, ww, wh, qx + (float)(i - 1), qy + (float)(j - 1));
+                    egx[ne] = (g[0][2] + 2.0f * g[1][2] + g[2][2]) - (g[0][0] + 2.0f * g[1][0] + g[2][0]);
+                    egy[ne] = (g[2][0] + 2.0f * g[2][1] + g[2][2]) - (g[0][0] + 2.0f * g[0][1] + g[0][2]);
                     ne++;
                 }
                 break;
@@ -511,9 +654,10 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         }
     }
     if (!inpainted && ne >= 8) {
-        /* What lies just outside most edge points is iris; points with something clearly
-         * brighter beyond them (the lid margin, skin) are dropped. The median is the iris level
-         * as long as the lid hides less than half of the outline. */
+        /* What lies beyond most edge points (evo: the brightest of the profile up to 0.5 r out)
+         * is iris; points with something clearly brighter beyond them (the lid margin, skin
+         * between the lashes) are dropped. The median is the iris level as long as the lid
+         * hides less than half of the outline. */
         float srt[NRAYS];
         memcpy(srt, evo, sizeof(float) * (size_t)ne);
         for (int i = 1; i < ne; i++)
@@ -525,8 +669,14 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         int m = 0;
         for (int i = 0; i < ne; i++)
             if (evo[i] <= lim)
-                ex[m] = ex[i], ey[m] = ey[i], evo[m] = evo[i], m++;
+                ex[m] = ex[i], ey[m] = ey[i], evo[m] = evo[i], egx[m] = egx[i], egy[m] = egy[i], m++;
         ne = m;
+    }
+    int lid = 0;
+    if (!inpainted && ne >= 12) {
+        const int kept = drop_lid_line(ex, ey, egx, egy, ne, cx + x0, cy + y0, r);
+        lid = kept < ne;
+        ne = kept;
     }
     if (ne < 8)
         return 0;
@@ -560,14 +710,14 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             if (fv_ellipse_fit(sx, sy, 6, &e) || e.a < 0.5 * r || e.a > 2.5 * r || e.b < minab * e.a ||
                 hypot(e.cx - (cx + x0), e.cy - (cy + y0)) > r)
                 continue;
-            const int cnt = count_near(&e, ex, ey, ne, fmax(1.0, 0.06 * e.a));
+            const int cnt = count_near(&e, ex, ey, egx, egy, ne, fmax(1.0, 0.06 * e.a), GRAD_MINCOS);
             if (cnt > best)
                 best = cnt, be = e;
         }
         if (best >= 8) {
             const double tol = fmax(1.0, 0.06 * be.a);
             for (int i = 0; i < ne; i++)
-                if (fv_ellipse_distance(&be, ex[i], ey[i]) <= tol)
+                if (count_near(&be, ex + i, ey + i, egx + i, egy + i, 1, tol, GRAD_MINCOS))
                     ex[n] = ex[i], ey[n] = ey[i], n++;
         }
     }
@@ -610,7 +760,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     if (fv_ellipse_fit(ex, ey, n, &e))
         return 0;
     const double dc = hypot(e.cx - out->x, e.cy - out->y);
-    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < (inpainted ? 0.3 : minab) * e.a || dc > 0.6 * r)
+    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < (inpainted ? 0.3 : minab) * e.a || dc > (lid ? 1.0 : 0.6) * r)
         return 0;
     out->fit = 1;
     out->e = e;
@@ -758,9 +908,28 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     /* small images: the search image is the full-resolution frame, already inpainted; refine
      * from it (into another buffer) rather than inpainting the window again */
     const int reuse = c.scale == 1;
-    if (refine(t, reuse ? work : luma, w, h, reuse ? w : stride, &c, reuse, reuse ? lowres : work, mask, stack, &p)) {
+    /* Frames bigger than REFINE_MAX_SIDE: refined on the frame halved (lowres is free after the
+     * search). The ellipse keeps sub-pixel precision from the edge points, the sensor noise that
+     * pushes crossings outward halves, and the work quarters. */
+    const uint8_t *rsrc = reuse ? work : luma;
+    int rw = w, rh = h, rs = 1;
+    ptrdiff_t rst = reuse ? w : stride;
+    while (!reuse && imin(rw, rh) > REFINE_MAX_SIDE && rs < c.scale) {
+        uint8_t *dst = rsrc == lowres ? lowres + px / 2 : lowres;
+        const int nw = rw / 2, nh = rh / 2;
+        for (int y = 0; y < nh; y++)
+            t->dsp.et_down2_row(dst + (size_t)y * nw, rsrc + (2 * y) * rst, rsrc + (2 * y + 1) * rst, nw);
+        rsrc = dst, rst = nw, rw = nw, rh = nh, rs *= 2;
+    }
+    candidate rc = c;
+    rc.x /= (float)rs, rc.y /= (float)rs, rc.r /= (float)rs, rc.scale /= rs;
+    if (refine(t, rsrc, rw, rh, rst, &rc, reuse, reuse ? lowres : work, mask, stack, &p)) {
         /* no dark region stands out in the window: keep the search's answer, flagged low */
         p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
+    } else if (rs > 1) {
+        const float f = (float)rs;
+        p.x *= f, p.y *= f, p.r *= f;
+        p.e.cx *= f, p.e.cy *= f, p.e.a *= f, p.e.b *= f;
     }
     /* Small images (min side <= SEARCH_MAX_SIDE: remote-camera crops, ~10 px pupils inside an
      * often equally dark iris): the best contrast box's centre beat the refined centroid and the
