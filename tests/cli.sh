@@ -5,6 +5,7 @@
 set -u
 BUILD=${BUILD:-build}
 B=$BUILD/bin
+BT=$BUILD/tools
 SCENE=assets/range.glb
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
@@ -243,6 +244,12 @@ expect_usage "bench unknown kernel" "--kernel: .nope. is not a kernel" $B/fovea-
 expect_usage "bench calls without kernel" '--calls N needs --kernel NAME' $B/fovea-bench --kernels --calls 3
 # the checkers themselves catch what they are for (so the checks below can fail)
 printf '{"traceEvents":[{"ph":"M","pid":1,"tid":0,"name":"thread_name","args":{"name":"w"}},{"ph":"B","pid":1,"tid":0,"ts":1,"name":"x"}]}' >"$T/open.json"
+# eval_eye (synthetic tracker accuracy): bad flags get one line and exit 2; a small run works
+expect_usage "eval_eye bad size" "bad --size.*10x10" $BT/eval_eye --size 10x10
+expect_usage "eval_eye bad frames" "bad --frames.*0" $BT/eval_eye --frames 0
+expect_usage "eval_eye unknown flag" "unknown option.*--bogus" $BT/eval_eye --bogus
+out=$($BT/eval_eye --frames 6 2>&1) && echo "$out" | grep -q "full view .*frames: median" && ok || bad "eval_eye run: $out"
+
 python3 tools/check_trace.py "$T/open.json" 1 >/dev/null && bad "check_trace accepted an unclosed span" || ok
 printf '{"scene": "x", "runs": []}' >"$T/schema-bad.json"
 python3 tools/check_schema.py docs/bench.schema.json "$T/schema-bad.json" >/dev/null && bad "check_schema accepted a bad file" || ok

@@ -1,0 +1,162 @@
+/* eval_eye: pupil-centre accuracy of the tracker on a seeded random set of synthetic
+ * headset-camera frames (core/eyetrack/synth.c), split by how much of the pupil the lid leaves
+ * in view. The set is the one tests/test_eyetrack.c bounds at 320x240 (test_partial_occlusion)
+ * made at any size: gaze +-20 deg, pupil 1.6-2.8 mm, 2-6 LEDs, sensor noise 2-14 grey levels,
+ * brightness 0.55-1; every other frame looks up (3-13 deg) into a lid opened 0.35-0.65.
+ *
+ *   build/tools/eval_eye [--size WxH] [--frames N] [--seed N]
+ *
+ * Prints, per bin (full view, 70-99%, 50-70% in view; frames under 50% are skipped), the
+ * frames, median / p90 / max error in pixels and the share within 1 and 3 px, and the time
+ * per frame spent tracking (one thread, best kernels; the tracker's output does not depend on
+ * them). Deterministic except for the time. Exit status: 0, 1 out of memory, 2 bad usage. */
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "eyetrack/eyetrack.h"
+#include "eyetrack/synth.h"
+
+static const char *prog = "eval_eye";
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: %s [--size WxH] [--frames N] [--seed N]\n"
+               "  --size WxH   frame size (default 320x240; 64..4096 each side)\n"
+               "  --frames N   frames drawn before the visibility split (default 400; 1..100000)\n"
+               "  --seed N     random set (default 1)\n",
+            prog);
+}
+
+static _Noreturn void bad(const char *what, const char *arg)
+{
+    fprintf(stderr, "%s: %s: '%s' (--help for usage)\n", prog, what, arg);
+    exit(2);
+}
+
+static long num(const char *flag, const char *s, long lo, long hi)
+{
+    char *end;
+    const long v = strtol(s, &end, 10);
+    if (end == s || *end || v < lo || v > hi)
+        bad(flag, s);
+    return v;
+}
+
+static uint64_t rng;
+static float rnd(void) /* splitmix64 -> [0, 1) */
+{
+    uint64_t z = (rng += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (float)((z ^ (z >> 31)) >> 40) * (1.0f / 16777216.0f);
+}
+
+static int cmp_float(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int main(int argc, char **argv)
+{
+    int w = 320, h = 240, frames = 400;
+    long seed = 1;
+    static const struct option opts[] = { { "size", required_argument, 0, 's' },
+                                          { "frames", required_argument, 0, 'n' },
+                                          { "seed", required_argument, 0, 'r' },
+                                          { "help", no_argument, 0, 'h' },
+                                          { 0, 0, 0, 0 } };
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+        switch (c) {
+        case 's': {
+            char tail;
+            if (sscanf(optarg, "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 4096 || h > 4096)
+                bad("bad --size (WxH, 64..4096)", optarg);
+            break;
+        }
+        case 'n': frames = (int)num("bad --frames (1..100000)", optarg, 1, 100000); break;
+        case 'r': seed = num("bad --seed", optarg, 0, 0x7fffffffL); break;
+        case 'h': usage(stdout); return 0;
+        default: bad("unknown option or missing argument", argv[optind - 1]);
+        }
+    }
+    if (optind != argc)
+        bad("unexpected argument", argv[optind]);
+    fv_synth_params p;
+    fv_synth_default_params(&p, w, h);
+    p.supersample = 2;
+    uint8_t *img = malloc((size_t)w * h);
+    float *err[3];
+    for (int b = 0; b < 3; b++)
+        err[b] = malloc(sizeof(float) * (size_t)frames);
+    fv_eye_tracker *t = fv_eye_create(NULL);
+    if (!img || !err[0] || !err[1] || !err[2] || !t) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        return 1;
+    }
+    rng = (uint64_t)seed * 0x2545f4914f6cdd1dull;
+    const int progress = isatty(2);
+    int n[3] = { 0, 0, 0 };
+    double track_s = 0;
+    int tracked = 0;
+    for (int i = 0; i < frames; i++) {
+        p.noise_sigma = 2.0f + 12.0f * rnd();
+        p.brightness = 0.55f + 0.45f * rnd();
+        p.n_leds = 2 + (int)(4.999f * rnd());
+        const int up = i % 2;
+        const float yaw = -20.0f + 40.0f * rnd(), pitch = up ? 3.0f + 10.0f * rnd() : -10.0f + 20.0f * rnd();
+        const float pupil = 1.6f + 1.2f * rnd(), open = up ? 0.35f + 0.3f * rnd() : 1.0f;
+        const fv_synth_state s = { yaw, pitch, pupil, open };
+        fv_synth_truth gt;
+        fv_synth_render(&p, &s, 1000u + (uint64_t)i, img, w, &gt);
+        if (gt.pupil_visible < 0.5f)
+            continue;
+        fv_eye_result r;
+        const double t0 = now_s();
+        fv_track_image(t, img, w, h, w, &r);
+        track_s += now_s() - t0, tracked++;
+        const float e = r.found ? hypotf(r.pupil_x - gt.pupil_x, r.pupil_y - gt.pupil_y) : INFINITY;
+        const int b = gt.pupil_visible >= 0.99f ? 0 : gt.pupil_visible >= 0.7f ? 1 : 2;
+        err[b][n[b]++] = e;
+        if (progress && i % 50 == 49)
+            fprintf(stderr, "\r%s: %d / %d frames", prog, i + 1, frames);
+    }
+    if (progress)
+        fprintf(stderr, "\r%*s\r", 40, "");
+    printf("%s: %dx%d, %d frames drawn, seed %ld\n", prog, w, h, frames, seed);
+    static const char *names[3] = { "full view", "70-99% in view", "50-70% in view" };
+    for (int b = 0; b < 3; b++) {
+        if (!n[b]) {
+            printf("  %-15s    0 frames\n", names[b]);
+            continue;
+        }
+        qsort(err[b], (size_t)n[b], sizeof(float), cmp_float);
+        int k1 = 0, k3 = 0;
+        for (int i = 0; i < n[b]; i++)
+            k1 += err[b][i] <= 1.0f, k3 += err[b][i] <= 3.0f;
+        printf("  %-15s %4d frames: median %.2f px, p90 %.2f px, max %.2f px, within 1 px %.0f%%, within 3 px %.0f%%\n",
+               names[b], n[b], (double)err[b][n[b] / 2], (double)err[b][n[b] * 9 / 10], (double)err[b][n[b] - 1],
+               100.0 * k1 / n[b], 100.0 * k3 / n[b]);
+    }
+    if (tracked)
+        printf("  time per frame (tracking only, one thread): %.3f ms\n", 1e3 * track_s / tracked);
+    fv_eye_destroy(t);
+    free(img);
+    for (int b = 0; b < 3; b++)
+        free(err[b]);
+    return 0;
+}
