@@ -129,10 +129,10 @@ static void histogram(const uint8_t *img, int w, int h, ptrdiff_t stride, uint32
 
 /* Reflections: pixels >= thr, grown by `grow` pixels (a glint's halo is brighter than its
  * background too), replaced by the mean of their unmasked 4-neighbours, ring by ring from the
- * outside in. mask is w*h bytes of scratch, idx w*h ints; the work is proportional to the
- * masked area, not the image. */
+ * outside in. mask is w*h bytes of scratch, idx and fr w*h ints each; the work is proportional
+ * to the masked area, not the image. */
 static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
-                           uint8_t fallback)
+                           int *fr, uint8_t fallback)
 {
     int n = 0;
     for (int y = 0; y < h; y++)
@@ -157,30 +157,58 @@ static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int th
         }
         from = to;
     }
-    /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on) */
-    for (int pass = 0; pass < 3 + 2 * grow && n; pass++) { /* enough for a grown glint; big bright areas get the fallback */
+    /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on), QUEUED
+     * in the next pass's frontier. Pass p fills exactly the pixels 4-adjacent to a source, i.e.
+     * (p = 0) to an unmasked pixel or (p > 0) to one filled in pass p - 1, each from sources
+     * only, so a pass's order does not matter and only that frontier needs visiting: the
+     * pixels no pass reaches are seen twice, not once per pass. */
+    enum { QUEUED = 255 };
+    const int passes = 3 + 2 * grow; /* enough for a grown glint; big bright areas get the fallback */
+    int b0 = 0, b1 = 0;              /* fr[b0, b1): the pixels filled in the last pass */
+    for (int pass = 0; pass < passes; pass++) {
         const uint8_t lim = (uint8_t)(2 + pass);
 #define SRC(j) (mask[j] == 0 || (mask[j] >= 2 && mask[j] < lim))
-        int left = 0;
-        for (int j = 0; j < n; j++) {
-            const int i = idx[j], x = i % w, y = i / w;
+        if (pass > 0) { /* this pass's frontier: unfilled neighbours of the last pass's pixels */
+            const int e0 = b1;
+            for (int j = b0; j < e0; j++) {
+                const int i = fr[j], x = i % w, y = i / w;
+                const int nb[4] = { x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1, y + 1 < h ? i + w : -1 };
+                for (int k = 0; k < 4; k++)
+                    if (nb[k] >= 0 && mask[nb[k]] == 1) {
+                        mask[nb[k]] = QUEUED;
+                        fr[b1++] = nb[k];
+                    }
+            }
+            b0 = e0;
+            if (b0 == b1)
+                break;
+        }
+        const int *list = pass ? fr + b0 : idx, len = pass ? b1 - b0 : n;
+        int e = b1;
+        for (int j = 0; j < len; j++) {
+            const int i = list[j], x = i % w, y = i / w;
             int s = 0, c = 0;
             if (x > 0 && SRC(i - 1)) s += img[i - 1], c++;
             if (x + 1 < w && SRC(i + 1)) s += img[i + 1], c++;
             if (y > 0 && SRC(i - w)) s += img[i - w], c++;
             if (y + 1 < h && SRC(i + w)) s += img[i + w], c++;
-            if (c) {
+            if (c) { /* always, past pass 0 */
                 img[i] = (uint8_t)((s + c / 2) / c);
                 mask[i] = lim;
-            } else {
-                idx[left++] = i;
+                if (!pass)
+                    fr[e++] = i;
             }
         }
 #undef SRC
-        n = left;
+        if (!pass) {
+            b0 = 0, b1 = e;
+            if (!e)
+                break;
+        }
     }
     for (int j = 0; j < n; j++)
-        img[idx[j]] = fallback;
+        if (mask[idx[j]] == 1)
+            img[idx[j]] = fallback;
 }
 
 static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x1, int y1)
@@ -325,7 +353,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
     const int thr = imax(med + 40, med + (255 - med) / 2);
     if (hi >= thr)
-        inpaint_bright(d, work, sw, sh, thr, 1, mask, idx, (uint8_t)med);
+        inpaint_bright(d, work, sw, sh, thr, 1, mask, idx, (int *)ii, (uint8_t)med); /* ii: free until the integral below */
     const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
     /* level C */
     int cw = sw, ch = sh, f = 1;
@@ -394,7 +422,7 @@ typedef struct {
 } pupil;
 
 static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
-                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, pupil *out)
+                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, int *fr, pupil *out)
 {
     /* window around the candidate, reflections inpainted */
     /* headset-sized frames: the search's box can be much smaller than the pupil (the darkest
@@ -412,7 +440,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
     const int thr = imax(med + 40, med + (255 - med) / 2);
     if (!inpainted && percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
-        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, (uint8_t)med);
+        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, fr, (uint8_t)med);
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
     float inner = c->inner, ring = c->ring;
@@ -758,7 +786,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     /* small images: the search image is the full-resolution frame, already inpainted; refine
      * from it (into another buffer) rather than inpainting the window again */
     const int reuse = c.scale == 1;
-    if (refine(t, reuse ? work : luma, w, h, reuse ? w : stride, &c, reuse, reuse ? lowres : work, mask, stack, &p)) {
+    if (refine(t, reuse ? work : luma, w, h, reuse ? w : stride, &c, reuse, reuse ? lowres : work, mask, stack, (int *)ii, &p)) {
         /* no dark region stands out in the window: keep the search's answer, flagged low */
         p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
     }
