@@ -277,50 +277,90 @@ typedef struct {
 
 /* Best contrast box over centres [x0, x1) x [y0, y1) and half-sizes k in [kmin, kmax]
  * (every k when step1, else a geometric-ish ladder). Score = mean(ring k..1.5k) - mean(box k)
- * - lambda * (mean(box) - dark) - mu * (distance from the image centre) / min side: lambda
+ * - (mean(box) - dark) - mu * (distance from the image centre) / min side: the darkness term
  * prefers the darker of two contrasting blobs (the pupil in the iris); a 1.5k ring beat 2k and
  * 3k on the MRL images (less lid and brow in it); mu (grey levels per image side) is a weak
  * prior for the eye being roughly centred in its camera, which keeps dark brows, hair and
- * vignetted corners from winning in dim images. */
-static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0, int x1, int y0, int y1,
-                       float dark, float mu, box_hit *best)
+ * vignetted corners from winning in dim images. Centres are visited k, y, x in order, and
+ * a later one wins only with a strictly higher score. */
+typedef struct {
+    const uint32_t *ii;
+    int iw, sw, sh;
+    float dark, prior, cxm, cym;
+} box_ctx;
+
+static inline void box_offer(const box_ctx *b, box_hit *best, float score, float mi, float mo, int x, int y, int k)
 {
-    const float lambda = 1.0f, rf = 1.5f;
-    const float cxm = 0.5f * (sw - 1), cym = 0.5f * (sh - 1), prior = mu / (float)(sw < sh ? sw : sh);
-    const int iw = sw + 1;
+    if (score <= best->score) /* the prior only lowers it */
+        return;
+    if (b->prior > 0) {
+        const float ddx = (float)x - b->cxm, ddy = (float)y - b->cym;
+        score -= b->prior * sqrtf(ddx * ddx + ddy * ddy);
+    }
+    if (score > best->score)
+        *best = (box_hit){ score, mi, mo, x, y, k };
+}
+
+/* Centres [xa, xb) of row y whose box or ring the image clips. */
+static void box_clipped(const box_ctx *b, box_hit *best, int k, int ko, int y, int xa, int xb)
+{
+    /* the box inside the image, most of the ring too: vignetted corners and image edges are
+     * dark and half a ring is no surround */
+    if (y - k < 0 || y + k + 1 > b->sh)
+        return;
+    xa = imax(xa, k), xb = imin(xb, b->sw - k);
+    const int na = (2 * k + 1) * (2 * k + 1), no_full = (2 * ko + 1) * (2 * ko + 1);
+    const int oy0 = imax(0, y - ko), oy1 = imin(b->sh, y + ko + 1);
+    for (int x = xa; x < xb; x++) {
+        const int ox0 = imax(0, x - ko), ox1 = imin(b->sw, x + ko + 1);
+        const int no = (ox1 - ox0) * (oy1 - oy0);
+        if (10 * (no - na) < 6 * (no_full - na))
+            continue;
+        const uint32_t si = box_sum(b->ii, b->iw, x - k, y - k, x + k + 1, y + k + 1);
+        const uint32_t so = box_sum(b->ii, b->iw, ox0, oy0, ox1, oy1) - si;
+        const float mi = (float)si / na, mo = (float)so / (no - na);
+        box_offer(b, best, mo - mi - (mi - b->dark), mi, mo, x, y, k);
+    }
+}
+
+static void box_search(const fv_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
+                       int x1, int y0, int y1, float dark, float mu, box_hit *best)
+{
+    const float rf = 1.5f;
+    const box_ctx b = { ii, sw + 1, sw, sh, dark, mu / (float)(sw < sh ? sw : sh), 0.5f * (sw - 1), 0.5f * (sh - 1) };
+    const int iw = sw + 1, xs = imax(0, x0), xe = imin(sw, x1);
+    enum { CHUNK = 256 };
+    float sc[CHUNK];
     for (int k = kmin; k <= kmax; k += (step1 || k < 4 ? 1 : k / 4)) {
         const int ko = (int)lrintf(rf * k);
         const int na_full = (2 * k + 1) * (2 * k + 1), no_full = (2 * ko + 1) * (2 * ko + 1);
         const float inv_a = 1.0f / (float)na_full, inv_r = 1.0f / (float)(no_full - na_full);
+        /* centres [xa, xb) of rows [ko, sh - ko) have their ring inside the image: no
+         * divisions, one row kernel call per chunk */
+        const int xa = imax(xs, ko), xb = imin(xe, sw - ko);
         for (int y = imax(0, y0); y < imin(sh, y1); y++) {
-            const int iy0 = imax(0, y - k), iy1 = imin(sh, y + k + 1);
-            const int oy0 = imax(0, y - ko), oy1 = imin(sh, y + ko + 1);
-            for (int x = imax(0, x0); x < imin(sw, x1); x++) {
-                const int ix0 = imax(0, x - k), ix1 = imin(sw, x + k + 1);
-                const int ox0 = imax(0, x - ko), ox1 = imin(sw, x + ko + 1);
-                const int na = (ix1 - ix0) * (iy1 - iy0), no = (ox1 - ox0) * (oy1 - oy0);
-                const uint32_t si = box_sum(ii, iw, ix0, iy0, ix1, iy1);
-                const uint32_t so = box_sum(ii, iw, ox0, oy0, ox1, oy1) - si;
-                float mi, mo;
-                if (na == na_full && no == no_full) { /* inside: no divisions */
-                    mi = (float)si * inv_a, mo = (float)so * inv_r;
-                } else {
-                    /* the box inside the image, most of the ring too: vignetted corners and
-                     * image edges are dark and half a ring is no surround */
-                    if (na != na_full || 10 * (no - na) < 6 * (no_full - na_full))
-                        continue;
-                    mi = (float)si / na, mo = (float)so / (no - na);
-                }
-                float score = mo - mi - lambda * (mi - dark);
-                if (score <= best->score) /* the prior only lowers it */
-                    continue;
-                if (prior > 0) {
-                    const float ddx = (float)x - cxm, ddy = (float)y - cym;
-                    score -= prior * sqrtf(ddx * ddx + ddy * ddy);
-                }
-                if (score > best->score)
-                    *best = (box_hit){ score, mi, mo, x, y, k };
+            if (y < ko || y >= sh - ko || xa >= xb) {
+                box_clipped(&b, best, k, ko, y, xs, xe);
+                continue;
             }
+            box_clipped(&b, best, k, ko, y, xs, xa);
+            for (int c0 = xa; c0 < xb; c0 += CHUNK) {
+                const int cn = imin(CHUNK, xb - c0);
+                const uint32_t *it = ii + (y - k) * iw + c0 - k, *ib = ii + (y + k + 1) * iw + c0 - k;
+                const uint32_t *ot = ii + (y - ko) * iw + c0 - ko, *ob = ii + (y + ko + 1) * iw + c0 - ko;
+                if (!(d->et_box_score_row(sc, it, ib, 2 * k + 1, ot, ob, 2 * ko + 1, cn, inv_a, inv_r, dark) >
+                      best->score))
+                    continue; /* nothing in the chunk beats the best */
+                for (int j = 0; j < cn; j++) {
+                    if (sc[j] <= best->score)
+                        continue;
+                    const int x = c0 + j;
+                    const uint32_t si = box_sum(ii, iw, x - k, y - k, x + k + 1, y + k + 1);
+                    const uint32_t so = box_sum(ii, iw, x - ko, y - ko, x + ko + 1, y + ko + 1) - si;
+                    box_offer(&b, best, sc[j], (float)si * inv_a, (float)so * inv_r, x, y, k);
+                }
+            }
+            box_clipped(&b, best, k, ko, y, xb, xe);
         }
     }
 }
@@ -374,14 +414,14 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     /* centres no nearer the border than margin_frac of the side: vignetted corners and image
      * edges are dark, and a pupil there is cut anyway */
     const int mx = (int)lrintf(t->p.border_frac * side);
-    box_search(ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, t->p.centre_prior, &b);
+    box_search(d, ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, t->p.centre_prior, &b);
     if (b.score <= -1e30f)
         return c;
     if (f > 1) { /* refine on F around C's answer */
         const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
         box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
         integral(d, work, sw, sh, ii);
-        box_search(ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
+        box_search(d, ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
         if (bf.score > -1e30f)
             b = bf;
         else
