@@ -127,6 +127,31 @@ static void histogram(const uint8_t *img, int w, int h, ptrdiff_t stride, uint32
         hist[v] = hs[0][v] + hs[1][v] + hs[2][v] + hs[3][v];
 }
 
+/* Pixel lists hold y << 16 | x (sides are at most 8192): the column and row without a
+ * division, the neighbours by adding +-1 and +-ROW. */
+#define PK(x, y) ((y) << 16 | (x))
+#define PK_X(p) ((p)&0xffff)
+#define PK_Y(p) ((p) >> 16)
+enum { ROW = 1 << 16 };
+
+/* Appends the nonzero bytes of row y (m, w bytes) to list[n...]; the new count. */
+static int list_nonzero(const uint8_t *m, int w, int y, int *list, int n)
+{
+    int x = 0;
+    for (; x + 8 <= w; x += 8) { /* mostly zero: eight at a time */
+        uint64_t v;
+        memcpy(&v, m + x, sizeof v);
+        if (v)
+            for (int j = x; j < x + 8; j++)
+                if (m[j])
+                    list[n++] = PK(j, y);
+    }
+    for (; x < w; x++)
+        if (m[x])
+            list[n++] = PK(x, y);
+    return n;
+}
+
 /* Reflections: pixels >= thr, grown by `grow` pixels (a glint's halo is brighter than its
  * background too), replaced by the mean of their unmasked 4-neighbours, ring by ring from the
  * outside in. mask is w*h bytes of scratch, idx and fr w*h ints each; the work is proportional
@@ -137,78 +162,86 @@ static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int th
     int n = 0;
     for (int y = 0; y < h; y++)
         if (dsp->et_thresh_row(mask + y * w, img + y * w, w, thr))
-            for (int x = 0; x < w; x++)
-                if (mask[y * w + x])
-                    idx[n++] = y * w + x;
+            n = list_nonzero(mask + y * w, w, y, idx, n);
     if (!n)
         return;
-    for (int i = 0; i < n; i++)
-        mask[idx[i]] = 1;
-    for (int g = 0, from = 0; g < grow; g++) {
+    for (int j = 0; j < n; j++)
+        mask[PK_Y(idx[j]) * w + PK_X(idx[j])] = 1;
+    int from = 0; /* idx[from, n): the last ring; the only pixels with unmasked neighbours */
+    for (int g = 0; g < grow; g++) {
         const int to = n;
         for (int j = from; j < to; j++) {
-            const int i = idx[j], x = i % w, y = i / w;
-            const int nb[4] = { x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1, y + 1 < h ? i + w : -1 };
-            for (int k = 0; k < 4; k++)
-                if (nb[k] >= 0 && !mask[nb[k]]) {
-                    mask[nb[k]] = 1;
-                    idx[n++] = nb[k];
-                }
+            const int p = idx[j], x = PK_X(p), y = PK_Y(p), i = y * w + x;
+#define GROW(cond, di, dp)                                                                                              \
+    if ((cond) && !mask[i + (di)])                                                                                     \
+        mask[i + (di)] = 1, idx[n++] = p + (dp);
+            GROW(x > 0, -1, -1)
+            GROW(x + 1 < w, 1, 1)
+            GROW(y > 0, -w, -ROW)
+            GROW(y + 1 < h, w, ROW)
+#undef GROW
         }
         from = to;
     }
     /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on), QUEUED
      * in the next pass's frontier. Pass p fills exactly the pixels 4-adjacent to a source, i.e.
      * (p = 0) to an unmasked pixel or (p > 0) to one filled in pass p - 1, each from sources
-     * only, so a pass's order does not matter and only that frontier needs visiting: the
-     * pixels no pass reaches are seen twice, not once per pass. */
+     * only, so a pass's order does not matter and only that frontier needs visiting (for
+     * pass 0, the last ring): the pixels no pass reaches are not seen again until the end. */
     enum { QUEUED = 255 };
     const int passes = 3 + 2 * grow; /* enough for a grown glint; big bright areas get the fallback */
     int b0 = 0, b1 = 0;              /* fr[b0, b1): the pixels filled in the last pass */
     for (int pass = 0; pass < passes; pass++) {
         const uint8_t lim = (uint8_t)(2 + pass);
-#define SRC(j) (mask[j] == 0 || (mask[j] >= 2 && mask[j] < lim))
         if (pass > 0) { /* this pass's frontier: unfilled neighbours of the last pass's pixels */
             const int e0 = b1;
             for (int j = b0; j < e0; j++) {
-                const int i = fr[j], x = i % w, y = i / w;
-                const int nb[4] = { x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1, y + 1 < h ? i + w : -1 };
-                for (int k = 0; k < 4; k++)
-                    if (nb[k] >= 0 && mask[nb[k]] == 1) {
-                        mask[nb[k]] = QUEUED;
-                        fr[b1++] = nb[k];
-                    }
+                const int p = fr[j], x = PK_X(p), y = PK_Y(p), i = y * w + x;
+#define QUEUE(cond, di, dp)                                                                                             \
+    if ((cond) && mask[i + (di)] == 1)                                                                                 \
+        mask[i + (di)] = QUEUED, fr[b1++] = p + (dp);
+                QUEUE(x > 0, -1, -1)
+                QUEUE(x + 1 < w, 1, 1)
+                QUEUE(y > 0, -w, -ROW)
+                QUEUE(y + 1 < h, w, ROW)
+#undef QUEUE
             }
             b0 = e0;
             if (b0 == b1)
                 break;
         }
-        const int *list = pass ? fr + b0 : idx, len = pass ? b1 - b0 : n;
+        const int *list = pass ? fr + b0 : idx + from, len = pass ? b1 - b0 : n - from;
         int e = b1;
         for (int j = 0; j < len; j++) {
-            const int i = list[j], x = i % w, y = i / w;
+            const int p = list[j], x = PK_X(p), y = PK_Y(p), i = y * w + x;
             int s = 0, c = 0;
-            if (x > 0 && SRC(i - 1)) s += img[i - 1], c++;
-            if (x + 1 < w && SRC(i + 1)) s += img[i + 1], c++;
-            if (y > 0 && SRC(i - w)) s += img[i - w], c++;
-            if (y + 1 < h && SRC(i + w)) s += img[i + w], c++;
+#define SRC(cond, di)                                                                                                   \
+    if ((cond) && (mask[i + (di)] == 0 || (mask[i + (di)] >= 2 && mask[i + (di)] < lim)))                              \
+        s += img[i + (di)], c++;
+            SRC(x > 0, -1)
+            SRC(x + 1 < w, 1)
+            SRC(y > 0, -w)
+            SRC(y + 1 < h, w)
+#undef SRC
             if (c) { /* always, past pass 0 */
-                img[i] = (uint8_t)((s + c / 2) / c);
+                /* (s + c / 2) / c, with constant divisors */
+                img[i] = (uint8_t)(c == 1 ? s : c == 2 ? (s + 1) / 2 : c == 3 ? (s + 1) / 3 : (s + 2) / 4);
                 mask[i] = lim;
                 if (!pass)
-                    fr[e++] = i;
+                    fr[e++] = p;
             }
         }
-#undef SRC
         if (!pass) {
             b0 = 0, b1 = e;
             if (!e)
                 break;
         }
     }
-    for (int j = 0; j < n; j++)
-        if (mask[idx[j]] == 1)
-            img[idx[j]] = fallback;
+    for (int j = 0; j < n; j++) {
+        const int i = PK_Y(idx[j]) * w + PK_X(idx[j]);
+        if (mask[i] == 1)
+            img[i] = fallback;
+    }
 }
 
 static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x1, int y1)
@@ -699,19 +732,21 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
         return 0;
     const int thr = imax((int)pp->ring + 40, (int)(pp->ring + 0.5f * (255.0f - pp->ring)));
     const float max_area = fmaxf(4.0f, 0.8f * pp->r * pp->r);
-    memset(lab, 0, (size_t)ww * wh);
+    /* lab: 255 bright and not yet in a blob, 1 in one, 0 dark (thr above 255: none bright) */
     int n = 0;
     for (int y = 0; y < wh; y++)
+        t->dsp.et_thresh_row(lab + y * ww, luma + (y + y0) * stride + x0, ww, imin(thr, 256));
+    for (int y = 0; y < wh; y++)
         for (int x = 0; x < ww; x++) {
-            if (lab[y * ww + x] || luma[(y + y0) * stride + x + x0] < thr)
+            if (lab[y * ww + x] != 255)
                 continue;
             /* flood fill one 4-connected blob */
             int sp = 0, area = 0, touches = 0, peak = 0;
             double sw = 0, sx = 0, sy = 0;
-            stack[sp++] = y * ww + x;
+            stack[sp++] = PK(x, y);
             lab[y * ww + x] = 1;
             while (sp) {
-                const int i = stack[--sp], px = i % ww, py = i / ww;
+                const int q = stack[--sp], px = PK_X(q), py = PK_Y(q), i = py * ww + px;
                 const int v = luma[(py + y0) * stride + px + x0];
                 const double wt = v - thr + 1;
                 peak = imax(peak, v);
@@ -719,14 +754,14 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
                 area++;
                 if (px == 0 || py == 0 || px == ww - 1 || py == wh - 1)
                     touches = 1;
-                const int nb[4] = { px > 0 ? i - 1 : -1, px + 1 < ww ? i + 1 : -1, py > 0 ? i - ww : -1,
-                                    py + 1 < wh ? i + ww : -1 };
-                for (int k = 0; k < 4; k++)
-                    if (nb[k] >= 0 && !lab[nb[k]] &&
-                        luma[(nb[k] / ww + y0) * stride + nb[k] % ww + x0] >= thr) {
-                        lab[nb[k]] = 1;
-                        stack[sp++] = nb[k];
-                    }
+#define PUSH(cond, di, dq)                                                                                              \
+    if ((cond) && lab[i + (di)] == 255)                                                                                \
+        lab[i + (di)] = 1, stack[sp++] = q + (dq);
+                PUSH(px > 0, -1, -1)
+                PUSH(px + 1 < ww, 1, 1)
+                PUSH(py > 0, -ww, -ROW)
+                PUSH(py + 1 < wh, ww, ROW)
+#undef PUSH
             }
             if (touches || area > max_area)
                 continue;
