@@ -494,8 +494,10 @@ typedef struct {
     float inliers; /* fraction of rays giving inlier edge points */
 } pupil;
 
+/* Scratch: win, mask w*h bytes, idx, fr w*h ints (fr: the search's integral image buffer, free
+ * by now), dxx w floats. */
 static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
-                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, int *fr, pupil *out)
+                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, int *fr, float *dxx, pupil *out)
 {
     /* window around the candidate, reflections inpainted */
     /* headset-sized frames: the search's box can be much smaller than the pupil (the darkest
@@ -521,45 +523,57 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     const int iters = inpainted ? 2 : 6;
     for (int it = 0; it < iters; it++) {
         /* blob and surround levels around the current estimate */
-        double si = 0, so = 0;
-        int ni = 0, no = 0;
-        const float ri = 0.7f * r, ro0 = 1.2f * r, ro1 = 1.7f * r;
+        const float ri = 0.7f * r, ro0 = 1.2f * r, ro1 = 1.7f * r, rr = 1.5f * r;
+        const float ri2 = ri * ri, ro02 = ro0 * ro0, ro12 = ro1 * ro1, rr2 = rr * rr;
         const int bx0 = imax(0, (int)(cx - ro1)), bx1 = imin(ww, (int)(cx + ro1) + 1);
         const int by0 = imax(0, (int)(cy - ro1)), by1 = imin(wh, (int)(cy + ro1) + 1);
-        for (int y = by0; y < by1; y++)
+        const int ax0 = imax(0, (int)(cx - rr)), ax1 = imin(ww, (int)(cx + rr) + 1);
+        const int ay0 = imax(0, (int)(cy - rr)), ay1 = imin(wh, (int)(cy + rr) + 1);
+        /* dx * dx of every column either loop visits (the same float operations as per pixel) */
+        const int qx0 = imin(ax0, bx0), qx1 = imax(ax1, bx1);
+        for (int x = qx0; x < qx1; x++) {
+            const float dx = x + 0.5f - cx;
+            dxx[x - qx0] = dx * dx;
+        }
+        /* integer sums: exact, as the double sums were */
+        int64_t si = 0, so = 0;
+        int ni = 0, no = 0;
+        for (int y = by0; y < by1; y++) {
+            const float dy = y + 0.5f - cy, dyy = dy * dy;
+            const uint8_t *row = win + y * ww;
             for (int x = bx0; x < bx1; x++) {
-                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy, d2 = dx * dx + dy * dy;
-                const int v = win[y * ww + x];
-                if (d2 <= ri * ri)
+                const float d2 = dxx[x - qx0] + dyy;
+                const int v = row[x];
+                if (d2 <= ri2)
                     si += v, ni++;
-                else if (d2 >= ro0 * ro0 && d2 <= ro1 * ro1)
+                else if (d2 >= ro02 && d2 <= ro12)
                     so += v, no++;
             }
+        }
         if (ni)
-            inner = (float)(si / ni);
+            inner = (float)((double)si / ni);
         if (no)
-            ring = (float)(so / no);
+            ring = (float)((double)so / no);
         if (!(ring > inner))
             return -1;
         const float th = 0.5f * (inner + ring);
         /* weighted centroid of the dark pixels near the estimate */
-        const float rr = 1.5f * r;
         double sw = 0, sx = 0, sy = 0;
         int area = 0;
-        const int ax0 = imax(0, (int)(cx - rr)), ax1 = imin(ww, (int)(cx + rr) + 1);
-        const int ay0 = imax(0, (int)(cy - rr)), ay1 = imin(wh, (int)(cy + rr) + 1);
-        for (int y = ay0; y < ay1; y++)
+        for (int y = ay0; y < ay1; y++) {
+            const float dy = y + 0.5f - cy, dyy = dy * dy;
+            const uint8_t *row = win + y * ww;
             for (int x = ax0; x < ax1; x++) {
-                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy;
-                if (dx * dx + dy * dy > rr * rr)
+                if (dxx[x - qx0] + dyy > rr2)
                     continue;
-                const float v = win[y * ww + x];
+                const float v = row[x];
                 if (v < th) {
                     const double wt = th - v;
                     sw += wt, sx += wt * (x + 0.5f), sy += wt * (y + 0.5f);
                     area++;
                 }
             }
+        }
         if (sw <= 0)
             return -1;
         const float nx = (float)(sx / sw), ny = (float)(sy / sw);
@@ -845,14 +859,17 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     r->status = FV_EYE_LOST;
     const size_t px = (size_t)w * h;
     const size_t ii_bytes = ((size_t)(w + 1) * (h + 1)) * sizeof(uint32_t);
-    uint8_t *m = scratch(t, 3 * px + ii_bytes + px * sizeof(int) + 64 + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
+    const size_t row_bytes = (size_t)w * sizeof(float);
+    uint8_t *m = scratch(t, 3 * px + ii_bytes + px * sizeof(int) + row_bytes + 64 +
+                                2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
     if (!m)
         return -1;
     uint32_t *ii = (uint32_t *)m;
     int *stack = (int *)(m + ii_bytes);
-    fv_eye_glint *gl = (fv_eye_glint *)(m + ii_bytes + px * sizeof(int));
-    uint8_t *work = m + ii_bytes + px * sizeof(int) + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint), *mask = work + px,
-            *lowres = mask + px;
+    float *rowf = (float *)(m + ii_bytes + px * sizeof(int));
+    fv_eye_glint *gl = (fv_eye_glint *)(m + ii_bytes + px * sizeof(int) + row_bytes);
+    uint8_t *work = m + ii_bytes + px * sizeof(int) + row_bytes + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint),
+            *mask = work + px, *lowres = mask + px;
 
     const candidate c = coarse_search(t, luma, w, h, stride, work, mask, lowres, ii, stack);
     if (!c.ok)
@@ -861,7 +878,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     /* small images: the search image is the full-resolution frame, already inpainted; refine
      * from it (into another buffer) rather than inpainting the window again */
     const int reuse = c.scale == 1;
-    if (refine(t, reuse ? work : luma, w, h, reuse ? w : stride, &c, reuse, reuse ? lowres : work, mask, stack, (int *)ii, &p)) {
+    if (refine(t, reuse ? work : luma, w, h, reuse ? w : stride, &c, reuse, reuse ? lowres : work, mask, stack, (int *)ii, rowf, &p)) {
         /* no dark region stands out in the window: keep the search's answer, flagged low */
         p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
     }
