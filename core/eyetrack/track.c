@@ -510,12 +510,14 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         return -1;
     for (int y = 0; y < wh; y++)
         memcpy(win + (size_t)y * ww, luma + (y + y0) * stride + x0, (size_t)ww);
-    uint32_t hist[256];
-    histogram(win, ww, wh, ww, hist);
-    const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
-    const int thr = imax(med + 40, med + (255 - med) / 2);
-    if (!inpainted && percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
-        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, fr, (uint8_t)med);
+    if (!inpainted) { /* small frames: the search image, inpainted already; nothing else needs these levels */
+        uint32_t hist[256];
+        histogram(win, ww, wh, ww, hist);
+        const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
+        const int thr = imax(med + 40, med + (255 - med) / 2);
+        if (percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr)
+            inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, fr, (uint8_t)med);
+    }
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
     float inner = c->inner, ring = c->ring;
@@ -752,6 +754,14 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
         t->dsp.et_thresh_row(lab + y * ww, luma + (y + y0) * stride + x0, ww, imin(thr, 256));
     for (int y = 0; y < wh; y++)
         for (int x = 0; x < ww; x++) {
+            if (x + 8 <= ww) { /* mostly dark: skip eight at a time */
+                uint64_t v;
+                memcpy(&v, lab + y * ww + x, sizeof v);
+                if (!v) {
+                    x += 7;
+                    continue;
+                }
+            }
             if (lab[y * ww + x] != 255)
                 continue;
             /* flood fill one 4-connected blob */

@@ -57,6 +57,13 @@ static int thresh_row_avx2(uint8_t *restrict dst, const uint8_t *src, int n, int
         _mm256_storeu_si256((__m256i *)(dst + x), m);
         count += __builtin_popcount((unsigned)_mm256_movemask_epi8(m));
     }
+    if (x + 16 <= n) { /* short rows (the glint window of a small crop) */
+        const __m128i s = _mm_loadu_si128((const __m128i *)(src + x));
+        const __m128i m = _mm_cmpeq_epi8(_mm_max_epu8(s, _mm256_castsi256_si128(tv)), s);
+        _mm_storeu_si128((__m128i *)(dst + x), m);
+        count += __builtin_popcount((unsigned)_mm_movemask_epi8(m));
+        x += 16;
+    }
     if (x < n)
         count += fv_et_thresh_row_c(dst + x, src + x, n - x, t);
     return count;
