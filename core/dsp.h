@@ -75,15 +75,25 @@ typedef void (*fv_taa_blend_fn)(const struct fv_taa_frame *f, const struct fv_ta
                                 struct fv_taa_flow *flow);
 typedef void (*fv_taa_fill_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                                ptrdiff_t stride, int x0, int y0, int w, int h);
-/* ---- eye tracker kernels (core/eyetrack/kernels.c; integer, so every ISA is exact) ----
+/* ---- eye tracker kernels (core/eyetrack/kernels.c; integer or one rounding per float
+ * operation in a fixed order, so every ISA is exact) ----
  * et_down2_row: dst[x] = (a[2x] + a[2x+1] + b[2x] + b[2x+1] + 2) >> 2 for x in [0, n)
  *   (reads 2n pixels of each source row).
  * et_integral_row: dst[x] = above[x] + (src[0] + ... + src[x]) (uint32, wraps mod 2^32; the
  *   tracker's images are far too small to wrap), for x in [0, n).
- * et_thresh_row: dst[x] = src[x] >= t ? 255 : 0 (t in [0, 256]); returns the count of 255s. */
+ * et_thresh_row: dst[x] = src[x] >= t ? 255 : 0 (t in [0, 256]); returns the count of 255s.
+ * et_box_score_row: box search scores of n centres in a row of an integral image, every box
+ *   and ring inside it: for x in [0, n), si = ib[x+din] - it[x+din] - ib[x] + it[x] (the box
+ *   between rows it and ib), so = (the same over ot, ob, dout) - si (the ring),
+ *   mi = (float)si * inv_a, mo = (float)so * inv_r, dst[x] = (mo - mi) - (mi - dark), each
+ *   operation rounded to float in that order; returns the largest dst[x] (-inf for n = 0; the
+ *   sign of a zero maximum is unspecified). The box sums must be below 2^31. */
 typedef void (*fv_et_down2_row_fn)(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n);
 typedef void (*fv_et_integral_row_fn)(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
 typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, int n, int t);
+typedef float (*fv_et_box_score_row_fn)(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din,
+                                        const uint32_t *ot, const uint32_t *ob, int dout, int n, float inv_a,
+                                        float inv_r, float dark);
 
 /* ---- layered depth of field (core/dof/weier.c; core/dof/weier_impl.h has the structs) ----
  * dof_coc_row: coc[x] = g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 for x in [0, n),
@@ -145,6 +155,7 @@ typedef struct fv_dsp {
     fv_et_down2_row_fn et_down2_row;
     fv_et_integral_row_fn et_integral_row;
     fv_et_thresh_row_fn et_thresh_row;
+    fv_et_box_score_row_fn et_box_score_row;
 } fv_dsp;
 
 unsigned fv_cpu_isas(void);            /* FV_ISA_* bits this CPU runs */
@@ -198,6 +209,8 @@ void fv_dof_init_neon(fv_dsp *d);
 void fv_et_down2_row_c(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n);
 void fv_et_integral_row_c(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
 int fv_et_thresh_row_c(uint8_t *restrict dst, const uint8_t *src, int n, int t);
+float fv_et_box_score_row_c(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din, const uint32_t *ot,
+                            const uint32_t *ob, int dout, int n, float inv_a, float inv_r, float dark);
 void fv_eyetrack_init_c(fv_dsp *d);
 #if defined(__x86_64__)
 void fv_eyetrack_init_sse41(fv_dsp *d);

@@ -299,11 +299,12 @@ static void combine_run(void *st, const fv_dsp *d, int row0, int rows)
 typedef struct {
     uint8_t *img, *half, *bin;
     uint32_t *ii;
+    float *score;
 } et_st;
 static void et_free(void *st)
 {
     et_st *t = st;
-    free(t->img), free(t->half), free(t->bin), free(t->ii), free(t);
+    free(t->img), free(t->half), free(t->bin), free(t->ii), free(t->score), free(t);
 }
 static void *et_setup(void)
 {
@@ -335,6 +336,36 @@ static void integral_run(void *st, const fv_dsp *d, int row0, int rows)
         const size_t y = (size_t)((row0 + k) % EH);
         d->et_integral_row(t->ii + (y + 1) * (EW + 1) + 1, t->ii + y * (EW + 1) + 1, t->img + y * EW, EW);
     }
+}
+/* box search scores: box half-size 8, ring 12 (the tracker's 1.5), every centre whose ring is
+ * inside the image */
+enum { ET_K = 8, ET_KO = 12 };
+static void *box_setup(void)
+{
+    et_st *t = et_setup();
+    if (!t)
+        return NULL;
+    t->score = malloc((size_t)EW * sizeof *t->score);
+    if (!t->score)
+        return et_free(t), NULL;
+    for (int y = 0; y < EH; y++)
+        fv_et_integral_row_c(t->ii + (y + 1) * (EW + 1) + 1, t->ii + y * (EW + 1) + 1, t->img + y * EW, EW);
+    return t;
+}
+static volatile float et_fsink;
+static void box_run(void *st, const fv_dsp *d, int row0, int rows)
+{
+    et_st *t = st;
+    const int iw = EW + 1, n = EW - 2 * ET_KO, na = (2 * ET_K + 1) * (2 * ET_K + 1);
+    const float inv_a = 1.0f / (float)na, inv_r = 1.0f / (float)((2 * ET_KO + 1) * (2 * ET_KO + 1) - na);
+    float m = 0;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % (EH - 2 * ET_KO));
+        const uint32_t *ot = t->ii + y * iw, *it = ot + (ET_KO - ET_K) * (iw + 1);
+        m += d->et_box_score_row(t->score, it, it + (2 * ET_K + 1) * iw, 2 * ET_K + 1, ot, ot + (2 * ET_KO + 1) * iw,
+                                 2 * ET_KO + 1, n, inv_a, inv_r, 30.0f);
+    }
+    et_fsink = m;
 }
 static volatile int et_sink;
 static void thresh_run(void *st, const fv_dsp *d, int row0, int rows)
@@ -368,6 +399,8 @@ const fv_kbench_kernel fv_kbench_kernels[] = {
     {"et_down2_row", "640x480 -> 320x240, 240 rows", {F(et_down2_row), 0}, EH / 2, et_setup, NULL, down2_run, et_free},
     {"et_integral_row", "640x480, 480 rows", {F(et_integral_row), 0}, EH, et_setup, NULL, integral_run, et_free},
     {"et_thresh_row", "640x480, 480 rows", {F(et_thresh_row), 0}, EH, et_setup, NULL, thresh_run, et_free},
+    {"et_box_score_row", "640x480 integral, k 8 ring 12, 456 rows", {F(et_box_score_row), 0}, EH - 2 * ET_KO,
+     box_setup, NULL, box_run, et_free},
 };
 const int fv_kbench_count = (int)(sizeof fv_kbench_kernels / sizeof fv_kbench_kernels[0]);
 

@@ -1,8 +1,10 @@
 /* fovea: checkasm-style tests of the eye tracker's kernels (fv_dsp et_*): every ISA version this
  * machine runs against the plain-C reference, on random and edge inputs (all 0, all 255,
  * thresholds 0, 1, 255, 256), odd sizes, unaligned rows, with canaries around every output.
- * Integer kernels: the bound is exact equality. The references themselves are checked against
- * the formulas on hand-computed cases. Deterministic (fixed-seed splitmix64). */
+ * The bound is exact equality (bits, for the float one too: it rounds the same operations in the
+ * same order). The references themselves are checked against the formulas on hand-computed
+ * cases (et_box_score_row: against sums straight from the image). Deterministic (fixed-seed splitmix64). */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -141,6 +143,67 @@ static void run_thresh(const fv_dsp *d, const char *isa, int n, int off, int mod
     free(bs), free(br), free(bt);
 }
 
+/* Box and ring scores over the integral image of a random (dout + 1) x (n + dout) image: ring
+ * half-size ko >= box half-size k, the box centred in the ring. M_EXTREME offsets the integral
+ * image by nearly 2^32 (its sums wrap; the box sums do not). */
+static void run_box_score(const fv_dsp *d, const char *isa, int n, int off, int mode)
+{
+    const int k = (int)(fv_test_rand(&rng) % 12), ko = k + (int)(fv_test_rand(&rng) % 8);
+    const int din = 2 * k + 1, dout = 2 * ko + 1, iw = n + dout, ih = dout + 1;
+    uint8_t *bimg;
+    uint8_t *img = in8(iw * ih, off, &bimg);
+    fill8(img, iw * ih, mode);
+    const uint32_t base = mode == M_EXTREME ? 0xfffff000u : (uint32_t)(fv_test_rand(&rng) >> 48);
+    uint32_t *bii = malloc(((size_t)iw * (ih + 1) + (size_t)off) * sizeof *bii);
+    assert_non_null(bii);
+    uint32_t *ii = bii + off; /* rows (ih + 1) of iw: a zero-sum first row and column */
+    for (int y = 0; y <= ih; y++)
+        for (int x = 0; x < iw; x++)
+            ii[y * iw + x] = base + (y && x ? (ii[(y - 1) * iw + x] - base) + (ii[y * iw + x - 1] - base) -
+                                                  (ii[(y - 1) * iw + x - 1] - base) + img[(y - 1) * iw + x - 1]
+                                            : 0);
+    const uint32_t *ot = ii, *ob = ii + dout * iw, *it = ii + (ko - k) * iw + (ko - k), *ib = it + din * iw;
+    const float inv_a = 1.0f / (float)(din * din), inv_r = 1.0f / (float)(dout * dout - din * din + (ko == k));
+    const float dark = mode == M_ZERO ? 0.0f : 255.0f * fv_test_randf(&rng);
+    float *r = malloc(((size_t)n + 2 * CANARY) * sizeof *r), *t = malloc(((size_t)n + 2 * CANARY + 1) * sizeof *t);
+    assert_non_null(r);
+    assert_non_null(t);
+    const float fcanary = -12345.678f;
+    for (int i = 0; i < n + 2 * CANARY + 1; i++)
+        t[i] = fcanary;
+    float *tp = t + CANARY + (off & 1); /* 4-byte aligned, not 16 */
+    const float mr = fv_et_box_score_row_c(r, it, ib, din, ot, ob, dout, n, inv_a, inv_r, dark);
+    const float mt = d->et_box_score_row(tp, it, ib, din, ot, ob, dout, n, inv_a, inv_r, dark);
+    for (int i = 1; i <= CANARY; i++)
+        if (memcmp(&tp[-i], &fcanary, sizeof fcanary) || memcmp(&tp[n + i - 1], &fcanary, sizeof fcanary))
+            fail_msg("%s et_box_score_row n=%d: wrote outside its output", isa, n);
+    float want_max = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        /* the reference against the formula, the sums straight from the image */
+        uint32_t si = 0, so = 0;
+        for (int y = 0; y < dout; y++)
+            for (int x = 0; x < dout; x++) {
+                const int v = img[y * iw + i + x];
+                if (y >= ko - k && y < ko + k + 1 && x >= ko - k && x < ko + k + 1)
+                    si += (uint32_t)v;
+                else
+                    so += (uint32_t)v;
+            }
+        const float mi = (float)si * inv_a, mo = (float)so * inv_r, want = (mo - mi) - (mi - dark);
+        if (memcmp(&r[i], &want, sizeof want))
+            fail_msg("c et_box_score_row n=%d: %d: %.9g, formula %.9g", n, i, (double)r[i], (double)want);
+        want_max = want > want_max ? want : want_max;
+        if (memcmp(&tp[i], &r[i], sizeof r[i]))
+            fail_msg("%s et_box_score_row n=%d off=%d mode=%d k=%d ko=%d: %d: c=%.9g %s=%.9g", isa, n, off, mode, k, ko, i,
+                     (double)r[i], isa, (double)tp[i]);
+    }
+    if (!(mr == want_max))
+        fail_msg("c et_box_score_row n=%d: max %.9g, want %.9g", n, (double)mr, (double)want_max);
+    if (!(mt == mr))
+        fail_msg("%s et_box_score_row n=%d: max c=%.9g %s=%.9g", isa, n, (double)mr, isa, (double)mt);
+    free(bimg), free(bii), free(r), free(t);
+}
+
 static void run_all(const char *kernel, runner fn, size_t member)
 {
     int tested = 0;
@@ -190,6 +253,12 @@ static void test_thresh(void **state)
     run_all("et_thresh_row", run_thresh, offsetof(fv_dsp, et_thresh_row));
 }
 
+static void test_box_score(void **state)
+{
+    (void)state;
+    run_all("et_box_score_row", run_box_score, offsetof(fv_dsp, et_box_score_row));
+}
+
 static void test_reference_by_hand(void **state)
 {
     (void)state;
@@ -222,6 +291,7 @@ int main(void)
         cmocka_unit_test(test_down2),
         cmocka_unit_test(test_integral),
         cmocka_unit_test(test_thresh),
+        cmocka_unit_test(test_box_score),
     };
     return cmocka_run_group_tests_name("kernels_eyetrack", tests, NULL, NULL);
 }

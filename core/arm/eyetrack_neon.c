@@ -56,9 +56,38 @@ static int thresh_row_neon(uint8_t *restrict dst, const uint8_t *src, int n, int
     return count;
 }
 
+static float box_score_row_neon(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din,
+                                const uint32_t *ot, const uint32_t *ob, int dout, int n, float inv_a, float inv_r,
+                                float dark)
+{
+    const float32x4_t va = vdupq_n_f32(inv_a), vr = vdupq_n_f32(inv_r), vd = vdupq_n_f32(dark);
+    float32x4_t vm = vdupq_n_f32(-__builtin_inff());
+    if (n < 4)
+        return fv_et_box_score_row_c(dst, it, ib, din, ot, ob, dout, n, inv_a, inv_r, dark);
+    /* the last block overlaps the one before it: it stores the same values again, and the
+     * maximum does not mind */
+    for (int x = 0;; x += 4) {
+        if (x > n - 4)
+            x = n - 4;
+        const uint32x4_t si = vaddq_u32(vsubq_u32(vld1q_u32(ib + x + din), vld1q_u32(it + x + din)),
+                                        vsubq_u32(vld1q_u32(it + x), vld1q_u32(ib + x)));
+        const uint32x4_t so = vsubq_u32(vaddq_u32(vsubq_u32(vld1q_u32(ob + x + dout), vld1q_u32(ot + x + dout)),
+                                                  vsubq_u32(vld1q_u32(ot + x), vld1q_u32(ob + x))),
+                                        si);
+        const float32x4_t mi = vmulq_f32(vcvtq_f32_u32(si), va), mo = vmulq_f32(vcvtq_f32_u32(so), vr);
+        const float32x4_t s = vsubq_f32(vsubq_f32(mo, mi), vsubq_f32(mi, vd));
+        vst1q_f32(dst + x, s);
+        vm = vmaxq_f32(vm, s);
+        if (x == n - 4)
+            break;
+    }
+    return vmaxvq_f32(vm);
+}
+
 void fv_eyetrack_init_neon(fv_dsp *d)
 {
     d->et_down2_row = down2_row_neon;
     d->et_integral_row = integral_row_neon;
     d->et_thresh_row = thresh_row_neon;
+    d->et_box_score_row = box_score_row_neon;
 }

@@ -1,6 +1,8 @@
 /* fovea eye tracker: plain-C reference kernels (the contracts are in dsp.h). The SIMD versions
  * live in core/x86/eyetrack_{sse41,avx2}.c and core/arm/eyetrack_neon.c and must match these
- * exactly (integer arithmetic). */
+ * exactly (integer arithmetic, or float operations in the same order). */
+#include <math.h>
+
 #include "dsp.h"
 
 void fv_et_down2_row_c(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n)
@@ -29,9 +31,25 @@ int fv_et_thresh_row_c(uint8_t *restrict dst, const uint8_t *src, int n, int t)
     return count;
 }
 
+float fv_et_box_score_row_c(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din, const uint32_t *ot,
+                            const uint32_t *ob, int dout, int n, float inv_a, float inv_r, float dark)
+{
+    float m = -INFINITY;
+    for (int x = 0; x < n; x++) {
+        const uint32_t si = ib[x + din] - it[x + din] - ib[x] + it[x];
+        const uint32_t so = ob[x + dout] - ot[x + dout] - ob[x] + ot[x] - si;
+        const float mi = (float)si * inv_a, mo = (float)so * inv_r;
+        const float s = (mo - mi) - (mi - dark);
+        dst[x] = s;
+        m = s > m ? s : m;
+    }
+    return m;
+}
+
 void fv_eyetrack_init_c(fv_dsp *d)
 {
     d->et_down2_row = fv_et_down2_row_c;
     d->et_integral_row = fv_et_integral_row_c;
     d->et_thresh_row = fv_et_thresh_row_c;
+    d->et_box_score_row = fv_et_box_score_row_c;
 }

@@ -132,60 +132,121 @@ static void histogram(const uint8_t *img, int w, int h, ptrdiff_t stride, uint32
         hist[v] = hs[0][v] + hs[1][v] + hs[2][v] + hs[3][v];
 }
 
+/* Pixel lists hold y << 16 | x (sides are at most 8192): the column and row without a
+ * division, the neighbours by adding +-1 and +-ROW. */
+#define PK(x, y) ((y) << 16 | (x))
+#define PK_X(p) ((p)&0xffff)
+#define PK_Y(p) ((p) >> 16)
+enum { ROW = 1 << 16 };
+
+/* Appends the nonzero bytes of row y (m, w bytes) to list[n...]; the new count. */
+static int list_nonzero(const uint8_t *m, int w, int y, int *list, int n)
+{
+    int x = 0;
+    for (; x + 8 <= w; x += 8) { /* mostly zero: eight at a time */
+        uint64_t v;
+        memcpy(&v, m + x, sizeof v);
+        if (v)
+            for (int j = x; j < x + 8; j++)
+                if (m[j])
+                    list[n++] = PK(j, y);
+    }
+    for (; x < w; x++)
+        if (m[x])
+            list[n++] = PK(x, y);
+    return n;
+}
+
 /* Reflections: pixels >= thr, grown by `grow` pixels (a glint's halo is brighter than its
  * background too), replaced by the mean of their unmasked 4-neighbours, ring by ring from the
- * outside in. mask is w*h bytes of scratch, idx w*h ints; the work is proportional to the
- * masked area, not the image. */
+ * outside in. mask is w*h bytes of scratch, idx and fr w*h ints each; the work is proportional
+ * to the masked area, not the image. */
 static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
-                           uint8_t fallback)
+                           int *fr, uint8_t fallback)
 {
     int n = 0;
     for (int y = 0; y < h; y++)
         if (dsp->et_thresh_row(mask + y * w, img + y * w, w, thr))
-            for (int x = 0; x < w; x++)
-                if (mask[y * w + x])
-                    idx[n++] = y * w + x;
+            n = list_nonzero(mask + y * w, w, y, idx, n);
     if (!n)
         return;
-    for (int i = 0; i < n; i++)
-        mask[idx[i]] = 1;
-    for (int g = 0, from = 0; g < grow; g++) {
+    for (int j = 0; j < n; j++)
+        mask[PK_Y(idx[j]) * w + PK_X(idx[j])] = 1;
+    int from = 0; /* idx[from, n): the last ring; the only pixels with unmasked neighbours */
+    for (int g = 0; g < grow; g++) {
         const int to = n;
         for (int j = from; j < to; j++) {
-            const int i = idx[j], x = i % w, y = i / w;
-            const int nb[4] = { x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1, y + 1 < h ? i + w : -1 };
-            for (int k = 0; k < 4; k++)
-                if (nb[k] >= 0 && !mask[nb[k]]) {
-                    mask[nb[k]] = 1;
-                    idx[n++] = nb[k];
-                }
+            const int p = idx[j], x = PK_X(p), y = PK_Y(p), i = y * w + x;
+#define GROW(cond, di, dp)                                                                                              \
+    if ((cond) && !mask[i + (di)])                                                                                     \
+        mask[i + (di)] = 1, idx[n++] = p + (dp);
+            GROW(x > 0, -1, -1)
+            GROW(x + 1 < w, 1, 1)
+            GROW(y > 0, -w, -ROW)
+            GROW(y + 1 < h, w, ROW)
+#undef GROW
         }
         from = to;
     }
-    /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on) */
-    for (int pass = 0; pass < 3 + 2 * grow && n; pass++) { /* enough for a grown glint; big bright areas get the fallback */
+    /* mask: 0 source, 1 to fill, 2 + p filled in pass p (a source from pass p + 1 on), QUEUED
+     * in the next pass's frontier. Pass p fills exactly the pixels 4-adjacent to a source, i.e.
+     * (p = 0) to an unmasked pixel or (p > 0) to one filled in pass p - 1, each from sources
+     * only, so a pass's order does not matter and only that frontier needs visiting (for
+     * pass 0, the last ring): the pixels no pass reaches are not seen again until the end. */
+    enum { QUEUED = 255 };
+    const int passes = 3 + 2 * grow; /* enough for a grown glint; big bright areas get the fallback */
+    int b0 = 0, b1 = 0;              /* fr[b0, b1): the pixels filled in the last pass */
+    for (int pass = 0; pass < passes; pass++) {
         const uint8_t lim = (uint8_t)(2 + pass);
-#define SRC(j) (mask[j] == 0 || (mask[j] >= 2 && mask[j] < lim))
-        int left = 0;
-        for (int j = 0; j < n; j++) {
-            const int i = idx[j], x = i % w, y = i / w;
+        if (pass > 0) { /* this pass's frontier: unfilled neighbours of the last pass's pixels */
+            const int e0 = b1;
+            for (int j = b0; j < e0; j++) {
+                const int p = fr[j], x = PK_X(p), y = PK_Y(p), i = y * w + x;
+#define QUEUE(cond, di, dp)                                                                                             \
+    if ((cond) && mask[i + (di)] == 1)                                                                                 \
+        mask[i + (di)] = QUEUED, fr[b1++] = p + (dp);
+                QUEUE(x > 0, -1, -1)
+                QUEUE(x + 1 < w, 1, 1)
+                QUEUE(y > 0, -w, -ROW)
+                QUEUE(y + 1 < h, w, ROW)
+#undef QUEUE
+            }
+            b0 = e0;
+            if (b0 == b1)
+                break;
+        }
+        const int *list = pass ? fr + b0 : idx + from, len = pass ? b1 - b0 : n - from;
+        int e = b1;
+        for (int j = 0; j < len; j++) {
+            const int p = list[j], x = PK_X(p), y = PK_Y(p), i = y * w + x;
             int s = 0, c = 0;
-            if (x > 0 && SRC(i - 1)) s += img[i - 1], c++;
-            if (x + 1 < w && SRC(i + 1)) s += img[i + 1], c++;
-            if (y > 0 && SRC(i - w)) s += img[i - w], c++;
-            if (y + 1 < h && SRC(i + w)) s += img[i + w], c++;
-            if (c) {
-                img[i] = (uint8_t)((s + c / 2) / c);
+#define SRC(cond, di)                                                                                                   \
+    if ((cond) && (mask[i + (di)] == 0 || (mask[i + (di)] >= 2 && mask[i + (di)] < lim)))                              \
+        s += img[i + (di)], c++;
+            SRC(x > 0, -1)
+            SRC(x + 1 < w, 1)
+            SRC(y > 0, -w)
+            SRC(y + 1 < h, w)
+#undef SRC
+            if (c) { /* always, past pass 0 */
+                /* (s + c / 2) / c, with constant divisors */
+                img[i] = (uint8_t)(c == 1 ? s : c == 2 ? (s + 1) / 2 : c == 3 ? (s + 1) / 3 : (s + 2) / 4);
                 mask[i] = lim;
-            } else {
-                idx[left++] = i;
+                if (!pass)
+                    fr[e++] = p;
             }
         }
-#undef SRC
-        n = left;
+        if (!pass) {
+            b0 = 0, b1 = e;
+            if (!e)
+                break;
+        }
     }
-    for (int j = 0; j < n; j++)
-        img[idx[j]] = fallback;
+    for (int j = 0; j < n; j++) {
+        const int i = PK_Y(idx[j]) * w + PK_X(idx[j]);
+        if (mask[i] == 1)
+            img[i] = fallback;
+    }
 }
 
 static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x1, int y1)
@@ -288,50 +349,90 @@ typedef struct {
 
 /* Best contrast box over centres [x0, x1) x [y0, y1) and half-sizes k in [kmin, kmax]
  * (every k when step1, else a geometric-ish ladder). Score = mean(ring k..1.5k) - mean(box k)
- * - lambda * (mean(box) - dark) - mu * (distance from the image centre) / min side: lambda
+ * - (mean(box) - dark) - mu * (distance from the image centre) / min side: the darkness term
  * prefers the darker of two contrasting blobs (the pupil in the iris); a 1.5k ring beat 2k and
  * 3k on the MRL images (less lid and brow in it); mu (grey levels per image side) is a weak
  * prior for the eye being roughly centred in its camera, which keeps dark brows, hair and
- * vignetted corners from winning in dim images. */
-static void box_search(const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0, int x1, int y0, int y1,
-                       float dark, float mu, box_hit *best)
+ * vignetted corners from winning in dim images. Centres are visited k, y, x in order, and
+ * a later one wins only with a strictly higher score. */
+typedef struct {
+    const uint32_t *ii;
+    int iw, sw, sh;
+    float dark, prior, cxm, cym;
+} box_ctx;
+
+static inline void box_offer(const box_ctx *b, box_hit *best, float score, float mi, float mo, int x, int y, int k)
 {
-    const float lambda = 1.0f, rf = 1.5f;
-    const float cxm = 0.5f * (sw - 1), cym = 0.5f * (sh - 1), prior = mu / (float)(sw < sh ? sw : sh);
-    const int iw = sw + 1;
+    if (score <= best->score) /* the prior only lowers it */
+        return;
+    if (b->prior > 0) {
+        const float ddx = (float)x - b->cxm, ddy = (float)y - b->cym;
+        score -= b->prior * sqrtf(ddx * ddx + ddy * ddy);
+    }
+    if (score > best->score)
+        *best = (box_hit){ score, mi, mo, x, y, k };
+}
+
+/* Centres [xa, xb) of row y whose box or ring the image clips. */
+static void box_clipped(const box_ctx *b, box_hit *best, int k, int ko, int y, int xa, int xb)
+{
+    /* the box inside the image, most of the ring too: vignetted corners and image edges are
+     * dark and half a ring is no surround */
+    if (y - k < 0 || y + k + 1 > b->sh)
+        return;
+    xa = imax(xa, k), xb = imin(xb, b->sw - k);
+    const int na = (2 * k + 1) * (2 * k + 1), no_full = (2 * ko + 1) * (2 * ko + 1);
+    const int oy0 = imax(0, y - ko), oy1 = imin(b->sh, y + ko + 1);
+    for (int x = xa; x < xb; x++) {
+        const int ox0 = imax(0, x - ko), ox1 = imin(b->sw, x + ko + 1);
+        const int no = (ox1 - ox0) * (oy1 - oy0);
+        if (10 * (no - na) < 6 * (no_full - na))
+            continue;
+        const uint32_t si = box_sum(b->ii, b->iw, x - k, y - k, x + k + 1, y + k + 1);
+        const uint32_t so = box_sum(b->ii, b->iw, ox0, oy0, ox1, oy1) - si;
+        const float mi = (float)si / na, mo = (float)so / (no - na);
+        box_offer(b, best, mo - mi - (mi - b->dark), mi, mo, x, y, k);
+    }
+}
+
+static void box_search(const fv_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
+                       int x1, int y0, int y1, float dark, float mu, box_hit *best)
+{
+    const float rf = 1.5f;
+    const box_ctx b = { ii, sw + 1, sw, sh, dark, mu / (float)(sw < sh ? sw : sh), 0.5f * (sw - 1), 0.5f * (sh - 1) };
+    const int iw = sw + 1, xs = imax(0, x0), xe = imin(sw, x1);
+    enum { CHUNK = 256 };
+    float sc[CHUNK];
     for (int k = kmin; k <= kmax; k += (step1 || k < 4 ? 1 : k / 4)) {
         const int ko = (int)lrintf(rf * k);
         const int na_full = (2 * k + 1) * (2 * k + 1), no_full = (2 * ko + 1) * (2 * ko + 1);
         const float inv_a = 1.0f / (float)na_full, inv_r = 1.0f / (float)(no_full - na_full);
+        /* centres [xa, xb) of rows [ko, sh - ko) have their ring inside the image: no
+         * divisions, one row kernel call per chunk */
+        const int xa = imax(xs, ko), xb = imin(xe, sw - ko);
         for (int y = imax(0, y0); y < imin(sh, y1); y++) {
-            const int iy0 = imax(0, y - k), iy1 = imin(sh, y + k + 1);
-            const int oy0 = imax(0, y - ko), oy1 = imin(sh, y + ko + 1);
-            for (int x = imax(0, x0); x < imin(sw, x1); x++) {
-                const int ix0 = imax(0, x - k), ix1 = imin(sw, x + k + 1);
-                const int ox0 = imax(0, x - ko), ox1 = imin(sw, x + ko + 1);
-                const int na = (ix1 - ix0) * (iy1 - iy0), no = (ox1 - ox0) * (oy1 - oy0);
-                const uint32_t si = box_sum(ii, iw, ix0, iy0, ix1, iy1);
-                const uint32_t so = box_sum(ii, iw, ox0, oy0, ox1, oy1) - si;
-                float mi, mo;
-                if (na == na_full && no == no_full) { /* inside: no divisions */
-                    mi = (float)si * inv_a, mo = (float)so * inv_r;
-                } else {
-                    /* the box inside the image, most of the ring too: vignetted corners and
-                     * image edges are dark and half a ring is no surround */
-                    if (na != na_full || 10 * (no - na) < 6 * (no_full - na_full))
-                        continue;
-                    mi = (float)si / na, mo = (float)so / (no - na);
-                }
-                float score = mo - mi - lambda * (mi - dark);
-                if (score <= best->score) /* the prior only lowers it */
-                    continue;
-                if (prior > 0) {
-                    const float ddx = (float)x - cxm, ddy = (float)y - cym;
-                    score -= prior * sqrtf(ddx * ddx + ddy * ddy);
-                }
-                if (score > best->score)
-                    *best = (box_hit){ score, mi, mo, x, y, k };
+            if (y < ko || y >= sh - ko || xa >= xb) {
+                box_clipped(&b, best, k, ko, y, xs, xe);
+                continue;
             }
+            box_clipped(&b, best, k, ko, y, xs, xa);
+            for (int c0 = xa; c0 < xb; c0 += CHUNK) {
+                const int cn = imin(CHUNK, xb - c0);
+                const uint32_t *it = ii + (y - k) * iw + c0 - k, *ib = ii + (y + k + 1) * iw + c0 - k;
+                const uint32_t *ot = ii + (y - ko) * iw + c0 - ko, *ob = ii + (y + ko + 1) * iw + c0 - ko;
+                if (!(d->et_box_score_row(sc, it, ib, 2 * k + 1, ot, ob, 2 * ko + 1, cn, inv_a, inv_r, dark) >
+                      best->score))
+                    continue; /* nothing in the chunk beats the best */
+                for (int j = 0; j < cn; j++) {
+                    if (sc[j] <= best->score)
+                        continue;
+                    const int x = c0 + j;
+                    const uint32_t si = box_sum(ii, iw, x - k, y - k, x + k + 1, y + k + 1);
+                    const uint32_t so = box_sum(ii, iw, x - ko, y - ko, x + ko + 1, y + ko + 1) - si;
+                    box_offer(&b, best, sc[j], (float)si * inv_a, (float)so * inv_r, x, y, k);
+                }
+            }
+            box_clipped(&b, best, k, ko, y, xb, xe);
         }
     }
 }
@@ -364,7 +465,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
     const int thr = imax(med + 40, med + (255 - med) / 2);
     if (hi >= thr)
-        inpaint_bright(d, work, sw, sh, thr, 1, mask, idx, (uint8_t)med);
+        inpaint_bright(d, work, sw, sh, thr, 1, mask, idx, (int *)ii, (uint8_t)med); /* ii: free until the integral below */
     const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
     /* level C */
     int cw = sw, ch = sh, f = 1;
@@ -385,14 +486,14 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     /* centres no nearer the border than margin_frac of the side: vignetted corners and image
      * edges are dark, and a pupil there is cut anyway */
     const int mx = (int)lrintf(t->p.border_frac * side);
-    box_search(ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, t->p.centre_prior, &b);
+    box_search(d, ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, t->p.centre_prior, &b);
     if (b.score <= -1e30f)
         return c;
     if (f > 1) { /* refine on F around C's answer */
         const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
         box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
         integral(d, work, sw, sh, ii);
-        box_search(ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
+        box_search(d, ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
         if (bf.score > -1e30f)
             b = bf;
         else
@@ -487,8 +588,10 @@ static int drop_lid_line(float *ex, float *ey, float *egx, float *egy, int ne, f
     return m;
 }
 
+/* Scratch: win, mask w*h bytes, idx, fr w*h ints (fr: the search's integral image buffer, free
+ * by now), dxx w floats. */
 static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
-                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, pupil *out)
+                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, int *fr, float *dxx, pupil *out)
 {
     /* window around the candidate, reflections inpainted */
     /* headset-sized frames: the search's box can be much smaller than the pupil (the darkest
@@ -501,14 +604,16 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         return -1;
     for (int y = 0; y < wh; y++)
         memcpy(win + (size_t)y * ww, luma + (y + y0) * stride + x0, (size_t)ww);
-    uint32_t hist[256];
-    histogram(win, ww, wh, ww, hist);
-    const int med = percentile(hist, (uint32_t)(ww * wh), 0.5);
-    const int thr = imax(med + 40, med + (255 - med) / 2);
-    int masked = 0;
-    if (!inpainted && percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr) {
-        inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, (uint8_t)med);
-        masked = 1;
+    int med = 0, masked = 0;
+    if (!inpainted) { /* small frames: the search image, inpainted already; nothing else needs these levels */
+        uint32_t hist[256];
+        histogram(win, ww, wh, ww, hist);
+        med = percentile(hist, (uint32_t)(ww * wh), 0.5);
+        const int thr = imax(med + 40, med + (255 - med) / 2);
+        if (percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr) {
+            inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, fr, (uint8_t)med);
+            masked = 1;
+        }
     }
 
     float cx = c->x - x0, cy = c->y - y0, r = c->r;
@@ -518,24 +623,37 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     int grown = 0;
     for (int it = 0; it < iters; it++) {
         /* blob and surround levels around the current estimate */
-        double si = 0, so = 0;
-        int ni = 0, no = 0;
-        const float ri = 0.7f * r, ro0 = 1.2f * r, ro1 = 1.7f * r;
+        const float ri = 0.7f * r, ro0 = 1.2f * r, ro1 = 1.7f * r, rr = 1.5f * r;
+        const float ri2 = ri * ri, ro02 = ro0 * ro0, ro12 = ro1 * ro1, rr2 = rr * rr;
         const int bx0 = imax(0, (int)(cx - ro1)), bx1 = imin(ww, (int)(cx + ro1) + 1);
         const int by0 = imax(0, (int)(cy - ro1)), by1 = imin(wh, (int)(cy + ro1) + 1);
-        for (int y = by0; y < by1; y++)
+        const int ax0 = imax(0, (int)(cx - rr)), ax1 = imin(ww, (int)(cx + rr) + 1);
+        const int ay0 = imax(0, (int)(cy - rr)), ay1 = imin(wh, (int)(cy + rr) + 1);
+        /* dx * dx of every column either loop visits (the same float operations as per pixel) */
+        const int qx0 = imin(ax0, bx0), qx1 = imax(ax1, bx1);
+        for (int x = qx0; x < qx1; x++) {
+            const float dx = x + 0.5f - cx;
+            dxx[x - qx0] = dx * dx;
+        }
+        /* integer sums: exact, as the double sums were */
+        int64_t si = 0, so = 0;
+        int ni = 0, no = 0;
+        for (int y = by0; y < by1; y++) {
+            const float dy = y + 0.5f - cy, dyy = dy * dy;
+            const uint8_t *row = win + y * ww;
             for (int x = bx0; x < bx1; x++) {
-                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy, d2 = dx * dx + dy * dy;
-                const int v = win[y * ww + x];
-                if (d2 <= ri * ri)
+                const float d2 = dxx[x - qx0] + dyy;
+                const int v = row[x];
+                if (d2 <= ri2)
                     si += v, ni++;
-                else if (d2 >= ro0 * ro0 && d2 <= ro1 * ro1)
+                else if (d2 >= ro02 && d2 <= ro12)
                     so += v, no++;
             }
+        }
         if (ni)
-            inner = (float)(si / ni);
+            inner = (float)((double)si / ni);
         if (no)
-            ring = (float)(so / no);
+            ring = (float)((double)so / no);
         /* Headset-sized frames: the search's box can sit between reflections inside a much
          * bigger pupil, with pupil all around it too; grow it until its surround is not pupil */
         if (!inpainted && grown < 4 && ring < inner + 0.25f * (med - inner) && 1.7f * 1.4f * r < half) {
@@ -546,23 +664,22 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             return -1;
         const float th = 0.5f * (inner + ring);
         /* weighted centroid of the dark pixels near the estimate */
-        const float rr = 1.5f * r;
         double sw = 0, sx = 0, sy = 0;
         int area = 0;
-        const int ax0 = imax(0, (int)(cx - rr)), ax1 = imin(ww, (int)(cx + rr) + 1);
-        const int ay0 = imax(0, (int)(cy - rr)), ay1 = imin(wh, (int)(cy + rr) + 1);
-        for (int y = ay0; y < ay1; y++)
+        for (int y = ay0; y < ay1; y++) {
+            const float dy = y + 0.5f - cy, dyy = dy * dy;
+            const uint8_t *row = win + y * ww;
             for (int x = ax0; x < ax1; x++) {
-                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy;
-                if (dx * dx + dy * dy > rr * rr)
+                if (dxx[x - qx0] + dyy > rr2)
                     continue;
-                const float v = win[y * ww + x];
+                const float v = row[x];
                 if (v < th) {
                     const double wt = th - v;
                     sw += wt, sx += wt * (x + 0.5f), sy += wt * (y + 0.5f);
                     area++;
                 }
             }
+        }
         if (sw <= 0)
             return -1;
         const float nx = (float)(sx / sw), ny = (float)(sy / sw);
@@ -781,19 +898,29 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
         return 0;
     const int thr = imax((int)pp->ring + 40, (int)(pp->ring + 0.5f * (255.0f - pp->ring)));
     const float max_area = fmaxf(4.0f, 0.8f * pp->r * pp->r);
-    memset(lab, 0, (size_t)ww * wh);
+    /* lab: 255 bright and not yet in a blob, 1 in one, 0 dark (thr above 255: none bright) */
     int n = 0;
     for (int y = 0; y < wh; y++)
+        t->dsp.et_thresh_row(lab + y * ww, luma + (y + y0) * stride + x0, ww, imin(thr, 256));
+    for (int y = 0; y < wh; y++)
         for (int x = 0; x < ww; x++) {
-            if (lab[y * ww + x] || luma[(y + y0) * stride + x + x0] < thr)
+            if (x + 8 <= ww) { /* mostly dark: skip eight at a time */
+                uint64_t v;
+                memcpy(&v, lab + y * ww + x, sizeof v);
+                if (!v) {
+                    x += 7;
+                    continue;
+                }
+            }
+            if (lab[y * ww + x] != 255)
                 continue;
             /* flood fill one 4-connected blob */
             int sp = 0, area = 0, touches = 0, peak = 0;
             double sw = 0, sx = 0, sy = 0;
-            stack[sp++] = y * ww + x;
+            stack[sp++] = PK(x, y);
             lab[y * ww + x] = 1;
             while (sp) {
-                const int i = stack[--sp], px = i % ww, py = i / ww;
+                const int q = stack[--sp], px = PK_X(q), py = PK_Y(q), i = py * ww + px;
                 const int v = luma[(py + y0) * stride + px + x0];
                 const double wt = v - thr + 1;
                 peak = imax(peak, v);
@@ -801,14 +928,14 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
                 area++;
                 if (px == 0 || py == 0 || px == ww - 1 || py == wh - 1)
                     touches = 1;
-                const int nb[4] = { px > 0 ? i - 1 : -1, px + 1 < ww ? i + 1 : -1, py > 0 ? i - ww : -1,
-                                    py + 1 < wh ? i + ww : -1 };
-                for (int k = 0; k < 4; k++)
-                    if (nb[k] >= 0 && !lab[nb[k]] &&
-                        luma[(nb[k] / ww + y0) * stride + nb[k] % ww + x0] >= thr) {
-                        lab[nb[k]] = 1;
-                        stack[sp++] = nb[k];
-                    }
+#define PUSH(cond, di, dq)                                                                                              \
+    if ((cond) && lab[i + (di)] == 255)                                                                                \
+        lab[i + (di)] = 1, stack[sp++] = q + (dq);
+                PUSH(px > 0, -1, -1)
+                PUSH(px + 1 < ww, 1, 1)
+                PUSH(py > 0, -ww, -ROW)
+                PUSH(py + 1 < wh, ww, ROW)
+#undef PUSH
             }
             if (touches || area > max_area)
                 continue;
@@ -892,14 +1019,17 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     r->status = FV_EYE_LOST;
     const size_t px = (size_t)w * h;
     const size_t ii_bytes = ((size_t)(w + 1) * (h + 1)) * sizeof(uint32_t);
-    uint8_t *m = scratch(t, 3 * px + ii_bytes + px * sizeof(int) + 64 + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
+    const size_t row_bytes = (size_t)w * sizeof(float);
+    uint8_t *m = scratch(t, 3 * px + ii_bytes + px * sizeof(int) + row_bytes + 64 +
+                                2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint));
     if (!m)
         return -1;
     uint32_t *ii = (uint32_t *)m;
     int *stack = (int *)(m + ii_bytes);
-    fv_eye_glint *gl = (fv_eye_glint *)(m + ii_bytes + px * sizeof(int));
-    uint8_t *work = m + ii_bytes + px * sizeof(int) + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint), *mask = work + px,
-            *lowres = mask + px;
+    float *rowf = (float *)(m + ii_bytes + px * sizeof(int));
+    fv_eye_glint *gl = (fv_eye_glint *)(m + ii_bytes + px * sizeof(int) + row_bytes);
+    uint8_t *work = m + ii_bytes + px * sizeof(int) + row_bytes + 2 * FV_EYE_MAX_GLINTS * sizeof(fv_eye_glint),
+            *mask = work + px, *lowres = mask + px;
 
     const candidate c = coarse_search(t, luma, w, h, stride, work, mask, lowres, ii, stack);
     if (!c.ok)
@@ -923,7 +1053,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     }
     candidate rc = c;
     rc.x /= (float)rs, rc.y /= (float)rs, rc.r /= (float)rs, rc.scale /= rs;
-    if (refine(t, rsrc, rw, rh, rst, &rc, reuse, reuse ? lowres : work, mask, stack, &p)) {
+    if (refine(t, rsrc, rw, rh, rst, &rc, reuse, reuse ? lowres : work, mask, stack, (int *)ii, rowf, &p)) {
         /* no dark region stands out in the window: keep the search's answer, flagged low */
         p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
     } else if (rs > 1) {

@@ -57,9 +57,50 @@ static int thresh_row_avx2(uint8_t *restrict dst, const uint8_t *src, int n, int
         _mm256_storeu_si256((__m256i *)(dst + x), m);
         count += __builtin_popcount((unsigned)_mm256_movemask_epi8(m));
     }
+    if (x + 16 <= n) { /* short rows (the glint window of a small crop) */
+        const __m128i s = _mm_loadu_si128((const __m128i *)(src + x));
+        const __m128i m = _mm_cmpeq_epi8(_mm_max_epu8(s, _mm256_castsi256_si128(tv)), s);
+        _mm_storeu_si128((__m128i *)(dst + x), m);
+        count += __builtin_popcount((unsigned)_mm_movemask_epi8(m));
+        x += 16;
+    }
     if (x < n)
         count += fv_et_thresh_row_c(dst + x, src + x, n - x, t);
     return count;
+}
+
+/* The box sums are below 2^31, so the signed conversion is the C reference's unsigned one. */
+static float box_score_row_avx2(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din,
+                                const uint32_t *ot, const uint32_t *ob, int dout, int n, float inv_a, float inv_r,
+                                float dark)
+{
+#define L(p) _mm256_loadu_si256((const __m256i *)(p))
+    const __m256 va = _mm256_set1_ps(inv_a), vr = _mm256_set1_ps(inv_r), vd = _mm256_set1_ps(dark);
+    __m256 vm = _mm256_set1_ps(-__builtin_inff());
+    if (n < 8)
+        return fv_et_box_score_row_c(dst, it, ib, din, ot, ob, dout, n, inv_a, inv_r, dark);
+    /* the last block overlaps the one before it: it stores the same values again, and the
+     * maximum does not mind */
+    for (int x = 0;; x += 8) {
+        if (x > n - 8)
+            x = n - 8;
+        const __m256i si =
+            _mm256_add_epi32(_mm256_sub_epi32(L(ib + x + din), L(it + x + din)), _mm256_sub_epi32(L(it + x), L(ib + x)));
+        const __m256i so = _mm256_sub_epi32(_mm256_add_epi32(_mm256_sub_epi32(L(ob + x + dout), L(ot + x + dout)),
+                                                             _mm256_sub_epi32(L(ot + x), L(ob + x))),
+                                            si);
+        const __m256 mi = _mm256_mul_ps(_mm256_cvtepi32_ps(si), va), mo = _mm256_mul_ps(_mm256_cvtepi32_ps(so), vr);
+        const __m256 s = _mm256_sub_ps(_mm256_sub_ps(mo, mi), _mm256_sub_ps(mi, vd));
+        _mm256_storeu_ps(dst + x, s);
+        vm = _mm256_max_ps(vm, s);
+        if (x == n - 8)
+            break;
+    }
+#undef L
+    __m128 h = _mm_max_ps(_mm256_castps256_ps128(vm), _mm256_extractf128_ps(vm, 1));
+    h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+    h = _mm_max_ss(h, _mm_shuffle_ps(h, h, 1));
+    return _mm_cvtss_f32(h);
 }
 
 void fv_eyetrack_init_avx2(fv_dsp *d)
@@ -67,4 +108,5 @@ void fv_eyetrack_init_avx2(fv_dsp *d)
     d->et_down2_row = down2_row_avx2;
     d->et_integral_row = integral_row_avx2;
     d->et_thresh_row = thresh_row_avx2;
+    d->et_box_score_row = box_score_row_avx2;
 }

@@ -62,9 +62,41 @@ static int thresh_row_sse41(uint8_t *restrict dst, const uint8_t *src, int n, in
     return count;
 }
 
+/* The box sums are below 2^31, so the signed conversion is the C reference's unsigned one. */
+static float box_score_row_sse41(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din,
+                                 const uint32_t *ot, const uint32_t *ob, int dout, int n, float inv_a, float inv_r,
+                                 float dark)
+{
+#define L(p) _mm_loadu_si128((const __m128i *)(p))
+    const __m128 va = _mm_set1_ps(inv_a), vr = _mm_set1_ps(inv_r), vd = _mm_set1_ps(dark);
+    __m128 vm = _mm_set1_ps(-__builtin_inff());
+    if (n < 4)
+        return fv_et_box_score_row_c(dst, it, ib, din, ot, ob, dout, n, inv_a, inv_r, dark);
+    /* the last block overlaps the one before it: it stores the same values again, and the
+     * maximum does not mind */
+    for (int x = 0;; x += 4) {
+        if (x > n - 4)
+            x = n - 4;
+        const __m128i si = _mm_add_epi32(_mm_sub_epi32(L(ib + x + din), L(it + x + din)), _mm_sub_epi32(L(it + x), L(ib + x)));
+        const __m128i so = _mm_sub_epi32(
+            _mm_add_epi32(_mm_sub_epi32(L(ob + x + dout), L(ot + x + dout)), _mm_sub_epi32(L(ot + x), L(ob + x))), si);
+        const __m128 mi = _mm_mul_ps(_mm_cvtepi32_ps(si), va), mo = _mm_mul_ps(_mm_cvtepi32_ps(so), vr);
+        const __m128 s = _mm_sub_ps(_mm_sub_ps(mo, mi), _mm_sub_ps(mi, vd));
+        _mm_storeu_ps(dst + x, s);
+        vm = _mm_max_ps(vm, s);
+        if (x == n - 4)
+            break;
+    }
+#undef L
+    vm = _mm_max_ps(vm, _mm_movehl_ps(vm, vm));
+    vm = _mm_max_ss(vm, _mm_shuffle_ps(vm, vm, 1));
+    return _mm_cvtss_f32(vm);
+}
+
 void fv_eyetrack_init_sse41(fv_dsp *d)
 {
     d->et_down2_row = down2_row_sse41;
     d->et_integral_row = integral_row_sse41;
     d->et_thresh_row = thresh_row_sse41;
+    d->et_box_score_row = box_score_row_sse41;
 }
