@@ -87,13 +87,18 @@ typedef void (*fv_taa_fill_fn)(const struct fv_taa_frame *f, const struct fv_taa
  *   between rows it and ib), so = (the same over ot, ob, dout) - si (the ring),
  *   mi = (float)si * inv_a, mo = (float)so * inv_r, dst[x] = (mo - mi) - (mi - dark), each
  *   operation rounded to float in that order; returns the largest dst[x] (-inf for n = 0; the
- *   sign of a zero maximum is unspecified). The box sums must be below 2^31. */
+ *   sign of a zero maximum is unspecified). The box sums must be below 2^31.
+ * et_box3_row: one row of a 3x3 box filter with replicated edges: dst[x] = (S * 3641 + 16384)
+ *   >> 15 (S / 9 rounded, as a rounding 16-bit high multiply gives it), S the sum of r0, r1, r2
+ *   over columns clamp(x - 1 .. x + 1, 0, n - 1), for x in [0, n) (reads n pixels of each row). */
 typedef void (*fv_et_down2_row_fn)(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n);
 typedef void (*fv_et_integral_row_fn)(uint32_t *restrict dst, const uint32_t *above, const uint8_t *src, int n);
 typedef int (*fv_et_thresh_row_fn)(uint8_t *restrict dst, const uint8_t *src, int n, int t);
 typedef float (*fv_et_box_score_row_fn)(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din,
                                         const uint32_t *ot, const uint32_t *ob, int dout, int n, float inv_a,
                                         float inv_r, float dark);
+typedef void (*fv_et_box3_row_fn)(uint8_t *restrict dst, const uint8_t *r0, const uint8_t *r1, const uint8_t *r2,
+                                  int n);
 
 /* ---- layered depth of field (core/dof/weier.c; core/dof/weier_impl.h has the structs) ----
  * dof_coc_row: coc[x] = g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 for x in [0, n),
@@ -156,6 +161,7 @@ typedef struct fv_dsp {
     fv_et_integral_row_fn et_integral_row;
     fv_et_thresh_row_fn et_thresh_row;
     fv_et_box_score_row_fn et_box_score_row;
+    fv_et_box3_row_fn et_box3_row;
 } fv_dsp;
 
 unsigned fv_cpu_isas(void);            /* FV_ISA_* bits this CPU runs */
@@ -211,6 +217,14 @@ void fv_et_integral_row_c(uint32_t *restrict dst, const uint32_t *above, const u
 int fv_et_thresh_row_c(uint8_t *restrict dst, const uint8_t *src, int n, int t);
 float fv_et_box_score_row_c(float *restrict dst, const uint32_t *it, const uint32_t *ib, int din, const uint32_t *ot,
                             const uint32_t *ob, int dout, int n, float inv_a, float inv_r, float dark);
+void fv_et_box3_row_c(uint8_t *restrict dst, const uint8_t *r0, const uint8_t *r1, const uint8_t *r2, int n);
+/* one pixel of et_box3_row (the C reference, and the SIMD versions' edges and tails) */
+static inline uint8_t fv_et_box3_px(const uint8_t *r0, const uint8_t *r1, const uint8_t *r2, int n, int x)
+{
+    const int a = x > 0 ? x - 1 : 0, c = x + 1 < n ? x + 1 : n - 1;
+    const int s = r0[a] + r0[x] + r0[c] + r1[a] + r1[x] + r1[c] + r2[a] + r2[x] + r2[c];
+    return (uint8_t)((s * 3641 + 16384) >> 15);
+}
 void fv_eyetrack_init_c(fv_dsp *d);
 #if defined(__x86_64__)
 void fv_eyetrack_init_sse41(fv_dsp *d);

@@ -367,6 +367,14 @@ static void box_run(void *st, const fv_dsp *d, int row0, int rows)
     }
     et_fsink = m;
 }
+static void box3_run(void *st, const fv_dsp *d, int row0, int rows)
+{
+    et_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % (EH - 2)) + 1;
+        d->et_box3_row(t->bin + y * EW, t->img + (y - 1) * EW, t->img + y * EW, t->img + (y + 1) * EW, EW);
+    }
+}
 static volatile int et_sink;
 static void thresh_run(void *st, const fv_dsp *d, int row0, int rows)
 {
@@ -401,6 +409,7 @@ const fv_kbench_kernel fv_kbench_kernels[] = {
     {"et_thresh_row", "640x480, 480 rows", {F(et_thresh_row), 0}, EH, et_setup, NULL, thresh_run, et_free},
     {"et_box_score_row", "640x480 integral, k 8 ring 12, 456 rows", {F(et_box_score_row), 0}, EH - 2 * ET_KO,
      box_setup, NULL, box_run, et_free},
+    {"et_box3_row", "640x480, 478 rows", {F(et_box3_row), 0}, EH - 2, et_setup, NULL, box3_run, et_free},
 };
 const int fv_kbench_count = (int)(sizeof fv_kbench_kernels / sizeof fv_kbench_kernels[0]);
 

@@ -237,6 +237,31 @@ static void run_all(const char *kernel, runner fn, size_t member)
     printf("[ kernels  ] %s: %d ISA version(s) tested\n", kernel, tested);
 }
 
+static void run_box3(const fv_dsp *d, const char *isa, int n, int off, int mode)
+{
+    uint8_t *b0, *b1, *b2, *br, *bt;
+    uint8_t *r0 = in8(n, off, &b0), *r1 = in8(n, off + 1, &b1), *r2 = in8(n, off + 2, &b2);
+    fill8(r0, n, mode);
+    fill8(r1, n, mode);
+    fill8(r2, n, mode);
+    uint8_t *r = out8(n, off, &br), *t = out8(n, off, &bt);
+    fv_et_box3_row_c(r, r0, r1, r2, n);
+    d->et_box3_row(t, r0, r1, r2, n);
+    canaries8(t, n, isa, "et_box3_row");
+    for (int i = 0; i < n; i++) {
+        /* the reference against the formula, edges replicated */
+        int s = 0;
+        for (int k = -1; k <= 1; k++) {
+            const int c = i + k < 0 ? 0 : i + k >= n ? n - 1 : i + k;
+            s += r0[c] + r1[c] + r2[c];
+        }
+        assert_int_equal(r[i], (s * 3641 + 16384) >> 15);
+        if (t[i] != r[i])
+            fail_msg("%s et_box3_row n=%d off=%d mode=%d: pixel %d: c=%d %s=%d", isa, n, off, mode, i, r[i], isa, t[i]);
+    }
+    free(b0), free(b1), free(b2), free(br), free(bt);
+}
+
 static void test_down2(void **state)
 {
     (void)state;
@@ -257,6 +282,12 @@ static void test_box_score(void **state)
 {
     (void)state;
     run_all("et_box_score_row", run_box_score, offsetof(fv_dsp, et_box_score_row));
+}
+
+static void test_box3(void **state)
+{
+    (void)state;
+    run_all("et_box3_row", run_box3, offsetof(fv_dsp, et_box3_row));
 }
 
 static void test_reference_by_hand(void **state)
@@ -282,6 +313,29 @@ static void test_reference_by_hand(void **state)
     assert_int_equal(fv_et_thresh_row_c(m, s, 4, 3), 2);
     assert_int_equal(m[0], 0);
     assert_int_equal(m[2], 255);
+    /* box3: a constant v comes back as v (9 v 3641 = 32769 v), for every v; a lone 255 in the
+     * middle row gives 255 / 9 = 28.33 -> 28 at it and its two neighbours, 0 beyond; at the left
+     * edge the replicated column counts twice: 2 * 90 / 9 = 20 */
+    uint8_t c0[5], c1[5], c2[5], bo[5];
+    for (int v = 0; v < 256; v++) {
+        memset(c0, v, 5), memset(c1, v, 5), memset(c2, v, 5);
+        fv_et_box3_row_c(bo, c0, c1, c2, 5);
+        for (int i = 0; i < 5; i++)
+            assert_int_equal(bo[i], v);
+    }
+    memset(c0, 0, 5), memset(c1, 0, 5), memset(c2, 0, 5);
+    c1[2] = 255;
+    fv_et_box3_row_c(bo, c0, c1, c2, 5);
+    assert_int_equal(bo[0], 0);
+    assert_int_equal(bo[1], 28);
+    assert_int_equal(bo[2], 28);
+    assert_int_equal(bo[3], 28);
+    assert_int_equal(bo[4], 0);
+    c1[2] = 0, c0[0] = 90;
+    fv_et_box3_row_c(bo, c0, c1, c2, 5);
+    assert_int_equal(bo[0], 20);
+    assert_int_equal(bo[1], 10);
+    assert_int_equal(bo[2], 0);
 }
 
 int main(void)
@@ -292,6 +346,7 @@ int main(void)
         cmocka_unit_test(test_integral),
         cmocka_unit_test(test_thresh),
         cmocka_unit_test(test_box_score),
+        cmocka_unit_test(test_box3),
     };
     return cmocka_run_group_tests_name("kernels_eyetrack", tests, NULL, NULL);
 }

@@ -46,10 +46,17 @@ float fv_et_box_score_row_c(float *restrict dst, const uint32_t *it, const uint3
     return m;
 }
 
+void fv_et_box3_row_c(uint8_t *restrict dst, const uint8_t *r0, const uint8_t *r1, const uint8_t *r2, int n)
+{
+    for (int x = 0; x < n; x++)
+        dst[x] = fv_et_box3_px(r0, r1, r2, n, x);
+}
+
 void fv_eyetrack_init_c(fv_dsp *d)
 {
     d->et_down2_row = fv_et_down2_row_c;
     d->et_integral_row = fv_et_integral_row_c;
     d->et_thresh_row = fv_et_thresh_row_c;
     d->et_box_score_row = fv_et_box_score_row_c;
+    d->et_box3_row = fv_et_box3_row_c;
 }

@@ -273,19 +273,6 @@ static inline float sample(const uint8_t *img, int w, int h, float x, float y)
     return a + fy * (b - a);
 }
 
-/* One row of a 3x3 box filter, edges replicated: dst[x] = (S * 3641 + 16384) >> 15 (S / 9,
- * rounded; the form a rounding high multiply gives) with S the sum of r0, r1, r2 over columns
- * x - 1 .. x + 1, clamped to [0, n). */
-static void box3_row(uint8_t *restrict dst, const uint8_t *r0, const uint8_t *r1, const uint8_t *r2, int n)
-{
-    int prev = r0[0] + r1[0] + r2[0], cur = prev;
-    for (int x = 0; x < n; x++) {
-        const int next = x + 1 < n ? r0[x + 1] + r1[x + 1] + r2[x + 1] : cur;
-        dst[x] = (uint8_t)(((prev + cur + next) * 3641 + 16384) >> 15);
-        prev = cur, cur = next;
-    }
-}
-
 /* Distance along the ray (cx, cy) + d (dx, dy) of the steepest rise within +-span of d0:
  * central differences 1 px wide every 0.5 px, the peak refined by a parabola through the
  * differences 1 px either side of it. */
@@ -705,7 +692,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
          * true edge and push crossings out into a dark iris (idx is free once inpainted) */
         uint8_t *bl = (uint8_t *)idx;
         for (int y = 0; y < wh; y++)
-            box3_row(bl + y * ww, win + imax(0, y - 1) * ww, win + y * ww, win + imin(wh - 1, y + 1) * ww, ww);
+            t->dsp.et_box3_row(bl + y * ww, win + imax(0, y - 1) * ww, win + y * ww, win + imin(wh - 1, y + 1) * ww, ww);
         ew = bl;
     }
     float ex[NRAYS], ey[NRAYS];
