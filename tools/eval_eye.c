@@ -4,7 +4,11 @@
  * made at any size: gaze +-20 deg, pupil 1.6-2.8 mm, 2-6 LEDs, sensor noise 2-14 grey levels,
  * brightness 0.55-1; every other frame looks up (3-13 deg) into a lid opened 0.35-0.65.
  *
- *   build/tools/eval_eye [--size WxH] [--frames N] [--seed N]
+ *   build/tools/eval_eye [--size WxH] [--frames N] [--seed N] [--history]
+ *
+ * --history: each frame is tracked with fv_track_frame after the tracker (reset) has seen the
+ * same eye with the lids open for 4 frames, as a headset sees it before the lid comes down;
+ * without it, fv_track_image (no history). A frame flagged BLINK counts as a miss.
  *
  * Prints, per bin (full view, 70-99%, 50-70% in view; frames under 50% are skipped), the
  * frames, median / p90 / max error in pixels and the share within 1 and 3 px, and the time
@@ -25,10 +29,11 @@ static const char *prog = "eval_eye";
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: %s [--size WxH] [--frames N] [--seed N]\n"
+    fprintf(f, "usage: %s [--size WxH] [--frames N] [--seed N] [--history]\n"
                "  --size WxH   frame size (default 320x240; 64..4096 each side)\n"
                "  --frames N   frames drawn before the visibility split (default 400; 1..100000)\n"
-               "  --seed N     random set (default 1)\n",
+               "  --seed N     random set (default 1)\n"
+               "  --history    track each frame after 4 open-eye frames of the same eye\n",
             prog);
 }
 
@@ -73,9 +78,11 @@ int main(int argc, char **argv)
 {
     int w = 320, h = 240, frames = 400;
     long seed = 1;
+    int history = 0;
     static const struct option opts[] = { { "size", required_argument, 0, 's' },
                                           { "frames", required_argument, 0, 'n' },
                                           { "seed", required_argument, 0, 'r' },
+                                          { "history", no_argument, 0, 'H' },
                                           { "help", no_argument, 0, 'h' },
                                           { 0, 0, 0, 0 } };
     int c;
@@ -90,6 +97,7 @@ int main(int argc, char **argv)
         }
         case 'n': frames = (int)num("bad --frames (1..100000)", optarg, 1, 100000); break;
         case 'r': seed = num("bad --seed", optarg, 0, 0x7fffffffL); break;
+        case 'H': history = 1; break;
         case 'h': usage(stdout); return 0;
         default: bad("unknown option or missing argument", argv[optind - 1]);
         }
@@ -126,10 +134,20 @@ int main(int argc, char **argv)
         if (gt.pupil_visible < 0.5f)
             continue;
         fv_eye_result r;
+        if (history) {
+            fv_eye_reset(t);
+            const fv_synth_state o = { yaw, pitch, pupil, 1.0f };
+            for (int k = 0; k < 4; k++) {
+                fv_synth_truth og;
+                fv_synth_render(&p, &o, 5000u + 8u * (uint64_t)i + (uint64_t)k, img, w, &og);
+                fv_track_frame(t, img, w, h, w, &r);
+            }
+            fv_synth_render(&p, &s, 1000u + (uint64_t)i, img, w, &gt);
+        }
         const double t0 = now_s();
-        fv_track_image(t, img, w, h, w, &r);
+        (history ? fv_track_frame : fv_track_image)(t, img, w, h, w, &r);
         track_s += now_s() - t0, tracked++;
-        const float e = r.found ? hypotf(r.pupil_x - gt.pupil_x, r.pupil_y - gt.pupil_y) : INFINITY;
+        const float e = r.found && r.status == FV_EYE_OK ? hypotf(r.pupil_x - gt.pupil_x, r.pupil_y - gt.pupil_y) : INFINITY;
         const int b = gt.pupil_visible >= 0.99f ? 0 : gt.pupil_visible >= 0.7f ? 1 : 2;
         err[b][n[b]++] = e;
         if (progress && i % 50 == 49)
@@ -137,7 +155,8 @@ int main(int argc, char **argv)
     }
     if (progress)
         fprintf(stderr, "\r%*s\r", 40, "");
-    printf("%s: %dx%d, %d frames drawn, seed %ld\n", prog, w, h, frames, seed);
+    printf("%s: %dx%d, %d frames drawn, seed %ld%s\n", prog, w, h, frames, seed,
+           history ? ", after 4 open-eye frames" : "");
     static const char *names[3] = { "full view", "70-99% in view", "50-70% in view" };
     for (int b = 0; b < 3; b++) {
         if (!n[b]) {
