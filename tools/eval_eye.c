@@ -9,6 +9,7 @@
  * --history: each frame is tracked with fv_track_frame after the tracker (reset) has seen the
  * same eye with the lids open for 4 frames, as a headset sees it before the lid comes down;
  * without it, fv_track_image (no history). A frame flagged BLINK counts as a miss.
+ * --frames 160 is the set tests/test_eyetrack.c bounds (test_partial_occlusion).
  *
  * Prints, per bin (full view, 70-99%, 50-70% in view; frames under 50% are skipped), the
  * frames, median / p90 / max error in pixels and the share within 1 and 3 px, and the time
@@ -50,15 +51,6 @@ static long num(const char *flag, const char *s, long lo, long hi)
     if (end == s || *end || v < lo || v > hi)
         bad(flag, s);
     return v;
-}
-
-static uint64_t rng;
-static float rnd(void) /* splitmix64 -> [0, 1) */
-{
-    uint64_t z = (rng += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return (float)((z ^ (z >> 31)) >> 40) * (1.0f / 16777216.0f);
 }
 
 static int cmp_float(const void *a, const void *b)
@@ -116,19 +108,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: out of memory\n", prog);
         return 1;
     }
-    rng = (uint64_t)seed * 0x2545f4914f6cdd1dull;
+    uint64_t rng = (uint64_t)seed;
     const int progress = isatty(2);
     int n[3] = { 0, 0, 0 };
     double track_s = 0;
     int tracked = 0;
     for (int i = 0; i < frames; i++) {
-        p.noise_sigma = 2.0f + 12.0f * rnd();
-        p.brightness = 0.55f + 0.45f * rnd();
-        p.n_leds = 2 + (int)(4.999f * rnd());
-        const int up = i % 2;
-        const float yaw = -20.0f + 40.0f * rnd(), pitch = up ? 3.0f + 10.0f * rnd() : -10.0f + 20.0f * rnd();
-        const float pupil = 1.6f + 1.2f * rnd(), open = up ? 0.35f + 0.3f * rnd() : 1.0f;
-        const fv_synth_state s = { yaw, pitch, pupil, open };
+        fv_synth_state s;
+        fv_synth_lid_set_frame(&rng, i, &p, &s);
         fv_synth_truth gt;
         fv_synth_render(&p, &s, 1000u + (uint64_t)i, img, w, &gt);
         if (gt.pupil_visible < 0.5f)
@@ -136,7 +123,7 @@ int main(int argc, char **argv)
         fv_eye_result r;
         if (history) {
             fv_eye_reset(t);
-            const fv_synth_state o = { yaw, pitch, pupil, 1.0f };
+            const fv_synth_state o = { s.yaw_deg, s.pitch_deg, s.pupil_mm, 1.0f };
             for (int k = 0; k < 4; k++) {
                 fv_synth_truth og;
                 fv_synth_render(&p, &o, 5000u + 8u * (uint64_t)i + (uint64_t)k, img, w, &og);

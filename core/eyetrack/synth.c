@@ -199,6 +199,23 @@ static float shade(const fv_synth_params *p, const fv_synth_state *s, const geom
     return v;
 }
 
+static float uniform(uint64_t *st) /* [0,1) */
+{
+    return (float)(mix((*st)++) >> 40) * (1.0f / 16777216.0f);
+}
+
+void fv_synth_lid_set_frame(uint64_t *rng, int i, fv_synth_params *p, fv_synth_state *s)
+{
+    p->noise_sigma = 2.0f + 12.0f * uniform(rng);
+    p->brightness = 0.55f + 0.45f * uniform(rng);
+    p->n_leds = 2 + (int)(4.999f * uniform(rng));
+    const int up = i % 2;
+    s->yaw_deg = -20.0f + 40.0f * uniform(rng);
+    s->pitch_deg = up ? 3.0f + 10.0f * uniform(rng) : -10.0f + 20.0f * uniform(rng);
+    s->pupil_mm = 1.6f + 1.2f * uniform(rng);
+    s->open = up ? 0.35f + 0.3f * uniform(rng) : 1.0f;
+}
+
 static float gauss(uint64_t *st)
 {
     /* Box-Muller on splitmix64 */

@@ -51,4 +51,11 @@ void fv_synth_truth_of(const fv_synth_params *p, const fv_synth_state *s, fv_syn
 void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t noise_seed, uint8_t *img,
                      ptrdiff_t stride, fv_synth_truth *t);
 
+/* Frame i of the "lid set" (bounded by tests/test_eyetrack.c, measured by tools/eval_eye.c):
+ * poses a headset camera sees, drawn from *rng (splitmix64 state): gaze yaw +-20 deg, pupil
+ * 1.6-2.8 mm, 2-6 LEDs, sensor noise 2-14 grey levels, brightness 0.55-1; odd i look up 3-13 deg
+ * into a lid opened 0.35-0.65, even i pitch +-10 deg with the lids open. Sets p's noise_sigma,
+ * brightness and n_leds, and *s. */
+void fv_synth_lid_set_frame(uint64_t *rng, int i, fv_synth_params *p, fv_synth_state *s);
+
 #endif

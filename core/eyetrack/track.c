@@ -43,10 +43,6 @@ struct fv_eye_tracker {
     /* history for blink detection (fv_track_frame only) */
     int nref;
     float ref_contrast, ref_radius, ref_inner, ref_ring;
-    /* the ellipse's major semi-axis from fits with the whole outline in view (no lid cut, most
-     * rays on it): a size prior for fits to a partial arc (fv_track_frame only) */
-    int nref_a;
-    float ref_a;
 };
 
 void fv_eye_default_params(fv_eye_params *p)
@@ -89,8 +85,6 @@ void fv_eye_reset(fv_eye_tracker *t)
 {
     t->nref = 0;
     t->ref_contrast = t->ref_radius = t->ref_inner = t->ref_ring = 0;
-    t->nref_a = 0;
-    t->ref_a = 0;
 }
 
 static void *scratch(fv_eye_tracker *t, size_t bytes)
@@ -537,7 +531,6 @@ typedef struct {
     int fit;
     fv_ellipse e;
     float inliers; /* fraction of rays giving inlier edge points */
-    int lid;       /* a lid line was cut from the edge points */
 } pupil;
 
 /* A lid across the pupil puts a run of edge points on a nearly straight line (its radius of
@@ -585,8 +578,7 @@ static int drop_lid_line(float *ex, float *ey, float *egx, float *egy, int ne, f
 /* Scratch: win, mask w*h bytes, idx, fr w*h ints (fr: the search's integral image buffer, free
  * by now), dxx w floats. */
 static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t stride, const candidate *c,
-                  int inpainted, float prior_a, uint8_t *win, uint8_t *mask, int *idx, int *fr, float *dxx,
-                  pupil *out)
+                  int inpainted, uint8_t *win, uint8_t *mask, int *idx, int *fr, float *dxx, pupil *out)
 {
     /* window around the candidate, reflections inpainted */
     /* headset-sized frames: the search's box can be much smaller than the pupil (the darkest
@@ -691,7 +683,6 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     out->ring = ring;
     out->fit = 0;
     out->inliers = 0;
-    out->lid = 0;
 
     /* edge points along rays: first outward crossing of the mid level */
     const float th = 0.5f * (inner + ring);
@@ -789,7 +780,6 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     if (!inpainted && ne >= 12) {
         const int kept = drop_lid_line(ex, ey, egx, egy, ne, cx + x0, cy + y0, r);
         lid = kept < ne;
-        out->lid = lid;
         ne = kept;
     }
     if (ne < 8)
@@ -797,15 +787,14 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     /* headset-sized pupils: aspect b/a >= 0.6 (gaze up to ~50 deg off the camera axis); flatter
      * fits are lid-line consensus */
     const double minab = 0.6;
-    int n = 0, best = 0;
-    fv_ellipse be = { 0, 0, 0, 0, 0 };
-    /* with a size prior, only ellipses whose major semi-axis is within -20% / +25% of it */
-    const double amin = prior_a > 0 ? 0.8 * prior_a : 0.0, amax = prior_a > 0 ? 1.25 * prior_a : 1e30;
+    int n = 0;
     if (!inpainted) {
         /* Headset-sized pupils: RANSAC over 6-point fits (a lid can hide a third of the outline
          * and put its own edge in the middle of the points, which moves a least-squares fit),
          * then the least-squares refit below on the consensus. Deterministic sampling. */
         uint64_t st = 0x5eedu;
+        int best = 0;
+        fv_ellipse be;
         for (int it = 0; it < 64; it++) {
             float sx[6], sy[6];
             int pick[6], k = 0;
@@ -823,7 +812,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
             }
             fv_ellipse e;
             if (fv_ellipse_fit(sx, sy, 6, &e) || e.a < 0.5 * r || e.a > 2.5 * r || e.b < minab * e.a ||
-                hypot(e.cx - (cx + x0), e.cy - (cy + y0)) > r || e.a < amin || e.a > amax)
+                hypot(e.cx - (cx + x0), e.cy - (cy + y0)) > r)
                 continue;
             const int cnt = count_near(&e, ex, ey, egx, egy, ne, fmax(1.0, 0.06 * e.a), GRAD_MINCOS);
             if (cnt > best)
@@ -874,11 +863,8 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     }
     if (fv_ellipse_fit(ex, ey, n, &e))
         return 0;
-    if ((e.a < amin || e.a > amax) && best >= 8)
-        e = be; /* a partial arc's least-squares fit left the size the pupil has had */
     const double dc = hypot(e.cx - out->x, e.cy - out->y);
-    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < (inpainted ? 0.3 : minab) * e.a || dc > (lid ? 1.0 : 0.6) * r ||
-        e.a < amin || e.a > amax)
+    if (e.a < 0.5 * r || e.a > 2.5 * r || e.b < (inpainted ? 0.3 : minab) * e.a || dc > (lid ? 1.0 : 0.6) * r)
         return 0;
     out->fit = 1;
     out->e = e;
@@ -1054,10 +1040,9 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     }
     candidate rc = c;
     rc.x /= (float)rs, rc.y /= (float)rs, rc.r /= (float)rs, rc.scale /= rs;
-    const float prior_a = history && !reuse && t->nref_a >= 3 ? t->ref_a / (float)rs : 0.0f;
-    if (refine(t, rsrc, rw, rh, rst, &rc, reuse, prior_a, reuse ? lowres : work, mask, stack, (int *)ii, rowf, &p)) {
+    if (refine(t, rsrc, rw, rh, rst, &rc, reuse, reuse ? lowres : work, mask, stack, (int *)ii, rowf, &p)) {
         /* no dark region stands out in the window: keep the search's answer, flagged low */
-        p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0, p.lid = 0;
+        p.x = c.x, p.y = c.y, p.r = c.r, p.inner = c.inner, p.ring = c.ring, p.fit = 0, p.inliers = 0;
     } else if (rs > 1) {
         const float f = (float)rs;
         p.x *= f, p.y *= f, p.r *= f;
@@ -1139,11 +1124,6 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
             t->ref_inner += a * (p.inner - t->ref_inner);
             t->ref_ring += a * (p.ring - t->ref_ring);
             t->nref++;
-            if (p.fit && !p.lid && p.inliers >= 0.5f) {
-                const float b = t->nref_a < 10 ? 1.0f / (t->nref_a + 1) : 0.1f;
-                t->ref_a += b * ((float)p.e.a - t->ref_a);
-                t->nref_a++;
-            }
         }
     } else if (history && r->status == FV_EYE_LOST && t->nref >= 3) {
         r->status = FV_EYE_BLINK;
