@@ -1,7 +1,6 @@
 /* fovea platform: gaze calibration files (see calibfile.h). */
 #include "calibfile.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,20 +23,9 @@ int fv_calib_save(const fv_calib *c, const char *path, char *err, size_t err_len
 
 int fv_calib_load(fv_calib *c, const char *path, char *err, size_t err_len)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return fv_err(err, err_len, "%s: %s", path, strerror(errno));
     char buf[8192];
-    const size_t n = fread(buf, 1, sizeof buf - 1, f);
-    const int bad = ferror(f), more = !feof(f) && fgetc(f) != EOF;
-    fclose(f);
-    if (bad)
-        return fv_err(err, err_len, "%s: read error (a directory?)", path);
-    if (more)
-        return fv_err(err, err_len, "%s: too large for a calibration file", path);
-    buf[n] = '\0';
-    if (memchr(buf, '\0', n))
-        return fv_err(err, err_len, "%s: not a text file", path);
+    if (fv_read_text_file(path, buf, sizeof buf, "a calibration file", err, err_len) < 0)
+        return -1;
     char why[256];
     if (fv_calib_parse(c, buf, why, sizeof why))
         return fv_err(err, err_len, "%s: %s", path, why);

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "err.h"
+#include "output.h"
 
 /* Reads exactly n numbers from s; 0 or -1. */
 static int numbers(const char *s, float *v, int n)
@@ -85,19 +86,8 @@ int fv_lens_parse(fv_lens *l, const char *text, const char *name, float r_max, c
 
 int fv_lens_load(fv_lens *l, const char *path, float r_max, char *err, size_t err_len)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return fv_err(err, err_len, "%s: %s", path, strerror(errno));
     char buf[16384];
-    const size_t n = fread(buf, 1, sizeof buf - 1, f);
-    const int bad = ferror(f), more = !feof(f) && fgetc(f) != EOF;
-    fclose(f);
-    if (bad)
-        return fv_err(err, err_len, "%s: read error (a directory?)", path);
-    if (more)
-        return fv_err(err, err_len, "%s: too large for a lens profile", path);
-    buf[n] = 0;
-    if (memchr(buf, 0, n))
-        return fv_err(err, err_len, "%s: not a text file", path);
+    if (fv_read_text_file(path, buf, sizeof buf, "a lens profile", err, err_len) < 0)
+        return -1;
     return fv_lens_parse(l, buf, path, r_max, err, err_len);
 }

@@ -182,3 +182,21 @@ int fv_mkdirs(const char *path, char *err, size_t err_len)
         return fv_err(err, err_len, "%s: not a directory", path);
     return 0;
 }
+
+long fv_read_text_file(const char *path, char *buf, size_t cap, const char *kind, char *err, size_t err_len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return fv_err(err, err_len, "%s: %s", path, strerror(errno));
+    const size_t n = fread(buf, 1, cap - 1, f);
+    const int bad = ferror(f), more = !feof(f) && fgetc(f) != EOF;
+    fclose(f);
+    if (bad)
+        return fv_err(err, err_len, "%s: read error (a directory?)", path);
+    if (more)
+        return fv_err(err, err_len, "%s: too large for %s", path, kind);
+    buf[n] = '\0';
+    if (memchr(buf, '\0', n))
+        return fv_err(err, err_len, "%s: not a text file", path);
+    return (long)n;
+}

@@ -43,6 +43,11 @@ void fv_progress_begin(fv_progress *p, const char *what, long total);
 void fv_progress_update(fv_progress *p, long done);
 void fv_progress_end(fv_progress *p);
 
+/* Reads a small text file whole into buf (cap bytes, NUL-terminated): its length, or -1 with a
+ * reason naming the file in err (cannot open, read error, over cap - 1 bytes: "too large for
+ * <kind>", a NUL byte: "not a text file"). */
+long fv_read_text_file(const char *path, char *buf, size_t cap, const char *kind, char *err, size_t err_len);
+
 /* mkdir -p; 0 on success. */
 int fv_mkdirs(const char *path, char *err, size_t err_len);
 
