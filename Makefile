@@ -63,7 +63,7 @@ ALL_CFLAGS = $(BASE_CFLAGS) $(CFLAGS)
 ALL_CXXFLAGS = $(BASE_CXXFLAGS) $(CXXFLAGS)
 ALL_LDFLAGS = $(SANFLAGS) -pthread $(LDFLAGS)
 
-CORE_C := $(wildcard core/*.c core/dof/*.c core/eyetrack/*.c)
+CORE_C := $(wildcard core/*.c core/base/*.c core/dof/*.c core/eyetrack/*.c)
 CORE_CXX := $(wildcard core/*.cpp)
 ifeq ($(ARCH),x86_64)
 CORE_ISA := $(wildcard core/x86/*.c)
@@ -216,7 +216,7 @@ PREFIX ?= /usr/local
 install: all
 	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/fovea $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig
 	install -m 644 $(LIB) $(PLIB) $(DESTDIR)$(PREFIX)/lib/
-	install -m 644 core/*.h core/dof/*.h core/eyetrack/*.h platform/*.h $(DESTDIR)$(PREFIX)/include/fovea/
+	install -m 644 core/*.h core/base/*.h core/dof/*.h core/eyetrack/*.h platform/*.h $(DESTDIR)$(PREFIX)/include/fovea/
 	install -m 755 $(APPS) $(DESTDIR)$(PREFIX)/bin/
 	sed -e 's|@PREFIX@|$(PREFIX)|g' tools/fovea.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/fovea.pc
 

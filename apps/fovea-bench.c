@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "base/clock.h"
 #include "kbench.h"
 #include "output.h"
 #include "perfctr.h"

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/clock.h"
 #include "calibfile.h"
 #include "cli.h"
 #include "display.h"
@@ -81,7 +82,7 @@ typedef struct app {
 static int64_t a_now(void *c)
 {
     (void)c;
-    return fv_clock_now_ns();
+    return fv_time_ns();
 }
 static void a_sleep(void *c, int64_t t)
 {
@@ -92,7 +93,7 @@ static int a_wait_edge(void *c, int64_t deadline, int64_t *t)
 {
     app *a = c;
     char err[512];
-    int rc = fv_vsync_wait(a->vsync, deadline - fv_clock_now_ns(), t, err, sizeof err);
+    int rc = fv_vsync_wait(a->vsync, deadline - fv_time_ns(), t, err, sizeof err);
     if (rc < 0 && !a->reported_vsync) {
         fprintf(stderr, "%s: vsync %s failed (%s); running on the predictor and the timer\n", prog,
                 fv_vsync_kind(a->vsync), err);
@@ -131,7 +132,7 @@ static void a_sample_gaze(void *c, int64_t now)
 static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
 {
     app *a = c;
-    if (stop_requested || fv_clock_now_ns() >= a->end_ns || (a->disp && fv_display_quit_requested(a->disp)))
+    if (stop_requested || fv_time_ns() >= a->end_ns || (a->disp && fv_display_quit_requested(a->disp)))
         return -1;
     fv_pose head = a->view;
     if (a->trace && a->trace->has_head) {
@@ -334,7 +335,7 @@ int main(int argc, char **argv)
     fv_frameloop_params lp;
     fv_frameloop_default_params(&lp, period);
     fv_frameloop_ops ops = {&a, a_now, a_sleep, a_wait_edge, a_sample_gaze, a_render, a_present};
-    a.t_start_ns = fv_clock_now_ns();
+    a.t_start_ns = fv_time_ns();
     a.end_ns = seconds > 0 ? a.t_start_ns + (int64_t)(seconds * 1e9) : INT64_MAX;
     /* the trace recorder (--trace-out): one slot per worker of the pipeline's pool; a 2^20-event
      * ring per worker (40 MB) holds about 80 stereo frames at 1280x1440 (the newest are kept) */
@@ -369,7 +370,7 @@ int main(int argc, char **argv)
     const long skip = nrec > 40 ? 20 : 0;
     fv_latency_summary s;
     fv_latency_summarise(rec + skip, nrec - skip, &s);
-    const double run_s = (double)(fv_clock_now_ns() - a.t_start_ns) * 1e-9;
+    const double run_s = (double)(fv_time_ns() - a.t_start_ns) * 1e-9;
     printf("fovea-headset: %ld frames in %.2f s, %dx%d per eye, vsync %s (%.2f Hz nominal), display %s\n", nrec,
            run_s, a.W, a.H, vsync_spec, 1e9 / (double)period, a.disp ? fv_display_kind(a.disp) : "none");
     printf("  frame rate %.2f fps; late %ld of %ld (%.1f %%)\n", s.fps, s.late, s.frames,
@@ -380,7 +381,7 @@ int main(int argc, char **argv)
            "state %s%s\n",
            loop.pred.edges, loop.pred.missed, loop.pred.spurious, loop.pred.doubled, loop.pred.relocks,
            fv_vsync_pred_jitter_ns(&loop.pred) * 1e-3, fv_vsync_pred_period_ns(&loop.pred) * 1e-3,
-           fv_vsync_state_name(fv_vsync_pred_state(&loop.pred, fv_clock_now_ns())),
+           fv_vsync_state_name(fv_vsync_pred_state(&loop.pred, fv_time_ns())),
            loop.source_dead ? " (source failed)" : "");
     if (a.cam)
         printf("  camera: %ld frames tracked%s\n", fv_gazesrc_frames(a.cam),

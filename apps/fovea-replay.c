@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/clock.h"
 #include "cli.h"
 #include "metrics.h"
 #include "output.h"
@@ -256,7 +257,7 @@ int main(int argc, char **argv)
         if (ref)
             fv_pipeline_set_time_ns(ref, (int64_t)llround(t_ms * 1e6));
         fv_pose head = tr.has_head ? smp.head : view;
-        fv_prof_instant(prof, 0, FV_PROF_TRACK_MARKERS, "frame", fv_prof_now(), (int)f);
+        fv_prof_instant(prof, 0, FV_PROF_TRACK_MARKERS, "frame", fv_time_ns(), (int)f);
         fv_frame_stats st[2], sum;
         memset(&sum, 0, sizeof sum);
         for (int e = 0; e < neyes; e++) {

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "base/clock.h"
 #include "cli.h"
 #include "dsp.h"
 #include "eyesrc.h"
@@ -50,12 +51,6 @@ static void on_sigint(int sig)
     stop_requested = 1;
 }
 
-static int64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -227,10 +222,10 @@ int main(int argc, char **argv)
         fv_eye_result r, scratch_r;
         for (long k = 0; k < bench; k++) {
             fv_eye_result *rr = k ? &scratch_r : &r;
-            const int64_t t0 = now_ns();
+            const int64_t t0 = fv_time_ns();
             const int st = (images || k) ? fv_track_image(trk, fr.luma, fr.w, fr.h, fr.stride, rr)
                                          : fv_track_frame(trk, fr.luma, fr.w, fr.h, fr.stride, rr);
-            run_ns[k] += (double)(now_ns() - t0);
+            run_ns[k] += (double)(fv_time_ns() - t0);
             if (st)
                 fv_fail(prog, FV_EXIT_FAIL, "frame %ld (%dx%d): the tracker failed", fr.index, fr.w, fr.h);
         }

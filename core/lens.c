@@ -2,7 +2,7 @@
 
 #include <math.h>
 
-#include "err.h"
+#include "base/err.h"
 
 void fv_lens_default(fv_lens *l)
 {

@@ -1,4 +1,5 @@
 #include "pipeline.h"
+#include "base/clock.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -8,9 +9,7 @@
 
 #include "prof.h"
 #include "raycast.h"
-#include "err.h"
-
-const char *const fv_stage_names[FV_STAGE_COUNT] = {"trace", "reproject", "reconstruct", "coc", "dof_filter", "combine"};
+#include "base/err.h"
 
 #define SRGB_LUT 4096
 #define FOVEA_STEPS 4 /* fovea scales 1, 1.25, 1.5, 1.75, 2 */
@@ -51,12 +50,6 @@ struct fv_pipeline {
     uint8_t srgb[SRGB_LUT + 1]; /* linear [0,1] -> sRGB 8-bit */
 };
 
-int64_t fv_time_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 void fv_pipeline_config_default(fv_pipeline_config *c)
 {

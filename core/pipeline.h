@@ -14,18 +14,7 @@
 #include "reproject.h"
 #include "sampling.h"
 #include "scene.h"
-
-enum {
-    FV_STAGE_TRACE,
-    FV_STAGE_REPROJECT,
-    FV_STAGE_RECONSTRUCT,
-    FV_STAGE_COC,
-    FV_STAGE_DOF_FILTER,
-    FV_STAGE_COMBINE,
-    FV_STAGE_COUNT
-};
-/* JSON / CSV names: trace, reproject, reconstruct, coc, dof_filter, combine */
-extern const char *const fv_stage_names[FV_STAGE_COUNT];
+#include "stage.h"
 
 typedef struct fv_pipeline_config {
     fv_camera_desc cam;      /* size, vertical FOV, IPD, frustum shift */
@@ -88,8 +77,5 @@ const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride);
 /* The eye's last image as sRGB-encoded 8-bit RGB, rows of dst_stride bytes. */
 void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride);
-
-/* Monotonic clock in nanoseconds (CLOCK_MONOTONIC). */
-int64_t fv_time_ns(void);
 
 #endif

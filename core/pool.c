@@ -1,5 +1,6 @@
 #define _GNU_SOURCE
 #include "pool.h"
+#include "base/clock.h"
 #include "prof.h"
 
 #include <pthread.h>
@@ -50,7 +51,7 @@ int fv_online_cpus(void)
 
 static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, int id, fv_prof *prof)
 {
-    const int64_t t0 = prof ? fv_prof_now() : 0;
+    const int64_t t0 = prof ? fv_time_ns() : 0;
     for (;;) {
         int i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed);
         if (i >= count)
@@ -58,7 +59,7 @@ static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, int id, fv_pr
         fn(ctx, i, id);
     }
     if (prof) /* this worker's share of the job, on its own track */
-        fv_prof_span(prof, id, id, "pool job", t0, fv_prof_now(), count);
+        fv_prof_span(prof, id, id, "pool job", t0, fv_time_ns(), count);
 }
 
 static void *worker_main(void *arg)
@@ -144,11 +145,11 @@ void fv_pool_run(fv_pool *p, int count, fv_task_fn fn, void *ctx)
         return;
     if (!p || p->threads == 1 || count == 1) {
         fv_prof *prof = p ? p->prof : NULL;
-        const int64_t t0 = prof ? fv_prof_now() : 0;
+        const int64_t t0 = prof ? fv_time_ns() : 0;
         for (int i = 0; i < count; i++)
             fn(ctx, i, 0);
         if (prof)
-            fv_prof_span(prof, 0, 0, "pool job", t0, fv_prof_now(), count);
+            fv_prof_span(prof, 0, 0, "pool job", t0, fv_time_ns(), count);
         return;
     }
     pthread_mutex_lock(&p->mu);

@@ -1,10 +1,11 @@
 #include "prof.h"
+#include "stage.h"
+#include "base/clock.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#include "pipeline.h"
 #include "raycast.h"
 
 const char *const fv_prof_stage_names[FV_PROF_STAGES] = {"frame", "trace", "reconstruct", "dof"};
@@ -67,12 +68,6 @@ void fv_prof_destroy(fv_prof *p)
 
 int fv_prof_slots(const fv_prof *p) { return p ? p->slots : 0; }
 
-int64_t fv_prof_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 static inline void put(fv_prof *p, int slot, int track, const char *name, int64_t t0, int64_t t1, int arg, char kind)
 {
@@ -122,14 +117,14 @@ int64_t fv_prof_stage_mark(fv_prof *p, int stage, int end)
         return 0;
     /* the counters are read outside the span: the hook's own cost is not in the stage's time */
     if (end) {
-        const int64_t t = fv_prof_now();
+        const int64_t t = fv_time_ns();
         if (p->hook)
             p->hook(p->hook_ctx, stage, 1);
         return t;
     }
     if (p->hook)
         p->hook(p->hook_ctx, stage, 0);
-    return fv_prof_now();
+    return fv_time_ns();
 }
 
 size_t fv_prof_count(const fv_prof *p, int slot)

@@ -46,7 +46,6 @@ typedef struct fv_prof_event {
 fv_prof *fv_prof_create(int slots, size_t capacity);
 void fv_prof_destroy(fv_prof *p);
 int fv_prof_slots(const fv_prof *p);
-int64_t fv_prof_now(void); /* CLOCK_MONOTONIC, ns */
 
 /* Recording (slot: the calling thread's slot; out-of-range slots are ignored). */
 void fv_prof_span(fv_prof *p, int slot, int track, const char *name, int64_t t0_ns, int64_t t1_ns, int arg);

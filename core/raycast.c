@@ -1,11 +1,11 @@
 #include "raycast.h"
+#include "base/clock.h"
 #include "prof.h"
 
 #include <math.h>
 #include <stdatomic.h>
 #include <string.h>
 
-#include "pipeline.h"
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
 
@@ -82,7 +82,7 @@ static const unsigned char *tile_order(void)
 static void trace_tile(void *ctx, int index, int thread_id)
 {
     rc_job *j = ctx;
-    const int64_t tile_t0 = j->prof ? fv_prof_now() : 0;
+    const int64_t tile_t0 = j->prof ? fv_time_ns() : 0;
     const fv_camera *cam = j->cam;
     const fv_pyr_level *l0 = &j->pyr->lv[0];
     int tx = index % j->tiles_x, ty = index / j->tiles_x;
@@ -166,7 +166,7 @@ static void trace_tile(void *ctx, int index, int thread_id)
     }
     atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
     if (j->prof)
-        fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_prof_now(), index);
+        fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_time_ns(), index);
 }
 
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,

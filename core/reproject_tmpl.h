@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "reproject.h"
+#include "base/util.h"
 
 /* Footprint (previous-frame pixels) -> pyramid level: floor(log2 f) from the exponent bits. */
 static inline int taa_level(float f, int max_level)
@@ -35,7 +36,6 @@ static inline int taa_level(float f, int max_level)
     return e < max_level ? e : max_level;
 }
 
-static inline float taa_clampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
 
 /* 2^l and 2^-l: exact, without a division on the sample's dependency chain */
 static const float taa_pow2[8] = {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f, 128.0f};
@@ -93,8 +93,8 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
             int taps = 1;
             tap(L, u * inv_ts - 0.5f, v * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
             if (o >= 0.125f) { /* quincunx: the footprint's four corners at half extent */
-                const float ul = taa_clampf(u - o, 0.0f, umax), ur = taa_clampf(u + o, 0.0f, umax);
-                const float vt = taa_clampf(v - o, 0.0f, vmax), vb = taa_clampf(v + o, 0.0f, vmax);
+                const float ul = fv_clampf(u - o, 0.0f, umax), ur = fv_clampf(u + o, 0.0f, umax);
+                const float vt = fv_clampf(v - o, 0.0f, vmax), vb = fv_clampf(v + o, 0.0f, vmax);
                 tap(L, ul * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
                 tap(L, ur * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
                 tap(L, ul * inv_ts - 0.5f, vb * inv_ts - 0.5f, z, inv_tol, &acc, &accw);

@@ -2,7 +2,7 @@
  * mesh records (normals, uvs, material, per-triangle texel density) stay here for shading,
  * indexed by Embree geometry ID. The glTF loader is a client of the builder API. */
 #include "scene.h"
-#include "err.h"
+#include "base/err.h"
 
 #include "gltf_shim.h"
 

@@ -1,5 +1,5 @@
 #include "trace.h"
-#include "err.h"
+#include "base/err.h"
 
 #include <errno.h>
 #include <math.h>

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "err.h"
+#include "base/err.h"
 #include "output.h"
 
 int fv_calib_save(const fv_calib *c, const char *path, char *err, size_t err_len)

@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "display_sdl.h"
-#include "err.h"
+#include "base/err.h"
 #include "output.h"
 
 enum { D_KMS, D_FBDEV, D_WINDOW, D_PNG, D_Y4M, D_NONE };

@@ -10,7 +10,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-#include "err.h"
+#include "base/err.h"
 
 #ifdef FV_HAVE_DRM
 #include <xf86drm.h>

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "err.h"
+#include "base/err.h"
 
 #ifdef FV_HAVE_SDL2
 #include <SDL.h>

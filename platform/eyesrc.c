@@ -1,5 +1,6 @@
 /* fovea platform: Y4M and image-list eye sources (see eyesrc.h). */
 #include "eyesrc.h"
+#include "base/clock.h"
 
 #include <errno.h>
 #include <math.h>
@@ -11,7 +12,7 @@
 
 #include <stb/stb_image.h>
 
-#include "err.h"
+#include "base/err.h"
 
 typedef struct {
     char *path; /* as written */
@@ -305,16 +306,10 @@ int fv_eyesrc_open_v4l2(fv_eyesrc **out, const fv_v4l2_config *cfg, int silent_m
     return 0;
 }
 
-static int64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 static int next_v4l2(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
 {
-    const int64_t since = mono_ns();
+    const int64_t since = fv_time_ns();
     char why[512] = "";
     while (!(s->stop && *s->stop)) {
         fv_v4l2_frame vf;
@@ -332,7 +327,7 @@ static int next_v4l2(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
             f->t_ns = vf.t_ns;
             return 1;
         }
-        if (mono_ns() - since > (int64_t)s->silent_ms * 1000000) {
+        if (fv_time_ns() - since > (int64_t)s->silent_ms * 1000000) {
             if (st == FV_V4L2_GONE)
                 return fv_err(err, err_len, "%s: no frame for %d ms, the device is gone (%s)", s->cam->path,
                               s->silent_ms, why);

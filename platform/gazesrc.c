@@ -1,5 +1,6 @@
 /* fovea platform: eye-camera gaze source thread (see gazesrc.h). */
 #include "gazesrc.h"
+#include "base/clock.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -9,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "err.h"
+#include "base/err.h"
 #include "eyesrc.h"
 #include "eyetrack/eyetrack.h"
 #include "eyetrack/gazefilter.h"
@@ -56,7 +57,7 @@ static void *run(void *arg)
 {
     fv_gazesrc *g = arg;
     char err[512];
-    int64_t next_t = fv_clock_now_ns();
+    int64_t next_t = fv_time_ns();
     const int64_t frame_ns = (int64_t)(1e9 / g->fps);
     while (!atomic_load(&g->stop)) {
         fv_eye_frame fr;
@@ -82,7 +83,7 @@ static void *run(void *arg)
             t = next_t;
             next_t += frame_ns;
         } else if (t == 0) {
-            t = fv_clock_now_ns();
+            t = fv_time_ns();
         }
         fv_eye_result r;
         if (fv_track_frame(g->trk, fr.luma, fr.w, fr.h, fr.stride, &r)) {

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <stb/stb_image.h>
 
-#include "err.h"
+#include "base/err.h"
 
 uint8_t *fv_read_png(const char *path, int *w, int *h, char *err, size_t err_len)
 {

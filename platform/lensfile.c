@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "err.h"
+#include "base/err.h"
 #include "output.h"
 
 /* Reads exactly n numbers from s; 0 or -1. */

@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <jpeglib.h>
 
-#include "err.h"
+#include "base/err.h"
 
 /* libjpeg reports fatal errors through error_exit (default: exit()): jump back instead. Corrupt
  * data it can limp past (a truncated frame, bad Huffman codes) only warns; a camera frame like

@@ -1,4 +1,5 @@
 #include "output.h"
+#include "base/clock.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -8,7 +9,7 @@
 #include <stb/stb_image_write.h>
 
 #include "pipeline.h" /* fv_time_ns */
-#include "err.h"
+#include "base/err.h"
 
 int fv_afile_open(fv_afile *a, const char *path, char *err, size_t err_len)
 {

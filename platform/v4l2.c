@@ -2,6 +2,7 @@
  * named with the device and strerror, ioctls are retried on EINTR. */
 #define _DEFAULT_SOURCE
 #include "v4l2.h"
+#include "base/clock.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -17,7 +18,7 @@
 #include <unistd.h>
 #include <linux/videodev2.h>
 
-#include "err.h"
+#include "base/err.h"
 #include "mjpeg.h"
 
 _Static_assert(FV_PIX_GREY == V4L2_PIX_FMT_GREY, "GREY fourcc");
@@ -35,12 +36,6 @@ static const uint32_t default_formats[] = {FV_PIX_GREY,  FV_PIX_Y16,  FV_PIX_Y12
 
 static int readable(uint32_t fourcc) { return fv_pix_supported(fourcc) || fourcc == FV_PIX_MJPEG; }
 
-static int64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 /* ---- configuration ---------------------------------------------------------------------- */
 
@@ -624,7 +619,7 @@ int fv_v4l2_open(fv_v4l2 *cam, const fv_v4l2_config *cfg, char *err, size_t err_
         return 0;
     if (cfg->wait_for_device && (e == ENOENT || e == ENODEV || e == ENXIO)) {
         cam->gone = 1;
-        cam->next_try_ns = mono_ns() + fv_v4l2_backoff_ns(0);
+        cam->next_try_ns = fv_time_ns() + fv_v4l2_backoff_ns(0);
         return 0;
     }
     fv_err(err, err_len, "%s", cam->last_err);
@@ -648,7 +643,7 @@ static fv_v4l2_status go_gone(fv_v4l2 *cam, const char *call, const char *why, c
     close_stream(cam);
     cam->gone = 1;
     cam->reopen_attempts = 0;
-    cam->next_try_ns = mono_ns() + fv_v4l2_backoff_ns(0);
+    cam->next_try_ns = fv_time_ns() + fv_v4l2_backoff_ns(0);
     fv_err(cam->last_err, sizeof cam->last_err, "%s on %s: %s", call, cam->path, why);
     fv_err(err, err_len, "%s (device gone; reopening)", cam->last_err);
     return FV_V4L2_GONE;
@@ -659,7 +654,7 @@ static fv_v4l2_status go_gone(fv_v4l2 *cam, const char *call, const char *why, c
 static int reopen(fv_v4l2 *cam, int64_t deadline_ns, char *err, size_t err_len)
 {
     for (;;) {
-        if (mono_ns() >= cam->next_try_ns) {
+        if (fv_time_ns() >= cam->next_try_ns) {
             int e;
             if (open_stream(cam, &e, cam->last_err, sizeof cam->last_err) == 0) {
                 cam->gone = 0;
@@ -668,11 +663,11 @@ static int reopen(fv_v4l2 *cam, int64_t deadline_ns, char *err, size_t err_len)
                 cam->last_err[0] = 0;
                 return 0;
             }
-            cam->next_try_ns = mono_ns() + fv_v4l2_backoff_ns(++cam->reopen_attempts);
+            cam->next_try_ns = fv_time_ns() + fv_v4l2_backoff_ns(++cam->reopen_attempts);
         }
         /* Sleep to the next attempt or the caller's deadline, whichever is first: a tracking loop
          * calling next() with a timeout must not spin while the device is away. */
-        int64_t now = mono_ns();
+        int64_t now = fv_time_ns();
         if (now >= deadline_ns)
             break;
         int64_t until = cam->next_try_ns < deadline_ns ? cam->next_try_ns : deadline_ns;
@@ -680,7 +675,7 @@ static int reopen(fv_v4l2 *cam, int64_t deadline_ns, char *err, size_t err_len)
         while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR)
             ;
     }
-    int64_t wait = cam->next_try_ns - mono_ns();
+    int64_t wait = cam->next_try_ns - fv_time_ns();
     fv_err(err, err_len, "%s: device gone; %d reopen attempts failed, next in %lld ms; last error: %s", cam->path,
            cam->reopen_attempts, (long long)(wait > 0 ? wait / 1000000 : 0), cam->last_err);
     return -1;
@@ -752,7 +747,7 @@ static void drain_to_newest(fv_v4l2 *cam, struct v4l2_buffer *b)
 
 fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, char *err, size_t err_len)
 {
-    int64_t deadline = mono_ns() + (int64_t)(timeout_ms > 0 ? timeout_ms : 0) * 1000000;
+    int64_t deadline = fv_time_ns() + (int64_t)(timeout_ms > 0 ? timeout_ms : 0) * 1000000;
     if (cam->held >= 0) { /* the zero-copy frame lent by the previous call goes back */
         int i = cam->held;
         cam->held = -1;
@@ -771,7 +766,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, ch
             fv_err(err, err_len, "%s: camera not open", cam->path[0] ? cam->path : "v4l2");
             return FV_V4L2_ERROR;
         }
-        int64_t now = mono_ns();
+        int64_t now = fv_time_ns();
         int ms = deadline > now ? (int)((deadline - now + 999999) / 1000000) : 0;
         struct pollfd pfd = {.fd = cam->fd, .events = POLLIN};
         int r = cam->sys.poll(cam->sys.user, &pfd, ms);
@@ -790,7 +785,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, ch
         if (xioctl(cam, VIDIOC_DQBUF, &b) < 0) {
             int e = errno;
             if (e == EAGAIN && !(pfd.revents & (POLLERR | POLLHUP))) {
-                if (mono_ns() >= deadline)
+                if (fv_time_ns() >= deadline)
                     return FV_V4L2_TIMEOUT;
                 continue; /* woken without a buffer */
             }
@@ -809,7 +804,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, ch
         int bad = bad_buf;
         if (!bad && cam->cfg.latest_only)
             drain_to_newest(cam, &b);
-        int64_t t_deq = mono_ns();
+        int64_t t_deq = fv_time_ns();
         size_t used = buffer_used(cam, &b);
         const uint8_t *src = cam->bufs[b.index].start;
         if (!bad && cam->fourcc == FV_PIX_MJPEG)
@@ -829,7 +824,7 @@ fv_v4l2_status fv_v4l2_next(fv_v4l2 *cam, int timeout_ms, fv_v4l2_frame *out, ch
                 call_err(cam, "VIDIOC_QBUF", e, err, err_len);
                 return FV_V4L2_ERROR;
             }
-            if (mono_ns() >= deadline)
+            if (fv_time_ns() >= deadline)
                 return FV_V4L2_TIMEOUT;
             continue;
         }

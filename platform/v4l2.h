@@ -24,6 +24,7 @@
 #include <stdint.h>
 
 #include "mjpeg.h"
+#include "base/clock.h"
 #include "pixfmt.h"
 
 struct pollfd;

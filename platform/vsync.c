@@ -1,5 +1,6 @@
 /* Vsync sources by spec: GPIO (vsync_gpio.c), timer, replay of recorded edges. */
 #include "vsync.h"
+#include "base/clock.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -7,14 +8,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "err.h"
+#include "base/err.h"
 
-int64_t fv_clock_now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 void fv_clock_sleep_until_ns(int64_t t_ns)
 {
@@ -79,7 +74,7 @@ static int open_replay(fv_vsync *v, const char *path, char *err, size_t err_len)
     fclose(f);
     if (v->n_edges == 0)
         return fv_err(err, err_len, "vsync replay %s: no edge times", path);
-    v->t0_ns = fv_clock_now_ns();
+    v->t0_ns = fv_time_ns();
     return 0;
 }
 
@@ -99,7 +94,7 @@ int fv_vsync_open(fv_vsync **out, const char *spec, char *err, size_t err_len)
         }
         v->kind = K_TIMER;
         v->period_ns = (int64_t)(1e9 / hz + 0.5);
-        v->t0_ns = fv_clock_now_ns() + v->period_ns;
+        v->t0_ns = fv_time_ns() + v->period_ns;
     } else if (!strncmp(spec, "replay:", 7)) {
         v->kind = K_REPLAY;
         if (open_replay(v, spec + 7, err, err_len)) {
@@ -151,7 +146,7 @@ int fv_vsync_wait(fv_vsync *v, int64_t timeout_ns, int64_t *t_ns, char *err, siz
         timeout_ns = 0;
     if (v->kind == K_GPIO)
         return fv_vsync_gpio_wait(v->gpio, timeout_ns, t_ns, err, err_len);
-    int64_t now = fv_clock_now_ns(), deadline = now + timeout_ns, t;
+    int64_t now = fv_time_ns(), deadline = now + timeout_ns, t;
     if (v->kind == K_TIMER) {
         /* like a GPIO line read late: the kernel queues 16 events, older ones are lost */
         int64_t passed = (now - v->t0_ns) / v->period_ns;

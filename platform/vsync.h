@@ -38,7 +38,6 @@ const char *fv_vsync_kind(const fv_vsync *v); /* "gpio", "timer", "replay" */
 void fv_vsync_close(fv_vsync *v);
 
 /* ---- clocks ---- */
-int64_t fv_clock_now_ns(void);              /* CLOCK_MONOTONIC */
 void fv_clock_sleep_until_ns(int64_t t_ns); /* absolute clock_nanosleep, restarted on EINTR */
 
 #endif

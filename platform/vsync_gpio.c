@@ -6,7 +6,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "err.h"
+#include "base/err.h"
 
 #ifdef FV_HAVE_GPIOD
 #include <gpiod.h>

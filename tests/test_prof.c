@@ -1,6 +1,7 @@
 /* fovea: the trace recorder (core/prof.c) and the kernel benchmark table (core/kbench.c). */
 #include <string.h>
 
+#include "base/clock.h"
 #include "testutil.h"
 
 #include "kbench.h"
@@ -46,8 +47,8 @@ static void test_ring(void **state)
 static void task(void *ctx, int i, int tid)
 {
     fv_prof *p = ctx;
-    const int64_t t = fv_prof_now();
-    fv_prof_span(p, tid, tid, "item", t, fv_prof_now(), i);
+    const int64_t t = fv_time_ns();
+    fv_prof_span(p, tid, tid, "item", t, fv_time_ns(), i);
 }
 static void test_pool_threads(void **state)
 {

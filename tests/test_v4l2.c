@@ -16,17 +16,12 @@
 
 #include <jpeglib.h>
 
+#include "base/clock.h"
 #include "testutil.h"
 #include "mjpeg.h"
 #include "pixfmt.h"
 #include "v4l2.h"
 
-static int64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 #define assert_contains(hay, needle)                                                       \
     do {                                                                                   \
@@ -239,9 +234,9 @@ static void test_wait_for_device(void **st)
      * machine may deschedule us once) */
     int64_t best = INT64_MAX;
     for (int i = 0; i < 3; i++) {
-        int64_t t0 = now_ns();
+        int64_t t0 = fv_time_ns();
         assert_int_equal(fv_v4l2_next(&cam, 0, &f, err, sizeof err), FV_V4L2_GONE);
-        int64_t dt = now_ns() - t0;
+        int64_t dt = fv_time_ns() - t0;
         best = dt < best ? dt : best;
         assert_contains(err, path);
     }
@@ -249,9 +244,9 @@ static void test_wait_for_device(void **st)
     assert_true(cam.reopen_attempts <= 1);
     int64_t t0;
 
-    t0 = now_ns();
+    t0 = fv_time_ns();
     assert_int_equal(fv_v4l2_next(&cam, 250, &f, err, sizeof err), FV_V4L2_GONE);
-    int64_t dt = now_ns() - t0;
+    int64_t dt = fv_time_ns() - t0;
     /* attempts at ~50 and ~150 ms; the third (~350 ms) is past the deadline, which it sleeps to
      * (a loop calling next() must not spin) but not beyond */
     assert_true(cam.reopen_attempts >= 1 && cam.reopen_attempts <= 3);
@@ -729,7 +724,7 @@ static void test_fake_yuyv_stream(void **st)
     fv_v4l2_frame fr;
     for (uint32_t seq = 0; seq < 3; seq++) {
         f.ready = 1;
-        f.stamp_ns = now_ns() - 2000000;
+        f.stamp_ns = fv_time_ns() - 2000000;
         assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
         assert_frame(&fr, seq, 5, 3);
         assert_int_equal(fr.stride, 5);
@@ -744,13 +739,13 @@ static void test_fake_yuyv_stream(void **st)
     f.ready = 2;
     f.eintr_dqbuf = 2;
     f.error_next = 1;
-    f.stamp_ns = now_ns() - 1000000;
+    f.stamp_ns = fv_time_ns() - 1000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_frame(&fr, 4, 5, 3);
 
     /* A frame that waited in the queue keeps the driver's (old) stamp. */
     f.ready = 1;
-    f.stamp_ns = now_ns() - 3000000000;
+    f.stamp_ns = fv_time_ns() - 3000000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_true(fr.t_from_driver);
     assert_true(fr.t_ns == f.stamp_ns / 1000 * 1000);
@@ -786,14 +781,14 @@ static void test_fake_grey_zero_copy(void **st)
     fv_v4l2_frame fr;
     f.ready = 1;
     f.stamp_ns = 12345; /* garbage: must not be used */
-    int64_t t0 = now_ns();
+    int64_t t0 = fv_time_ns();
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_frame(&fr, 0, 4, 2);
     assert_int_equal(fr.stride, 7);
     assert_ptr_equal(fr.luma, f.mem[0]); /* lent, not copied */
     assert_int_equal(fake_queued(&f), 3);
     assert_false(fr.t_from_driver);
-    assert_true(fr.t_ns >= t0 && fr.t_ns <= now_ns());
+    assert_true(fr.t_ns >= t0 && fr.t_ns <= fv_time_ns());
     assert_int_equal(fv_v4l2_next(&cam, 0, &fr, err, sizeof err), FV_V4L2_TIMEOUT);
     assert_int_equal(fake_queued(&f), 4); /* given back on the next call */
     fv_v4l2_close(&cam);
@@ -819,7 +814,7 @@ static void test_fake_unplug_reopen(void **st)
         fail_msg("%s", err);
     fv_v4l2_frame fr;
     f.ready = 1;
-    f.stamp_ns = now_ns() - 1000000;
+    f.stamp_ns = fv_time_ns() - 1000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_frame(&fr, 0, 6, 2);
 
@@ -837,11 +832,11 @@ static void test_fake_unplug_reopen(void **st)
     f.vanish = 0;
     f.absent = 1;
     f.gain = 0;
-    int64_t t0 = now_ns();
+    int64_t t0 = fv_time_ns();
     assert_int_equal(fv_v4l2_next(&cam, 0, &fr, err, sizeof err), FV_V4L2_GONE);
     assert_true(cam.reopen_attempts <= 1); /* 0 unless 50 ms passed since the loss */
     assert_int_equal(fv_v4l2_next(&cam, 120, &fr, err, sizeof err), FV_V4L2_GONE);
-    assert_true(now_ns() - t0 < 1000000000);
+    assert_true(fv_time_ns() - t0 < 1000000000);
     assert_true(cam.reopen_attempts >= 1);
     assert_contains(err, "open on /fake/video0");
 
@@ -849,7 +844,7 @@ static void test_fake_unplug_reopen(void **st)
     f.absent = 0;
     f.ready = 1;
     f.seq = 0;
-    f.stamp_ns = now_ns() + 500000000; /* from the future (a driver bug): not trusted */
+    f.stamp_ns = fv_time_ns() + 500000000; /* from the future (a driver bug): not trusted */
     fv_v4l2_status s = FV_V4L2_GONE;
     for (int i = 0; i < 40 && s == FV_V4L2_GONE; i++)
         s = fv_v4l2_next(&cam, 100, &fr, err, sizeof err);
@@ -885,7 +880,7 @@ static void test_fake_latest_and_copy(void **st)
     fv_v4l2_frame fr;
     /* three frames waiting: the newest is returned, the two older handed back */
     f.ready = 3;
-    f.stamp_ns = now_ns() - 1000000;
+    f.stamp_ns = fv_time_ns() - 1000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_frame(&fr, 2, 8, 4);
     assert_int_equal(cam.stale, 2);
@@ -1123,7 +1118,7 @@ static void test_fake_mjpeg_stream(void **st)
     assert_int_equal(cam.fourcc, FV_PIX_MJPEG);
     fv_v4l2_frame fr;
     f.ready = 1;
-    f.stamp_ns = now_ns() - 1000000;
+    f.stamp_ns = fv_time_ns() - 1000000;
     assert_int_equal(fv_v4l2_next(&cam, 100, &fr, err, sizeof err), FV_V4L2_FRAME);
     assert_int_equal(fr.fourcc, FV_PIX_MJPEG);
     assert_int_equal(fr.stride, 32);

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "pipeline.h"
+#include "base/clock.h"
 #include "raycast.h"
 #include "reproject.h"
 #include "scene.h"

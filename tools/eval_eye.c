@@ -23,6 +23,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/clock.h"
 #include "eyetrack/eyetrack.h"
 #include "eyetrack/synth.h"
 
@@ -59,12 +60,6 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 int main(int argc, char **argv)
 {
@@ -131,9 +126,9 @@ int main(int argc, char **argv)
             }
             fv_synth_render(&p, &s, 1000u + (uint64_t)i, img, w, &gt);
         }
-        const double t0 = now_s();
+        const double t0 = (1e-9 * (double)fv_time_ns());
         (history ? fv_track_frame : fv_track_image)(t, img, w, h, w, &r);
-        track_s += now_s() - t0, tracked++;
+        track_s += (1e-9 * (double)fv_time_ns()) - t0, tracked++;
         const float e = r.found && r.status == FV_EYE_OK ? hypotf(r.pupil_x - gt.pupil_x, r.pupil_y - gt.pupil_y) : INFINITY;
         const int b = gt.pupil_visible >= 0.99f ? 0 : gt.pupil_visible >= 0.7f ? 1 : 2;
         err[b][n[b]++] = e;

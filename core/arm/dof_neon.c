@@ -16,12 +16,11 @@
 #include <arm_neon.h>
 
 #include "dof/weier_impl.h"
+#include "base/util.h"
 #include "dsp.h"
 
 #define CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
 
-static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
-static inline int maxi(int a, int b) { return a > b ? a : b; }
 
 static inline float32x4_t sel(uint32x4_t m, float32x4_t a, float32x4_t b) { return vbslq_f32(m, a, b); }
 
@@ -48,7 +47,7 @@ static void coc_row_neon(float *restrict coc, const float *rgbd, int n, float K,
 static inline void mask_row(float *restrict m, const float *rgbd, const float *coc, int w, int base, int len)
 {
     for (int k = 0; k < len; k++) {
-        const int q = clampi(base + k, 0, w - 1);
+        const int q = fv_clampi(base + k, 0, w - 1);
         const float32x4_t p = vsetq_lane_f32(1.0f, vld1q_f32(rgbd + 4 * q), 3);
         const uint32x4_t far = vcgtq_f32(vdupq_n_f32(coc[q]), vdupq_n_f32(0.0f));
         vst1q_f32(m + 4 * k, vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(p), far)));
@@ -72,7 +71,7 @@ static void hgauss_row_neon(float *restrict dst, const float *rgbd, const float 
         const uint8_t *sg = sig + c0;
         int Rc = 0;
         for (int i = 0; i < cn; i++)
-            Rc = maxi(Rc, tab->rad[sg[i]]);
+            Rc = fv_maxi(Rc, tab->rad[sg[i]]);
         mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
         const float *mc = m + 4 * Rc; /* output pixel c0 + i at mc + 4 i */
         float *d = dst + 4 * (ptrdiff_t)(x0 + c0);
@@ -80,7 +79,7 @@ static void hgauss_row_neon(float *restrict dst, const float *rgbd, const float 
         for (; i + 4 <= cn; i += 4) {
             const uint8_t *s = sg + i;
             const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
-            const int R = maxi(maxi(tab->rad[s[0]], tab->rad[s[1]]), maxi(tab->rad[s[2]], tab->rad[s[3]]));
+            const int R = fv_maxi(fv_maxi(tab->rad[s[0]], tab->rad[s[1]]), fv_maxi(tab->rad[s[2]], tab->rad[s[3]]));
             float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
             for (int j = -R; j <= R; j++) {
                 const int k = j < 0 ? -j : j;
@@ -107,12 +106,12 @@ static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t str
     for (; i + 4 <= n; i += 4) {
         const uint8_t *s = sig + i;
         const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
-        const int R = maxi(maxi(tab->rad[s[0]], tab->rad[s[1]]), maxi(tab->rad[s[2]], tab->rad[s[3]]));
+        const int R = fv_maxi(fv_maxi(tab->rad[s[0]], tab->rad[s[1]]), fv_maxi(tab->rad[s[2]], tab->rad[s[3]]));
         const float *col = src + 4 * (ptrdiff_t)(x0 + i);
         float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
         for (int j = -R; j <= R; j++) {
             const int k = j < 0 ? -j : j;
-            const float *p = col + 4 * (ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride;
+            const float *p = col + 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride;
             a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
             a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
             a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
@@ -129,7 +128,7 @@ static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t str
         const int R = tab->rad[sig[i]];
         float32x4_t a = vdupq_n_f32(0.0f);
         for (int j = -R; j <= R; j++)
-            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + 4 * (ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride),
+            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride),
                                          wt[j < 0 ? -j : j]));
         vst1q_f32(dst + 4 * (ptrdiff_t)(x0 + i), a);
     }

@@ -38,6 +38,7 @@
 #include <string.h>
 
 #include "dof/dof.h"
+#include "base/clock.h"
 #include "dof/model_util.h"
 
 #define HU_HALF 7                                 /* 15 taps */
@@ -91,8 +92,8 @@ static void hu_dilate_h_row(void *ctx, int y, int tid)
     for (int x = 0; x < j->w; x++) {
         float m = near[x];
         for (int k = 1; k <= HU_HALF; k++) {
-            m = hu_reach_max(m, near[fv_dm_clampi(x - k, 0, j->w - 1)], k);
-            m = hu_reach_max(m, near[fv_dm_clampi(x + k, 0, j->w - 1)], k);
+            m = hu_reach_max(m, near[fv_clampi(x - k, 0, j->w - 1)], k);
+            m = hu_reach_max(m, near[fv_clampi(x + k, 0, j->w - 1)], k);
         }
         nh[x] = m;
     }
@@ -108,8 +109,8 @@ static void hu_dilate_v_row(void *ctx, int y, int tid)
     for (int x = 0; x < j->w; x++) {
         float m = nh[y * st + x];
         for (int k = 1; k <= HU_HALF; k++) {
-            m = hu_reach_max(m, nh[fv_dm_clampi(y - k, 0, j->h - 1) * st + x], k);
-            m = hu_reach_max(m, nh[fv_dm_clampi(y + k, 0, j->h - 1) * st + x], k);
+            m = hu_reach_max(m, nh[fv_clampi(y - k, 0, j->h - 1) * st + x], k);
+            m = hu_reach_max(m, nh[fv_clampi(y + k, 0, j->h - 1) * st + x], k);
         }
         eff[x] = sig[x] > m ? sig[x] : m;
     }
@@ -132,8 +133,8 @@ static void hu_pass1(const hu_job *j, int y, int img, int x0, int x1)
         const float *g = j->lut[i];
         float a[3] = {g[0] * c[0], g[0] * c[1], g[0] * c[2]};
         for (int k = 1; k <= HU_HALF; k++) {
-            const float *p = fv_dm_px(j->L, x, fv_dm_clampi(y - k, 0, j->h - 1));
-            const float *q = fv_dm_px(j->L, x, fv_dm_clampi(y + k, 0, j->h - 1));
+            const float *p = fv_dm_px(j->L, x, fv_clampi(y - k, 0, j->h - 1));
+            const float *q = fv_dm_px(j->L, x, fv_clampi(y + k, 0, j->h - 1));
             for (int ch = 0; ch < 3; ch++)
                 a[ch] += g[k] * (p[ch] + q[ch]);
         }
@@ -146,7 +147,7 @@ static void hu_pass1_row(void *ctx, int y, int tid)
     (void)tid;
     const hu_job *j = ctx;
     if (y >= j->by0 && y <= j->by1) /* pass 2 reads up to HU_HALF columns beyond the box */
-        hu_pass1(j, y, 0, fv_dm_clampi(j->bx0 - HU_HALF, 0, j->w - 1), fv_dm_clampi(j->bx1 + HU_HALF, 0, j->w - 1));
+        hu_pass1(j, y, 0, fv_clampi(j->bx0 - HU_HALF, 0, j->w - 1), fv_clampi(j->bx1 + HU_HALF, 0, j->w - 1));
     hu_pass1(j, y, 1, 0, j->w - 1);
 }
 
@@ -167,8 +168,8 @@ static void hu_pass2(const hu_job *j, int y, int img, int x0, int x1)
         const float *g = j->lut[i];
         float a[3] = {g[0] * src[4 * x], g[0] * src[4 * x + 1], g[0] * src[4 * x + 2]};
         for (int k = 1; k <= HU_HALF; k++) {
-            const float *p = src + 4 * fv_dm_clampi(x - k, 0, j->w - 1);
-            const float *q = src + 4 * fv_dm_clampi(x + k, 0, j->w - 1);
+            const float *p = src + 4 * fv_clampi(x - k, 0, j->w - 1);
+            const float *q = src + 4 * fv_clampi(x + k, 0, j->w - 1);
             for (int ch = 0; ch < 3; ch++)
                 a[ch] += g[k] * (p[ch] + q[ch]);
         }

@@ -4,9 +4,9 @@
 #include <math.h>
 
 #include "dof/weier_impl.h"
+#include "base/util.h"
 #include "dsp.h"
 
-static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
 
 void fv_dof_coc_row_c(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
 {
@@ -26,7 +26,7 @@ void fv_dof_hgauss_row_c(float *restrict dst, const float *rgbd, const float *co
         const int x = x0 + i, s = sig[i], R = tab->rad[s];
         float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
         for (int j = -R; j <= R; j++) {
-            const int q = clampi(x + j, 0, w - 1);
+            const int q = fv_clampi(x + j, 0, w - 1);
             if (!(coc[q] > 0.0f))
                 continue; /* only far-field samples enter the far layer */
             const float g = tab->w[s][j < 0 ? -j : j];
@@ -50,7 +50,7 @@ void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride
         const int x = x0 + i, s = sig[i], R = tab->rad[s];
         float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
         for (int j = -R; j <= R; j++) {
-            const float *p = src + 4 * ((ptrdiff_t)clampi(y + j, ylo, yhi - 1) * stride + x);
+            const float *p = src + 4 * ((ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride + x);
             const float g = tab->w[s][j < 0 ? -j : j];
             a0 += g * p[0];
             a1 += g * p[1];

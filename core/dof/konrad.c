@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "dof/dof.h"
+#include "base/clock.h"
 #include "dof/model_util.h"
 
 typedef struct ko_job {
@@ -68,11 +69,11 @@ static void ko_filter_row(void *ctx, int y, int tid)
         const float rc = fabsf(rad[y * st + x]), ac = ko_area(rc);
         float a[3] = {c[0], c[1], c[2]}, sw = 1.0f; /* C: weight exactly 1 */
         for (int dy = -R; dy <= R; dy++) {
-            const int py = fv_dm_clampi(y + dy, 0, j->h - 1);
+            const int py = fv_clampi(y + dy, 0, j->h - 1);
             for (int dx = -R; dx <= R; dx++) {
                 if (!dx && !dy)
                     continue;
-                const int px = fv_dm_clampi(x + dx, 0, j->w - 1);
+                const int px = fv_clampi(x + dx, 0, j->w - 1);
                 const float rs = rad[py * st + px], rp = fabsf(rs);
                 if ((float)(dx * dx + dy * dy) > rp * rp) /* factor 1 */
                     continue;

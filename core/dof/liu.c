@@ -37,6 +37,7 @@
 #include <string.h>
 
 #include "dof/dof.h"
+#include "base/clock.h"
 #include "dof/model_util.h"
 
 /* extra refractive power of the eye for the display's red, green, blue relative to green, D */
@@ -99,10 +100,10 @@ static void liu_filter_row(void *ctx, int y, int tid)
             a[ch] = c[ch], sw[ch] = 1.0f; /* C: weight exactly 1 */
         }
         for (int dy = -R; dy <= R; dy++) {
-            const int py = fv_dm_clampi(y + dy, 0, j->h - 1);
+            const int py = fv_clampi(y + dy, 0, j->h - 1);
             const float *drow = j->dist[dy + LIU_WIN] + LIU_WIN;
             for (int dx = -R; dx <= R; dx++) {
-                const int px = fv_dm_clampi(x + dx, 0, j->w - 1);
+                const int px = fv_clampi(x + dx, 0, j->w - 1);
                 const float *rp = rad + 4 * (py * st + px), d = drow[dx];
                 if (rp[3] + 0.5f <= d || (!dx && !dy)) /* no channel's disc reaches C */
                     continue;

@@ -30,6 +30,7 @@
 #include <string.h>
 
 #include "dof/dof.h"
+#include "base/clock.h"
 #include "dof/model_util.h"
 
 #define MA_TAPS 15

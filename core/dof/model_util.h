@@ -7,10 +7,10 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "../pipeline.h" /* fv_time_ns */
+#include "base/util.h"
+#include "base/clock.h"
 #include "dof.h"
 
-static inline int fv_dm_clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
 static inline double fv_dm_ms_since(int64_t t0_ns) { return (double)(fv_time_ns() - t0_ns) * 1e-6; }
 
 /* Level 0 pixel (x, y): r, g, b, depth_m. */

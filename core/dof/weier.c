@@ -38,6 +38,8 @@
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count. */
 #include "dof/dof.h"
+#include "base/util.h"
+#include "base/clock.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -45,7 +47,6 @@
 #include <string.h>
 
 #include "dof/weier_impl.h"
-#include "pipeline.h"
 
 #define TILE 16
 #define LOW 4          /* the near layer's reduced resolution in the periphery: 4x4 blocks */
@@ -55,9 +56,6 @@
 #define LAMBDA_STEPS 8 /* the level LUT's steps per pixel of CoC */
 #define LAMBDA_N (64 * LAMBDA_STEPS + 1) /* CoCs 0 .. 64 px */
 
-static inline float clampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
-static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
-static inline int mini(int a, int b) { return a < b ? a : b; }
 
 void fv_dof_gauss_tab_init(fv_dof_gauss_tab *t)
 {
@@ -105,8 +103,8 @@ static void xtaps_init(xtaps *t, int L, int w, int src_w)
     const float sc = 1.0f / (float)(1 << L);
     for (int x = 0; x < w; x++) {
         const float u = ((float)x + 0.5f) * sc - 0.5f, fu = floorf(u);
-        t->i0[x] = clampi((int)fu, 0, src_w - 1);
-        t->i1[x] = clampi((int)fu + 1, 0, src_w - 1);
+        t->i0[x] = fv_clampi((int)fu, 0, src_w - 1);
+        t->i1[x] = fv_clampi((int)fu + 1, 0, src_w - 1);
         t->ax[x] = u - fu;
     }
 }
@@ -119,8 +117,8 @@ static void upsample_row(const fv_dsp *dsp, const img4 *src, int L, const xtaps 
 {
     const float sc = 1.0f / (float)(1 << L);
     const float v = ((float)y + 0.5f) * sc - 0.5f, fv = floorf(v), ay = v - fv;
-    const float *ra = src->px + 4 * (ptrdiff_t)clampi((int)fv, 0, src->h - 1) * src->stride;
-    const float *rb = src->px + 4 * (ptrdiff_t)clampi((int)fv + 1, 0, src->h - 1) * src->stride;
+    const float *ra = src->px + 4 * (ptrdiff_t)fv_clampi((int)fv, 0, src->h - 1) * src->stride;
+    const float *rb = src->px + 4 * (ptrdiff_t)fv_clampi((int)fv + 1, 0, src->h - 1) * src->stride;
     for (int i = 0; i < 4 * src->w; i++)
         tmp[i] = ra[i] + ay * (rb[i] - ra[i]);
     dsp->dof_upsample_row(dst, tmp, xt->i0, xt->i1, xt->ax, w);
@@ -158,7 +156,7 @@ typedef struct {
 static inline float t_of(const wctx *x, float fx, float fy)
 {
     const float dx = fx - x->v->gaze_x, dy = fy - x->v->gaze_y;
-    return clampf((sqrtf(dx * dx + dy * dy) - x->v->r0_px) * x->inv_tr, 0.0f, 1.0f);
+    return fv_clampf((sqrtf(dx * dx + dy * dy) - x->v->r0_px) * x->inv_tr, 0.0f, 1.0f);
 }
 
 static void coc_band(void *ctx, int band, int tid)
@@ -167,7 +165,7 @@ static void coc_band(void *ctx, int band, int tid)
     wctx *x = ctx;
     const fv_pyr_level *l0 = &x->v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
-    const int y0 = band * TILE, y1 = mini(y0 + TILE, x->h);
+    const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
     for (int y = y0; y < y1; y++)
         x->dsp->dof_coc_row(x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w, x->K, x->dn, x->df);
     /* one sweep for the tile statistics and the quarter-resolution near source: per 4x4 block
@@ -178,7 +176,7 @@ static void coc_band(void *ctx, int band, int tid)
         memset(src, 0, (size_t)x->lw * 4 * sizeof(float));
         for (int i = 0; i < x->lw; i++)
             rr[i] = 0.0f; /* the largest |c| of the block's near pixels, for now */
-        for (int y = by * LOW; y < mini(by * LOW + LOW, x->h); y++) {
+        for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++) {
             const float *c = x->wk->p1[0] + y * st, *p = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
             for (int i = 0; i < x->w; i++) {
                 if (!(c[i] < 0.0f))
@@ -210,7 +208,7 @@ static void coc_band(void *ctx, int band, int tid)
         float fc = 0.0f;
         for (int y = y0; y < y1; y++) {
             const float *c = x->wk->p1[0] + y * st;
-            for (int i = tx * TILE; i < mini((tx + 1) * TILE, x->w); i++)
+            for (int i = tx * TILE; i < fv_mini((tx + 1) * TILE, x->w); i++)
                 fc = c[i] > fc ? c[i] : fc;
         }
         x->t_fsig_own[band * x->tw + tx] = fc * 0.25f;
@@ -275,14 +273,14 @@ static void hpass_band(void *ctx, int band, int tid)
     wctx *x = ctx;
     const fv_pyr_level *l0 = &x->v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
-    const int y0 = band * TILE, y1 = mini(y0 + TILE, x->h);
+    const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
     uint8_t sig[TILE * 8];
     for (int y = y0 > x->cy0 ? y0 : x->cy0; y < y1 && y < x->cy1; y++) {
         const float *rgbd = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
         const float *coc = x->wk->p1[0] + y * st;
         float *fh = x->wk->p4[1] + 4 * y * st;
         for (int xs = x->cx0; xs < x->cx1; xs += TILE * 8) {
-            const int n = mini(x->cx1 - xs, TILE * 8);
+            const int n = fv_mini(x->cx1 - xs, TILE * 8);
             for (int i = 0; i < n; i++) {
                 const float c = coc[xs + i];
                 sig[i] = sig_index(c > 0.0f ? c * 0.25f : x->t_fsig[band * x->tw + (xs + i) / TILE]);
@@ -300,7 +298,7 @@ static void hpass_band(void *ctx, int band, int tid)
                 continue;
             if (!prepped) {
                 const int lo = x->cx0 - FV_DOF_RMAX > 0 ? x->cx0 - FV_DOF_RMAX : 0;
-                const int hi = mini(x->cx1 + FV_DOF_RMAX, x->w);
+                const int hi = fv_mini(x->cx1 + FV_DOF_RMAX, x->w);
                 for (int i = lo; i < hi; i++) {
                     const float rc = floorf(-coc[i] * 0.5f);
                     const float r = coc[i] < 0.0f ? (rc < (float)FV_DOF_RMAX ? rc : (float)FV_DOF_RMAX) : -1.0f;
@@ -312,7 +310,7 @@ static void hpass_band(void *ctx, int band, int tid)
                 }
                 prepped = 1;
             }
-            for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < mini((tx + 1) * TILE, x->cx1); i++)
+            for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++)
                 near_box_row(nh + 4 * i, nr + i, nw + i, s4, 4, sr, sw, 1, i, x->w, reach);
         }
         /* near radius / weight of the horizontal result moved into p1[1] / p1[2] for the
@@ -321,7 +319,7 @@ static void hpass_band(void *ctx, int band, int tid)
             for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
                 if (!(x->t_near[band * x->tw + tx] > 0.0f))
                     continue;
-                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < mini((tx + 1) * TILE, x->cx1); i++)
+                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++)
                     sr[i] = nr[i], sw[i] = nw[i];
             }
     }
@@ -340,7 +338,7 @@ static void lvpass_band(void *ctx, int band, int tid)
 {
     (void)tid;
     wctx *x = ctx;
-    for (int by = band * (TILE / LOW); by < mini((band + 1) * (TILE / LOW), x->lh); by++)
+    for (int by = band * (TILE / LOW); by < fv_mini((band + 1) * (TILE / LOW), x->lh); by++)
         for (int i = 0; i < x->lw; i++)
             near_box_row(x->l_v + 4 * ((ptrdiff_t)by * x->lw + i), NULL, NULL, x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw,
                          x->l_hr + i, x->l_hw + i, x->lw, by, x->lh, x->l_reach);
@@ -361,12 +359,12 @@ static void blur_periphery(const wctx *x, int tid, int y, const float *coc, cons
     for (int i = 0; i < x->w; i++) {
         const float a = coc[i] < 0.0f ? -coc[i] : coc[i];
         if (a > 0.0f && trow[i] > 0.0f) {
-            const float l = x->lambda[mini((int)(a * LAMBDA_STEPS), (LAMBDA_N - 1))];
+            const float l = x->lambda[fv_mini((int)(a * LAMBDA_STEPS), (LAMBDA_N - 1))];
             const int L = (int)l + (l > (float)(int)l);
             need = L > need ? L : need;
         }
     }
-    need = mini(need, x->up_levels);
+    need = fv_mini(need, x->up_levels);
     float *up[MAX_UP_LEVEL + 1];
     up[0] = (float *)sharp;
     float *tmp = slot(x, tid, 2);
@@ -388,7 +386,7 @@ static void vcombine_band(void *ctx, int band, int tid)
     const fv_dof_view *v = x->v;
     const fv_pyr_level *l0 = &v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
-    const int y0 = band * TILE, y1 = mini(y0 + TILE, x->h);
+    const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
     /* slots: 0 far, 1 near, 2..7 the far periphery's temporary and up-sampled levels, reused
      * afterwards by the near layer's up-sampling (3, 4) and the enhancement's levels (5..7);
      * 8 t; the enhancement's CoC-like width (9), result (10), temporary (11), ones (12) */
@@ -405,8 +403,8 @@ static void vcombine_band(void *ctx, int band, int tid)
         int tx0 = x->w, tx1 = x->w;
         if (dyr * dyr < r1 * r1) {
             const float half = sqrtf(r1 * r1 - dyr * dyr);
-            tx0 = clampi((int)floorf(v->gaze_x - half) - 1, 0, x->w);
-            tx1 = clampi((int)ceilf(v->gaze_x + half) + 1, 0, x->w);
+            tx0 = fv_clampi((int)floorf(v->gaze_x - half) - 1, 0, x->w);
+            tx1 = fv_clampi((int)ceilf(v->gaze_x + half) + 1, 0, x->w);
         }
         for (int i = 0; i < tx0; i++)
             trow[i] = 1.0f;
@@ -418,7 +416,7 @@ static void vcombine_band(void *ctx, int band, int tid)
         const int centre_row = y >= x->cy0 && y < x->cy1;
         if (centre_row) {
             for (int xs = x->cx0; xs < x->cx1; xs += TILE * 8) {
-                const int n = mini(x->cx1 - xs, TILE * 8);
+                const int n = fv_mini(x->cx1 - xs, TILE * 8);
                 for (int i = 0; i < n; i++)
                     sig[i] = sig_index(coc[xs + i] > 0.0f ? coc[xs + i] * 0.25f : 0.0f);
                 x->dsp->dof_vgauss_row(far, x->wk->p4[1], st, y, x->cy0, x->cy1, xs, n, sig, x->tab);
@@ -439,7 +437,7 @@ static void vcombine_band(void *ctx, int band, int tid)
                 const int reach = (int)x->t_near[(y / TILE) * x->tw + tx];
                 if (reach <= 0)
                     continue;
-                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < mini((tx + 1) * TILE, x->cx1); i++) {
+                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++) {
                     if (!(trow[i] < 1.0f))
                         continue;
                     /* rows of the column outside the rectangle or in tiles no near sample
@@ -484,8 +482,8 @@ static void vcombine_band(void *ctx, int band, int tid)
                 ecoc[i] = 2.0f * v->enh_fp[e < v->enh_n - 1 ? e : v->enh_n - 1];
                 emax = ecoc[i] > emax ? ecoc[i] : emax;
             }
-            const float lm = x->lambda[mini((int)(emax * LAMBDA_STEPS), (LAMBDA_N - 1))];
-            const int need = mini(mini((int)lm + (lm > (float)(int)lm), ENH_LEVELS), x->up_levels);
+            const float lm = x->lambda[fv_mini((int)(emax * LAMBDA_STEPS), (LAMBDA_N - 1))];
+            const int need = fv_mini(fv_mini((int)lm + (lm > (float)(int)lm), ENH_LEVELS), x->up_levels);
             up[0] = (float *)sharp;
             for (int L = 1; L <= need; L++) {
                 const fv_pyr_level *lv = &v->pyr->lv[L];
@@ -605,9 +603,9 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->band_ms = a, a += 2 * x->th;
     /* the centre rectangle: the transition disc plus the kernels' reach */
     const float reach = v->r1_px + 2.0f * FV_DOF_RMAX;
-    x->cx0 = clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = clampi((int)ceilf(v->gaze_x + reach), 0, x->w);
-    x->cy0 = clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
-    x->up_levels = mini(MAX_UP_LEVEL, v->pyr->levels - 1);
+    x->cx0 = fv_clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = fv_clampi((int)ceilf(v->gaze_x + reach), 0, x->w);
+    x->cy0 = fv_clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = fv_clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
+    x->up_levels = fv_mini(MAX_UP_LEVEL, v->pyr->levels - 1);
     x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
     const int64_t t0 = fv_time_ns();
     fv_pool_run(pool, x->th, coc_band, x);

@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "dsp.h"
+#include "base/util.h"
 #include "eyetrack/eyetrack.h"
 
 #define SEARCH_MAX_SIDE 160 /* search image F: min side at most this */
@@ -255,16 +256,13 @@ static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x
     return ii[y1 * iw + x1] - ii[y0 * iw + x1] - ii[y1 * iw + x0] + ii[y0 * iw + x0];
 }
 
-static inline int imin(int a, int b) { return a < b ? a : b; }
-static inline int imax(int a, int b) { return a > b ? a : b; }
-static inline float fclampf(float v, float lo, float hi) { return v < lo ? lo : v > hi ? hi : v; }
 
 /* Bilinear sample, pixel centres at +0.5 (clamped to the image). */
 static inline float sample(const uint8_t *img, int w, int h, float x, float y)
 {
     x -= 0.5f, y -= 0.5f;
-    x = fclampf(x, 0.0f, (float)w - 1.001f);
-    y = fclampf(y, 0.0f, (float)h - 1.001f);
+    x = fv_clampf(x, 0.0f, (float)w - 1.001f);
+    y = fv_clampf(y, 0.0f, (float)h - 1.001f);
     const int ix = (int)x, iy = (int)y;
     const float fx = x - ix, fy = y - iy;
     const uint8_t *r = img + iy * w + ix;
@@ -290,7 +288,7 @@ static float steepest_rise(const uint8_t *img, int w, int h, float cx, float cy,
     const float den = gm - 2.0f * best + gp;
     /* vertex of the parabola through (-1, gm), (0, best), (1, gp), in units of 1 px; the
      * samples of the search were 0.5 px apart, so at most a quarter pixel either way */
-    return bq + (den < 0 ? fclampf(0.5f * (gm - gp) / den, -0.25f, 0.25f) : 0.0f);
+    return bq + (den < 0 ? fv_clampf(0.5f * (gm - gp) / den, -0.25f, 0.25f) : 0.0f);
 #undef AT
 }
 
@@ -367,11 +365,11 @@ static void box_clipped(const box_ctx *b, box_hit *best, int k, int ko, int y, i
      * dark and half a ring is no surround */
     if (y - k < 0 || y + k + 1 > b->sh)
         return;
-    xa = imax(xa, k), xb = imin(xb, b->sw - k);
+    xa = fv_maxi(xa, k), xb = fv_mini(xb, b->sw - k);
     const int na = (2 * k + 1) * (2 * k + 1), no_full = (2 * ko + 1) * (2 * ko + 1);
-    const int oy0 = imax(0, y - ko), oy1 = imin(b->sh, y + ko + 1);
+    const int oy0 = fv_maxi(0, y - ko), oy1 = fv_mini(b->sh, y + ko + 1);
     for (int x = xa; x < xb; x++) {
-        const int ox0 = imax(0, x - ko), ox1 = imin(b->sw, x + ko + 1);
+        const int ox0 = fv_maxi(0, x - ko), ox1 = fv_mini(b->sw, x + ko + 1);
         const int no = (ox1 - ox0) * (oy1 - oy0);
         if (10 * (no - na) < 6 * (no_full - na))
             continue;
@@ -387,7 +385,7 @@ static void box_search(const fv_dsp *d, const uint32_t *ii, int sw, int sh, int 
 {
     const float rf = 1.5f;
     const box_ctx b = { ii, sw + 1, sw, sh, dark, mu / (float)(sw < sh ? sw : sh), 0.5f * (sw - 1), 0.5f * (sh - 1) };
-    const int iw = sw + 1, xs = imax(0, x0), xe = imin(sw, x1);
+    const int iw = sw + 1, xs = fv_maxi(0, x0), xe = fv_mini(sw, x1);
     enum { CHUNK = 256 };
     float sc[CHUNK];
     for (int k = kmin; k <= kmax; k += (step1 || k < 4 ? 1 : k / 4)) {
@@ -396,15 +394,15 @@ static void box_search(const fv_dsp *d, const uint32_t *ii, int sw, int sh, int 
         const float inv_a = 1.0f / (float)na_full, inv_r = 1.0f / (float)(no_full - na_full);
         /* centres [xa, xb) of rows [ko, sh - ko) have their ring inside the image: no
          * divisions, one row kernel call per chunk */
-        const int xa = imax(xs, ko), xb = imin(xe, sw - ko);
-        for (int y = imax(0, y0); y < imin(sh, y1); y++) {
+        const int xa = fv_maxi(xs, ko), xb = fv_mini(xe, sw - ko);
+        for (int y = fv_maxi(0, y0); y < fv_mini(sh, y1); y++) {
             if (y < ko || y >= sh - ko || xa >= xb) {
                 box_clipped(&b, best, k, ko, y, xs, xe);
                 continue;
             }
             box_clipped(&b, best, k, ko, y, xs, xa);
             for (int c0 = xa; c0 < xb; c0 += CHUNK) {
-                const int cn = imin(CHUNK, xb - c0);
+                const int cn = fv_mini(CHUNK, xb - c0);
                 const uint32_t *it = ii + (y - k) * iw + c0 - k, *ib = ii + (y + k + 1) * iw + c0 - k;
                 const uint32_t *ot = ii + (y - ko) * iw + c0 - ko, *ob = ii + (y + ko + 1) * iw + c0 - ko;
                 if (!(d->et_box_score_row(sc, it, ib, 2 * k + 1, ot, ob, 2 * ko + 1, cn, inv_a, inv_r, dark) >
@@ -435,7 +433,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     int sw = w, sh = h, scale = 1;
     const uint8_t *src = luma;
     ptrdiff_t sst = stride;
-    while (imin(sw, sh) > SEARCH_MAX_SIDE) { /* halve straight from the input, then in place-free ping-pong */
+    while (fv_mini(sw, sh) > SEARCH_MAX_SIDE) { /* halve straight from the input, then in place-free ping-pong */
         const int nw = sw / 2, nh = sh / 2;
         uint8_t *dst = src == work ? mask : work;
         for (int y = 0; y < nh; y++)
@@ -450,14 +448,14 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
     histogram(work, sw, sh, sw, hist);
     const int med = percentile(hist, (uint32_t)(sw * sh), 0.5);
     const int hi = percentile(hist, (uint32_t)(sw * sh), 0.995);
-    const int thr = imax(med + 40, med + (255 - med) / 2);
+    const int thr = fv_maxi(med + 40, med + (255 - med) / 2);
     if (hi >= thr)
         inpaint_bright(d, work, sw, sh, thr, 1, mask, idx, (int *)ii, (uint8_t)med); /* ii: free until the integral below */
     const float dark = (float)percentile(hist, (uint32_t)(sw * sh), 0.01);
     /* level C */
     int cw = sw, ch = sh, f = 1;
     const uint8_t *cs = work;
-    while (imin(cw, ch) > SEARCH_C_SIDE) {
+    while (fv_mini(cw, ch) > SEARCH_C_SIDE) {
         const int nw = cw / 2, nh = ch / 2;
         uint8_t *dst = cs == small ? mask : small;
         for (int y = 0; y < nh; y++)
@@ -465,9 +463,9 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
         cs = dst;
         cw = nw, ch = nh, f *= 2;
     }
-    const float side = (float)imin(cw, ch);
-    const int kmin = imax(1, (int)lrintf(t->p.min_radius_frac * side));
-    const int kmax = imax(kmin, (int)lrintf(t->p.max_radius_frac * side));
+    const float side = (float)fv_mini(cw, ch);
+    const int kmin = fv_maxi(1, (int)lrintf(t->p.min_radius_frac * side));
+    const int kmax = fv_maxi(kmin, (int)lrintf(t->p.max_radius_frac * side));
     box_hit b = { -1e30f, 0, 0, 0, 0, 0 };
     integral(d, cs, cw, ch, ii);
     /* centres no nearer the border than margin_frac of the side: vignetted corners and image
@@ -480,7 +478,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
         const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
         box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
         integral(d, work, sw, sh, ii);
-        box_search(d, ii, sw, sh, imax(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
+        box_search(d, ii, sw, sh, fv_maxi(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
         if (bf.score > -1e30f)
             b = bf;
         else
@@ -546,7 +544,7 @@ static int drop_lid_line(float *ex, float *ey, float *egx, float *egy, int ne, f
     int best = 0;
     float bnx = 0, bny = 0, bd = 0;
     for (int i = 0; i < ne; i++)
-        for (int dj = 2; dj <= imin(8, ne - 1); dj++) {
+        for (int dj = 2; dj <= fv_mini(8, ne - 1); dj++) {
             const int j = (i + dj) % ne;
             const float dx = ex[j] - ex[i], dy = ey[j] - ey[i], len = hypotf(dx, dy);
             if (len < 0.3f * r || fabsf(dy) > 0.643f * len) /* sin 40 deg */
@@ -583,9 +581,9 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
     /* window around the candidate, reflections inpainted */
     /* headset-sized frames: the search's box can be much smaller than the pupil (the darkest
      * part of it), and rays must reach the pupil's far edge inside the window */
-    const int half = imax((int)ceilf(3.0f * c->r), inpainted ? 0 : imin(w, h) / 4) + 2;
-    const int x0 = imax(0, (int)c->x - half), y0 = imax(0, (int)c->y - half);
-    const int x1 = imin(w, (int)c->x + half), y1 = imin(h, (int)c->y + half);
+    const int half = fv_maxi((int)ceilf(3.0f * c->r), inpainted ? 0 : fv_mini(w, h) / 4) + 2;
+    const int x0 = fv_maxi(0, (int)c->x - half), y0 = fv_maxi(0, (int)c->y - half);
+    const int x1 = fv_mini(w, (int)c->x + half), y1 = fv_mini(h, (int)c->y + half);
     const int ww = x1 - x0, wh = y1 - y0;
     if (ww < 4 || wh < 4)
         return -1;
@@ -596,7 +594,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         uint32_t hist[256];
         histogram(win, ww, wh, ww, hist);
         med = percentile(hist, (uint32_t)(ww * wh), 0.5);
-        const int thr = imax(med + 40, med + (255 - med) / 2);
+        const int thr = fv_maxi(med + 40, med + (255 - med) / 2);
         if (percentile(hist, (uint32_t)(ww * wh), 0.995) >= thr) {
             inpaint_bright(&t->dsp, win, ww, wh, thr, c->scale > 1 ? 3 : 1, mask, idx, fr, (uint8_t)med);
             masked = 1;
@@ -612,12 +610,12 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         /* blob and surround levels around the current estimate */
         const float ri = 0.7f * r, ro0 = 1.2f * r, ro1 = 1.7f * r, rr = 1.5f * r;
         const float ri2 = ri * ri, ro02 = ro0 * ro0, ro12 = ro1 * ro1, rr2 = rr * rr;
-        const int bx0 = imax(0, (int)(cx - ro1)), bx1 = imin(ww, (int)(cx + ro1) + 1);
-        const int by0 = imax(0, (int)(cy - ro1)), by1 = imin(wh, (int)(cy + ro1) + 1);
-        const int ax0 = imax(0, (int)(cx - rr)), ax1 = imin(ww, (int)(cx + rr) + 1);
-        const int ay0 = imax(0, (int)(cy - rr)), ay1 = imin(wh, (int)(cy + rr) + 1);
+        const int bx0 = fv_maxi(0, (int)(cx - ro1)), bx1 = fv_mini(ww, (int)(cx + ro1) + 1);
+        const int by0 = fv_maxi(0, (int)(cy - ro1)), by1 = fv_mini(wh, (int)(cy + ro1) + 1);
+        const int ax0 = fv_maxi(0, (int)(cx - rr)), ax1 = fv_mini(ww, (int)(cx + rr) + 1);
+        const int ay0 = fv_maxi(0, (int)(cy - rr)), ay1 = fv_mini(wh, (int)(cy + rr) + 1);
         /* dx * dx of every column either loop visits (the same float operations as per pixel) */
-        const int qx0 = imin(ax0, bx0), qx1 = imax(ax1, bx1);
+        const int qx0 = fv_mini(ax0, bx0), qx1 = fv_maxi(ax1, bx1);
         for (int x = qx0; x < qx1; x++) {
             const float dx = x + 0.5f - cx;
             dxx[x - qx0] = dx * dx;
@@ -670,7 +668,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
         if (sw <= 0)
             return -1;
         const float nx = (float)(sx / sw), ny = (float)(sy / sw);
-        const float nr = fclampf(sqrtf(area / (float)M_PI), 0.6f * r, 1.4f * r);
+        const float nr = fv_clampf(sqrtf(area / (float)M_PI), 0.6f * r, 1.4f * r);
         const int settled = fabsf(nx - cx) < 0.02f * r && fabsf(ny - cy) < 0.02f * r && fabsf(nr - r) < 0.02f * r;
         cx = nx, cy = ny, r = nr;
         if (settled)
@@ -692,7 +690,7 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
          * true edge and push crossings out into a dark iris (idx is free once inpainted) */
         uint8_t *bl = (uint8_t *)idx;
         for (int y = 0; y < wh; y++)
-            t->dsp.et_box3_row(bl + y * ww, win + imax(0, y - 1) * ww, win + y * ww, win + imin(wh - 1, y + 1) * ww, ww);
+            t->dsp.et_box3_row(bl + y * ww, win + fv_maxi(0, y - 1) * ww, win + y * ww, win + fv_mini(wh - 1, y + 1) * ww, ww);
         ew = bl;
     }
     float ex[NRAYS], ey[NRAYS];
@@ -734,8 +732,8 @@ static int refine(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_
                 const int ix = (int)(cx + de * dx), iy = (int)(cy + de * dy);
                 int near_mask = 0;
                 if (masked)
-                    for (int qy = imax(0, iy - 1); qy <= imin(wh - 1, iy + 1); qy++)
-                        for (int qx = imax(0, ix - 1); qx <= imin(ww - 1, ix + 1); qx++)
+                    for (int qy = fv_maxi(0, iy - 1); qy <= fv_mini(wh - 1, iy + 1); qy++)
+                        for (int qx = fv_maxi(0, ix - 1); qx <= fv_mini(ww - 1, ix + 1); qx++)
                             near_mask |= mask[qy * ww + qx] != 0;
                 if (!near_mask && vo <= ring + 0.6f * (ring - inner)) {
                     ex[ne] = cx + de * dx + x0;
@@ -878,17 +876,17 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
                        uint8_t *lab, int *stack, fv_eye_glint *g)
 {
     const float rad = fmaxf(2.2f * pp->r, 6.0f);
-    const int x0 = imax(0, (int)(pp->x - rad)), x1 = imin(w, (int)(pp->x + rad) + 1);
-    const int y0 = imax(0, (int)(pp->y - rad)), y1 = imin(h, (int)(pp->y + rad) + 1);
+    const int x0 = fv_maxi(0, (int)(pp->x - rad)), x1 = fv_mini(w, (int)(pp->x + rad) + 1);
+    const int y0 = fv_maxi(0, (int)(pp->y - rad)), y1 = fv_mini(h, (int)(pp->y + rad) + 1);
     const int ww = x1 - x0, wh = y1 - y0;
     if (ww < 1 || wh < 1)
         return 0;
-    const int thr = imax((int)pp->ring + 40, (int)(pp->ring + 0.5f * (255.0f - pp->ring)));
+    const int thr = fv_maxi((int)pp->ring + 40, (int)(pp->ring + 0.5f * (255.0f - pp->ring)));
     const float max_area = fmaxf(4.0f, 0.8f * pp->r * pp->r);
     /* lab: 255 bright and not yet in a blob, 1 in one, 0 dark (thr above 255: none bright) */
     int n = 0;
     for (int y = 0; y < wh; y++)
-        t->dsp.et_thresh_row(lab + y * ww, luma + (y + y0) * stride + x0, ww, imin(thr, 256));
+        t->dsp.et_thresh_row(lab + y * ww, luma + (y + y0) * stride + x0, ww, fv_mini(thr, 256));
     for (int y = 0; y < wh; y++)
         for (int x = 0; x < ww; x++) {
             if (x + 8 <= ww) { /* mostly dark: skip eight at a time */
@@ -910,7 +908,7 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
                 const int q = stack[--sp], px = PK_X(q), py = PK_Y(q), i = py * ww + px;
                 const int v = luma[(py + y0) * stride + px + x0];
                 const double wt = v - thr + 1;
-                peak = imax(peak, v);
+                peak = fv_maxi(peak, v);
                 sw += wt, sx += wt * (px + 0.5), sy += wt * (py + 0.5);
                 area++;
                 if (px == 0 || py == 0 || px == ww - 1 || py == wh - 1)
@@ -932,8 +930,8 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
             const float rb = sqrtf(area / (float)M_PI) + 2.5f;
             float bg = 0;
             for (int k = 0; k < 8; k++) {
-                const int bx = imin(w - 1, imax(0, (int)floorf(gl.x + rb * cosf(k * (float)M_PI / 4)))),
-                          by = imin(h - 1, imax(0, (int)floorf(gl.y + rb * sinf(k * (float)M_PI / 4))));
+                const int bx = fv_mini(w - 1, fv_maxi(0, (int)floorf(gl.x + rb * cosf(k * (float)M_PI / 4)))),
+                          by = fv_mini(h - 1, fv_maxi(0, (int)floorf(gl.y + rb * sinf(k * (float)M_PI / 4))));
                 bg += luma[by * stride + bx];
             }
             if (peak - bg / 8 < 50)
@@ -952,7 +950,7 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
             }
             g[j] = gl;
         }
-    return imin(n, t->p.max_glints);
+    return fv_mini(n, t->p.max_glints);
 }
 
 /* ---------------------------------------------------------------- frame */
@@ -964,8 +962,8 @@ static int find_glints(const fv_eye_tracker *t, const uint8_t *luma, int w, int 
 static int bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float cx, float cy, float r, float *ox,
                        float *oy)
 {
-    const int x0 = imax(3, (int)floorf(cx - r)), x1 = imin(w - 4, (int)floorf(cx + r));
-    const int y0 = imax(3, (int)floorf(cy - r)), y1 = imin(h - 4, (int)floorf(cy + r));
+    const int x0 = fv_maxi(3, (int)floorf(cx - r)), x1 = fv_mini(w - 4, (int)floorf(cx + r));
+    const int y0 = fv_maxi(3, (int)floorf(cy - r)), y1 = fv_mini(h - 4, (int)floorf(cy + r));
     int best = SPOT_MIN - 1, bx = -1, by = -1;
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
@@ -1031,7 +1029,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     const uint8_t *rsrc = reuse ? work : luma;
     int rw = w, rh = h, rs = 1;
     ptrdiff_t rst = reuse ? w : stride;
-    while (!reuse && imin(rw, rh) > REFINE_MAX_SIDE && rs < c.scale) {
+    while (!reuse && fv_mini(rw, rh) > REFINE_MAX_SIDE && rs < c.scale) {
         uint8_t *dst = rsrc == lowres ? lowres + px / 2 : lowres;
         const int nw = rw / 2, nh = rh / 2;
         for (int y = 0; y < nh; y++)
@@ -1060,7 +1058,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
          * and toward a corneal reflection inside the box (it hides part of the pupil, and its
          * inpainted area looks less dark than the pupil, which pushes the box away from it),
          * then on a pixel centre again like the box it came from. */
-        const float a = fclampf(t->p.crop_centre_weight, 0.0f, 1.0f), gw = fclampf(t->p.glint_weight, 0.0f, 1.0f);
+        const float a = fv_clampf(t->p.crop_centre_weight, 0.0f, 1.0f), gw = fv_clampf(t->p.glint_weight, 0.0f, 1.0f);
         float px = c.x + a * (0.5f * (float)w - c.x), py = c.y + a * (0.5f * (float)h - c.y);
         float gx, gy;
         if (gw > 0 && bright_spot(luma, w, h, stride, c.x, c.y, c.r, &gx, &gy))
@@ -1098,8 +1096,8 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     }
 
     /* confidence: contrast (grey levels) and how much of the outline the fit explains */
-    const float cc = fclampf((r->contrast - 4.0f) / 24.0f, 0.0f, 1.0f);
-    const float fit = p.fit ? fclampf(p.inliers / 0.6f, 0.0f, 1.0f) : 0.5f;
+    const float cc = fv_clampf((r->contrast - 4.0f) / 24.0f, 0.0f, 1.0f);
+    const float fit = p.fit ? fv_clampf(p.inliers / 0.6f, 0.0f, 1.0f) : 0.5f;
     r->confidence = cc * (0.4f + 0.6f * fit);
 
     if (r->contrast < 3.0f) {

@@ -18,12 +18,11 @@
 #include <stdint.h>
 
 #include "dof/weier_impl.h"
+#include "base/util.h"
 #include "dsp.h"
 
 #define DOF_CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
 
-static inline int dof_clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
-static inline int dof_maxi(int a, int b) { return a > b ? a : b; }
 
 /* ---- coc_row: 4 pixels ---- */
 typedef struct {
@@ -68,7 +67,7 @@ static inline void dof_mask_row(float *restrict m, const float *rgbd, const floa
 {
     const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
     for (int k = 0; k < len; k++) {
-        const int q = dof_clampi(base + k, 0, w - 1);
+        const int q = fv_clampi(base + k, 0, w - 1);
         const __m128 p = _mm_blend_ps(_mm_loadu_ps(rgbd + 4 * q), one, 8);
         _mm_store_ps(m + 4 * k, _mm_and_ps(p, _mm_cmpgt_ps(_mm_set1_ps(coc[q]), zero)));
     }
@@ -121,7 +120,7 @@ static inline void dof_gauss_4(float *d, const float *p, const ptrdiff_t *off, i
     for (; i + 4 <= n; i += 4) {
         const uint8_t *s = sig + i;
         const float *const wt[4] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]]};
-        const int R = dof_maxi(dof_maxi(tab->rad[s[0]], tab->rad[s[1]]), dof_maxi(tab->rad[s[2]], tab->rad[s[3]]));
+        const int R = fv_maxi(fv_maxi(tab->rad[s[0]], tab->rad[s[1]]), fv_maxi(tab->rad[s[2]], tab->rad[s[3]]));
         __m128 a[4];
         dof_g4(a, p + 4 * i, off, wt, R);
         for (int k = 0; k < 4; k++)
@@ -143,14 +142,14 @@ static inline void dof_offsets_h(ptrdiff_t *off, int R)
 static inline void dof_offsets_v(ptrdiff_t *off, int R, ptrdiff_t stride, int y, int ylo, int yhi)
 {
     for (int j = -R; j <= R; j++)
-        off[j] = 4 * (ptrdiff_t)dof_clampi(y + j, ylo, yhi - 1) * stride;
+        off[j] = 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride;
 }
 
 static inline int dof_span_rad(const uint8_t *sig, int n, const fv_dof_gauss_tab *tab)
 {
     int R = 0;
     for (int i = 0; i < n; i++)
-        R = dof_maxi(R, tab->rad[sig[i]]);
+        R = fv_maxi(R, tab->rad[sig[i]]);
     return R;
 }
 

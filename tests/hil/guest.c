@@ -32,6 +32,7 @@
 #include <linux/v4l2-dv-timings.h>
 #include <linux/videodev2.h>
 
+#include "base/clock.h"
 #include "eyesrc.h"
 #include "eyetrack/eyetrack.h"
 #include "display.h"
@@ -40,12 +41,6 @@
 #include "pattern.h"
 #include "v4l2.h"
 
-static int64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 static void result(const char *name, int pass, const char *fmt, ...)
 {
@@ -291,8 +286,8 @@ static int check_buf_error(fv_v4l2 *cam, const char *cap_dev)
         return 0;
     }
     int frames = 0, presses = 1;
-    int64_t t0 = now_ns();
-    while (now_ns() - t0 < 5000000000LL && (frames < 3 || cam->skipped == skipped0)) {
+    int64_t t0 = fv_time_ns();
+    while (fv_time_ns() - t0 < 5000000000LL && (frames < 3 || cam->skipped == skipped0)) {
         fv_v4l2_frame f;
         fv_v4l2_status st = fv_v4l2_next(cam, 200, &f, err, sizeof err);
         if (st == FV_V4L2_FRAME)
@@ -325,17 +320,17 @@ static int check_reopen(fv_v4l2 *cam, vout *o, const char *cap_dev)
         return 0;
     }
     vout_close(o); /* vivid comes back once its last user has gone: the output's handle too */
-    int64_t t0 = now_ns(), t_gone = 0, t_back = 0;
+    int64_t t0 = fv_time_ns(), t_gone = 0, t_back = 0;
     long gone = 0;
-    while (now_ns() - t0 < 10000000000LL && !t_back) {
+    while (fv_time_ns() - t0 < 10000000000LL && !t_back) {
         fv_v4l2_frame f;
         fv_v4l2_status st = fv_v4l2_next(cam, 200, &f, err, sizeof err);
         if (st == FV_V4L2_GONE) {
             gone++;
             if (!t_gone)
-                t_gone = now_ns();
+                t_gone = fv_time_ns();
         } else if (st == FV_V4L2_FRAME && t_gone) {
-            t_back = now_ns();
+            t_back = fv_time_ns();
         } else if (st == FV_V4L2_ERROR) {
             break;
         }
@@ -386,7 +381,7 @@ static int cmd_v4l2(int argc, char **argv)
 
     /* the first frame in every output buffer, output streaming before the capture starts */
     fv_eye_frame ef;
-    int64_t t0 = now_ns();
+    int64_t t0 = fv_time_ns();
     if (fv_eyesrc_next(src, &ef, err, sizeof err) != 1 || ef.w * 2 != LW || ef.h * 2 != LH) {
         result("v4l2-loop", 0, "reason=\"video: %s (want 320x240)\"", err);
         return 1;
@@ -489,7 +484,7 @@ static int cmd_v4l2(int argc, char **argv)
         if (!got)
             mismatched_frames++;
     }
-    double secs = (double)(now_ns() - t0) / 1e9;
+    double secs = (double)(fv_time_ns() - t0) / 1e9;
     fv_eye_destroy(trk);
     int buferr_ok = check_buf_error(&cam, cap_dev);
     int reopen_ok = check_reopen(&cam, &o, cap_dev) && buferr_ok;
@@ -568,7 +563,7 @@ static void *toggle_main(void *arg)
     for (long k = 0; k < tg->n && !tg->stop; k++) {
         int64_t t = tg->start + k * VS_PERIOD_NS;
         fv_clock_sleep_until_ns(t);
-        int64_t w = now_ns();
+        int64_t w = fv_time_ns();
         if (w - t > VS_PERIOD_NS / 4) {
             /* woken too late (the emulated CPU was not scheduled): leave this edge out rather
              * than put two edges a few microseconds apart on the line, which no display does */
@@ -616,7 +611,7 @@ static int cmd_gpio(int argc, char **argv)
     fv_vsync_pred_params pp;
     fv_vsync_pred_default_params(&pp, VS_PERIOD_NS);
     fv_vsync_pred pred;
-    fv_vsync_pred_init(&pred, &pp, now_ns());
+    fv_vsync_pred_init(&pred, &pp, fv_time_ns());
 
     size_t cap = (size_t)(seconds * VS_HZ) + 16;
     double *lock = malloc(cap * sizeof *lock), *lock_abs = malloc(cap * sizeof *lock_abs);
@@ -624,7 +619,7 @@ static int cmd_gpio(int argc, char **argv)
     toggler tg = {.pull = pull, .n = (long)(seconds * VS_HZ), .late_us = malloc(cap * sizeof(double))};
     if (!lock || !lock_abs || !after_drop || !path_us || !tg.late_us)
         return 1;
-    tg.start = now_ns() + 50000000;
+    tg.start = fv_time_ns() + 50000000;
     pthread_t th;
     if (pthread_create(&th, NULL, toggle_main, &tg)) {
         result("gpio-lock", 0, "reason=pthread_create");
@@ -634,7 +629,7 @@ static int cmd_gpio(int argc, char **argv)
     int n_lock = 0, n_after = 0, n_path = 0, unlocked_after_warmup = 0;
     long edges = 0;
     int64_t end = tg.start + tg.n * VS_PERIOD_NS + 500000000;
-    while (now_ns() < end) {
+    while (fv_time_ns() < end) {
         int64_t t;
         int r = fv_vsync_gpio_wait(g, 100000000, &t, err, sizeof err);
         if (r < 0) {
@@ -722,11 +717,11 @@ static int wait_host(const char *tty, int timeout_ms)
         t.c_cc[VTIME] = 0;
         tcsetattr(fd, TCSANOW, &t);
     }
-    int64_t end = now_ns() + (int64_t)timeout_ms * 1000000;
+    int64_t end = fv_time_ns() + (int64_t)timeout_ms * 1000000;
     char c;
     int r = -1;
     for (;;) {
-        int left = (int)((end - now_ns()) / 1000000);
+        int left = (int)((end - fv_time_ns()) / 1000000);
         if (left <= 0)
             break;
         struct pollfd p = {.fd = fd, .events = POLLIN};
@@ -743,7 +738,7 @@ static int wait_host(const char *tty, int timeout_ms)
 
 static int kms_show(fv_kms *k, const uint8_t *rgb, int w, int h, double *ms, char *err, size_t n)
 {
-    int64_t t0 = now_ns(), tv;
+    int64_t t0 = fv_time_ns(), tv;
     if (fv_kms_present(k, rgb, w, h, (ptrdiff_t)w * 3, err, n))
         return -1;
     int r = fv_kms_wait_flip(k, 1000000000, &tv, err, n);
@@ -752,7 +747,7 @@ static int kms_show(fv_kms *k, const uint8_t *rgb, int w, int h, double *ms, cha
             snprintf(err, n, "page flip: no event within 1 s");
         return -1;
     }
-    *ms = (double)(now_ns() - t0) / 1e6;
+    *ms = (double)(fv_time_ns() - t0) / 1e6;
     return 0;
 }
 
