@@ -509,7 +509,7 @@ static void print_counters(const run_result *r)
     }
     printf("counters (%s, per frame, all threads):\n", r->mode);
     for (int s = 0; s < FV_PROF_STAGES; s++) {
-        printf("  %-12s", fv_prof_stage_names[s]);
+        printf("  %-12s", fv_prof_stage_name(s));
         for (int k = 0; k < FV_PERF_N; k++)
             printf(" %s %.4g", fv_perf_names[k], r->ctr[s][k]);
         printf("\n");
@@ -557,7 +557,7 @@ static void json_run(FILE *f, const run_result *r, int w, int h, double gbps)
     } else {
         fprintf(f, ", \"per_frame\": {");
         for (int s = 0; s < FV_PROF_STAGES; s++) {
-            fprintf(f, "%s\"%s\": {", s ? ", " : "", fv_prof_stage_names[s]);
+            fprintf(f, "%s\"%s\": {", s ? ", " : "", fv_prof_stage_name(s));
             for (int k = 0; k < FV_PERF_N; k++)
                 fprintf(f, "%s\"%s\": %.0f", k ? ", " : "", fv_perf_names[k], r->ctr[s][k]);
             fputc('}', f);

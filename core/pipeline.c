@@ -198,8 +198,8 @@ static float pyr_depth(void *ctx, float x, float y)
 }
 
 /* Focus depth, CoC, filter, combine of one eye into es->out. */
-static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, float gaze_x, float gaze_y,
-                       fv_frame_stats *st)
+static void render_dof(fv_pipeline *p, eye_state *es, fv_eye eye, const fv_pyramid *pyr, float gaze_x,
+                       float gaze_y, fv_frame_stats *st)
 {
     const fv_pyr_level *l0 = &pyr->lv[0];
     const fv_dof_params *dp = &p->cfg.dof;
@@ -212,10 +212,11 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
     }
     const float gx = gaze_x * (float)l0->w, gy = gaze_y * (float)l0->h;
     const float ppd = es->cam.focal_px * 0.017453292f;
-    int64_t t0 = fv_time_ns();
+    /* the focus estimate is part of the CoC stage (Weier's Table 1 has no row of its own) */
+    const int64_t t0 = fv_prof_stage_begin(p->prof, FV_STAGE_COC);
     const float focus_m = fv_focus_update(&es->focus, pyr_depth, (void *)l0, gx, gy, ppd, dt_ms);
     st->focus_m = focus_m;
-    const double focus_ms = (double)(fv_time_ns() - t0) * 1e-6;
+    const double focus_ms = (double)(fv_prof_stage_end(p->prof, FV_STAGE_COC, t0, (int)eye) - t0) * 1e-6;
     if (!(focus_m > 0.0f)) { /* no depth under the gaze yet: nothing to focus on, show it sharp */
         for (int y = 0; y < l0->h; y++)
             memcpy(es->out + 4 * (ptrdiff_t)y * l0->stride, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride,
@@ -243,23 +244,15 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
         .enh_fp = p->enh_fp,
         .enh_n = p->enh_n,
         .enh_step = 4.0f,
+        .prof = p->prof,
+        .prof_arg = (int)eye,
     };
     v.e_px_per_mm = fv_retina_px_per_mm(v.focal_px, FV_EYE_IMAGE_DIST_MM) * v.blur_scale;
     fv_dof_times t = {NAN, NAN, NAN};
     p->dof_fn(&v, &p->dof_work, es->out, l0->stride, p->pool, &p->dsp, &t);
-    /* the focus estimate is part of the CoC stage (Weier's Table 1 has no row of its own) */
     st->stage_ms[FV_STAGE_COC] = (isnan(t.coc_ms) ? 0.0 : t.coc_ms) + focus_ms;
     st->stage_ms[FV_STAGE_DOF_FILTER] = t.filter_ms;
     st->stage_ms[FV_STAGE_COMBINE] = t.combine_ms;
-}
-
-/* A stage's span on its own track (recorded by the rendering thread, slot 0). */
-static void prof_stage(fv_prof *prof, int stage, int64_t t0, fv_eye eye)
-{
-    if (prof) {
-        const int64_t t1 = fv_prof_stage_mark(prof, stage, 1);
-        fv_prof_span(prof, 0, FV_PROF_TRACK_STAGE + stage, fv_prof_stage_names[stage], t0, t1, (int)eye);
-    }
 }
 
 void fv_pipeline_set_prof(fv_pipeline *p, fv_prof *prof)
@@ -297,8 +290,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     fv_taa_frame tf;
     fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa,
                            .prof = p->prof};
-    const int64_t pf0 = fv_prof_stage_mark(p->prof, FV_PROF_FRAME, 0), pc0 = fv_prof_stage_mark(p->prof, FV_PROF_CAST, 0);
-    int64_t t0 = fv_time_ns();
+    const int64_t t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME), tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
     if (p->taa && es->hist_valid) {
         fv_taa_frame_setup(&tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
         opt.taa = &tf;
@@ -307,27 +299,21 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
     double taa_ms = NAN;
     st->samples = fv_raycast(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
-    int64_t t1 = fv_time_ns();
-    prof_stage(p->prof, FV_PROF_CAST, pc0, eye);
-    const int64_t pr0 = fv_prof_stage_mark(p->prof, FV_PROF_RECONSTRUCT, 0);
+    const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
+    const int64_t tr0 = fv_prof_stage_begin(p->prof, FV_STAGE_RECONSTRUCT);
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
     fv_pullpush_from(pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(pyr));
-    int64_t t2 = fv_time_ns();
-    prof_stage(p->prof, FV_PROF_RECONSTRUCT, pr0, eye);
+    const int64_t t2 = fv_prof_stage_end(p->prof, FV_STAGE_RECONSTRUCT, tr0, (int)eye);
     st->focus_m = NAN;
-    if (p->dof) {
-        const int64_t pd0 = fv_prof_stage_mark(p->prof, FV_PROF_DOF, 0);
-        render_dof(p, es, pyr, gaze_x, gaze_y, st);
-        prof_stage(p->prof, FV_PROF_DOF, pd0, eye);
-    }
-    int64_t t3 = fv_time_ns();
-    prof_stage(p->prof, FV_PROF_FRAME, pf0, eye);
+    if (p->dof)
+        render_dof(p, es, eye, pyr, gaze_x, gaze_y, st);
+    const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, (int)eye);
     es->cur = dst;
     es->prev_cam = es->cam;
     es->hist_valid = 1;
     es->frame++;
     /* reprojection runs inside the ray-casting tiles: its share is the workers' time in it */
-    const double cast_ms = (double)(t1 - t0) * 1e-6;
+    const double cast_ms = (double)(t1 - tc0) * 1e-6;
     if (p->taa) {
         if (isnan(taa_ms))
             taa_ms = 0.0; /* first frame: no history yet */

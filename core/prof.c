@@ -8,7 +8,12 @@
 
 #include "raycast.h"
 
-const char *const fv_prof_stage_names[FV_PROF_STAGES] = {"frame", "trace", "reconstruct", "dof"};
+const char *fv_prof_stage_name(int stage)
+{
+    if (stage >= 0 && stage < FV_STAGE_COUNT)
+        return fv_stage_names[stage];
+    return stage == FV_PROF_FRAME ? "frame" : "?";
+}
 
 /* One slot's ring: written by one thread only; padded so neighbours' counters do not share a
  * cache line. */
@@ -111,20 +116,22 @@ void fv_prof_set_stage_hook(fv_prof *p, fv_prof_stage_hook fn, void *ctx)
     p->hook_ctx = ctx;
 }
 
-int64_t fv_prof_stage_mark(fv_prof *p, int stage, int end)
+int64_t fv_prof_stage_begin(fv_prof *p, int stage)
 {
-    if (!p)
-        return 0;
-    /* the counters are read outside the span: the hook's own cost is not in the stage's time */
-    if (end) {
-        const int64_t t = fv_time_ns();
-        if (p->hook)
-            p->hook(p->hook_ctx, stage, 1);
-        return t;
-    }
-    if (p->hook)
+    if (p && p->hook)
         p->hook(p->hook_ctx, stage, 0);
     return fv_time_ns();
+}
+
+int64_t fv_prof_stage_end(fv_prof *p, int stage, int64_t t0_ns, int arg)
+{
+    const int64_t t = fv_time_ns();
+    if (p) {
+        if (p->hook)
+            p->hook(p->hook_ctx, stage, 1);
+        fv_prof_span(p, 0, FV_PROF_TRACK_STAGE + stage, fv_prof_stage_name(stage), t0_ns, t, arg);
+    }
+    return t;
 }
 
 size_t fv_prof_count(const fv_prof *p, int slot)

@@ -18,16 +18,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* The pipeline's profiled stages (tracks FV_PROF_TRACK_STAGE + stage; the counter hook's ids). */
-enum {
-    FV_PROF_FRAME,       /* the whole fv_pipeline_render */
-    FV_PROF_CAST,        /* ray casting tiles (with reprojection and the first pulls inside) */
-    FV_PROF_RECONSTRUCT, /* the rest of pull-push */
-    FV_PROF_DOF,         /* focus, CoC, DoF filter, combine */
-    FV_PROF_STAGES
-};
-extern const char *const fv_prof_stage_names[FV_PROF_STAGES]; /* frame, trace, reconstruct, dof */
+#include "stage.h"
 
+/* Stage spans and the counter hook use the pipeline's stage ids (core/stage.h), plus one past
+ * them for the whole frame. A stage fused into another's pass has no span of its own: the
+ * reprojection runs inside the ray-casting tiles (its spans are on the workers' tracks) and the
+ * layered filter's combine inside its vertical pass (the dof_filter span holds both). */
+#define FV_PROF_FRAME FV_STAGE_COUNT        /* the whole fv_pipeline_render */
+#define FV_PROF_STAGES (FV_STAGE_COUNT + 1) /* ids a stage span or hook call may carry */
+const char *fv_prof_stage_name(int stage);  /* fv_stage_names[stage], "frame"; "?" otherwise */
 #define FV_PROF_TRACK_STAGE 1000
 #define FV_PROF_TRACK_MARKERS 2000
 
@@ -59,12 +58,15 @@ void fv_prof_instant(fv_prof *p, int slot, int track, const char *name, int64_t 
 void fv_prof_frame_markers(fv_prof *p, long frame, int64_t gaze_latch_ns, int64_t photon_ns, int late);
 
 /* Per-stage hook (hardware counters): called on the rendering thread at the start (end = 0) and
- * the end (end = 1) of each FV_PROF_* stage, with p NULL-checked by the caller's helper below. */
+ * the end (end = 1) of each stage span (stage: an fv_stage or FV_PROF_FRAME). */
 typedef void (*fv_prof_stage_hook)(void *ctx, int stage, int end);
 void fv_prof_set_stage_hook(fv_prof *p, fv_prof_stage_hook fn, void *ctx);
-/* Records nothing by itself; returns the time for the stage's span and calls the hook. p may be
- * NULL (returns 0). */
-int64_t fv_prof_stage_mark(fv_prof *p, int stage, int end);
+/* The one way stages are timed. begin calls the hook and returns the start time; end returns the
+ * end time, calls the hook and records the span (slot 0, track FV_PROF_TRACK_STAGE + stage, arg,
+ * e.g. the eye). Call both from the rendering thread. The hook runs outside the span, so its own
+ * cost is not in the stage's time. p may be NULL: then they only read the clock. */
+int64_t fv_prof_stage_begin(fv_prof *p, int stage);
+int64_t fv_prof_stage_end(fv_prof *p, int stage, int64_t t0_ns, int arg);
 
 /* Reading back (no thread recording). Events of a slot, oldest first: index in [0, count). */
 size_t fv_prof_count(const fv_prof *p, int slot);
@@ -73,7 +75,7 @@ size_t fv_prof_dropped(const fv_prof *p, int slot);
 
 /* Memory roofline model: bytes a post-processing stage reads and writes per frame on a w x h eye
  * image, counted from the buffers it touches (each byte of a buffer once: the compulsory traffic;
- * docs/bench-2026-11-22-profile.md lists the buffers). stage: FV_STAGE_* (core/pipeline.h).
+ * docs/bench-2026-11-22-profile.md lists the buffers). stage: FV_STAGE_* (core/stage.h).
  * holes: the fraction of level-0 pixels pull-push has to fill (weight < 1; 1 - samples / pixels;
  * 0 with full sampling, where push only reads the weights). 0 on success, -1 for a stage without
  * a model (trace). */

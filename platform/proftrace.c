@@ -36,7 +36,7 @@ static void track_name(char *buf, size_t len, int track)
     if (track >= FV_PROF_TRACK_MARKERS)
         snprintf(buf, len, "markers");
     else if (track >= FV_PROF_TRACK_STAGE && track < FV_PROF_TRACK_STAGE + FV_PROF_STAGES)
-        snprintf(buf, len, "stage %s", fv_prof_stage_names[track - FV_PROF_TRACK_STAGE]);
+        snprintf(buf, len, "stage %s", fv_prof_stage_name(track - FV_PROF_TRACK_STAGE));
     else if (track >= FV_PROF_TRACK_STAGE)
         snprintf(buf, len, "stage %d", track - FV_PROF_TRACK_STAGE);
     else

@@ -1,4 +1,5 @@
 /* fovea: the trace recorder (core/prof.c) and the kernel benchmark table (core/kbench.c). */
+#include <math.h>
 #include <string.h>
 
 #include "base/clock.h"
@@ -114,19 +115,86 @@ static void test_pipeline_spans(void **state)
         for (size_t i = 0; i < fv_prof_count(p, s); i++) {
             const fv_prof_event *e = fv_prof_event_at(p, s, i);
             frames += e->track == FV_PROF_TRACK_STAGE + FV_PROF_FRAME;
-            casts += e->track == FV_PROF_TRACK_STAGE + FV_PROF_CAST;
+            casts += e->track == FV_PROF_TRACK_STAGE + FV_STAGE_TRACE;
             tiles += !strcmp(e->name, "tile");
             assert_true(e->t1_ns >= e->t0_ns);
         }
     assert_int_equal(frames, 3);
     assert_int_equal(casts, 3);
     assert_int_equal(tiles, 3 * 4 * 3); /* 64x48: 4x3 tiles of 16 */
-    assert_int_equal(hook_calls[FV_PROF_CAST][0], 3);
-    assert_int_equal(hook_calls[FV_PROF_CAST][1], 3);
-    assert_int_equal(hook_calls[FV_PROF_RECONSTRUCT][1], 3);
-    assert_int_equal(hook_calls[FV_PROF_DOF][0], 0); /* no depth of field */
+    assert_int_equal(hook_calls[FV_STAGE_TRACE][0], 3);
+    assert_int_equal(hook_calls[FV_STAGE_TRACE][1], 3);
+    assert_int_equal(hook_calls[FV_STAGE_RECONSTRUCT][1], 3);
+    assert_int_equal(hook_calls[FV_STAGE_COC][0], 0); /* no depth of field */
     fv_prof_destroy(p);
     fv_pipeline_destroy(pl);
+    fv_scene_free(scene);
+}
+
+/* with depth of field the models time their stages through the recorder too: every stage of
+ * the pipeline's enum that has a pass of its own gets a span on its track inside the frame's,
+ * with the eye as its argument, and the hook is called in begin/end pairs */
+static void test_pipeline_dof_spans(void **state)
+{
+    (void)state;
+    fv_scene *scene = fv_scene_create();
+    assert_non_null(scene);
+    static const float grey[3] = {0.5f, 0.5f, 0.5f};
+    fv_test_add_quad(scene, -2.0f, -2.0f, 2.0f, 2.0f, -2.0f, grey, -1);
+    char cerr[256];
+    assert_int_equal(fv_scene_commit(scene, cerr, sizeof cerr), 0);
+    for (int model = 0; model < FV_DOF_MODEL_COUNT; model++) {
+        fv_pipeline_config cfg;
+        fv_pipeline_config_default(&cfg);
+        cfg.cam.width = 64, cfg.cam.height = 48, cfg.threads = 2;
+        cfg.dof.preset = FV_DOF_MEDIUM;
+        cfg.dof.model = (fv_dof_model)model;
+        char err[256];
+        fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
+        assert_non_null(pl);
+        fv_prof *p = fv_prof_create(2, 1 << 14);
+        assert_non_null(p);
+        memset(hook_calls, 0, sizeof hook_calls);
+        fv_prof_set_stage_hook(p, hook, NULL);
+        fv_pipeline_set_prof(pl, p);
+        static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
+        fv_frame_stats st;
+        assert_int_equal(fv_pipeline_render(pl, FV_EYE_RIGHT, &origin, 0.5f, 0.5f, &st), 0);
+        int64_t f0 = 0, f1 = 0;
+        int spans[FV_PROF_STAGES] = {0};
+        for (size_t i = 0; i < fv_prof_count(p, 0); i++) {
+            const fv_prof_event *e = fv_prof_event_at(p, 0, i);
+            if (e->track < FV_PROF_TRACK_STAGE || e->track >= FV_PROF_TRACK_STAGE + FV_PROF_STAGES)
+                continue;
+            const int sid = e->track - FV_PROF_TRACK_STAGE;
+            spans[sid]++;
+            assert_string_equal(e->name, fv_prof_stage_name(sid));
+            assert_int_equal(e->arg, (int)FV_EYE_RIGHT);
+            if (sid == FV_PROF_FRAME)
+                f0 = e->t0_ns, f1 = e->t1_ns;
+        }
+        assert_int_equal(spans[FV_PROF_FRAME], 1);
+        for (size_t i = 0; i < fv_prof_count(p, 0); i++) { /* every stage span inside the frame */
+            const fv_prof_event *e = fv_prof_event_at(p, 0, i);
+            if (e->track >= FV_PROF_TRACK_STAGE && e->track < FV_PROF_TRACK_STAGE + FV_STAGE_COUNT)
+                assert_true(e->t0_ns >= f0 && e->t1_ns <= f1);
+        }
+        assert_int_equal(spans[FV_STAGE_TRACE], 1);
+        assert_int_equal(spans[FV_STAGE_RECONSTRUCT], 1);
+        assert_int_equal(spans[FV_STAGE_REPROJECT], 0); /* inside the tiles: worker tracks */
+        assert_int_equal(spans[FV_STAGE_COC], 2);      /* the focus estimate, then the CoC pass */
+        assert_int_equal(spans[FV_STAGE_DOF_FILTER], 1);
+        /* a separate combine pass: hussain's; weier's runs inside its filter, the gathers have none */
+        assert_int_equal(spans[FV_STAGE_COMBINE], model == FV_DOF_MODEL_HUSSAIN);
+        for (int s = 0; s < FV_PROF_STAGES; s++) {
+            assert_int_equal(hook_calls[s][0], hook_calls[s][1]);
+            assert_int_equal(hook_calls[s][1], spans[s]);
+        }
+        assert_false(isnan(st.stage_ms[FV_STAGE_COC]));
+        assert_false(isnan(st.stage_ms[FV_STAGE_DOF_FILTER]));
+        fv_prof_destroy(p);
+        fv_pipeline_destroy(pl);
+    }
     fv_scene_free(scene);
 }
 
@@ -179,6 +247,7 @@ int main(void)
         cmocka_unit_test(test_ring),
         cmocka_unit_test(test_pool_threads),
         cmocka_unit_test(test_pipeline_spans),
+        cmocka_unit_test(test_pipeline_dof_spans),
         cmocka_unit_test(test_stage_bytes),
         cmocka_unit_test(test_kbench_table),
     };

@@ -15,7 +15,9 @@
 
 #include "../dsp.h"
 #include "../pool.h"
+#include "../prof.h"
 #include "../pullpush.h"
+#include "../stage.h"
 #include "coc.h"
 #include "focus.h"
 
@@ -56,7 +58,18 @@ typedef struct fv_dof_view {
     const float *enh_fp;
     int enh_n;
     float enh_step;
+    struct fv_prof *prof;   /* trace recorder for the stage spans (core/prof.h), NULL = off */
+    int prof_arg;           /* the spans' argument (the eye) */
 } fv_dof_view;
+
+/* A model's stage boundaries (coc, dof_filter, combine): the time, and the stage's span and
+ * counter hook when the view has a recorder. */
+static inline int64_t fv_dof_stage_begin(const fv_dof_view *v, fv_stage s) { return fv_prof_stage_begin(v->prof, s); }
+static inline int64_t fv_dof_stage_end(const fv_dof_view *v, fv_stage s, int64_t t0_ns)
+{
+    return fv_prof_stage_end(v->prof, s, t0_ns, v->prof_arg);
+}
+static inline double fv_dof_ms(int64_t t0_ns, int64_t t1_ns) { return (double)(t1_ns - t0_ns) * 1e-6; }
 
 /* Scratch a model may use, allocated once for the eye size (dof.c): FV_DOF_PLANES4 planes of
  * 4 floats a pixel and FV_DOF_PLANES1 planes of 1 float a pixel, all w x h with rows `stride`

@@ -230,13 +230,13 @@ void fv_dof_hussain(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t
     j.w = j.L->w, j.h = j.L->h;
     fv_coc_hussain_default(&j.K, v->prm->pupil_mm, v->focal_px);
 
-    int64_t t0 = fv_time_ns();
+    int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, j.h, hu_coc_row, &j);
     fv_pool_run(pool, j.h, hu_dilate_h_row, &j);
     fv_pool_run(pool, j.h, hu_dilate_v_row, &j);
-    t->coc_ms = fv_dm_ms_since(t0);
+    t->coc_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_COC, t0));
 
-    t0 = fv_time_ns();
+    t0 = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     /* normalised truncated Gaussians; row 0 (sigma 0) is never read (copies instead) */
     for (int i = 0; i < HU_LUT_N; i++) {
         const double s = (double)i / HU_LUT_PER_PX;
@@ -258,9 +258,9 @@ void fv_dof_hussain(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t
     j.by1 = (int)fminf(ceilf(v->gaze_y + rb) + 1.0f, (float)(j.h - 1));
     fv_pool_run(pool, j.h, hu_pass1_row, &j);
     fv_pool_run(pool, j.h, hu_pass2_row, &j);
-    t->filter_ms = fv_dm_ms_since(t0);
+    t->filter_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, t0));
 
-    t0 = fv_time_ns();
+    t0 = fv_dof_stage_begin(v, FV_STAGE_COMBINE);
     fv_pool_run(pool, j.h, hu_combine_row, &j);
-    t->combine_ms = fv_dm_ms_since(t0);
+    t->combine_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_COMBINE, t0));
 }

@@ -100,15 +100,15 @@ void fv_dof_konrad(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t 
     ko_job j = {.v = v, .L = &v->pyr->lv[0], .wk = wk, .out = out, .os = out_stride};
     j.w = j.L->w, j.h = j.L->h;
 
-    int64_t t0 = fv_time_ns();
+    int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, j.h, ko_coc_row, &j);
     j.tiles = (fv_dm_tiles){.rad = wk->p1[0], .stride = wk->stride, .step = 1, .nch = 1, .w = j.w, .h = j.h,
                             .tmax = wk->p1[1], .reach = (int *)wk->p1[2]};
     fv_dm_tiles_run(&j.tiles, pool);
-    t->coc_ms = fv_dm_ms_since(t0);
+    t->coc_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_COC, t0));
 
-    t0 = fv_time_ns();
+    t0 = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     fv_pool_run(pool, j.h, ko_filter_row, &j);
-    t->filter_ms = fv_dm_ms_since(t0);
+    t->filter_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, t0));
     t->combine_ms = NAN;
 }

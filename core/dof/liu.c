@@ -140,15 +140,15 @@ void fv_dof_liu(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out
         for (int dx = -LIU_WIN; dx <= LIU_WIN; dx++)
             j.dist[dy + LIU_WIN][dx + LIU_WIN] = sqrtf((float)(dx * dx + dy * dy));
 
-    int64_t t0 = fv_time_ns();
+    int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, j.h, liu_coc_row, &j);
     j.tiles = (fv_dm_tiles){.rad = wk->p4[0], .stride = wk->stride, .step = 4, .nch = 3, .w = j.w, .h = j.h,
                             .tmax = wk->p1[1], .reach = (int *)wk->p1[2]};
     fv_dm_tiles_run(&j.tiles, pool);
-    t->coc_ms = fv_dm_ms_since(t0);
+    t->coc_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_COC, t0));
 
-    t0 = fv_time_ns();
+    t0 = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     fv_pool_run(pool, j.h, liu_filter_row, &j);
-    t->filter_ms = fv_dm_ms_since(t0);
+    t->filter_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, t0));
     t->combine_ms = NAN;
 }

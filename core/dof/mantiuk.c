@@ -157,14 +157,14 @@ void fv_dof_mantiuk(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t
     fv_coc_mantiuk_default(&j.m);
     j.m.aperture = v->prm->pupil_mm;
 
-    int64_t t0 = fv_time_ns();
+    int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, j.h, ma_coc_row, &j);
     fv_pool_run(pool, j.bh, ma_down_row, &j);
     fv_pool_run(pool, j.h, ma_final_row, &j);
-    t->coc_ms = fv_dm_ms_since(t0);
+    t->coc_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_COC, t0));
 
-    t0 = fv_time_ns();
+    t0 = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     fv_pool_run(pool, j.h, ma_filter_row, &j);
-    t->filter_ms = fv_dm_ms_since(t0);
+    t->filter_ms = fv_dof_ms(t0, fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, t0));
     t->combine_ms = NAN;
 }

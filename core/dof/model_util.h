@@ -8,10 +8,7 @@
 #include <stdint.h>
 
 #include "base/util.h"
-#include "base/clock.h"
 #include "dof.h"
-
-static inline double fv_dm_ms_since(int64_t t0_ns) { return (double)(fv_time_ns() - t0_ns) * 1e-6; }
 
 /* Level 0 pixel (x, y): r, g, b, depth_m. */
 static inline const float *fv_dm_px(const fv_pyr_level *L, int x, int y)
