@@ -8,7 +8,7 @@
 #include <time.h>
 
 #include "prof.h"
-#include "raycast.h"
+#include "tile.h"
 #include "base/err.h"
 
 #define SRGB_LUT 4096
@@ -288,7 +288,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     const int dst = p->taa ? es->cur ^ 1 : 0;
     fv_pyramid *pyr = &es->pyr[dst];
     fv_taa_frame tf;
-    fv_raycast_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa,
+    fv_tile_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa,
                            .prof = p->prof};
     const int64_t t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME), tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
     if (p->taa && es->hist_valid) {
@@ -298,11 +298,11 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     /* The S_in pattern moves by whole pixels with the point of regard. */
     int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
     double taa_ms = NAN;
-    st->samples = fv_raycast(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
+    st->samples = fv_tile_pass(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
     const int64_t tr0 = fv_prof_stage_begin(p->prof, FV_STAGE_RECONSTRUCT);
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
-    fv_pullpush_from(pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(pyr));
+    fv_pullpush_from(pyr, &p->dsp, p->pool, fv_tile_pulled_levels(pyr));
     const int64_t t2 = fv_prof_stage_end(p->prof, FV_STAGE_RECONSTRUCT, tr0, (int)eye);
     st->focus_m = NAN;
     if (p->dof)

@@ -6,7 +6,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "raycast.h"
+#include "tile.h" /* FV_TILE_PULL_LEVELS */
 
 const char *fv_prof_stage_name(int stage)
 {

@@ -215,3 +215,42 @@ void fv_reproject_init_c(fv_dsp *d)
     d->taa_blend = fv_taa_blend_c;
     d->taa_fill = fv_taa_fill_c;
 }
+
+/* The history a tile will read lies around the tile moved by the head motion: guess the move
+ * from the previous frame's depth at the tile (one texel of coarse_level) and prefetch those level-0
+ * rows, so they arrive while the tile's rays are traced (the reads are otherwise latency-bound
+ * misses: each history row is a separate 4-line stretch of a ~37 MB image). */
+void fv_taa_prefetch(const fv_taa_frame *f, int coarse_level, int x0, int y0, int tw, int th)
+{
+    const fv_pyr_level *h0 = &f->hist->lv[0];
+    int dx = 0, dy = 0;
+    if (!f->identity) {
+        const int l = f->hist->levels - 1 < coarse_level ? f->hist->levels - 1 : coarse_level;
+        const fv_pyr_level *hl = &f->hist->lv[l];
+        const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
+        int hx = (int)cx >> l, hy = (int)cy >> l;
+        hx = hx < hl->w ? hx : hl->w - 1;
+        hy = hy < hl->h ? hy : hl->h - 1;
+        float u, v;
+        if (fv_taa_project(f, cx, cy, hl->rgbd[4 * ((ptrdiff_t)hy * hl->stride + hx) + 3], &u, &v) <= 0.0f ||
+            !(fabsf(u - cx) < 4096.0f && fabsf(v - cy) < 4096.0f))
+            return;
+        dx = (int)floorf(u - cx);
+        dy = (int)floorf(v - cy);
+    }
+    int xa = x0 + dx - 1, xb = x0 + dx + tw + 1, ya = y0 + dy - 1, yb = y0 + dy + th + 1;
+    xa = xa < -1 ? -1 : xa;
+    xb = xb > h0->w ? h0->w : xb;
+    ya = ya < -1 ? -1 : ya;
+    yb = yb > h0->h ? h0->h : yb;
+    if (xa > xb)
+        return;
+    for (int y = ya; y <= yb; y++) {
+        const float *r = h0->rgbd + 4 * ((ptrdiff_t)y * h0->stride + xa);
+        for (int x = 0; x <= 4 * (xb - xa); x += 16) /* one 64-byte line = 4 pixels */
+            __builtin_prefetch(r + x);
+        __builtin_prefetch(r + 4 * (xb - xa));
+        __builtin_prefetch(h0->wgt + (ptrdiff_t)y * h0->stride + xa);
+        __builtin_prefetch(h0->wgt + (ptrdiff_t)y * h0->stride + xb);
+    }
+}

@@ -2,7 +2,7 @@
  * (Weier et al. 2018 §3.1; disocclusion rejection after Yang et al. 2009).
  *
  * Runs inside each ray-casting tile, after its samples are shaded and before the tile pulls
- * itself up the pyramid (core/raycast.c), so the tile is still in cache:
+ * itself up the pyramid (the tile driver, core/tile.c), so the tile is still in cache:
  *   1. blend: every sample cast this frame is moved to world space with its depth, projected
  *      into the previous frame, and blended with the previous pyramid read over the sample's
  *      footprint (ray differential: d / z' previous pixels, widened by 1/sqrt of the local
@@ -82,6 +82,11 @@ struct fv_sampler;
 struct fv_dsp;
 void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
                      const fv_pyr_level *l0, const struct fv_dsp *dsp, int x0, int y0, int tw, int th);
+
+/* Prefetches the level-0 history that fv_taa_tile_run of the tile [x0, x0+tw) x [y0, y0+th) will
+ * read, guessing the tile's motion from the history's depth at coarse_level (the level where the
+ * tile is one texel). Call it before the tile's rays are cast, so the lines arrive meanwhile. */
+void fv_taa_prefetch(const fv_taa_frame *f, int coarse_level, int x0, int y0, int tw, int th);
 
 /* The mapping itself, for tests and tools: current pixel (px, py) at depth d -> previous pixel
  * (*u, *v); returns the previous view depth (<= 0: behind the previous eye). */

@@ -1,0 +1,86 @@
+#include "tile.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <string.h>
+
+#include "base/clock.h"
+#include "prof.h"
+#include "raycast.h"
+
+typedef struct {
+    const fv_scene *scene;
+    const fv_camera *cam;
+    const fv_sampler *smp;
+    int gx, gy, tiles_x, tiles_y;
+    fv_pyramid *pyr;
+    const fv_dsp *dsp;
+    int phase;
+    const fv_taa_frame *taa;
+    const fv_taa_params *taa_prm;
+    atomic_long rays;
+    atomic_llong taa_ns;
+    struct fv_prof *prof; /* NULL: no trace recording */
+} tile_job;
+
+static void run_tile(void *ctx, int index, int thread_id)
+{
+    tile_job *j = ctx;
+    const int64_t tile_t0 = j->prof ? fv_time_ns() : 0;
+    const fv_camera *cam = j->cam;
+    const fv_pyr_level *l0 = &j->pyr->lv[0];
+    int tx = index % j->tiles_x, ty = index / j->tiles_x;
+    int x0 = tx * FV_TILE, y0 = ty * FV_TILE;
+    int tw = cam->width - x0 < FV_TILE ? cam->width - x0 : FV_TILE;
+    int th = cam->height - y0 < FV_TILE ? cam->height - y0 : FV_TILE;
+
+    if (j->taa) /* early: the lines arrive while the rays are traced */
+        fv_taa_prefetch(j->taa, FV_TILE_PULL_LEVELS, x0, y0, tw, th);
+    uint32_t rows[FV_TILE];
+    for (int y = 0; y < th; y++) {
+        rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
+        /* Pixels without a sample carry weight 0 into pull-push, which never reads the colour of
+         * a zero-weight pixel: clearing the weights is enough (a quarter of the bytes). */
+        memset(l0->wgt + (y0 + y) * l0->stride + x0, 0, sizeof(float) * (size_t)tw);
+    }
+
+    const long rays = fv_raycast_tile(j->scene, cam, l0, x0, y0, tw, th, rows);
+    if (j->taa) {
+        const int64_t t0 = fv_time_ns();
+        fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], j->dsp, x0, y0, tw, th);
+        const int64_t t1 = fv_time_ns();
+        atomic_fetch_add_explicit(&j->taa_ns, t1 - t0, memory_order_relaxed);
+        if (j->prof)
+            fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
+    }
+    /* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level
+     * 4. Tiles start on multiples of 16, so every block starts on even coordinates. */
+    int xl = x0, yl = y0, wl = tw, hl = th;
+    for (int l = 0; l < FV_TILE_PULL_LEVELS && l + 1 < j->pyr->levels; l++) {
+        fv_pull_block(j->pyr, j->dsp, l, xl, yl, wl, hl);
+        xl >>= 1, yl >>= 1, wl = (wl + 1) >> 1, hl = (hl + 1) >> 1;
+    }
+    atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
+    if (j->prof)
+        fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_time_ns(), index);
+}
+
+long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
+                  const fv_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms)
+{
+    tile_job j = {.scene = scene, .cam = cam, .smp = smp, .gx = gx, .gy = gy, .pyr = pyr, .dsp = dsp};
+    if (opt) {
+        j.phase = opt->phase;
+        j.taa = opt->taa;
+        j.taa_prm = opt->taa_prm;
+        j.prof = opt->prof;
+    }
+    j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
+    j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
+    atomic_init(&j.rays, 0);
+    atomic_init(&j.taa_ns, 0);
+    fv_pool_run(pool, j.tiles_x * j.tiles_y, run_tile, &j);
+    if (taa_ms)
+        *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
+    return atomic_load(&j.rays);
+}
