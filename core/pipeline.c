@@ -8,10 +8,10 @@
 #include <time.h>
 
 #include "prof.h"
+#include "output_convert.h"
 #include "tile.h"
 #include "base/err.h"
 
-#define SRGB_LUT 4096
 #define FOVEA_STEPS 4 /* fovea scales 1, 1.25, 1.5, 1.75, 2 */
 
 typedef struct {
@@ -47,7 +47,7 @@ struct fv_pipeline {
     int64_t t_ns;            /* the frame time set by fv_pipeline_set_time_ns; INT64_MIN: none */
     eye_state eyes[2];
     fv_prof *prof;           /* trace recorder (fv_pipeline_set_prof); NULL: off */
-    uint8_t srgb[SRGB_LUT + 1]; /* linear [0,1] -> sRGB 8-bit */
+    fv_output_conv conv;     /* the display format conversion (sRGB LUT) */
 };
 
 
@@ -144,11 +144,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         goto bad;
     }
     fv_dsp_init(&p->dsp, cfg->isa_mask);
-    for (int i = 0; i <= SRGB_LUT; i++) {
-        double v = (double)i / SRGB_LUT;
-        double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
-        p->srgb[i] = (uint8_t)(s * 255.0 + 0.5);
-    }
+    fv_output_conv_init(&p->conv);
     return p;
 bad:
     fv_pipeline_destroy(p);
@@ -269,19 +265,8 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     d.eye = eye;
     if (fv_camera_setup(&es->cam, &d, head))
         return -1;
-    if (es->cam.lens_on && !es->lca && (es->cam.lens_scale_rgb[0] != es->cam.lens_scale ||
-                                        es->cam.lens_scale_rgb[2] != es->cam.lens_scale)) {
-        /* built once: the lens does not change; radii out to the farthest image corner */
-        if ((es->lca = malloc(sizeof *es->lca))) {
-            float rmax = 0.0f;
-            const float xs[2] = {es->cam.tan_left, es->cam.tan_right}, ys[2] = {es->cam.tan_bottom, es->cam.tan_top};
-            for (int i = 0; i < 4; i++) {
-                const float dx = xs[i & 1] - es->cam.lens_cx, dy = ys[i >> 1] - es->cam.lens_cy;
-                rmax = fmaxf(rmax, sqrtf(dx * dx + dy * dy));
-            }
-            fv_lens_lca_init(es->lca, es->cam.lens_k1, es->cam.lens_k2, es->cam.lens_scale_rgb, 1.05f * rmax);
-        }
-    }
+    if (es->cam.lens_on && !es->lca) /* built once: the lens does not change */
+        es->lca = fv_output_lca_create(&es->cam);
     for (int i = 0; i < FV_STAGE_COUNT; i++)
         st->stage_ms[i] = NAN;
     /* with reprojection, render into the other pyramid and read this one as history */
@@ -370,57 +355,11 @@ const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stri
     return p->dof ? p->eyes[slot(eye)].out : l0->rgbd;
 }
 
-/* Channel c of img, bilinear at pixel coordinates (fx, fy) (pixel centres at integers), clamped. */
-static float sample_ch(const float *img, ptrdiff_t stride, int w, int h, float fx, float fy, int c)
-{
-    const float x0f = floorf(fx), y0f = floorf(fy), ax = fx - x0f, ay = fy - y0f;
-    const int x0 = (int)fminf(fmaxf(x0f, 0.0f), (float)(w - 1)), x1 = (int)fminf(fmaxf(x0f + 1.0f, 0.0f), (float)(w - 1));
-    const int y0 = (int)fminf(fmaxf(y0f, 0.0f), (float)(h - 1)), y1 = (int)fminf(fmaxf(y0f + 1.0f, 0.0f), (float)(h - 1));
-    const float *r0 = img + 4 * (ptrdiff_t)y0 * stride, *r1 = img + 4 * (ptrdiff_t)y1 * stride;
-    const float a = r0[4 * x0 + c] + ax * (r0[4 * x1 + c] - r0[4 * x0 + c]);
-    const float b = r1[4 * x0 + c] + ax * (r1[4 * x1 + c] - r1[4 * x0 + c]);
-    return a + ay * (b - a);
-}
-
-static inline uint8_t to_srgb8(const fv_pipeline *p, float v)
-{
-    /* clamp before converting: NaN-free by construction, but never index out of range */
-    const int i = v > 0.0f ? (v < 1.0f ? (int)(v * SRGB_LUT + 0.5f) : SRGB_LUT) : 0;
-    return p->srgb[i];
-}
-
 void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride)
 {
-    const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
     const eye_state *es = &p->eyes[slot(eye)];
+    const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
     ptrdiff_t stride;
     const float *img = fv_pipeline_image(p, eye, &stride);
-    if (es->lca && es->lca->on) {
-        /* red and blue read where green's rays carry their directions (core/lens.h) */
-        const fv_camera *c = &es->cam;
-        const float inv = 1.0f / c->px_tan;
-        for (int y = 0; y < l0->h; y++) {
-            const float *s = img + 4 * y * stride, ty = c->tan_top - ((float)y + 0.5f) * c->px_tan;
-            uint8_t *o = dst + y * dst_stride;
-            for (int x = 0; x < l0->w; x++) {
-                const float tx = c->tan_left + ((float)x + 0.5f) * c->px_tan;
-                for (int ch = 0; ch < 2; ch++) {
-                    float qx, qy;
-                    fv_lens_lca_source(es->lca, ch, c->lens_cx, c->lens_cy, tx, ty, &qx, &qy);
-                    const float v = sample_ch(img, stride, l0->w, l0->h, (qx - c->tan_left) * inv - 0.5f,
-                                              (c->tan_top - qy) * inv - 0.5f, ch ? 2 : 0);
-                    o[3 * x + (ch ? 2 : 0)] = to_srgb8(p, v);
-                }
-                o[3 * x + 1] = to_srgb8(p, s[4 * x + 1]);
-            }
-        }
-        return;
-    }
-    for (int y = 0; y < l0->h; y++) {
-        const float *s = img + 4 * y * stride;
-        uint8_t *o = dst + y * dst_stride;
-        for (int x = 0; x < l0->w; x++)
-            for (int c = 0; c < 3; c++)
-                o[3 * x + c] = to_srgb8(p, s[4 * x + c]);
-    }
+    fv_output_convert(&p->conv, img, stride, l0->w, l0->h, &es->cam, es->lca, dst, dst_stride);
 }

@@ -1,0 +1,85 @@
+/* fovea: the last stage of a frame: the eye's linear RGB float image to the display format
+ * (sRGB-encoded 8-bit RGB), with the lens's lateral chromatic aberration resampled on the way
+ * where the HMD lens profile has per-channel scales (core/lens.h). */
+#include "output_convert.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+void fv_output_conv_init(fv_output_conv *p)
+{
+    for (int i = 0; i <= FV_SRGB_LUT; i++) {
+        double v = (double)i / FV_SRGB_LUT;
+        double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+        p->srgb[i] = (uint8_t)(s * 255.0 + 0.5);
+    }
+}
+
+fv_lens_lca *fv_output_lca_create(const fv_camera *cam)
+{
+    if (!cam->lens_on || (cam->lens_scale_rgb[0] == cam->lens_scale && cam->lens_scale_rgb[2] == cam->lens_scale))
+        return NULL;
+    fv_lens_lca *lca = malloc(sizeof *lca);
+    if (!lca)
+        return NULL;
+    /* radii out to the farthest image corner */
+    float rmax = 0.0f;
+    const float xs[2] = {cam->tan_left, cam->tan_right}, ys[2] = {cam->tan_bottom, cam->tan_top};
+    for (int i = 0; i < 4; i++) {
+        const float dx = xs[i & 1] - cam->lens_cx, dy = ys[i >> 1] - cam->lens_cy;
+        rmax = fmaxf(rmax, sqrtf(dx * dx + dy * dy));
+    }
+    fv_lens_lca_init(lca, cam->lens_k1, cam->lens_k2, cam->lens_scale_rgb, 1.05f * rmax);
+    return lca;
+}
+
+/* Channel c of img, bilinear at pixel coordinates (fx, fy) (pixel centres at integers), clamped. */
+static float sample_ch(const float *img, ptrdiff_t stride, int w, int h, float fx, float fy, int c)
+{
+    const float x0f = floorf(fx), y0f = floorf(fy), ax = fx - x0f, ay = fy - y0f;
+    const int x0 = (int)fminf(fmaxf(x0f, 0.0f), (float)(w - 1)), x1 = (int)fminf(fmaxf(x0f + 1.0f, 0.0f), (float)(w - 1));
+    const int y0 = (int)fminf(fmaxf(y0f, 0.0f), (float)(h - 1)), y1 = (int)fminf(fmaxf(y0f + 1.0f, 0.0f), (float)(h - 1));
+    const float *r0 = img + 4 * (ptrdiff_t)y0 * stride, *r1 = img + 4 * (ptrdiff_t)y1 * stride;
+    const float a = r0[4 * x0 + c] + ax * (r0[4 * x1 + c] - r0[4 * x0 + c]);
+    const float b = r1[4 * x0 + c] + ax * (r1[4 * x1 + c] - r1[4 * x0 + c]);
+    return a + ay * (b - a);
+}
+
+static inline uint8_t to_srgb8(const fv_output_conv *p, float v)
+{
+    /* clamp before converting: NaN-free by construction, but never index out of range */
+    const int i = v > 0.0f ? (v < 1.0f ? (int)(v * FV_SRGB_LUT + 0.5f) : FV_SRGB_LUT) : 0;
+    return p->srgb[i];
+}
+
+void fv_output_convert(const fv_output_conv *p, const float *img, ptrdiff_t stride, int w, int h,
+                       const fv_camera *c, const fv_lens_lca *lca, uint8_t *dst, ptrdiff_t dst_stride)
+{
+    if (lca && lca->on) {
+        /* red and blue read where green's rays carry their directions (core/lens.h) */
+        const float inv = 1.0f / c->px_tan;
+        for (int y = 0; y < h; y++) {
+            const float *s = img + 4 * y * stride, ty = c->tan_top - ((float)y + 0.5f) * c->px_tan;
+            uint8_t *o = dst + y * dst_stride;
+            for (int x = 0; x < w; x++) {
+                const float tx = c->tan_left + ((float)x + 0.5f) * c->px_tan;
+                for (int ch = 0; ch < 2; ch++) {
+                    float qx, qy;
+                    fv_lens_lca_source(lca, ch, c->lens_cx, c->lens_cy, tx, ty, &qx, &qy);
+                    const float v = sample_ch(img, stride, w, h, (qx - c->tan_left) * inv - 0.5f,
+                                              (c->tan_top - qy) * inv - 0.5f, ch ? 2 : 0);
+                    o[3 * x + (ch ? 2 : 0)] = to_srgb8(p, v);
+                }
+                o[3 * x + 1] = to_srgb8(p, s[4 * x + 1]);
+            }
+        }
+        return;
+    }
+    for (int y = 0; y < h; y++) {
+        const float *s = img + 4 * y * stride;
+        uint8_t *o = dst + y * dst_stride;
+        for (int x = 0; x < w; x++)
+            for (int c = 0; c < 3; c++)
+                o[3 * x + c] = to_srgb8(p, s[4 * x + c]);
+    }
+}
