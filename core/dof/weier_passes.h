@@ -1,0 +1,100 @@
+/* fovea: the layered depth-of-field filter's passes (core/dof/weier*.c, combine.c), private to
+ * them: the per-frame context, the constants and the pieces the files share. */
+#ifndef FOVEA_DOF_WEIER_PASSES_H
+#define FOVEA_DOF_WEIER_PASSES_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "base/util.h"
+#include "dof/dof.h"
+#include "dof/weier_impl.h"
+
+#define TILE 16
+#define LOW 4          /* the near layer's reduced resolution in the periphery: 4x4 blocks */
+#define NSLOT 13       /* per-thread row buffers of the fused vertical + combine pass */
+#define ENH_LEVELS 3   /* contrast enhancement: levels 1..3 (footprints up to ~8 px) */
+#define MAX_UP_LEVEL 5 /* periphery far blur: levels 1..5 (CoC up to 64 px) */
+#define LAMBDA_STEPS 8 /* the level LUT's steps per pixel of CoC */
+#define LAMBDA_N (64 * LAMBDA_STEPS + 1) /* CoCs 0 .. 64 px */
+
+/* An image of 4 floats a pixel (a pyramid level, or the quarter-resolution near layer). */
+typedef struct {
+    const float *px;
+    int w, h;
+    ptrdiff_t stride;
+} img4;
+
+/* Horizontal taps of a bilinear up-sampling by 2^L to level-0 pixel centres, per column x:
+ * texels i0, i1 and the weight of i1 (borders clamp). Built once per frame. */
+typedef struct {
+    int32_t *i0, *i1;
+    float *ax;
+} xtaps;
+
+
+typedef struct {
+    const fv_dof_view *v;
+    fv_dof_work *wk;
+    const fv_dsp *dsp;
+    const fv_dof_gauss_tab *tab;
+    float *out;
+    ptrdiff_t out_stride;
+    int w, h, tw, th;
+    float K;                   /* CoC scale: pupil_m * focal_px * blur_scale */
+    float dn, df;              /* the in-focus range [d_o - t, d_o + t] */
+    float inv_tr;              /* 1 / (r1 - r0) */
+    float *t_near, *t_fsig;    /* per tile, dilated: the largest near radius / far sigma that reach it */
+    float *t_near_own, *t_fsig_own;
+    int cx0, cx1, cy0, cy1;    /* the centre rectangle: full-resolution layers (t < 1 plus reach) */
+    /* quarter-resolution near layer (the periphery) */
+    int lw, lh;                /* its size */
+    float *l_src, *l_r, *l_w;  /* source: premultiplied (rgb, coverage) / radius / box weight */
+    float *l_h, *l_hr, *l_hw;  /* after the horizontal pass */
+    float *l_v;                /* after the vertical pass */
+    int l_reach;               /* the largest radius there */
+    int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
+    const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
+    int enh_on;                /* contrast enhancement runs */
+    float *band_ms;            /* per band: worker time (ms) in the filter and the combine (pairs) */
+    xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
+} fvw_ctx;
+
+
+static inline float fvw_t_of(const fvw_ctx *x, float fx, float fy)
+{
+    const float dx = fx - x->v->gaze_x, dy = fy - x->v->gaze_y;
+    return fv_clampf((sqrtf(dx * dx + dy * dy) - x->v->r0_px) * x->inv_tr, 0.0f, 1.0f);
+}
+
+
+/* sigma (pixels) -> table index */
+static inline uint8_t fvw_sig_index(float sigma)
+{
+    const float s = sigma * FV_DOF_SIG_STEPS + 0.5f;
+    return (uint8_t)(s < (float)(FV_DOF_NSIG - 1) ? (s > 0.0f ? (int)s : 0) : FV_DOF_NSIG - 1);
+}
+
+
+/* Per-thread row buffers of the fused pass. */
+static inline float *fvw_slot(const fvw_ctx *x, int tid, int k) { return x->wk->rows + ((size_t)tid * NSLOT + (size_t)k) * 4 * (size_t)x->w; }
+
+
+/* weier_filter.c: up-sampling helpers */
+void fvw_xtaps_init(xtaps *t, int L, int w, int src_w);
+void fvw_upsample_row(const fv_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w, float *restrict tmp,
+                      float *restrict dst);
+/* weier_coc.c: stage "coc" (bands of TILE rows; then the tiles' reach) */
+void fvw_coc_band(void *ctx, int band, int tid);
+void fvw_dilate_tiles(fvw_ctx *x);
+/* weier_filter.c: stage "dof_filter" (bands); the vertical pass runs the combine row by row */
+void fvw_hpass_band(void *ctx, int band, int tid);
+void fvw_lvpass_band(void *ctx, int band, int tid);
+void fvw_vcombine_band(void *ctx, int band, int tid);
+/* combine.c: stage "combine", one row */
+void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
+void fvw_combine_row(const fvw_ctx *x, int y, const float *sharp, const float *coc, const float *far, const float *near,
+                     const float *lnear, const float *trow, const float *enh);
+
+#endif
