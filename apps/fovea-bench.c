@@ -668,7 +668,7 @@ int main(int argc, char **argv)
            prog, scene_path, fv_scene_triangle_count(scene), load_ms, W, H, threads, threads == 1 ? "" : "s",
            fv_isa_name(dsp.isa), bo.warmup, bo.frames, bo.yaw_rate != 0.0f ? "turning" : "static",
            fv_dof_presets[cfg.dof.preset].name, cfg.dof.preset ? " " : "",
-           cfg.dof.preset ? fv_dof_model_names[cfg.dof.model] : "");
+           cfg.dof.preset ? fv_dof_models[cfg.dof.model].name : "");
     printf("%s: copy bandwidth %.2f GB/s (1 thread), %.2f GB/s (%d threads); load average %.2f %.2f %.2f\n", prog,
            gbps1, gbps, threads, la[0], la[1], la[2]);
     if (bo.yaw_rate != 0.0f)
@@ -747,7 +747,7 @@ int main(int argc, char **argv)
                    "\"dof\": \"%s\", \"dof_model\": \"%s\",\n \"machine\": {\"cpus\": %d, \"copy_gbps_1t\": %.3f, "
                    "\"copy_gbps\": %.3f, \"load_avg\": [%.2f, %.2f, %.2f]},\n \"runs\": [",
                 W, H, threads, bo.frames, bo.warmup, fv_isa_name(dsp.isa), fv_scene_triangle_count(scene), load_ms,
-                (double)bo.yaw_rate, fv_dof_presets[cfg.dof.preset].name, fv_dof_model_names[cfg.dof.model],
+                (double)bo.yaw_rate, fv_dof_presets[cfg.dof.preset].name, fv_dof_models[cfg.dof.model].name,
                 fv_online_cpus(), gbps1, gbps, la[0], la[1], la[2]);
         for (int i = 0; i < nres; i++) {
             fprintf(f, "%s\n  ", i ? "," : "");

@@ -109,9 +109,9 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
             fv_err(err, err_len, "depth-of-field parameters out of range");
             goto bad;
         }
-        p->dof_fn = fv_dof_model_fns[dp->model];
+        p->dof_fn = fv_dof_models[dp->model].run;
         if (!p->dof_fn) {
-            fv_err(err, err_len, "depth-of-field model '%s' is not built", fv_dof_model_names[dp->model]);
+            fv_err(err, err_len, "depth-of-field model '%s' is not built", fv_dof_models[dp->model].name);
             goto bad;
         }
         const fv_pyr_level *l0 = &p->eyes[0].pyr[0].lv[0];

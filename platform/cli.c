@@ -149,7 +149,7 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
     case FV_OPT_DOF_MODEL:
         if (fv_dof_model_parse(arg, &cfg->dof.model))
             fv_usage_error(prog, "--dof-model: '%s' is not one of weier, hussain, mantiuk, konrad, liu", arg);
-        if (!fv_dof_model_fns[cfg->dof.model])
+        if (!fv_dof_models[cfg->dof.model].run)
             fv_usage_error(prog, "--dof-model %s: this model is not built yet", arg);
         return 1;
     case FV_OPT_FOCUS_M:

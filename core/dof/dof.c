@@ -5,12 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *const fv_dof_model_names[FV_DOF_MODEL_COUNT] = {"weier", "hussain", "mantiuk", "konrad", "liu"};
 
 int fv_dof_model_parse(const char *name, fv_dof_model *out)
 {
     for (int i = 0; i < FV_DOF_MODEL_COUNT; i++)
-        if (!strcmp(name, fv_dof_model_names[i])) {
+        if (!strcmp(name, fv_dof_models[i].name)) {
             *out = (fv_dof_model)i;
             return 0;
         }
@@ -68,8 +67,9 @@ float fv_dof_thin_lens_px(const fv_dof_view *v, float depth_m)
     return v->prm->pupil_mm * 1e-3f * (1.0f / v->focus_m - 1.0f / g) * v->focal_px * v->blur_scale;
 }
 
-const fv_dof_model_fn fv_dof_model_fns[FV_DOF_MODEL_COUNT] = {
-    [FV_DOF_MODEL_WEIER] = fv_dof_weier,     [FV_DOF_MODEL_HUSSAIN] = fv_dof_hussain,
-    [FV_DOF_MODEL_MANTIUK] = fv_dof_mantiuk, [FV_DOF_MODEL_KONRAD] = fv_dof_konrad,
-    [FV_DOF_MODEL_LIU] = fv_dof_liu,
+/* The one table of models: a new model is an enum entry (dof.h), its file and a row here. */
+const fv_dof_model_info fv_dof_models[FV_DOF_MODEL_COUNT] = {
+    [FV_DOF_MODEL_WEIER] = {"weier", fv_dof_weier},       [FV_DOF_MODEL_HUSSAIN] = {"hussain", fv_dof_hussain},
+    [FV_DOF_MODEL_MANTIUK] = {"mantiuk", fv_dof_mantiuk}, [FV_DOF_MODEL_KONRAD] = {"konrad", fv_dof_konrad},
+    [FV_DOF_MODEL_LIU] = {"liu", fv_dof_liu},
 };

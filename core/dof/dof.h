@@ -29,8 +29,7 @@ typedef enum {
     FV_DOF_MODEL_LIU,     /* disc bokeh, optional longitudinal chromatic aberration */
     FV_DOF_MODEL_COUNT
 } fv_dof_model;
-extern const char *const fv_dof_model_names[FV_DOF_MODEL_COUNT]; /* "weier", "hussain", ... */
-int fv_dof_model_parse(const char *name, fv_dof_model *out);     /* 0, or -1 for an unknown name */
+int fv_dof_model_parse(const char *name, fv_dof_model *out); /* 0, or -1 for an unknown name */
 
 typedef struct fv_dof_params {
     fv_dof_preset preset;  /* none = no DoF stage at all */
@@ -107,7 +106,11 @@ void fv_dof_konrad(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t 
                    const fv_dsp *dsp, fv_dof_times *t);
 void fv_dof_liu(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
                 const fv_dsp *dsp, fv_dof_times *t);
-extern const fv_dof_model_fn fv_dof_model_fns[FV_DOF_MODEL_COUNT];
+typedef struct fv_dof_model_info {
+    const char *name;   /* command line and JSON: "weier", "hussain", ... */
+    fv_dof_model_fn run;
+} fv_dof_model_info;
+extern const fv_dof_model_info fv_dof_models[FV_DOF_MODEL_COUNT];
 
 /* The signed CoC diameter in pixels of the eye image that the reference renderer
  * (core/reference.h, same pupil) produces at view depth depth_m: pupil_m |1/g - 1/focus| focal_px,
