@@ -1,0 +1,130 @@
+/* The ray stage's yardstick (core/ceiling.c) casts exactly the rays of the real stage: the same
+ * count and the same first-hit distances, for every pixel and for a sampler's set. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "ceiling.h"
+#include "dsp.h"
+#include "raycast.h"
+#include "testscene.h"
+#include "tile.h"
+
+#define W 77 /* not a multiple of the tile: partial tiles on both edges */
+#define H 50
+
+static fv_scene *scene_make(void)
+{
+    fv_scene *s = fv_scene_create();
+    assert_non_null(s);
+    static const float a[3] = {0.5f, 0.5f, 0.5f}, b[3] = {0.2f, 0.6f, 0.3f};
+    fv_test_add_quad(s, -3.0f, -3.0f, 0.5f, 3.0f, -4.0f, a, -1); /* a wall, part of the view misses */
+    fv_test_add_quad(s, -0.5f, -0.5f, 0.8f, 0.4f, -1.5f, b, -1); /* a nearer card in front */
+    char err[256];
+    assert_int_equal(fv_scene_commit(s, err, sizeof err), 0);
+    return s;
+}
+
+/* the real stage's level 0 for the same camera, sampler and gaze against the ceiling's depth */
+static void check_same_rays(const fv_sampler *smp, int packet)
+{
+    fv_scene *s = scene_make();
+    fv_camera_desc d;
+    fv_camera_desc_default(&d);
+    d.width = W, d.height = H;
+    fv_camera cam;
+    static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
+    assert_int_equal(fv_camera_setup(&cam, &d, &origin), 0);
+    fv_pool *pool = fv_pool_create(3);
+    assert_non_null(pool);
+    fv_dsp dsp;
+    fv_dsp_init(&dsp, FV_ISA_C);
+    fv_pyramid pyr;
+    assert_int_equal(fv_pyramid_init(&pyr, W, H), 0);
+    const int gx = 30, gy = 20;
+    fv_sampler full; /* the real stage samples every pixel through a full sampler */
+    fv_sampling_params fp;
+    fv_sampling_params_default(&fp);
+    fp.full = 1;
+    assert_int_equal(fv_sampler_init(&full, W, H, cam.focal_px, &fp), 0);
+    const long real = fv_tile_pass(s, &cam, smp ? smp : &full, gx, gy, &pyr, &dsp, pool, NULL, NULL);
+    fv_sampler_free(&full);
+    float *depth = malloc(sizeof(float) * W * H);
+    assert_non_null(depth);
+    for (int i = 0; i < W * H; i++)
+        depth[i] = -1.0f; /* untouched marker */
+    const fv_ceiling_opts o = {.packet = packet, .smp = smp, .gx = gx, .gy = gy, .phase = 0};
+    const long bare = fv_ceiling_trace(s, &cam, pool, &o, depth);
+    assert_int_equal(bare, real);
+    long hits = 0, misses = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const fv_pyr_level *l0 = &pyr.lv[0];
+            const float w = l0->wgt[y * l0->stride + x], z = l0->rgbd[4 * (y * l0->stride + x) + 3];
+            const float c = depth[y * W + x];
+            if (w == 0.0f) { /* not sampled: the ceiling traced no ray there either */
+                assert_float_equal(c, -1.0f, 0.0f);
+                continue;
+            }
+            if (isinf(c)) {
+                assert_float_equal(z, FV_DEPTH_MISS_M, 0.0f);
+                misses++;
+            } else {
+                assert_float_equal(c, z, 0.0f); /* the same ray: the same bits */
+                hits++;
+            }
+        }
+    assert_true(hits > 0 && misses > 0);
+    if (!smp)
+        assert_int_equal(real, W * H);
+    free(depth);
+    fv_pyramid_free(&pyr);
+    fv_pool_destroy(pool);
+    fv_scene_free(s);
+}
+
+static void test_full_frame_16(void **state)
+{
+    (void)state;
+    check_same_rays(NULL, 16);
+}
+
+static void test_full_frame_8(void **state)
+{
+    (void)state;
+    check_same_rays(NULL, 8);
+}
+
+static void test_sampled(void **state)
+{
+    (void)state;
+    fv_sampling_params p;
+    fv_sampling_params_default(&p);
+    p.r0_deg = 5.0f, p.r1_deg = 12.0f, p.p_min = 0.3f;
+    fv_camera_desc d;
+    fv_camera_desc_default(&d);
+    d.width = W, d.height = H;
+    fv_camera cam;
+    static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
+    assert_int_equal(fv_camera_setup(&cam, &d, &origin), 0);
+    fv_sampler smp;
+    assert_int_equal(fv_sampler_init(&smp, W, H, cam.focal_px, &p), 0);
+    check_same_rays(&smp, 16);
+    check_same_rays(&smp, 8);
+    fv_sampler_free(&smp);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_full_frame_16),
+        cmocka_unit_test(test_full_frame_8),
+        cmocka_unit_test(test_sampled),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
