@@ -1,7 +1,7 @@
 /* fovea: the scene's private parts, shared by the files that implement core/scene.h (scene.c:
- * lifecycle, lights, views; scene_mesh.c: Embree geometry; texture.c; shade.c; gltf_import.c).
- * Not a public API. Mesh records (normals, uvs, material, per-triangle texel density) stay
- * here for shading, indexed by Embree geometry ID. */
+ * lifecycle, lights, views; scene_mesh.c: Embree geometry; texture.c; shade.c). Not a public
+ * API; gltf_import.c needs none of it (it uses the builder API). Mesh records (normals, uvs,
+ * material, per-triangle texel density) stay here for shading, indexed by Embree geometry ID. */
 #ifndef FOVEA_SCENE_IMPL_H
 #define FOVEA_SCENE_IMPL_H
 
@@ -14,9 +14,6 @@
 
 #define FV_TEX_MAX_SIDE 16384
 #define FV_TEX_MAX_LEVELS 15 /* 16384 -> 1 */
-#define FV_TEX_MAX_TEXELS ((size_t)1 << 26) /* 8192^2: about 1.4 GB as float RGBA with mips */
-#define FV_MAX_VERTICES ((size_t)1 << 28)
-#define FV_MAX_TRIANGLES ((size_t)1 << 28)
 
 typedef struct fv_texture {
     int levels;
@@ -53,7 +50,7 @@ struct fv_scene {
     size_t triangle_count;
     float lo[3], hi[3];
     int committed;
-    float light_exposure; /* multiplies every KHR light contribution, see update_exposure */
+    float light_exposure; /* multiplies every KHR light contribution, see update_exposure (scene.c) */
     int has_view;
     float view_pos[3], view_quat[4];
     pthread_mutex_t rtc_err_lock; /* Embree may report from its own threads */

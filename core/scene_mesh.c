@@ -9,6 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define FV_MAX_VERTICES ((size_t)1 << 28)
+#define FV_MAX_TRIANGLES ((size_t)1 << 28)
+
 int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_len)
 {
     if (!s || !m) {

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define FV_TEX_MAX_TEXELS ((size_t)1 << 26) /* 8192^2: about 1.4 GB as float RGBA with mips */
+
 /* 2x2 box filter; an odd source side folds its last texel into the last output texel
  * (3 taps), so every source texel contributes and 1-texel sides pass through. */
 static void downsample(const float *src, int sw, int sh, float *dst, int dw, int dh)
