@@ -21,7 +21,7 @@
 #include "prof.h"
 #include "proftrace.h"
 #include "scene.h"
-#include "trace.h"
+#include "tracefile.h"
 #include "vsync.h"
 
 static const char *prog = "fovea-headset";

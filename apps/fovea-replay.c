@@ -13,7 +13,7 @@
 #include "pipeline.h"
 #include "reference.h"
 #include "scene.h"
-#include "trace.h"
+#include "tracefile.h"
 #include "prof.h"
 #include "proftrace.h"
 

@@ -24,6 +24,19 @@ typedef struct fv_lens {
 
 /* No distortion: k = 0, scales 1, centres at the image centre. */
 void fv_lens_default(fv_lens *l);
+
+/* Lens profile text (the files: platform/lensfile.h). One `key values` per line, '#' comments
+ * and blank lines skipped, every key optional (defaults: fv_lens_default):
+ *   k1 0.10                  radial coefficients
+ *   k2 0.02
+ *   chroma 0.994 1.0 1.008   per-channel scale R G B (lateral chromatic aberration)
+ *   left_center 0.53 0.5     lens centre per eye, normalised image coordinates
+ *   right_center 0.47 0.5
+ * Unknown keys, missing or extra values, lines of 512 bytes or more, NUL bytes and a mapping that
+ * folds over within r_max (fv_lens_validate) are errors. text holds text_len bytes (no terminator
+ * needed); name is used in messages ("NAME:LINE: reason" or "NAME: reason"). 0, or -1. */
+int fv_lens_parse(fv_lens *l, const char *text, size_t text_len, const char *name, float r_max, char *err,
+                  size_t err_len);
 /* 0 when the radial mapping is monotonic (invertible) out to r_max tangent units and the
  * numbers are sane; -1 with a reason otherwise. */
 int fv_lens_validate(const fv_lens *l, float r_max, char *err, size_t err_len);

@@ -3,7 +3,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -146,43 +145,6 @@ out:
     free(buf);
     if (rc)
         fv_trace_free(tr);
-    return rc;
-}
-
-int fv_trace_load(fv_trace *tr, const char *path, char *err, size_t err_len)
-{
-    memset(tr, 0, sizeof *tr);
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return fv_err(err, err_len, "%s: %s", path, strerror(errno));
-    size_t cap = 1 << 16, len = 0;
-    char *buf = malloc(cap);
-    for (;;) {
-        if (!buf) {
-            fclose(f);
-            return fv_err(err, err_len, "%s: out of memory", path);
-        }
-        len += fread(buf + len, 1, cap - len, f);
-        if (len < cap)
-            break;
-        if (cap > ((size_t)1 << 30)) {
-            free(buf);
-            fclose(f);
-            return fv_err(err, err_len, "%s: larger than 1 GiB", path);
-        }
-        char *nb = realloc(buf, cap *= 2);
-        if (!nb)
-            free(buf);
-        buf = nb;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return fv_err(err, err_len, "%s: read error", path);
-    }
-    int rc = fv_trace_parse(tr, buf, len, path, err, err_len);
-    free(buf);
     return rc;
 }
 

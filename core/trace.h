@@ -20,9 +20,9 @@ typedef struct fv_trace {
     int has_head;
 } fv_trace;
 
-/* 0 on success; -1 with a one-line reason (file and line) in err. */
-int fv_trace_load(fv_trace *tr, const char *path, char *err, size_t err_len);
-/* Parses CSV text already in memory (name is used in messages only). */
+/* Parses CSV text in memory (len bytes, no terminator needed; name, e.g. the file's path, is
+ * used in messages only). 0 on success; -1 with a one-line reason ("NAME:LINE: reason" or
+ * "NAME: reason") in err and tr empty. Files: fv_trace_load (platform/tracefile.h). */
 int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name, char *err, size_t err_len);
 void fv_trace_free(fv_trace *tr);
 

@@ -2,7 +2,6 @@
 #include "gazesrc.h"
 #include "base/clock.h"
 
-#include <math.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
@@ -14,6 +13,7 @@
 #include "eyesrc.h"
 #include "eyetrack/eyetrack.h"
 #include "eyetrack/gazefilter.h"
+#include "eyetrack/gazemap.h"
 #include "vsync.h"
 
 struct fv_gazesrc {
@@ -35,17 +35,6 @@ struct fv_gazesrc {
     atomic_long frames;
     char why[512];
 };
-
-void fv_gaze_dir_to_image(const fv_camera *cam, float yaw_deg, float pitch_deg, float *gx, float *gy)
-{
-    const float d2r = 3.14159265358979f / 180.0f;
-    /* direction (sin yaw cos pitch, sin pitch, cos yaw cos pitch): x/z and y/z tangents */
-    const float tx = tanf(yaw_deg * d2r), ty = tanf(pitch_deg * d2r) / cosf(yaw_deg * d2r);
-    *gx = (tx - cam->tan_left) / (cam->tan_right - cam->tan_left);
-    *gy = (cam->tan_top - ty) / (cam->tan_top - cam->tan_bottom);
-    *gx = *gx < 0.0f ? 0.0f : *gx > 1.0f ? 1.0f : *gx;
-    *gy = *gy < 0.0f ? 0.0f : *gy > 1.0f ? 1.0f : *gy;
-}
 
 static void fail(fv_gazesrc *g, const char *why)
 {
@@ -90,23 +79,9 @@ static void *run(void *arg)
             fail(g, "eye tracker: bad frame or out of memory");
             return NULL;
         }
-        float yaw = 0, pitch = 0;
-        int valid = r.status == FV_EYE_OK && r.found;
-        const int pg = g->has_calib && g->calib.input == FV_CALIB_PUPIL_GLINT;
-        if (pg && !r.has_pg) /* no glint this frame: no calibrated gaze */
-            valid = 0;
-        if (valid) {
-            if (g->has_calib) {
-                fv_calib_apply(&g->calib, pg ? r.pg_x : r.pupil_x, pg ? r.pg_y : r.pupil_y, &yaw, &pitch);
-            } else {
-                /* uncalibrated: the pupil centre's place in the camera image, as a direction over
-                 * the display's field of view */
-                const float nx = r.pupil_x / (float)fr.w, ny = r.pupil_y / (float)fr.h;
-                const float hx = atanf(g->cam.tan_right) * 57.29578f, hy = atanf(g->cam.tan_top) * 57.29578f;
-                yaw = (2.0f * nx - 1.0f) * hx;
-                pitch = (1.0f - 2.0f * ny) * hy;
-            }
-        }
+        float yaw, pitch;
+        const int valid =
+            fv_gaze_from_eye(&r, fr.w, fr.h, g->has_calib ? &g->calib : NULL, &g->cam, &yaw, &pitch);
         fv_gaze_out out;
         fv_gaze_filter_update(&g->filt, (double)t * 1e-6, valid, yaw, pitch, r.confidence, &out);
         if (out.state != FV_GAZE_NONE) {

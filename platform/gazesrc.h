@@ -1,7 +1,7 @@
 /* fovea platform: the eye-camera gaze source of the headset. A thread reads the eye camera
  * (V4L2, or a Y4M file replayed in real time at fps and looped), tracks the pupil
- * (core/eyetrack/), maps it to a gaze direction through the calibration (without one: the
- * pupil centre in normalised camera-image coordinates, an uncalibrated stand-in), filters it
+ * (core/eyetrack/), maps it to a gaze direction (core/eyetrack/gazemap.h: through the
+ * calibration, or without one the uncalibrated linear stand-in), filters it
  * (core/eyetrack/gazefilter.h) and pushes samples stamped with the capture time into a gaze
  * ring (core/frameloop.h). A camera that fails mid-run stops the thread with a one-line reason
  * (fv_gazesrc_failed): the ring keeps the last good gaze. */
@@ -25,8 +25,5 @@ int fv_gazesrc_start(fv_gazesrc **g, const char *spec, const fv_calib *calib, co
 const char *fv_gazesrc_failed(fv_gazesrc *g);
 long fv_gazesrc_frames(fv_gazesrc *g); /* camera frames tracked so far */
 void fv_gazesrc_stop(fv_gazesrc *g);
-
-/* Gaze direction (yaw right, pitch up, degrees) to normalised image coordinates of cam. */
-void fv_gaze_dir_to_image(const fv_camera *cam, float yaw_deg, float pitch_deg, float *gx, float *gy);
 
 #endif

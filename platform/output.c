@@ -201,3 +201,44 @@ long fv_read_text_file(const char *path, char *buf, size_t cap, const char *kind
         return fv_err(err, err_len, "%s: not a text file", path);
     return (long)n;
 }
+
+char *fv_read_file_alloc(const char *path, size_t *len_out, char *err, size_t err_len)
+{
+    *len_out = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fv_err(err, err_len, "%s: %s", path, strerror(errno));
+        return NULL;
+    }
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    for (;;) {
+        if (!buf) {
+            fclose(f);
+            fv_err(err, err_len, "%s: out of memory", path);
+            return NULL;
+        }
+        len += fread(buf + len, 1, cap - len, f);
+        if (len < cap)
+            break;
+        if (cap > ((size_t)1 << 30)) {
+            free(buf);
+            fclose(f);
+            fv_err(err, err_len, "%s: larger than 1 GiB", path);
+            return NULL;
+        }
+        char *nb = realloc(buf, cap *= 2);
+        if (!nb)
+            free(buf);
+        buf = nb;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        fv_err(err, err_len, "%s: read error", path);
+        return NULL;
+    }
+    *len_out = len;
+    return buf;
+}

@@ -1,21 +1,30 @@
-/* Lens profiles: parsing and its errors; the distortion against its formula, its inverse, and
- * the camera's rays and projection with and without a lens. */
+/* Lens profiles: parsing from memory (core/lens.c) and its errors, the file loader
+ * (platform/lensfile.c); the distortion against its formula, its inverse, and the camera's rays
+ * and projection with and without a lens. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "camera.h"
+#include "lens.h"
 #include "lensfile.h"
 #include "testutil.h"
+
+static int parse(fv_lens *l, const char *text, const char *name, char *err, size_t err_len)
+{
+    return fv_lens_parse(l, text, strlen(text), name, 2.0f, err, err_len);
+}
 
 static void test_parse(void **st)
 {
     (void)st;
     fv_lens l;
     char err[256];
-    assert_int_equal(fv_lens_parse(&l,
-                                   "# test HMD\n\nk1 0.12\nk2 0.03 # comment\r\nchroma 0.99 1.0 1.01\n"
-                                   "left_center 0.53 0.48\n  right_center\t0.47 0.52\n",
-                                   "p.txt", 2.0f, err, sizeof err),
+    assert_int_equal(parse(&l,
+                           "# test HMD\n\nk1 0.12\nk2 0.03 # comment\r\nchroma 0.99 1.0 1.01\n"
+                           "left_center 0.53 0.48\n  right_center\t0.47 0.52\n",
+                           "p.txt", err, sizeof err),
                      0);
     assert_float_equal(l.k1, 0.12f, 0);
     assert_float_equal(l.k2, 0.03f, 0);
@@ -24,7 +33,7 @@ static void test_parse(void **st)
     assert_float_equal(l.center[0][0], 0.53f, 0);
     assert_float_equal(l.center[1][1], 0.52f, 0);
     /* empty: no distortion */
-    assert_int_equal(fv_lens_parse(&l, "# nothing\n", "e.txt", 2.0f, err, sizeof err), 0);
+    assert_int_equal(parse(&l, "# nothing\n", "e.txt", err, sizeof err), 0);
     assert_float_equal(l.k1, 0.0f, 0);
     assert_float_equal(l.scale[1], 1.0f, 0);
     assert_float_equal(l.center[1][0], 0.5f, 0);
@@ -44,12 +53,69 @@ static void test_parse(void **st)
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         err[0] = 0;
-        assert_int_equal(fv_lens_parse(&l, bad[i].text, "b.txt", 2.0f, err, sizeof err), -1);
+        assert_int_equal(parse(&l, bad[i].text, "b.txt", err, sizeof err), -1);
         if (!strstr(err, bad[i].why))
             fail_msg("'%s': got '%s', want '%s'", bad[i].text, err, bad[i].why);
     }
     assert_int_equal(fv_lens_load(&l, "/nonexistent/hmd.lens", 2.0f, err, sizeof err), -1);
     assert_non_null(strstr(err, "/nonexistent/hmd.lens: No such file"));
+}
+
+/* The in-memory parser: text_len bounds the text, exact messages, NUL bytes and long lines. */
+static void test_parse_memory(void **st)
+{
+    (void)st;
+    fv_lens l;
+    char err[256];
+    /* only the first line counts: the cut falls before "k2 oops" */
+    const char *text = "k1 0.25\nk2 oops\n";
+    assert_int_equal(fv_lens_parse(&l, text, 8, "cut.lens", 2.0f, err, sizeof err), 0);
+    assert_float_equal(l.k1, 0.25f, 0);
+    assert_float_equal(l.k2, 0.0f, 0);
+    /* no final newline */
+    assert_int_equal(fv_lens_parse(&l, "k2 0.01", 7, "nonl.lens", 2.0f, err, sizeof err), 0);
+    assert_float_equal(l.k2, 0.01f, 0);
+    assert_int_equal(fv_lens_parse(&l, "", 0, "empty.lens", 2.0f, err, sizeof err), 0);
+    assert_float_equal(l.scale[0], 1.0f, 0);
+
+    assert_int_equal(parse(&l, "# x\nk1 0.1\nk9 1\n", "m.lens", err, sizeof err), -1);
+    assert_string_equal(err, "m.lens:3: unknown key 'k9' (k1, k2, chroma, left_center, right_center)");
+    assert_int_equal(parse(&l, "right_center 0.5\n", "m.lens", err, sizeof err), -1);
+    assert_string_equal(err, "m.lens:1: right_center wants 2 numbers");
+    assert_int_equal(fv_lens_parse(&l, "k1 0.1\0\n", 8, "nul.lens", 2.0f, err, sizeof err), -1);
+    assert_string_equal(err, "nul.lens: not a text file (NUL byte)");
+    char longline[600];
+    memset(longline, ' ', sizeof longline);
+    memcpy(longline, "k1 0.1", 6);
+    assert_int_equal(fv_lens_parse(&l, longline, sizeof longline, "long.lens", 2.0f, err, sizeof err), -1);
+    assert_string_equal(err, "long.lens:1: line too long");
+}
+
+/* platform/lensfile.c: reads the file and names it in the parser's messages. */
+static void test_load_file(void **st)
+{
+    (void)st;
+    char path[] = "/tmp/fovea_lens_XXXXXX";
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    FILE *f = fdopen(fd, "w");
+    assert_non_null(f);
+    fputs("k1 0.1\nk2 0.02\nchroma 0.99 1 1.01\n", f);
+    fclose(f);
+    fv_lens l;
+    char err[512];
+    assert_int_equal(fv_lens_load(&l, path, 2.0f, err, sizeof err), 0);
+    assert_float_equal(l.k2, 0.02f, 0);
+    assert_float_equal(l.scale[2], 1.01f, 0);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("k1 0.1\nchroma 1\n", f);
+    fclose(f);
+    char want[256];
+    snprintf(want, sizeof want, "%s:2: chroma wants 3 numbers", path);
+    assert_int_equal(fv_lens_load(&l, path, 2.0f, err, sizeof err), -1);
+    unlink(path);
+    assert_string_equal(err, want);
 }
 
 static void test_formula_and_round_trip(void **st)
@@ -179,6 +245,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse),
+        cmocka_unit_test(test_parse_memory),
+        cmocka_unit_test(test_load_file),
         cmocka_unit_test(test_formula_and_round_trip),
         cmocka_unit_test(test_camera),
         cmocka_unit_test(test_lca_source),

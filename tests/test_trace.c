@@ -1,9 +1,13 @@
-/* Gaze / head trace parsing and interpolation. */
+/* Gaze / head traces: parsing from memory (core/trace.c), interpolation, and the file loader
+ * (platform/tracefile.c). */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "testutil.h"
 #include "trace.h"
+#include "tracefile.h"
 
 static int parse(fv_trace *t, const char *text, char *err)
 {
@@ -78,11 +82,82 @@ static void test_bad(void **st)
         assert_true(strlen(err) > 5);
         assert_null(t.s);
     }
+}
+
+/* The messages users see: name and line number, the same text as before the loader moved. */
+static void test_messages(void **st)
+{
+    (void)st;
+    static const struct {
+        const char *text, *want;
+    } cases[] = {
+        {"", "t.csv: no header line (t_ms,gaze_x,gaze_y)"},
+        {"t_ms,gaze_x,gaze_y\n", "t.csv: no samples after the header"},
+        {"# c\ntime,x,y\n0,0.5,0.5\n", "t.csv:2: header must start with t_ms,gaze_x,gaze_y"},
+        {"t_ms,gaze_x,gaze_y,head_px\n", "t.csv:1: header has 4 columns; expected 3, or 10 with head pose"},
+        {"t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qw,head_qz\n",
+         "t.csv:1: column 9 is 'head_qw', expected 'head_qz'"},
+        {"t_ms,gaze_x,gaze_y\n0,0.5,0.5\n11,0.5\n", "t.csv:3: 2 fields, expected 3 (truncated or malformed line)"},
+        {"t_ms,gaze_x,gaze_y\n0,0.5,0.5,7\n", "t.csv:2: 4 fields, expected 3 (truncated or malformed line)"},
+        {"t_ms,gaze_x,gaze_y\n0,0.5,abc\n", "t.csv:2: field 3 ('abc') is not a finite number"},
+        {"t_ms,gaze_x,gaze_y\n0,0.5,\n", "t.csv:2: field 3 ('') is not a finite number"},
+        {"t_ms,gaze_x,gaze_y\n10,0.5,0.5\n5,0.5,0.5\n", "t.csv:3: t_ms goes backwards (5 after 10)"},
+        {"t_ms,gaze_x,gaze_y\n0,40,0.5\n", "t.csv:2: gaze (40, 0.5) is far outside the normalised image [0,1]"},
+        {"t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw\n0,0.5,0.5,0,0,0,0,0,0,0\n",
+         "t.csv:2: head quaternion has length 0, expected about 1"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        fv_trace t;
+        char err[256] = "";
+        assert_int_equal(parse(&t, cases[i].text, err), -1);
+        assert_string_equal(err, cases[i].want);
+    }
+    /* len bounds the text: a cut after the first sample's line parses, a NUL inside is refused */
+    const char *text = "t_ms,gaze_x,gaze_y\n0,0.5,0.5\n10,0.6,0.5\n";
     fv_trace t;
     char err[256];
+    assert_int_equal(fv_trace_parse(&t, text, 29, "cut.csv", err, sizeof err), 0);
+    assert_int_equal(t.n, 1);
+    fv_trace_free(&t);
     assert_int_equal(fv_trace_parse(&t, "t_ms,gaze_x,gaze_y\n0,0.5\0,0.5\n", 29, "nul.csv", err, sizeof err), -1);
+    assert_string_equal(err, "nul.csv: not a text file (NUL byte)");
+    assert_null(t.s);
+}
+
+/* platform/tracefile.c: reads the file and names it in the parser's messages. */
+static void test_load(void **st)
+{
+    (void)st;
+    fv_trace t;
+    char err[512];
     assert_int_equal(fv_trace_load(&t, "/nonexistent/trace.csv", err, sizeof err), -1);
-    assert_non_null(strstr(err, "/nonexistent/trace.csv"));
+    assert_string_equal(err, "/nonexistent/trace.csv: No such file or directory");
+    assert_null(t.s);
+    assert_int_equal(fv_trace_load(&t, "/tmp", err, sizeof err), -1);
+    assert_string_equal(err, "/tmp: read error");
+
+    char path[] = "/tmp/fovea_trace_XXXXXX";
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    FILE *f = fdopen(fd, "w");
+    assert_non_null(f);
+    fputs("t_ms,gaze_x,gaze_y\n0,0.25,0.5\n10,0.75,0.5\n20,0.5\n", f);
+    fclose(f);
+    char want[256];
+    snprintf(want, sizeof want, "%s:4: 2 fields, expected 3 (truncated or malformed line)", path);
+    assert_int_equal(fv_trace_load(&t, path, err, sizeof err), -1);
+    assert_string_equal(err, want);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("t_ms,gaze_x,gaze_y\n0,0.25,0.5\n10,0.75,0.5\n", f);
+    fclose(f);
+    assert_int_equal(fv_trace_load(&t, path, err, sizeof err), 0);
+    unlink(path);
+    assert_int_equal(t.n, 2);
+    fv_trace_sample s;
+    fv_trace_at(&t, 5.0, &s);
+    assert_float_equal(s.gaze_x, 0.5f, 1e-6);
+    fv_trace_free(&t);
 }
 
 int main(void)
@@ -91,6 +166,8 @@ int main(void)
         cmocka_unit_test(test_good),
         cmocka_unit_test(test_head),
         cmocka_unit_test(test_bad),
+        cmocka_unit_test(test_messages),
+        cmocka_unit_test(test_load),
     };
     return cmocka_run_group_tests_name("trace", tests, NULL, NULL);
 }

@@ -23,7 +23,7 @@
 #include <string.h>
 
 #include "eyetrack/synth.h"
-#include "trace.h"
+#include "tracefile.h"
 
 static const char *prog = "gen_eye";
 

@@ -1,0 +1,93 @@
+/* fovea: the scene's private parts, shared by the files that implement core/scene.h (scene.c:
+ * lifecycle, lights, views; scene_mesh.c: Embree geometry; texture.c; shade.c). Not a public
+ * API; gltf_import.c needs none of it (it uses the builder API). Mesh records (normals, uvs,
+ * material, per-triangle texel density) stay here for shading, indexed by Embree geometry ID. */
+#ifndef FOVEA_SCENE_IMPL_H
+#define FOVEA_SCENE_IMPL_H
+
+#include "scene.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define FV_TEX_MAX_SIDE 16384
+#define FV_TEX_MAX_LEVELS 15 /* 16384 -> 1 */
+
+typedef struct fv_texture {
+    int levels;
+    int w[FV_TEX_MAX_LEVELS], h[FV_TEX_MAX_LEVELS];
+    const float *level[FV_TEX_MAX_LEVELS]; /* linear RGBA, rows top to bottom, into data */
+    float *data;
+} fv_texture;
+
+typedef struct fv_mesh_rec {
+    const float *pos;      /* world positions, 3 per vertex: Embree's vertex buffer */
+    const uint32_t *tri;   /* 3 per triangle: Embree's index buffer */
+    float *normals;        /* world, unit (or zero if degenerate), 3 per vertex */
+    float *uvs;            /* 2 per vertex, or NULL */
+    float *texel_density;  /* per triangle, mip-0 texels per metre; NULL without texture */
+    size_t vertex_count, tri_count;
+    float base_color[4];
+    int texture;
+} fv_mesh_rec;
+
+typedef struct fv_light_rec {
+    fv_light l;
+    float cos_inner, cos_outer; /* spot only */
+} fv_light_rec;
+
+struct fv_scene {
+    RTCDevice device;
+    RTCScene rtc;
+    fv_mesh_rec *meshes;
+    size_t mesh_count, mesh_cap;
+    fv_texture *textures;
+    int texture_count, texture_cap;
+    fv_light_rec *lights;
+    int light_count, light_cap;
+    size_t triangle_count;
+    float lo[3], hi[3];
+    int committed;
+    float light_exposure; /* multiplies every KHR light contribution, see update_exposure (scene.c) */
+    int has_view;
+    float view_pos[3], view_quat[4];
+    pthread_mutex_t rtc_err_lock; /* Embree may report from its own threads */
+    char rtc_err[192];
+};
+
+/* ---- shared helpers ------------------------------------------------------------------ */
+
+/* Grows *p (of *cap elements) to hold n; 0 on success. */
+int fv_scene_grow(void **p, size_t *cap, size_t n, size_t elem);
+/* Returns 1 and copies the first recorded Embree error into err, or 0 if none. */
+int fv_scene_take_rtc_error(fv_scene *s, char *err, size_t err_len);
+/* Trilinear between the two mip levels around lod (lod 0 = full resolution), REPEAT addressing. */
+void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4]);
+
+static inline void cross3(const float a[3], const float b[3], float o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static inline float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline float len3(const float a[3]) { return sqrtf(dot3(a, a)); }
+
+static inline void tri_edges(const float *pos, const uint32_t *tri, float e1[3], float e2[3])
+{
+    const float *p0 = pos + 3 * (size_t)tri[0], *p1 = pos + 3 * (size_t)tri[1], *p2 = pos + 3 * (size_t)tri[2];
+    for (int k = 0; k < 3; k++) e1[k] = p1[k] - p0[k], e2[k] = p2[k] - p0[k];
+}
+
+/* glTF's recommended range window: smooth falloff to zero at range (0 = infinite). Used by
+ * shading and by the exposure fixed at commit. */
+static inline float range_window(float d, float range)
+{
+    if (range <= 0.0f) return 1.0f;
+    const float x = d / range, x4 = x * x * x * x;
+    return x4 >= 1.0f ? 0.0f : 1.0f - x4;
+}
+
+#endif
