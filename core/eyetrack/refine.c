@@ -2,7 +2,7 @@
  * between the blob and its surround, iterated weighted centroid of the darker pixels, then rays
  * from there give sub-pixel edge points; in headset mode the lid's edge points are cut and
  * RANSAC picks the consensus, then a direct least-squares ellipse fit with outlier rejection
- * (ellipse.c). The mode's settings (fv_et_settings) say which sub-steps run. */
+ * (ellipse.c). The mode's settings (fv_eye_mode_settings) say which sub-steps run. */
 #include <math.h>
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -155,7 +155,7 @@ typedef struct {
  * inpainted already). -1 when the window is too small. */
 static int cut_window(const fv_et_refine_args *a, window *wn)
 {
-    const fv_et_settings *set = a->set;
+    const fv_eye_mode_settings *set = a->set;
     const fv_et_candidate *c = &a->c;
     /* headset frames: the search's box can be much smaller than the pupil (the darkest part of
      * it), and rays must reach the pupil's far edge inside the window */
@@ -265,7 +265,7 @@ static int centroid(const fv_et_refine_args *a, window *wn)
  * (a pupil edge, not a glint's halo) and has no much brighter lid beyond. */
 static void edge_points(const fv_et_refine_args *a, const window *wn, edges *ed)
 {
-    const fv_et_settings *set = a->set;
+    const fv_eye_mode_settings *set = a->set;
     const int ww = wn->ww, wh = wn->wh, x0 = wn->x0, y0 = wn->y0;
     const float cx = wn->cx, cy = wn->cy, r = wn->r, inner = wn->inner, ring = wn->ring;
     const float th = 0.5f * (inner + ring);
@@ -368,7 +368,7 @@ static void drop_bright_beyond(edges *ed, float inner, float frac)
  * outline and put its own edge in the middle of the points, which moves a least-squares fit);
  * deterministic sampling. Compacts the consensus to the front of ed->x, ed->y and returns its
  * size, or 0 when fewer than 8 points support the best fit. (pcx, pcy), r: the centroid. */
-static int ransac(const fv_et_settings *set, edges *ed, float pcx, float pcy, float r)
+static int ransac(const fv_eye_mode_settings *set, edges *ed, float pcx, float pcy, float r)
 {
     float *ex = ed->x, *ey = ed->y;
     const int ne = ed->n;
@@ -436,7 +436,7 @@ static int near_median_radius(edges *ed, float pcx, float pcy)
  * and refitting (up to 3 rounds); the fit goes to out if its size, aspect and centre fit the
  * centroid (out->x, out->y, out->r), the centre looser when a lid line was cut (the visible
  * part's centroid sits low). */
-static void fit_outline(const fv_et_settings *set, edges *ed, int n, int lid, fv_et_pupil *out)
+static void fit_outline(const fv_eye_mode_settings *set, edges *ed, int n, int lid, fv_et_pupil *out)
 {
     float *ex = ed->x, *ey = ed->y;
     const float r = out->r;
@@ -468,7 +468,7 @@ static void fit_outline(const fv_et_settings *set, edges *ed, int n, int lid, fv
 
 int fv_et_refine(const fv_et_refine_args *a, fv_et_pupil *out)
 {
-    const fv_et_settings *set = a->set;
+    const fv_eye_mode_settings *set = a->set;
     window wn;
     if (cut_window(a, &wn) || centroid(a, &wn))
         return -1;

@@ -5,45 +5,17 @@
  *    short side <= 160 with its reflections inpainted.
  * 2. refine.c: levels, centroid and, from edge points, an ellipse, in a window around it.
  * 3. glints.c: small bright blobs of the raw image close to the pupil.
- * 4. The reported centre: the ellipse's (else the centroid) for headset frames; for tight eye
- *    crops the search box's centre, nudged toward the crop's centre and a reflection.
- * 5. blink.c: confidence, loss and blinks against the tracker's running reference. */
+ * 4. The reported centre: headset mode, the ellipse's (else the centroid); crop mode, the search
+ *    box's centre nudged toward the crop's centre and a reflection.
+ * 5. blink.c: confidence, loss and blinks against the tracker's running reference.
+ * The mode (eyetrack.h) is the tracker's, or for AUTO decided per frame by its size; its settings
+ * (mode.c) say what steps 2 and 4 do. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/util.h"
 #include "eyetrack/track_impl.h"
-
-const fv_et_settings fv_et_headset_settings = {
-    .refine_on_search_image = 0,
-    .refine_max_side = 320, /* the edge points keep sub-pixel precision, noise halves, work quarters */
-    .window_side_div = 4,
-    .reflect_grow_px = 3,
-    .centroid_iters = 6,
-    .box_grow_max = 4,
-    .smooth_rays = 1,
-    .edge_search_px = 3.0f,
-    .beyond_frac = 0.35f,
-    .lid_line = 1,
-    .ransac_iters = 64,
-    .ransac_grad_mincos = 0.85, /* 32 deg */
-    .min_aspect = 0.6,          /* gaze up to ~50 deg off the camera axis; flatter is lid consensus */
-    .report_box_centre = 0,
-};
-
-/* Tuned on the MRL infrared crops (~10 px pupils inside an often equally dark iris; the weights
- * on the even-numbered images, docs/eyetrack.md): the search box's centre beat every refinement
- * tried, which only gives levels, size, fit quality and glints here. */
-const fv_et_settings fv_et_crop_settings = {
-    .refine_on_search_image = 1,
-    .centroid_iters = 2,
-    .min_aspect = 0.3,
-    .report_box_centre = 1,
-    .centre_weight = 0.05f,
-    .glint_weight = 0.3f,
-    .spot_min_grey = 20,
-};
 
 void fv_eye_default_params(fv_eye_params *p)
 {
@@ -52,13 +24,10 @@ void fv_eye_default_params(fv_eye_params *p)
     p->max_radius_frac = 0.17f;
     p->border_frac = 0.1f;
     p->centre_prior = 20.0f;
-    /* both chosen on the even-numbered MRL images (docs/eyetrack.md) */
-    p->crop_centre_weight = 0.05f;
-    p->glint_weight = 0.3f;
     p->max_glints = FV_EYE_MAX_GLINTS;
 }
 
-fv_eye_tracker *fv_eye_create(const fv_eye_params *p)
+fv_eye_tracker *fv_eye_create(const fv_eye_params *p, fv_eye_mode mode)
 {
     fv_eye_tracker *t = calloc(1, sizeof *t);
     if (!t)
@@ -67,6 +36,7 @@ fv_eye_tracker *fv_eye_create(const fv_eye_params *p)
         t->p = *p;
     else
         fv_eye_default_params(&t->p);
+    t->mode = fv_eye_mode_name(mode) ? mode : FV_EYE_MODE_AUTO;
     if (t->p.max_glints < 0 || t->p.max_glints > FV_EYE_MAX_GLINTS)
         t->p.max_glints = FV_EYE_MAX_GLINTS;
     fv_dsp_init(&t->dsp, t->p.isa_mask);
@@ -116,7 +86,7 @@ static int scratch(fv_eye_tracker *t, int w, int h, fv_et_scratch *s)
  * the frame halved while its short side exceeds refine_max_side, never below the search
  * image's scale (lowres is free after the search). The result in full-resolution pixels; when
  * no dark region stands out in the window, the search's answer with no fit. */
-static void refine_pupil(const fv_eye_tracker *t, const fv_et_settings *set, const uint8_t *luma, int w, int h,
+static void refine_pupil(const fv_eye_tracker *t, const fv_eye_mode_settings *set, const uint8_t *luma, int w, int h,
                          ptrdiff_t stride, const fv_et_candidate *c, const fv_et_scratch *s, fv_et_pupil *p)
 {
     const int reuse = set->refine_on_search_image;
@@ -149,10 +119,10 @@ static void refine_pupil(const fv_eye_tracker *t, const fv_et_settings *set, con
  * centre) and toward a corneal reflection inside the box (it hides part of the pupil, and its
  * inpainted area looks less dark than the pupil, which pushes the box away from it), then on a
  * pixel centre again like the box it came from. */
-static void crop_centre(const fv_eye_tracker *t, const fv_et_settings *set, const uint8_t *luma, int w, int h,
-                        ptrdiff_t stride, const fv_et_candidate *c, fv_eye_result *r)
+static void crop_centre(const fv_eye_mode_settings *set, const uint8_t *luma, int w, int h, ptrdiff_t stride,
+                        const fv_et_candidate *c, fv_eye_result *r)
 {
-    const float a = fv_clampf(t->p.crop_centre_weight, 0.0f, 1.0f), gw = fv_clampf(t->p.glint_weight, 0.0f, 1.0f);
+    const float a = set->centre_weight, gw = set->glint_weight;
     float px = c->x + a * (0.5f * (float)w - c->x), py = c->y + a * (0.5f * (float)h - c->y);
     float gx, gy;
     if (gw > 0 && fv_et_bright_spot(luma, w, h, stride, c->x, c->y, c->r, set->spot_min_grey, &gx, &gy))
@@ -171,8 +141,8 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     fv_et_scratch s;
     if (scratch(t, w, h, &s))
         return -1;
-    const fv_et_settings *set =
-        fv_mini(w, h) <= FV_ET_SEARCH_MAX_SIDE ? &fv_et_crop_settings : &fv_et_headset_settings;
+    r->mode = fv_eye_resolve_mode(t->mode, w, h);
+    const fv_eye_mode_settings *set = fv_eye_mode_get_settings(r->mode);
 
     const fv_et_candidate c = fv_et_search(&t->dsp, &t->p, luma, w, h, stride, &s);
     if (!c.ok)
@@ -181,7 +151,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     refine_pupil(t, set, luma, w, h, stride, &c, &s, &p);
     const int ng = fv_et_find_glints(&t->dsp, luma, w, h, stride, &p, t->p.max_glints, s.work, s.stack, s.gl);
     if (set->report_box_centre) {
-        crop_centre(t, set, luma, w, h, stride, &c, r);
+        crop_centre(set, luma, w, h, stride, &c, r);
     } else if (p.fit) {
         r->pupil_x = (float)p.e.cx;
         r->pupil_y = (float)p.e.cy;

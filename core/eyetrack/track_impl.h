@@ -17,38 +17,6 @@
 #define FV_ET_SEARCH_MAX_SIDE 160 /* search image F: min side at most this */
 #define FV_ET_NRAYS 48            /* edge-point rays of the refinement */
 
-/* What tracking does differently in each mode (docs/eyetrack.md, "Detector"). */
-typedef struct fv_et_settings {
-    /* refinement (refine.c) */
-    int refine_on_search_image; /* refine on the (inpainted) search image, not the frame */
-    int refine_max_side;        /* else on the frame halved while its min side exceeds this
-                                   (never below the search image's scale) */
-    int window_side_div;        /* refine window half-size >= min(w, h) / this (0: 3r only) */
-    int reflect_grow_px;        /* reflections grown by this before inpainting the window, when
-                                   it is finer than the search image (1 px otherwise) */
-    int centroid_iters;         /* weighted-centroid iterations at most */
-    int box_grow_max;           /* times the search box may grow 1.4x while its surround is
-                                   still as dark as the pupil */
-    int smooth_rays;            /* rays run on the window smoothed by a 3x3 box */
-    float edge_search_px;       /* edge = steepest rise within +-this of the level crossing
-                                   (0: the crossing) */
-    float beyond_frac;          /* drop edge points with something brighter than iris + this
-                                   x (iris - pupil) within 0.5r beyond them (0: off) */
-    int lid_line;               /* cut a straight run of edge points (a lid) */
-    int ransac_iters;           /* 6-point RANSAC draws before the least-squares fit (0: a
-                                   median-radius cut instead) */
-    double ransac_grad_mincos;  /* RANSAC support: gradient within acos(this) of the normal */
-    double min_aspect;          /* fits flatter than b/a < this are rejected */
-    /* reported centre (track.c) */
-    int report_box_centre;      /* the search box's centre on a pixel centre, moved by the two
-                                   weights below; else the ellipse centre (or the centroid) */
-    float centre_weight;        /* that far toward the image centre */
-    float glint_weight;         /* that far toward the brightest spot within the box */
-    int spot_min_grey;          /* the spot: grey levels above the median of its ring */
-} fv_et_settings;
-
-extern const fv_et_settings fv_et_headset_settings, fv_et_crop_settings;
-
 typedef struct fv_et_history { /* running reference of the pupil (fv_track_frame only) */
     int n;
     float contrast, radius, inner, ring;
@@ -56,6 +24,7 @@ typedef struct fv_et_history { /* running reference of the pupil (fv_track_frame
 
 struct fv_eye_tracker {
     fv_eye_params p;
+    fv_eye_mode mode; /* as created: AUTO is resolved per frame */
     fv_dsp dsp;
     uint8_t *mem;
     size_t cap;
@@ -117,7 +86,7 @@ int fv_et_bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float 
 
 typedef struct fv_et_refine_args {
     const fv_dsp *dsp;
-    const fv_et_settings *set;
+    const fv_eye_mode_settings *set;
     const uint8_t *img; /* the image refined on (the frame, halved, or the search image) */
     int w, h;
     ptrdiff_t stride;
