@@ -35,13 +35,16 @@ static void usage(FILE *f)
             "  --out FILE         CSV output (written atomically)\n"
             "  --frames N         stop after N images / frames\n"
             "  --bench N          track each frame N times and report the median time per frame\n"
+            "  --mode auto|headset|crop  what the frames are: a headset eye camera's, or tight crops\n"
+            "                     around one eye (like the MRL set); auto (default) decides per frame:\n"
+            "                     crop when its short side is at most 160 px\n"
             "  --isa c|sse41|avx2|neon  cap the SIMD kernels (default: best available)\n"
             "  --quiet            no progress output\n"
             "  --help             this text\n");
 }
 
 enum { OPT_IMAGES = 1, OPT_VIDEO, OPT_DEVICE, OPT_OUT, OPT_FRAMES, OPT_BENCH, OPT_ISA, OPT_QUIET, OPT_CTRL, OPT_CSIZE,
-       OPT_HELP };
+       OPT_MODE, OPT_HELP };
 
 /* Ctrl-C ends a live capture cleanly (CSV committed, summary printed). */
 static volatile sig_atomic_t stop_requested;
@@ -124,6 +127,7 @@ int main(int argc, char **argv)
     fv_v4l2_config cam_cfg;
     fv_v4l2_config_default(&cam_cfg, NULL);
     unsigned isa_mask = ~0u;
+    fv_eye_mode mode = FV_EYE_MODE_AUTO;
     int quiet = 0;
     static const struct option opts[] = {
         {"images", required_argument, 0, OPT_IMAGES}, {"video", required_argument, 0, OPT_VIDEO},
@@ -131,7 +135,7 @@ int main(int argc, char **argv)
         {"frames", required_argument, 0, OPT_FRAMES}, {"bench", required_argument, 0, OPT_BENCH},
         {"isa", required_argument, 0, OPT_ISA}, {"quiet", no_argument, 0, OPT_QUIET},
         {"ctrl", required_argument, 0, OPT_CTRL}, {"camera-size", required_argument, 0, OPT_CSIZE},
-        {"help", no_argument, 0, OPT_HELP}, {0, 0, 0, 0}};
+        {"mode", required_argument, 0, OPT_MODE}, {"help", no_argument, 0, OPT_HELP}, {0, 0, 0, 0}};
     opterr = 0;
     int o;
     while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
@@ -148,6 +152,10 @@ int main(int argc, char **argv)
             else if (!strcmp(optarg, "avx2")) isa_mask = FV_ISA_SSE41 | FV_ISA_AVX2;
             else if (!strcmp(optarg, "neon")) isa_mask = FV_ISA_NEON;
             else fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", optarg);
+            break;
+        case OPT_MODE:
+            if (fv_eye_mode_parse(optarg, &mode))
+                fv_usage_error(prog, "--mode: '%s' is not one of auto, headset, crop", optarg);
             break;
         case OPT_QUIET: quiet = 1; break;
         case OPT_CTRL: {
@@ -195,7 +203,7 @@ int main(int argc, char **argv)
     fv_eye_params par;
     fv_eye_default_params(&par);
     par.isa_mask = isa_mask;
-    fv_eye_tracker *trk = fv_eye_create(&par);
+    fv_eye_tracker *trk = fv_eye_create(&par, mode);
     if (!trk)
         fv_fail(prog, FV_EXIT_FAIL, "out of memory");
     fv_afile out;

@@ -123,7 +123,7 @@ int fv_gazesrc_start(fv_gazesrc **out, const char *spec, const fv_calib *calib, 
         free(g);
         return -1;
     }
-    g->trk = fv_eye_create(NULL);
+    g->trk = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     if (!g->trk) {
         fv_eyesrc_close(g->src);
         free(g);

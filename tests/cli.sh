@@ -353,6 +353,15 @@ if $K --video $V --out "$T/track.csv" --quiet >"$T/out" 2>"$T/err"; then
 else
     bad "track good run failed: $(cat "$T/err")"
 fi
+# --mode: a bad value is one line and exit 2; auto (the default) gives the same CSV as no flag, and
+# so does headset on this 320x240 video (auto picks headset above a 160 px short side)
+expect_usage "track bad mode" "--mode: 'bogus' is not one of auto, headset, crop" $K --video $V --mode bogus --out "$T/k1.csv"
+for m in auto headset; do
+    if $K --video $V --mode $m --out "$T/track_$m.csv" --quiet >/dev/null 2>"$T/err" && cmp -s "$T/track.csv" "$T/track_$m.csv"; then ok
+    else bad "track --mode $m differs from no --mode: $(head -c 300 "$T/err")"; fi
+done
+if $K --video $V --mode crop --frames 3 --out "$T/track_crop.csv" --quiet >/dev/null 2>"$T/err" &&
+    [ "$(wc -l <"$T/track_crop.csv")" -eq 3 ]; then ok; else bad "track --mode crop: $(head -c 300 "$T/err")"; fi
 # fovea-replay's own Y4M (C420jpeg, 128x72, 2 frames) reads back
 if [ -s "$T/v.y4m" ] && $K --video "$T/v.y4m" --out "$T/v.csv" --quiet >"$T/out" 2>"$T/err"; then
     [ "$(wc -l <"$T/v.csv")" -eq 2 ] && ok || bad "track on the replay's C420jpeg video: $(cat "$T/v.csv")"

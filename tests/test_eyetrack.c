@@ -117,7 +117,7 @@ static void test_synthetic_clean(void **state)
     p.noise_sigma = 0;
     p.supersample = 2;
     uint8_t *img = malloc(W * H);
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     assert_non_null(t);
     enum { N = 9 };
     float err[N];
@@ -153,7 +153,7 @@ static void test_synthetic_noisy(void **state)
     fv_synth_default_params(&p, W, H);
     p.supersample = 2;
     uint8_t *img = malloc(W * H);
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     enum { N = 9 };
     float err[N];
     for (int i = 0; i < N; i++) {
@@ -200,7 +200,7 @@ static void test_partial_occlusion(void **state)
     fv_synth_default_params(&p, W, H);
     p.supersample = 2;
     uint8_t *img = malloc(W * H);
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     assert_non_null(img);
     assert_non_null(t);
     enum { N = 160 };
@@ -248,7 +248,7 @@ static void test_blinks(void **state)
     fv_synth_default_params(&p, W, H);
     p.supersample = 1;
     uint8_t *img = malloc(W * H);
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     /* open, closing, closed, opening, open */
     static const float open[] = { 1, 1, 1, 1, 0.3f, 0.0f, 0.0f, 0.0f, 0.3f, 1, 1 };
     const int n = (int)(sizeof open / sizeof open[0]);
@@ -279,7 +279,7 @@ static void test_blinks(void **state)
 static void test_bad_args(void **state)
 {
     (void)state;
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_AUTO);
     uint8_t img[64 * 64];
     memset(img, 128, sizeof img);
     fv_eye_result r;
@@ -301,7 +301,9 @@ static void test_robustness(void **state)
     (void)state;
     rng = 0x4444ull; /* each test its own draws, whatever runs before it */
     static const int sz[][2] = { { 8, 8 }, { 8, 300 }, { 300, 8 }, { 17, 13 }, { 161, 99 }, { 97, 161 }, { 640, 480 } };
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *ts[3]; /* every mode on every size */
+    for (int m = 0; m < 3; m++)
+        ts[m] = fv_eye_create(NULL, (fv_eye_mode)m);
     for (size_t k = 0; k < sizeof sz / sizeof sz[0]; k++) {
         const int w = sz[k][0], h = sz[k][1];
         const ptrdiff_t stride = w + 3;
@@ -316,8 +318,10 @@ static void test_robustness(void **state)
                                           : content == 3 ? (uint8_t)(x + y) : ((x / 3 + y / 3) & 1 ? 255 : 0);
                 }
             fv_eye_result r;
-            for (int mode = 0; mode < 2; mode++) {
-                assert_int_equal((mode ? fv_track_frame : fv_track_image)(t, img, w, h, stride, &r), 0);
+            for (int run = 0; run < 6; run++) {
+                fv_eye_tracker *t = ts[run / 2];
+                assert_int_equal((run % 2 ? fv_track_frame : fv_track_image)(t, img, w, h, stride, &r), 0);
+                assert_int_equal(r.mode, fv_eye_resolve_mode((fv_eye_mode)(run / 2), w, h));
                 assert_true(r.confidence >= 0.0f && r.confidence <= 1.0f);
                 assert_true(r.n_glints >= 0 && r.n_glints <= FV_EYE_MAX_GLINTS);
                 if (r.found)
@@ -328,6 +332,139 @@ static void test_robustness(void **state)
             free(buf);
         }
     }
+    for (int m = 0; m < 3; m++)
+        fv_eye_destroy(ts[m]);
+}
+
+/* ------------------------------------------------------------------ modes */
+
+/* Tracks one clean synthetic frame of w x h in mode m; the result, its error against the truth
+ * and the true pupil radius (pixels). */
+static fv_eye_result track_synth(fv_eye_mode m, int w, int h, float *err, float *r_px)
+{
+    fv_synth_params p;
+    fv_synth_default_params(&p, w, h);
+    p.noise_sigma = 0;
+    p.supersample = 2;
+    const fv_synth_state s = { 6.0f, -4.0f, 2.2f, 1.0f };
+    uint8_t *img = malloc((size_t)w * h);
+    assert_non_null(img);
+    fv_synth_truth gt;
+    fv_synth_render(&p, &s, 7u, img, w, &gt);
+    fv_eye_tracker *t = fv_eye_create(NULL, m);
+    assert_non_null(t);
+    fv_eye_result r;
+    assert_int_equal(fv_track_image(t, img, w, h, w, &r), 0);
+    fv_eye_destroy(t);
+    free(img);
+    *err = r.found ? hypotf(r.pupil_x - gt.pupil_x, r.pupil_y - gt.pupil_y) : INFINITY;
+    *r_px = gt.pupil_r_px;
+    return r;
+}
+
+/* AUTO is the size rule from before there were modes (crop up to a short side of 160 px,
+ * headset above) and tracks exactly as the mode it picks; explicit modes ignore the size. */
+static void test_mode_auto(void **state)
+{
+    (void)state;
+    static const int sz[][3] = { { 8, 8, FV_EYE_MODE_CROP },        { 160, 120, FV_EYE_MODE_CROP },
+                                 { 160, 4000, FV_EYE_MODE_CROP },   { 4000, 160, FV_EYE_MODE_CROP },
+                                 { 161, 161, FV_EYE_MODE_HEADSET }, { 161, 4000, FV_EYE_MODE_HEADSET },
+                                 { 640, 480, FV_EYE_MODE_HEADSET } };
+    for (size_t k = 0; k < sizeof sz / sizeof sz[0]; k++) {
+        const int w = sz[k][0], h = sz[k][1];
+        assert_int_equal(fv_eye_resolve_mode(FV_EYE_MODE_AUTO, w, h), sz[k][2]);
+        assert_int_equal(fv_eye_resolve_mode(FV_EYE_MODE_HEADSET, w, h), FV_EYE_MODE_HEADSET);
+        assert_int_equal(fv_eye_resolve_mode(FV_EYE_MODE_CROP, w, h), FV_EYE_MODE_CROP);
+    }
+    /* either side of the threshold, AUTO's result is the picked mode's to the bit (the result
+     * struct has no padding; the tracker zeroes it first) */
+    static const int fr[][3] = { { 160, 120, FV_EYE_MODE_CROP }, { 168, 162, FV_EYE_MODE_HEADSET } };
+    for (int k = 0; k < 2; k++) {
+        float ea, ep, rad;
+        const fv_eye_result ra = track_synth(FV_EYE_MODE_AUTO, fr[k][0], fr[k][1], &ea, &rad);
+        const fv_eye_result rp = track_synth((fv_eye_mode)fr[k][2], fr[k][0], fr[k][1], &ep, &rad);
+        assert_int_equal(ra.mode, fr[k][2]);
+        assert_true(ra.found);
+        assert_memory_equal(&ra, &rp, sizeof ra);
+    }
+}
+
+/* An explicit mode is honoured whatever the size: a crop-sized frame in headset mode takes the
+ * headset path (an ellipse fit, sub-pixel), a headset-sized one in crop mode the crop path (the
+ * box's centre on a pixel centre, pulled toward a glint: on a headset frame it is only
+ * inside the pupil, which is why headset cameras want headset mode). */
+static void test_mode_explicit(void **state)
+{
+    (void)state;
+    float e, rad;
+    fv_eye_result r = track_synth(FV_EYE_MODE_HEADSET, 160, 120, &e, &rad);
+    printf("[ eyetrack ] 160x120 in headset mode: error %.3f px, ellipse %d\n", (double)e, r.ellipse_fit);
+    assert_int_equal(r.mode, FV_EYE_MODE_HEADSET);
+    assert_int_equal(r.ellipse_fit, 1);
+    assert_true(e < 0.5f);
+    float ec;
+    const fv_eye_result rc = track_synth(FV_EYE_MODE_CROP, 160, 120, &ec, &rad);
+    assert_int_equal(rc.mode, FV_EYE_MODE_CROP);
+    assert_int_equal(rc.ellipse_fit, 0);
+    assert_true(r.pupil_x != rc.pupil_x || r.pupil_y != rc.pupil_y);
+
+    r = track_synth(FV_EYE_MODE_CROP, 320, 240, &e, &rad);
+    printf("[ eyetrack ] 320x240 in crop mode: error %.3f px, pupil radius %.1f px\n", (double)e, (double)rad);
+    assert_int_equal(r.mode, FV_EYE_MODE_CROP);
+    assert_true(r.found);
+    assert_int_equal(r.ellipse_fit, 0);
+    assert_true(r.pupil_x - floorf(r.pupil_x) == 0.5f && r.pupil_y - floorf(r.pupil_y) == 0.5f);
+    assert_true(e < rad);
+    assert_true(r.pupil_a_px > 0);
+}
+
+/* The crop mode's settings are the ones tuned on the MRL crops (docs/eyetrack.md); the names
+ * round-trip. */
+static void test_mode_settings(void **state)
+{
+    (void)state;
+    const fv_eye_mode_settings *c = fv_eye_mode_get_settings(FV_EYE_MODE_CROP);
+    assert_ptr_equal(c, &fv_eye_crop_settings);
+    assert_int_equal(c->mode, FV_EYE_MODE_CROP);
+    assert_true(c->centre_weight == 0.05f);
+    assert_true(c->glint_weight == 0.3f);
+    assert_int_equal(c->spot_min_grey, 20);
+    assert_int_equal(c->report_box_centre, 1);
+    assert_int_equal(c->refine_on_search_image, 1);
+    assert_int_equal(c->centroid_iters, 2);
+    assert_true(c->min_aspect == 0.3);
+    assert_int_equal(c->ransac_iters, 0);
+    const fv_eye_mode_settings *hs = fv_eye_mode_get_settings(FV_EYE_MODE_HEADSET);
+    assert_ptr_equal(hs, &fv_eye_headset_settings);
+    assert_int_equal(hs->mode, FV_EYE_MODE_HEADSET);
+    assert_int_equal(hs->report_box_centre, 0);
+    assert_true(hs->centre_weight == 0.0f && hs->glint_weight == 0.0f);
+    assert_int_equal(hs->refine_max_side, 320);
+    assert_int_equal(hs->ransac_iters, 64);
+    assert_true(hs->min_aspect == 0.6);
+    assert_null(fv_eye_mode_get_settings(FV_EYE_MODE_AUTO));
+    static const char *names[] = { "auto", "headset", "crop" };
+    for (int m = 0; m < 3; m++) {
+        fv_eye_mode got = FV_EYE_MODE_CROP;
+        assert_string_equal(fv_eye_mode_name((fv_eye_mode)m), names[m]);
+        assert_int_equal(fv_eye_mode_parse(names[m], &got), 0);
+        assert_int_equal(got, m);
+    }
+    fv_eye_mode got = FV_EYE_MODE_HEADSET;
+    assert_int_equal(fv_eye_mode_parse("Crop", &got), -1);
+    assert_int_equal(fv_eye_mode_parse("", &got), -1);
+    assert_int_equal(fv_eye_mode_parse(NULL, &got), -1);
+    assert_int_equal(got, FV_EYE_MODE_HEADSET);
+    assert_null(fv_eye_mode_name((fv_eye_mode)7));
+    /* an unknown mode at creation falls back to AUTO */
+    fv_eye_tracker *t = fv_eye_create(NULL, (fv_eye_mode)7);
+    assert_non_null(t);
+    uint8_t img[64 * 64];
+    memset(img, 128, sizeof img);
+    fv_eye_result r;
+    assert_int_equal(fv_track_image(t, img, 64, 64, 64, &r), 0);
+    assert_int_equal(r.mode, FV_EYE_MODE_CROP);
     fv_eye_destroy(t);
 }
 
@@ -449,7 +586,7 @@ static void test_end_to_end(void **state)
     p.supersample = 2;
     p.noise_sigma = 3.0f;
     uint8_t *img = malloc(W * H);
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     /* calibration: the 3x3 targets, 2 frames each, pupil size drifting */
     enum { PER = 2, NC = 9 * PER, NT = 12 };
     float ty[9], tp[9], gx[NC], gy[NC], px[NC], py[NC], yaw[NC], pitch[NC];
@@ -584,7 +721,7 @@ static void test_bundled_video(void **state)
     assert_non_null(f);
     char line[2048];
     assert_non_null(fgets(line, sizeof line, f)); /* header */
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     float err_px[512];
     int n_open = 0, vis = 0, matched = 0, closed = 0, closed_flagged = 0, open_ok = 0, frames = 0;
     fv_eye_frame fr;
@@ -682,7 +819,8 @@ static void test_mrl_subset(void **state)
     unlink(sub); /* read in full by the open */
     if (orc)
         fail_msg("%s", err);
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    /* auto, as fovea-track by default: the few crops over 160 px take the headset path */
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_AUTO);
     int n = 0, w3 = 0, w5 = 0, found = 0;
     fv_eye_frame fr;
     int rc;
@@ -710,6 +848,9 @@ int main(void)
         cmocka_unit_test(test_ellipse_fit),
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_robustness),
+        cmocka_unit_test(test_mode_auto),
+        cmocka_unit_test(test_mode_explicit),
+        cmocka_unit_test(test_mode_settings),
         cmocka_unit_test(test_synthetic_clean),
         cmocka_unit_test(test_synthetic_noisy),
         cmocka_unit_test(test_partial_occlusion),

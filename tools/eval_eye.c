@@ -4,12 +4,14 @@
  * made at any size: gaze +-20 deg, pupil 1.6-2.8 mm, 2-6 LEDs, sensor noise 2-14 grey levels,
  * brightness 0.55-1; every other frame looks up (3-13 deg) into a lid opened 0.35-0.65.
  *
- *   build/tools/eval_eye [--size WxH] [--frames N] [--seed N] [--history]
+ *   build/tools/eval_eye [--size WxH] [--frames N] [--seed N] [--history] [--mode M]
  *
  * --history: each frame is tracked with fv_track_frame after the tracker (reset) has seen the
  * same eye with the lids open for 4 frames, as a headset sees it before the lid comes down;
  * without it, fv_track_image (no history). A frame flagged BLINK counts as a miss.
  * --frames 160 is the set tests/test_eyetrack.c bounds (test_partial_occlusion).
+ * --mode: the tracker's mode (auto, headset, crop); headset by default, the frames being a
+ * headset camera's at any size.
  *
  * Prints, per bin (full view, 70-99%, 50-70% in view; frames under 50% are skipped), the
  * frames, median / p90 / max error in pixels and the share within 1 and 3 px, and the time
@@ -35,7 +37,8 @@ static void usage(FILE *f)
                "  --size WxH   frame size (default 320x240; 64..4096 each side)\n"
                "  --frames N   frames drawn before the visibility split (default 400; 1..100000)\n"
                "  --seed N     random set (default 1)\n"
-               "  --history    track each frame after 4 open-eye frames of the same eye\n",
+               "  --history    track each frame after 4 open-eye frames of the same eye\n"
+               "  --mode M     tracker mode: headset (default), crop or auto\n",
             prog);
 }
 
@@ -66,10 +69,12 @@ int main(int argc, char **argv)
     int w = 320, h = 240, frames = 400;
     long seed = 1;
     int history = 0;
+    fv_eye_mode mode = FV_EYE_MODE_HEADSET;
     static const struct option opts[] = { { "size", required_argument, 0, 's' },
                                           { "frames", required_argument, 0, 'n' },
                                           { "seed", required_argument, 0, 'r' },
                                           { "history", no_argument, 0, 'H' },
+                                          { "mode", required_argument, 0, 'm' },
                                           { "help", no_argument, 0, 'h' },
                                           { 0, 0, 0, 0 } };
     int c;
@@ -85,6 +90,10 @@ int main(int argc, char **argv)
         case 'n': frames = (int)num("bad --frames (1..100000)", optarg, 1, 100000); break;
         case 'r': seed = num("bad --seed", optarg, 0, 0x7fffffffL); break;
         case 'H': history = 1; break;
+        case 'm':
+            if (fv_eye_mode_parse(optarg, &mode))
+                bad("bad --mode (auto, headset, crop)", optarg);
+            break;
         case 'h': usage(stdout); return 0;
         default: bad("unknown option or missing argument", argv[optind - 1]);
         }
@@ -98,7 +107,7 @@ int main(int argc, char **argv)
     float *err[3];
     for (int b = 0; b < 3; b++)
         err[b] = malloc(sizeof(float) * (size_t)frames);
-    fv_eye_tracker *t = fv_eye_create(NULL);
+    fv_eye_tracker *t = fv_eye_create(NULL, mode);
     if (!img || !err[0] || !err[1] || !err[2] || !t) {
         fprintf(stderr, "%s: out of memory\n", prog);
         return 1;
@@ -137,8 +146,9 @@ int main(int argc, char **argv)
     }
     if (progress)
         fprintf(stderr, "\r%*s\r", 40, "");
-    printf("%s: %dx%d, %d frames drawn, seed %ld%s\n", prog, w, h, frames, seed,
-           history ? ", after 4 open-eye frames" : "");
+    printf("%s: %dx%d, %d frames drawn, seed %ld%s%s%s\n", prog, w, h, frames, seed,
+           history ? ", after 4 open-eye frames" : "", mode == FV_EYE_MODE_HEADSET ? "" : ", mode ",
+           mode == FV_EYE_MODE_HEADSET ? "" : fv_eye_mode_name(mode));
     static const char *names[3] = { "full view", "70-99% in view", "50-70% in view" };
     for (int b = 0; b < 3; b++) {
         if (!n[b]) {

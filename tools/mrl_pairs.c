@@ -3,7 +3,8 @@
  * absolute difference at most --mad grey levels after the best whole-pixel shift of up to +-4
  * px) and compares their labels (the second image's label moved by that shift): two labels of
  * the same picture should agree. With --track (a fovea-track CSV of the same list) it does the
- * same for the detections, and reports the detections' error on the pairs whose labels agree.
+ * same for the detections, and reports the detections' error on the pairs whose labels agree
+ * (the figures in docs/eyetrack.md are from fovea-track's default --mode auto).
  *
  *   build/tools/mrl_pairs ../shared/assets/eyes/mrl-dev/pupil.txt [--track out.csv]
  *

@@ -421,7 +421,7 @@ static int cmd_v4l2(int argc, char **argv)
     fprintf(stderr, "fovea-hil: capture: %s\n", desc);
     close(cfd);
 
-    fv_eye_tracker *trk = fv_eye_create(NULL);
+    fv_eye_tracker *trk = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
     double *errs = malloc((size_t)frames * sizeof *errs);
     if (!trk || !errs)
         return 1;
