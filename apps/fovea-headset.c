@@ -75,8 +75,10 @@ typedef struct app {
     int back;
     int64_t t_start_ns, end_ns;
     fv_gaze_ring *ring;
-    int reported_vsync, reported_cam;
+    int reported_vsync, reported_cam, reported_scale;
     long display_failures;
+    long frame;        /* frames rendered (the frame loop's numbering) */
+    int render_failed; /* a render failed: the run ends with status 1 */
 } app;
 
 static int64_t a_now(void *c)
@@ -143,15 +145,22 @@ static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
     const float gx = g ? g->x : 0.5f, gy = g ? g->y : 0.5f;
     /* the focus filter accommodates in photon time; a doubtful gaze widens the fovea */
     fv_pipeline_set_time_ns(a->pl, t_ns);
-    fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(g ? g->confidence : 0.0f));
+    if (fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(g ? g->confidence : 0.0f)) && !a->reported_scale) {
+        fprintf(stderr, "%s: no memory to widen the fovea for a doubtful gaze; keeping its size\n", prog);
+        a->reported_scale = 1;
+    }
     uint8_t *dst = a->img[a->back];
     for (int e = 0; e < 2; e++) {
         const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
         fv_frame_stats st;
-        if (fv_pipeline_render(a->pl, eye, &head, gx, gy, &st))
+        if (fv_pipeline_render(a->pl, eye, &head, gx, gy, &st)) {
+            fprintf(stderr, "%s: frame %ld (%s eye): rendering failed\n", prog, a->frame, e ? "right" : "left");
+            a->render_failed = 1;
             return -1;
+        }
         fv_pipeline_to_rgb8(a->pl, eye, dst + (size_t)e * a->W * 3, (ptrdiff_t)a->W * 6);
     }
+    a->frame++;
     return 0;
 }
 static int a_present(void *c, int which, int64_t vsync_ns)
@@ -298,15 +307,25 @@ int main(int argc, char **argv)
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)a.W / (float)a.H, a.view.pos, a.view.quat);
     a.pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
     fv_gaze_ring ring;
-    fv_gaze_ring_init(&ring);
+    if (fv_gaze_ring_init(&ring)) {
+        fv_pipeline_destroy(a.pl);
+        fv_scene_free(scene);
+        fv_display_close(a.disp, NULL, 0);
+        fv_vsync_close(a.vsync);
+        fv_trace_free(&tr);
+        fv_fail(prog, FV_EXIT_FAIL, "cannot create the gaze ring's lock");
+    }
     a.ring = &ring;
     if (a.pl && have_camera) {
         /* gaze maps to the left eye's image (the one the trace format describes) */
         fv_camera_desc cd = cfg.cam;
         cd.eye = FV_EYE_LEFT;
         fv_camera lc;
-        fv_camera_setup(&lc, &cd, &a.view);
-        if (fv_gazesrc_start(&a.cam, camera, calib_path ? &calib : NULL, &lc, cam_fps, &ring, err, sizeof err)) {
+        if (fv_camera_setup(&lc, &cd, &a.view)) {
+            snprintf(err, sizeof err, "the left eye's camera for the gaze mapping: bad size or field of view");
+            fv_pipeline_destroy(a.pl);
+            a.pl = NULL;
+        } else if (fv_gazesrc_start(&a.cam, camera, calib_path ? &calib : NULL, &lc, cam_fps, &ring, err, sizeof err)) {
             fv_pipeline_destroy(a.pl);
             a.pl = NULL;
         }
@@ -364,7 +383,7 @@ int main(int argc, char **argv)
             fv_prof_frame_markers(prof, rec[nrec].frame, rec[nrec].ray_start_ns, rec[nrec].photon_ns, rec[nrec].late);
         nrec++;
     }
-    status = FV_EXIT_OK;
+    status = a.render_failed ? FV_EXIT_FAIL : FV_EXIT_OK; /* the summary of the frames shown, either way */
     /* the summary: the first frames (acquiring the line, the first renders' cold caches still in
      * the 16-frame budget) left out */
     const long skip = nrec > 40 ? 20 : 0;

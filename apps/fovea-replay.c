@@ -246,7 +246,10 @@ int main(int argc, char **argv)
                 fv_camera_desc cd = cfg.cam;
                 fv_camera cam;
                 cd.eye = eye;
-                fv_camera_setup(&cam, &cd, &head); /* the size and FOV passed fv_pipeline_create */
+                if (fv_camera_setup(&cam, &cd, &head)) { /* (the size and FOV passed fv_pipeline_create) */
+                    fprintf(stderr, "%s: frame %ld%s: the reference's camera setup failed\n", prog, f, eye_name(eye));
+                    goto done;
+                }
                 if (e == 0 && !focus_given) { /* the first eye's depth at the point of regard, for both */
                     refp.focus_m = fv_reference_depth_at(scene, &cam, fv_gaze_px(smp.gaze_x, W),
                                                          fv_gaze_px(smp.gaze_y, H));
