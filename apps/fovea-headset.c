@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "benchio.h"
 #include "calibfile.h"
 #include "cli.h"
 #include "display.h"
@@ -182,36 +183,6 @@ static int a_present(void *c, int which, int64_t vsync_ns)
     }
     a->back ^= 1;
     return 0;
-}
-
-static void write_csv(const char *path, const fv_frame_record *r, long n, int64_t t0, char *err, size_t err_len,
-                      int *ok)
-{
-    fv_afile f;
-    *ok = 0;
-    if (fv_afile_open(&f, path, err, err_len))
-        return;
-    fprintf(f.f, "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,render_ms,late,"
-                 "photon_edge,vsync_state,budget_ms,gaze_x,gaze_y\n");
-#define MS(t) ((double)((t) - t0) * 1e-6)
-    for (long i = 0; i < n; i++) {
-        const fv_frame_record *q = &r[i];
-        fprintf(f.f, "%ld,", q->frame);
-        if (q->has_gaze)
-            fprintf(f.f, "%.3f", MS(q->gaze_t_ns));
-        fprintf(f.f, ",%.3f,%.3f,%.3f,%.3f,", MS(q->ray_start_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
-        if (q->has_gaze)
-            fprintf(f.f, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
-        fprintf(f.f, ",%.3f,%d,%d,%s,%.3f,", (double)(q->done_ns - q->ray_start_ns) * 1e-6, q->late, q->photon_edge,
-                fv_vsync_state_name(q->vsync_state), (double)q->budget_ns * 1e-6);
-        if (q->has_gaze)
-            fprintf(f.f, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
-        else
-            fputc(',', f.f);
-        fputc('\n', f.f);
-    }
-#undef MS
-    *ok = !fv_afile_commit(&f, err, err_len);
 }
 
 int main(int argc, char **argv)
@@ -406,9 +377,7 @@ int main(int argc, char **argv)
         printf("  camera: %ld frames tracked%s\n", fv_gazesrc_frames(a.cam),
                fv_gazesrc_failed(a.cam) ? " (failed mid-run)" : "");
     if (csv_path) {
-        int ok;
-        write_csv(csv_path, rec, nrec, a.t_start_ns, err, sizeof err, &ok);
-        if (!ok) {
+        if (fv_latency_csv_write(csv_path, rec, nrec, a.t_start_ns, err, sizeof err)) {
             fprintf(stderr, "%s: %s\n", prog, err);
             status = FV_EXIT_FAIL;
         }

@@ -8,7 +8,9 @@
 
 #include "base/err.h"
 #include "dsp.h"
+#include "output.h"
 #include "perfctr.h"
+#include "vsyncpred.h"
 
 _Static_assert(FV_PERF_N <= FV_BENCH_MAX_CTRS, "fv_bench_run holds too few counters");
 
@@ -342,4 +344,33 @@ void fv_stats_csv_row(FILE *f, long frame, double t_ms, float gaze_x, float gaze
     csv_num(f, q->flicker_periph, "%.4f");
     csv_num(f, focus_m, "%.4f");
     fputc('\n', f);
+}
+
+/* ---- fovea-headset's latency CSV ---- */
+int fv_latency_csv_write(const char *path, const fv_frame_record *r, long n, int64_t t0, char *err, size_t err_len)
+{
+    fv_afile f;
+    if (fv_afile_open(&f, path, err, err_len))
+        return -1;
+    fprintf(f.f, "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,render_ms,late,"
+                 "photon_edge,vsync_state,budget_ms,gaze_x,gaze_y\n");
+#define MS(t) ((double)((t) - t0) * 1e-6)
+    for (long i = 0; i < n; i++) {
+        const fv_frame_record *q = &r[i];
+        fprintf(f.f, "%ld,", q->frame);
+        if (q->has_gaze)
+            fprintf(f.f, "%.3f", MS(q->gaze_t_ns));
+        fprintf(f.f, ",%.3f,%.3f,%.3f,%.3f,", MS(q->ray_start_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
+        if (q->has_gaze) /* empty without a gaze sample */
+            fprintf(f.f, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
+        fprintf(f.f, ",%.3f,%d,%d,%s,%.3f,", (double)(q->done_ns - q->ray_start_ns) * 1e-6, q->late, q->photon_edge,
+                fv_vsync_state_name(q->vsync_state), (double)q->budget_ns * 1e-6);
+        if (q->has_gaze)
+            fprintf(f.f, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
+        else
+            fputc(',', f.f);
+        fputc('\n', f.f);
+    }
+#undef MS
+    return fv_afile_commit(&f, err, err_len);
 }

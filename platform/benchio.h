@@ -1,7 +1,7 @@
 /* fovea platform: the bench's and the replay's measuring and reporting (core/bench.h holds the
  * arithmetic): timed runs with hardware counters (perf_event_open), the load average, the
  * fovea-bench table, roofline and counter printouts and its JSON (docs/bench.schema.json), and
- * fovea-replay's stats.csv lines. Formats are the programs' contract: tests/cli.sh and
+ * fovea-replay's stats.csv lines, fovea-headset's latency CSV. Formats are the programs' contract: tests/cli.sh and
  * tools/check_schema.py check them. */
 #ifndef FOVEA_BENCHIO_H
 #define FOVEA_BENCHIO_H
@@ -9,6 +9,7 @@
 #include <stdio.h>
 
 #include "bench.h"
+#include "frameloop.h"
 #include "prof.h"
 #include "quality.h"
 #include "scene.h"
@@ -64,5 +65,10 @@ void fv_bench_write_json(FILE *f, const fv_bench_report *rep);
 void fv_stats_csv_header(FILE *f);
 void fv_stats_csv_row(FILE *f, long frame, double t_ms, float gaze_x, float gaze_y, const fv_frame_stats *sum,
                       const fv_quality_row *q, double focus_m);
+
+/* fovea-headset's --latency-csv: one line per frame record, times in ms since t0_ns; written
+ * atomically. 0, or -1 with a reason. */
+int fv_latency_csv_write(const char *path, const fv_frame_record *r, long n, int64_t t0_ns, char *err,
+                         size_t err_len);
 
 #endif

@@ -5,11 +5,13 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "testutil.h"
 #include "bench.h"
 #include "benchio.h"
 #include "quality.h"
+#include "vsyncpred.h"
 
 #define assert_near(a, b, eps) assert_true(fabs((double)(a) - (double)(b)) <= (eps))
 
@@ -341,13 +343,51 @@ static void test_report_lines(void **state)
     free(buf);
 }
 
+/* --latency-csv: times in ms from t0; the gaze fields empty for a frame without a gaze sample */
+static void test_latency_csv(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/fv_latXXXXXX", path[64], line[2][256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/lat.csv", dir);
+    const int64_t t0 = 1000000000;
+    fv_frame_record r[2];
+    memset(r, 0, sizeof r);
+    r[0].frame = 0, r[0].has_gaze = 1, r[0].gaze_t_ns = t0 + 1000000, r[0].ray_start_ns = t0 + 2000000;
+    r[0].done_ns = t0 + 9500000, r[0].target_ns = t0 + 11111111, r[0].photon_ns = t0 + 11111111;
+    r[0].late = 0, r[0].photon_edge = 1, r[0].budget_ns = 8000000, r[0].gaze_x = 0.25f, r[0].gaze_y = 0.5f;
+    r[1] = r[0];
+    r[1].frame = 1, r[1].has_gaze = 0, r[1].late = 1;
+    char err[256];
+    assert_int_equal(fv_latency_csv_write(path, r, 2, t0, err, sizeof err), 0);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    assert_non_null(fgets(line[0], sizeof line[0], f));
+    assert_string_equal(line[0], "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,"
+                                 "render_ms,late,photon_edge,vsync_state,budget_ms,gaze_x,gaze_y\n");
+    assert_non_null(fgets(line[0], sizeof line[0], f));
+    assert_non_null(fgets(line[1], sizeof line[1], f));
+    fclose(f);
+    char want[2][256];
+    snprintf(want[0], sizeof want[0], "0,1.000,2.000,9.500,11.111,11.111,10.111,7.500,0,1,%s,8.000,0.2500,0.5000\n",
+             fv_vsync_state_name(0));
+    snprintf(want[1], sizeof want[1], "1,,2.000,9.500,11.111,11.111,,7.500,1,1,%s,8.000,,\n", fv_vsync_state_name(0));
+    assert_string_equal(line[0], want[0]);
+    assert_string_equal(line[1], want[1]);
+    remove(path);
+    snprintf(path, sizeof path, "%s/no/such/dir/lat.csv", dir);
+    assert_int_equal(fv_latency_csv_write(path, r, 2, t0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "lat.csv"));
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_median),       cmocka_unit_test(test_stage_means), cmocka_unit_test(test_stats_sum),
         cmocka_unit_test(test_counter_hook), cmocka_unit_test(test_roofline),    cmocka_unit_test(test_sweep_parse),
         cmocka_unit_test(test_head_at),      cmocka_unit_test(test_copy_gbps),   cmocka_unit_test(test_mean_acc),
-        cmocka_unit_test(test_quality),      cmocka_unit_test(test_report_lines),
+        cmocka_unit_test(test_quality),      cmocka_unit_test(test_report_lines), cmocka_unit_test(test_latency_csv),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
