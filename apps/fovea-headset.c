@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "benchio.h"
 #include "calibfile.h"
 #include "cli.h"
 #include "display.h"
@@ -75,8 +76,10 @@ typedef struct app {
     int back;
     int64_t t_start_ns, end_ns;
     fv_gaze_ring *ring;
-    int reported_vsync, reported_cam;
+    int reported_vsync, reported_cam, reported_scale;
     long display_failures;
+    long frame;        /* frames rendered (the frame loop's numbering) */
+    int render_failed; /* a render failed: the run ends with status 1 */
 } app;
 
 static int64_t a_now(void *c)
@@ -143,15 +146,22 @@ static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
     const float gx = g ? g->x : 0.5f, gy = g ? g->y : 0.5f;
     /* the focus filter accommodates in photon time; a doubtful gaze widens the fovea */
     fv_pipeline_set_time_ns(a->pl, t_ns);
-    fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(g ? g->confidence : 0.0f));
+    if (fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(g ? g->confidence : 0.0f)) && !a->reported_scale) {
+        fprintf(stderr, "%s: no memory to widen the fovea for a doubtful gaze; keeping its size\n", prog);
+        a->reported_scale = 1;
+    }
     uint8_t *dst = a->img[a->back];
     for (int e = 0; e < 2; e++) {
         const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
         fv_frame_stats st;
-        if (fv_pipeline_render(a->pl, eye, &head, gx, gy, &st))
+        if (fv_pipeline_render(a->pl, eye, &head, gx, gy, &st)) {
+            fprintf(stderr, "%s: frame %ld (%s eye): rendering failed\n", prog, a->frame, e ? "right" : "left");
+            a->render_failed = 1;
             return -1;
+        }
         fv_pipeline_to_rgb8(a->pl, eye, dst + (size_t)e * a->W * 3, (ptrdiff_t)a->W * 6);
     }
+    a->frame++;
     return 0;
 }
 static int a_present(void *c, int which, int64_t vsync_ns)
@@ -173,36 +183,6 @@ static int a_present(void *c, int which, int64_t vsync_ns)
     }
     a->back ^= 1;
     return 0;
-}
-
-static void write_csv(const char *path, const fv_frame_record *r, long n, int64_t t0, char *err, size_t err_len,
-                      int *ok)
-{
-    fv_afile f;
-    *ok = 0;
-    if (fv_afile_open(&f, path, err, err_len))
-        return;
-    fprintf(f.f, "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,render_ms,late,"
-                 "photon_edge,vsync_state,budget_ms,gaze_x,gaze_y\n");
-#define MS(t) ((double)((t) - t0) * 1e-6)
-    for (long i = 0; i < n; i++) {
-        const fv_frame_record *q = &r[i];
-        fprintf(f.f, "%ld,", q->frame);
-        if (q->has_gaze)
-            fprintf(f.f, "%.3f", MS(q->gaze_t_ns));
-        fprintf(f.f, ",%.3f,%.3f,%.3f,%.3f,", MS(q->ray_start_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
-        if (q->has_gaze)
-            fprintf(f.f, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
-        fprintf(f.f, ",%.3f,%d,%d,%s,%.3f,", (double)(q->done_ns - q->ray_start_ns) * 1e-6, q->late, q->photon_edge,
-                fv_vsync_state_name(q->vsync_state), (double)q->budget_ns * 1e-6);
-        if (q->has_gaze)
-            fprintf(f.f, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
-        else
-            fputc(',', f.f);
-        fputc('\n', f.f);
-    }
-#undef MS
-    *ok = !fv_afile_commit(&f, err, err_len);
 }
 
 int main(int argc, char **argv)
@@ -298,15 +278,25 @@ int main(int argc, char **argv)
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)a.W / (float)a.H, a.view.pos, a.view.quat);
     a.pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
     fv_gaze_ring ring;
-    fv_gaze_ring_init(&ring);
+    if (fv_gaze_ring_init(&ring)) {
+        fv_pipeline_destroy(a.pl);
+        fv_scene_free(scene);
+        fv_display_close(a.disp, NULL, 0);
+        fv_vsync_close(a.vsync);
+        fv_trace_free(&tr);
+        fv_fail(prog, FV_EXIT_FAIL, "cannot create the gaze ring's lock");
+    }
     a.ring = &ring;
     if (a.pl && have_camera) {
         /* gaze maps to the left eye's image (the one the trace format describes) */
         fv_camera_desc cd = cfg.cam;
         cd.eye = FV_EYE_LEFT;
         fv_camera lc;
-        fv_camera_setup(&lc, &cd, &a.view);
-        if (fv_gazesrc_start(&a.cam, camera, calib_path ? &calib : NULL, &lc, cam_fps, &ring, err, sizeof err)) {
+        if (fv_camera_setup(&lc, &cd, &a.view)) {
+            snprintf(err, sizeof err, "the left eye's camera for the gaze mapping: bad size or field of view");
+            fv_pipeline_destroy(a.pl);
+            a.pl = NULL;
+        } else if (fv_gazesrc_start(&a.cam, camera, calib_path ? &calib : NULL, &lc, cam_fps, &ring, err, sizeof err)) {
             fv_pipeline_destroy(a.pl);
             a.pl = NULL;
         }
@@ -364,7 +354,7 @@ int main(int argc, char **argv)
             fv_prof_frame_markers(prof, rec[nrec].frame, rec[nrec].ray_start_ns, rec[nrec].photon_ns, rec[nrec].late);
         nrec++;
     }
-    status = FV_EXIT_OK;
+    status = a.render_failed ? FV_EXIT_FAIL : FV_EXIT_OK; /* the summary of the frames shown, either way */
     /* the summary: the first frames (acquiring the line, the first renders' cold caches still in
      * the 16-frame budget) left out */
     const long skip = nrec > 40 ? 20 : 0;
@@ -387,9 +377,7 @@ int main(int argc, char **argv)
         printf("  camera: %ld frames tracked%s\n", fv_gazesrc_frames(a.cam),
                fv_gazesrc_failed(a.cam) ? " (failed mid-run)" : "");
     if (csv_path) {
-        int ok;
-        write_csv(csv_path, rec, nrec, a.t_start_ns, err, sizeof err, &ok);
-        if (!ok) {
+        if (fv_latency_csv_write(csv_path, rec, nrec, a.t_start_ns, err, sizeof err)) {
             fprintf(stderr, "%s: %s\n", prog, err);
             status = FV_EXIT_FAIL;
         }

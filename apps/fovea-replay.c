@@ -7,10 +7,15 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "bench.h"
+#include "benchio.h"
 #include "cli.h"
-#include "metrics.h"
+#include "display.h"
 #include "output.h"
 #include "pipeline.h"
+#include "prof.h"
+#include "proftrace.h"
+#include "quality.h"
 #include "reference.h"
 #include "scene.h"
 #include "tracefile.h"
@@ -18,9 +23,6 @@
 #include "proftrace.h"
 
 static const char *prog = "fovea-replay";
-
-/* A normalised gaze coordinate in pixels (as the pipeline centres its pattern). */
-static float smp_gaze_px(float g, int size) { return floorf(g * (float)size) + 0.5f; }
 
 static void usage(FILE *f)
 {
@@ -45,7 +47,8 @@ static void usage(FILE *f)
             "                     is the view depth at the point of regard)\n"
             "  --trace-out FILE   write a Chrome trace-event JSON of the run (Perfetto,\n"
             "                     chrome://tracing): worker, stage and ray-tile tracks, frame markers\n"
-            "  --window           show frames in a window (not built yet)\n"
+            "  --window           also show each frame in a window (SDL2) as it is rendered; closing\n"
+            "                     it (or Esc) ends the run early\n"
             "  --quiet            no progress output\n" FV_COMMON_HELP "  --help             this text\n");
 }
 
@@ -80,27 +83,8 @@ static void render_reference(const fv_scene *scene, const fv_camera *cam, const 
     rp->base += ref_tiles(cam->width, cam->height);
 }
 
-/* Mean of the finite values of a column (NAN when there are none). */
-typedef struct {
-    double sum;
-    long n, inf; /* inf: PSNR of identical images, left out of the mean */
-} mean_acc;
-static void mean_add(mean_acc *m, double v)
-{
-    if (isfinite(v)) {
-        m->sum += v;
-        m->n++;
-    } else if (isinf(v)) {
-        m->inf++;
-    }
-}
-static double mean_get(const mean_acc *m) { return m->n ? m->sum / (double)m->n : m->inf ? INFINITY : NAN; }
-static void csv_num(FILE *f, double v, const char *fmt)
-{
-    fputc(',', f);
-    if (!isnan(v))
-        fprintf(f, fmt, v); /* inf prints as inf: identical images */
-}
+/* The eye's name in messages: "" for the single centre eye. */
+static const char *eye_name(fv_eye e) { return e == FV_EYE_LEFT ? " (left eye)" : e == FV_EYE_RIGHT ? " (right eye)" : ""; }
 
 int main(int argc, char **argv)
 {
@@ -108,7 +92,7 @@ int main(int argc, char **argv)
     fv_pipeline_config_default(&cfg);
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
-    int stereo = 0, quiet = 0, vs_full = 0;
+    int stereo = 0, quiet = 0, vs_full = 0, window = 0;
     fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
     float hz = 90.0f;
     static const struct option opts[] = {
@@ -136,7 +120,7 @@ int main(int argc, char **argv)
         case OPT_VS_FULL: vs_full = 1; break;
         case OPT_TRACE_OUT: prof_path = optarg; break;
         case OPT_REF: refp.spp = (int)fv_arg_long(prog, "--reference", optarg, 1, 65536); break;
-        case OPT_WINDOW: fv_usage_error(prog, "--window: the window display is not built yet; use --out / --y4m");
+        case OPT_WINDOW: window = 1; break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
@@ -168,7 +152,7 @@ int main(int argc, char **argv)
         fv_trace_free(&tr);
         fv_usage_error(prog, "%s", err);
     }
-    int W = cfg.cam.width, H = cfg.cam.height;
+    const int W = cfg.cam.width, H = cfg.cam.height, outw = stereo ? 2 * W : W;
     fv_pose view;
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)W / (float)H, view.pos, view.quat);
     fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err), *ref = NULL;
@@ -177,10 +161,18 @@ int main(int argc, char **argv)
         rc.samp.full = 1;
         ref = fv_pipeline_create(scene, &rc, err, sizeof err);
     }
-    if (!pl || (vs_full && !ref)) {
+    /* --window: no display (or no SDL2 in this build) is bad input, caught before any output */
+    fv_display *disp = NULL;
+    char werr[512];
+    const int no_window = pl && (!vs_full || ref) && window &&
+                          fv_display_open(&disp, "window", outw, H, (int)lrintf(hz), werr, sizeof werr);
+    if (!pl || (vs_full && !ref) || no_window) {
+        fv_pipeline_destroy(ref);
         fv_pipeline_destroy(pl);
         fv_scene_free(scene);
         fv_trace_free(&tr);
+        if (no_window) /* (the display's "window: " prefix would say it twice) */
+            fv_usage_error(prog, "--window: %s", strncmp(werr, "window: ", 8) ? werr : werr + 8);
         fv_usage_error(prog, "%s", err);
     }
 
@@ -189,6 +181,7 @@ int main(int argc, char **argv)
     fv_prof *prof = NULL;
     if (prof_path) {
         if (!(prof = fv_prof_create(fv_pool_threads(fv_pipeline_pool(pl)), (size_t)1 << 18))) {
+            fv_display_close(disp, NULL, 0);
             fv_pipeline_destroy(ref);
             fv_pipeline_destroy(pl);
             fv_scene_free(scene);
@@ -197,24 +190,15 @@ int main(int argc, char **argv)
         }
         fv_pipeline_set_prof(pl, prof);
     }
-    int outw = stereo ? 2 * W : W;
-    /* cur / prev: the (left) eye's image of this and the last frame, W * 3 bytes a row */
-    uint8_t *rgb = malloc((size_t)outw * H * 3), *prev = malloc((size_t)W * H * 3), *cur = malloc((size_t)W * H * 3);
-    uint8_t *full = NULL;
+    uint8_t *rgb = malloc((size_t)outw * H * 3), *full = vs_full ? malloc((size_t)W * H * 3) : NULL;
     float *refbuf = refp.spp ? malloc(sizeof(float) * 4 * (size_t)W * H) : NULL;
-    float *err_prev = NULL, *err_cur = NULL;
-    if (vs_full) {
-        full = malloc((size_t)W * H * 3);
-        err_prev = malloc((size_t)W * H * sizeof(float));
-        err_cur = malloc((size_t)W * H * sizeof(float));
-    }
-    mean_acc m_dl = {0}, m_all = {0}, m_fov = {0}, m_per = {0}, m_fl = {0};
-    float prev_gx = 0.0f, prev_gy = 0.0f;
+    fv_quality q; /* measured on the (left) eye's image */
+    const int q_ok = !fv_quality_init(&q, W, H, vs_full);
     fv_afile csv = {0};
     fv_y4m_writer y4m = {0};
     int y4m_open = 0;
     char path[4200];
-    if (!rgb || !prev || !cur || (refp.spp && !refbuf) || (vs_full && (!full || !err_prev || !err_cur))) {
+    if (!rgb || !q_ok || (refp.spp && !refbuf) || (vs_full && !full)) {
         fprintf(stderr, "%s: out of memory\n", prog);
         goto done;
     }
@@ -234,12 +218,7 @@ int main(int argc, char **argv)
         }
         y4m_open = 1;
     }
-    fprintf(csv.f, "frame,t_ms,gaze_x,gaze_y,samples");
-    for (int s = 0; s < FV_STAGE_COUNT; s++)
-        fprintf(csv.f, ",%s_ms", fv_stage_names[s]);
-    /* dluma_periph: mean |luma change| against the previous frame outside r1 of both gazes
-     * (temporal stability); psnr_*: against full sampling of the same frame (--vs-full) */
-    fprintf(csv.f, ",total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph,focus_m\n");
+    fv_stats_csv_header(csv.f);
 
     fv_progress prog_bar;
     const int neyes = stereo ? 2 : 1;
@@ -250,6 +229,10 @@ int main(int argc, char **argv)
     ref_progress rprog = {&prog_bar, 0, quiet};
     double t_first = trace_path ? tr.s[0].t_ms : 0.0;
     for (long f = 0; f < frames; f++) {
+        if (disp && fv_display_quit_requested(disp)) {
+            frames = f; /* the window was closed: the frames so far are the run */
+            break;
+        }
         fv_trace_sample smp;
         double t_ms = t_first + (double)f * 1000.0 / hz;
         fv_trace_at(&tr, t_ms, &smp);
@@ -259,90 +242,58 @@ int main(int argc, char **argv)
         fv_pose head = tr.has_head ? smp.head : view;
         fv_prof_instant(prof, 0, FV_PROF_TRACK_MARKERS, "frame", fv_time_ns(), (int)f);
         fv_frame_stats st[2], sum;
-        memset(&sum, 0, sizeof sum);
         for (int e = 0; e < neyes; e++) {
             fv_eye eye = stereo ? (e == 0 ? FV_EYE_LEFT : FV_EYE_RIGHT) : FV_EYE_CENTER;
             if (refp.spp) {
                 fv_camera_desc cd = cfg.cam;
                 fv_camera cam;
                 cd.eye = eye;
-                fv_camera_setup(&cam, &cd, &head); /* the size and FOV passed fv_pipeline_create */
+                if (fv_camera_setup(&cam, &cd, &head)) { /* (the size and FOV passed fv_pipeline_create) */
+                    fprintf(stderr, "%s: frame %ld%s: the reference's camera setup failed\n", prog, f, eye_name(eye));
+                    goto done;
+                }
                 if (e == 0 && !focus_given) { /* the first eye's depth at the point of regard, for both */
-                    refp.focus_m = fv_reference_depth_at(scene, &cam, smp_gaze_px(smp.gaze_x, W),
-                                                         smp_gaze_px(smp.gaze_y, H));
+                    refp.focus_m = fv_reference_depth_at(scene, &cam, fv_gaze_px(smp.gaze_x, W),
+                                                         fv_gaze_px(smp.gaze_y, H));
                     refp.focus_m = refp.focus_m > 0.05f ? refp.focus_m : 0.05f; /* as --focus-m's minimum */
                 }
                 render_reference(scene, &cam, &refp, fv_pipeline_pool(pl), refbuf, rgb + (size_t)e * W * 3,
                                  (ptrdiff_t)outw * 3, &rprog, &st[e]);
             } else {
-                fv_pipeline_render(pl, eye, &head, smp.gaze_x, smp.gaze_y, &st[e]);
+                if (fv_pipeline_render(pl, eye, &head, smp.gaze_x, smp.gaze_y, &st[e])) {
+                    fprintf(stderr, "%s: frame %ld%s: rendering failed\n", prog, f, eye_name(eye));
+                    goto done;
+                }
                 fv_pipeline_to_rgb8(pl, eye, rgb + (size_t)e * W * 3, (ptrdiff_t)outw * 3);
             }
-            for (int s = 0; s < FV_STAGE_COUNT; s++)
-                sum.stage_ms[s] = e ? sum.stage_ms[s] + st[e].stage_ms[s] : st[e].stage_ms[s];
-            sum.total_ms += st[e].total_ms;
-            sum.samples += st[e].samples;
+            fv_frame_stats_sum(&sum, &st[e], e == 0);
         }
-        /* metrics on the (left) eye's image */
-        const float gpx = smp_gaze_px(smp.gaze_x, W), gpy = smp_gaze_px(smp.gaze_y, H);
+        const float gpx = fv_gaze_px(smp.gaze_x, W), gpy = fv_gaze_px(smp.gaze_y, H);
         const fv_sampler *sm = fv_pipeline_sampler(pl);
-        double dl = NAN, p_all = NAN, p_fov = NAN, p_per = NAN, fl = NAN;
-        for (int y = 0; y < H; y++)
-            memcpy(cur + (size_t)y * W * 3, rgb + (size_t)y * outw * 3, (size_t)W * 3);
-        if (f > 0) {
-            fv_region per = {gpx, gpy, sm->r1_px, prev_gx, prev_gy, 1};
-            dl = fv_luma_mad(prev, cur, W, H, (ptrdiff_t)W * 3, &per);
-        }
         if (vs_full) {
             fv_eye eye = stereo ? FV_EYE_LEFT : FV_EYE_CENTER;
             fv_frame_stats rs;
-            fv_pipeline_render(ref, eye, &head, smp.gaze_x, smp.gaze_y, &rs);
-            fv_pipeline_to_rgb8(ref, eye, full, (ptrdiff_t)W * 3);
-            fv_region fov = fv_region_disc(gpx, gpy, sm->r0_px, 0), per = fv_region_disc(gpx, gpy, sm->r1_px, 1);
-            p_all = fv_luma_psnr(full, cur, W, H, (ptrdiff_t)W * 3, NULL);
-            p_fov = fv_luma_psnr(full, cur, W, H, (ptrdiff_t)W * 3, &fov);
-            p_per = fv_luma_psnr(full, cur, W, H, (ptrdiff_t)W * 3, &per);
-            /* flicker: how much the error against full sampling changes between frames */
-            fv_luma_error(full, cur, W, H, (ptrdiff_t)W * 3, err_cur);
-            if (f > 0) {
-                fv_region both = {gpx, gpy, sm->r1_px, prev_gx, prev_gy, 1};
-                fl = fv_mean_abs_diff(err_prev, err_cur, W, H, &both);
+            if (fv_pipeline_render(ref, eye, &head, smp.gaze_x, smp.gaze_y, &rs)) {
+                fprintf(stderr, "%s: frame %ld%s: the full-sampling render of --vs-full failed\n", prog, f,
+                        eye_name(eye));
+                goto done;
             }
-            float *t = err_prev;
-            err_prev = err_cur;
-            err_cur = t;
+            fv_pipeline_to_rgb8(ref, eye, full, (ptrdiff_t)W * 3);
         }
-        uint8_t *t8 = prev;
-        prev = cur;
-        cur = t8;
-        prev_gx = gpx;
-        prev_gy = gpy;
-        mean_add(&m_dl, dl);
-        mean_add(&m_all, p_all);
-        mean_add(&m_fov, p_fov);
-        mean_add(&m_per, p_per);
-        mean_add(&m_fl, fl);
+        fv_quality_row qr;
+        fv_quality_frame(&q, rgb, (ptrdiff_t)outw * 3, full, gpx, gpy, sm->r0_px, sm->r1_px, &qr);
         snprintf(path, sizeof path, "%s/frame_%05ld.png", out_dir, f);
         if (fv_write_png(path, rgb, outw, H, (ptrdiff_t)outw * 3, err, sizeof err) ||
             (y4m_open && fv_y4m_write_rgb(&y4m, rgb, (ptrdiff_t)outw * 3, err, sizeof err))) {
             fprintf(stderr, "%s: %s\n", prog, err);
             goto done;
         }
-        fprintf(csv.f, "%ld,%.3f,%.5f,%.5f,%ld", f, t_ms, (double)smp.gaze_x, (double)smp.gaze_y, sum.samples);
-        for (int s = 0; s < FV_STAGE_COUNT; s++) {
-            if (isnan(sum.stage_ms[s]))
-                fputs(",", csv.f); /* stage not built: empty field */
-            else
-                fprintf(csv.f, ",%.3f", sum.stage_ms[s]);
+        fv_stats_csv_row(csv.f, f, t_ms, smp.gaze_x, smp.gaze_y, &sum, &qr,
+                         refp.spp ? (double)refp.focus_m : (double)st[0].focus_m);
+        if (disp && fv_display_present(disp, rgb, outw, H, (ptrdiff_t)outw * 3, err, sizeof err)) {
+            fprintf(stderr, "%s: --window: %s\n", prog, err);
+            goto done;
         }
-        fprintf(csv.f, ",%.3f", sum.total_ms);
-        csv_num(csv.f, dl, "%.4f");
-        csv_num(csv.f, p_all, "%.3f");
-        csv_num(csv.f, p_fov, "%.3f");
-        csv_num(csv.f, p_per, "%.3f");
-        csv_num(csv.f, fl, "%.4f");
-        csv_num(csv.f, refp.spp ? (double)refp.focus_m : (double)st[0].focus_m, "%.4f");
-        fputc('\n', csv.f);
         if (!quiet && !refp.spp)
             fv_progress_update(&prog_bar, f + 1);
     }
@@ -355,11 +306,12 @@ int main(int argc, char **argv)
         printf("%s: %ld frame%s of %dx%d%s in %s/ (stats.csv)\n", prog, frames, frames == 1 ? "" : "s", W, H,
                stereo ? " x 2 eyes" : "", out_dir);
         if (frames > 1)
-            printf("%s: mean periphery luma change between frames %.3f (of 255)\n", prog, mean_get(&m_dl));
+            printf("%s: mean periphery luma change between frames %.3f (of 255)\n", prog, fv_mean_get(&q.dluma));
         if (vs_full)
             printf("%s: luma PSNR against full sampling, mean over frames: all %.2f dB, fovea %.2f dB, periphery "
                    "%.2f dB; periphery flicker (change of the error between frames) %.3f\n",
-                   prog, mean_get(&m_all), mean_get(&m_fov), mean_get(&m_per), mean_get(&m_fl));
+                   prog, fv_mean_get(&q.psnr_all), fv_mean_get(&q.psnr_fovea), fv_mean_get(&q.psnr_periph),
+                   fv_mean_get(&q.flicker));
     }
     status = FV_EXIT_OK;
     if (prof) {
@@ -375,13 +327,11 @@ done:
     fv_afile_abort(&csv);
     if (y4m_open)
         fv_y4m_abort(&y4m);
+    fv_display_close(disp, NULL, 0);
     free(rgb);
-    free(prev);
-    free(cur);
     free(full);
-    free(err_prev);
-    free(err_cur);
     free(refbuf);
+    fv_quality_free(&q);
     fv_pipeline_destroy(ref);
     fv_pipeline_destroy(pl);
     fv_prof_destroy(prof);

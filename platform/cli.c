@@ -1,12 +1,13 @@
 #include "cli.h"
 
-#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "base/parse.h"
 
 static _Noreturn void vexit(const char *prog, int status, const char *fmt, va_list ap)
 {
@@ -44,39 +45,27 @@ _Noreturn void fv_bad_option(const char *prog, char **argv)
 
 long fv_arg_long(const char *prog, const char *flag, const char *s, long lo, long hi)
 {
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (end == s || *end || errno)
-        fv_usage_error(prog, "%s: '%s' is not a whole number", flag, s);
-    if (v < lo || v > hi)
-        fv_usage_error(prog, "%s: %ld is out of range [%ld, %ld]", flag, v, lo, hi);
+    char err[4400]; /* the message quotes the argument whole */
+    long v;
+    if (fv_parse_long(flag, s, lo, hi, &v, err, sizeof err))
+        fv_usage_error(prog, "%s", err);
     return v;
 }
 
 float fv_arg_float(const char *prog, const char *flag, const char *s, float lo, float hi)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v))
-        fv_usage_error(prog, "%s: '%s' is not a number", flag, s);
-    if (v < lo || v > hi)
-        fv_usage_error(prog, "%s: %g is out of range [%g, %g]", flag, v, (double)lo, (double)hi);
-    return (float)v;
+    char err[4400];
+    float v;
+    if (fv_parse_float(flag, s, lo, hi, &v, err, sizeof err))
+        fv_usage_error(prog, "%s", err);
+    return v;
 }
 
 void fv_arg_size(const char *prog, const char *flag, const char *s, int *w, int *h)
 {
-    char a[32], b[32];
-    const char *x = strchr(s, 'x');
-    if (!x || x == s || (size_t)(x - s) >= sizeof a || strlen(x + 1) >= sizeof b || !x[1])
-        fv_usage_error(prog, "%s: '%s' is not WxH (for example 1280x1440)", flag, s);
-    memcpy(a, s, (size_t)(x - s));
-    a[x - s] = '\0';
-    strcpy(b, x + 1);
-    *w = (int)fv_arg_long(prog, flag, a, 16, 8192);
-    *h = (int)fv_arg_long(prog, flag, b, 16, 8192);
+    char err[4400];
+    if (fv_parse_size(flag, s, w, h, err, sizeof err))
+        fv_usage_error(prog, "%s", err);
 }
 
 int fv_arg_onoff(const char *prog, const char *flag, const char *s)

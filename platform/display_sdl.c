@@ -17,11 +17,34 @@ struct fv_window {
     int quit;
 };
 
+static int env_set(const char *name)
+{
+    const char *v = getenv(name);
+    return v && *v;
+}
+
 int fv_window_open(fv_window **out, int w, int h, char *err, size_t err_len)
 {
     *out = NULL;
-    if (SDL_InitSubSystem(SDL_INIT_VIDEO))
+    /* Without a display SDL falls back to its invisible offscreen driver (and probing Wayland
+     * prints to stderr): no window is an error, unless SDL_VIDEODRIVER picks a driver on purpose. */
+    const int chosen = env_set("SDL_VIDEODRIVER");
+    if (!chosen && !env_set("DISPLAY") && !env_set("WAYLAND_DISPLAY"))
+        return fv_err(err, err_len, "window: no display (neither DISPLAY nor WAYLAND_DISPLAY is set)");
+    if (!chosen) /* only the drivers of the display named: nothing else probed when it fails */
+        SDL_SetHint("SDL_VIDEODRIVER", env_set("WAYLAND_DISPLAY") ? "wayland,x11" : "x11");
+    if (SDL_InitSubSystem(SDL_INIT_VIDEO)) {
+        if (!chosen)
+            return fv_err(err, err_len, "window: no display (SDL: %s; DISPLAY=%s, WAYLAND_DISPLAY=%s)",
+                          SDL_GetError(), env_set("DISPLAY") ? getenv("DISPLAY") : "",
+                          env_set("WAYLAND_DISPLAY") ? getenv("WAYLAND_DISPLAY") : "");
         return fv_err(err, err_len, "SDL_InitSubSystem(video): %s", SDL_GetError());
+    }
+    const char *drv = SDL_GetCurrentVideoDriver();
+    if (!chosen && drv && (!strcmp(drv, "offscreen") || !strcmp(drv, "dummy"))) {
+        SDL_QuitSubSystem(SDL_INIT_VIDEO);
+        return fv_err(err, err_len, "window: no display (SDL found only its %s video driver)", drv);
+    }
     fv_window *v = calloc(1, sizeof *v);
     if (!v) {
         SDL_QuitSubSystem(SDL_INIT_VIDEO);

@@ -176,6 +176,25 @@ fi
 expect_usage "replay odd y4m size" 'even frame sizes' $R --scene $SCENE --frames 1 --size 63x72 --y4m "$T/odd.y4m" --out "$T/odd"
 [ ! -e "$T/odd.y4m" ] && [ ! -e "$T/odd.y4m.tmp" ] && [ ! -e "$T/odd/stats.csv" ] && ok || bad "failed y4m run left files behind"
 
+# --window: without a display (or without SDL2 in the build) a one-line usage error and no
+# output; under a virtual X server (xvfb-run, when installed) every frame is shown and written
+expect_usage "replay window without display" '--window: (no display|fovea was built without SDL2)' \
+    env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER $R --scene $SCENE --frames 2 --size 64x72 --window --out "$T/win0"
+[ ! -e "$T/win0" ] && ok || bad "--window without a display left $T/win0 behind"
+if command -v xvfb-run >/dev/null 2>&1 && ! grep -q 'built without SDL2' "$T/err"; then
+    # (under ASan, leak checks off for this run: the X / D-Bus libraries SDL loads keep their own
+    # allocations to exit; every other replay run checks the program's)
+    if env -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+        xvfb-run -a $R --scene $SCENE --frames 3 --size 64x72 --stereo --window --out "$T/win" --quiet 2>"$T/err"; then
+        [ "$(ls "$T/win" | grep -c '^frame_0000[0-2]\.png$')" -eq 3 ] && [ "$(wc -l <"$T/win/stats.csv")" -eq 4 ] && ok ||
+            bad "--window under xvfb: $(ls "$T/win")"
+    else
+        bad "--window under xvfb failed: $(cat "$T/err")"
+    fi
+else
+    echo "skip: --window under xvfb-run (no xvfb-run or no SDL2 in this build)"
+fi
+
 # Depth of field: the DoF stage columns and the focus are filled; the blurred frame differs from
 # the sharp one; a fixed focus is reported as such; the same bytes for 1 and 3 threads
 if $R --scene $SCENE --frames 2 --size 96x108 --dof strong --out "$T/dof" --quiet 2>"$T/err" &&
