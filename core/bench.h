@@ -67,7 +67,7 @@ void fv_bench_ctrs_mean(const fv_bench_ctrs *c, int frames, fv_bench_run *r);
 #define FV_BENCH_NROOF 5
 extern const int fv_bench_roof_stages[FV_BENCH_NROOF]; /* reproject .. combine: the memory-bound passes */
 typedef struct fv_roof {
-    double read_bytes, written_bytes; /* compulsory bytes per frame (fv_prof_stage_bytes) */
+    double read_bytes, written_bytes; /* compulsory bytes per frame (fv_bench_stage_bytes) */
     double gbps;                      /* their sum over the stage's mean time */
     double fraction;                  /* of the copy bandwidth; NAN when that is unknown (0) */
 } fv_roof;
@@ -108,5 +108,13 @@ fv_pose fv_bench_head_at(const fv_pose *view, float yaw_rate_dps, int f);
 /* memcpy bandwidth in GB/s of read + written bytes (64 MiB, best of 5) on `threads` threads of a
  * core pool; 0 when out of memory. */
 double fv_bench_copy_gbps(int threads);
+
+/* Memory roofline model: bytes a post-processing stage reads and writes per frame on a w x h eye
+ * image, counted from the buffers it touches (each byte of a buffer once: the compulsory traffic;
+ * docs/bench-2026-11-22-profile.md lists the buffers). stage: FV_STAGE_* (core/stage.h).
+ * holes: the fraction of level-0 pixels pull-push has to fill (weight < 1; 1 - samples / pixels;
+ * 0 with full sampling, where push only reads the weights). 0 on success, -1 for a stage without
+ * a model (trace). */
+int fv_bench_stage_bytes(int stage, int w, int h, double holes, double *read_bytes, double *written_bytes);
 
 #endif

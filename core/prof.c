@@ -6,7 +6,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "tile.h" /* FV_TILE_PULL_LEVELS */
 
 const char *fv_prof_stage_name(int stage)
 {
@@ -157,57 +156,3 @@ size_t fv_prof_dropped(const fv_prof *p, int slot)
     return p->r[slot].n - fv_prof_count(p, slot);
 }
 
-int fv_prof_stage_bytes(int stage, int w, int h, double holes, double *rd, double *wr)
-{
-    const double N = (double)w * (double)h;
-    const double px = 16.0, wt = 4.0; /* a pixel: r, g, b, depth floats; a weight: one float */
-    *rd = *wr = 0.0;
-    switch (stage) {
-    case FV_STAGE_RECONSTRUCT: {
-        /* levels above the tiles' pulls are pulled (fine level read, coarse level written), then
-         * every level but the top is pushed: fine weights read; where a pixel is a hole (the
-         * fraction `holes`, taken for every level), its colour and the coarse colour above it
-         * read and its colour written */
-        int lw[32], lh[32], L = 0;
-        for (int cw = w, ch = h; L < 32; L++) {
-            lw[L] = cw, lh[L] = ch;
-            if (cw == 1 && ch == 1)
-                break;
-            cw = (cw + 1) / 2, ch = (ch + 1) / 2;
-        }
-        const int levels = L + 1;
-        const int pulled = levels - 1 < FV_TILE_PULL_LEVELS ? levels - 1 : FV_TILE_PULL_LEVELS;
-        for (int l = pulled; l + 1 < levels; l++) {
-            *rd += (px + wt) * lw[l] * (double)lh[l];
-            *wr += (px + wt) * lw[l + 1] * (double)lh[l + 1];
-        }
-        for (int l = 0; l + 1 < levels; l++) {
-            *rd += wt * lw[l] * (double)lh[l] + holes * (px * lw[l] * (double)lh[l] + px * lw[l + 1] * (double)lh[l + 1]);
-            *wr += holes * px * lw[l] * (double)lh[l];
-        }
-        return 0;
-    }
-    case FV_STAGE_REPROJECT:
-        if (!(holes > 0.0))
-            return 0; /* full sampling has no reprojection */
-        /* level 0 colour + weight read and written; the history's level 0 and, for holes, its
-         * coarser levels (a third more) read */
-        *rd = (px + wt) * N + (px + wt) * N * (4.0 / 3.0);
-        *wr = (px + wt) * N;
-        return 0;
-    case FV_STAGE_COC: /* level 0 colour + depth read, the CoC plane written */
-        *rd = px * N;
-        *wr = wt * N;
-        return 0;
-    case FV_STAGE_DOF_FILTER: /* level 0 + CoC read; the horizontal pass's layer written, read back */
-        *rd = (px + wt) * N + px * N;
-        *wr = px * N;
-        return 0;
-    case FV_STAGE_COMBINE: /* sharp, CoC, the blurred layer read; the output written */
-        *rd = (px + wt + px) * N;
-        *wr = px * N;
-        return 0;
-    default:
-        return -1;
-    }
-}

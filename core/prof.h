@@ -73,12 +73,4 @@ size_t fv_prof_count(const fv_prof *p, int slot);
 const fv_prof_event *fv_prof_event_at(const fv_prof *p, int slot, size_t index);
 size_t fv_prof_dropped(const fv_prof *p, int slot);
 
-/* Memory roofline model: bytes a post-processing stage reads and writes per frame on a w x h eye
- * image, counted from the buffers it touches (each byte of a buffer once: the compulsory traffic;
- * docs/bench-2026-11-22-profile.md lists the buffers). stage: FV_STAGE_* (core/stage.h).
- * holes: the fraction of level-0 pixels pull-push has to fill (weight < 1; 1 - samples / pixels;
- * 0 with full sampling, where push only reads the weights). 0 on success, -1 for a stage without
- * a model (trace). */
-int fv_prof_stage_bytes(int stage, int w, int h, double holes, double *read_bytes, double *written_bytes);
-
 #endif

@@ -8,6 +8,7 @@
 #include "kbench.h"
 #include "pipeline.h"
 #include "pool.h"
+#include "bench.h"
 #include "prof.h"
 #include "testscene.h"
 
@@ -202,14 +203,14 @@ static void test_stage_bytes(void **state)
 {
     (void)state;
     double rd, wr;
-    assert_int_equal(fv_prof_stage_bytes(FV_STAGE_TRACE, 1280, 1440, 0.7, &rd, &wr), -1);
-    assert_int_equal(fv_prof_stage_bytes(FV_STAGE_COC, 1280, 1440, 0.7, &rd, &wr), 0);
+    assert_int_equal(fv_bench_stage_bytes(FV_STAGE_TRACE, 1280, 1440, 0.7, &rd, &wr), -1);
+    assert_int_equal(fv_bench_stage_bytes(FV_STAGE_COC, 1280, 1440, 0.7, &rd, &wr), 0);
     assert_true(rd == 16.0 * 1280 * 1440 && wr == 4.0 * 1280 * 1440);
-    assert_int_equal(fv_prof_stage_bytes(FV_STAGE_REPROJECT, 1280, 1440, 0.0, &rd, &wr), 0);
+    assert_int_equal(fv_bench_stage_bytes(FV_STAGE_REPROJECT, 1280, 1440, 0.0, &rd, &wr), 0);
     assert_true(rd == 0.0 && wr == 0.0); /* full sampling: no reprojection */
     double r0, w0, r1, w1;
-    fv_prof_stage_bytes(FV_STAGE_RECONSTRUCT, 1280, 1440, 0.0, &r0, &w0);
-    fv_prof_stage_bytes(FV_STAGE_RECONSTRUCT, 1280, 1440, 0.76, &r1, &w1);
+    fv_bench_stage_bytes(FV_STAGE_RECONSTRUCT, 1280, 1440, 0.0, &r0, &w0);
+    fv_bench_stage_bytes(FV_STAGE_RECONSTRUCT, 1280, 1440, 0.76, &r1, &w1);
     /* full: the weights of every level (4/3 of level 0's) and the small levels' pulls */
     assert_true(r0 > 4.0 * 1280 * 1440 && r0 < 4.0 * 1280 * 1440 * 1.4 && w0 < 0.01 * r0);
     assert_true(r1 > 2.0 * r0 && w1 > 0.76 * 16.0 * 1280 * 1440);
