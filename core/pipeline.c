@@ -30,7 +30,7 @@ struct fv_pipeline {
     const fv_scene *scene;
     fv_pipeline_config cfg;
     fv_pool *pool;
-    fv_dsp dsp;
+    fv_render_dsp dsp;
     fv_sampler smp;
     /* fovea widened (fv_pipeline_set_fovea_scale): step k of FOVEA_STEPS scales r0, r1 by
      * 1 + k / FOVEA_STEPS; wide[k - 1] is built on the step's first use and kept */
@@ -143,7 +143,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         fv_err(err, err_len, "cannot start %d worker threads", cfg->threads);
         goto bad;
     }
-    fv_dsp_init(&p->dsp, cfg->isa_mask);
+    fv_render_dsp_init(&p->dsp, cfg->isa_mask);
     for (int i = 0; i <= SRGB_LUT; i++) {
         double v = (double)i / SRGB_LUT;
         double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
@@ -246,7 +246,7 @@ static void render_dof(fv_pipeline *p, eye_state *es, const fv_pyramid *pyr, flo
     };
     v.e_px_per_mm = fv_retina_px_per_mm(v.focal_px, FV_EYE_IMAGE_DIST_MM) * v.blur_scale;
     fv_dof_times t = {NAN, NAN, NAN};
-    p->dof_fn(&v, &p->dof_work, es->out, l0->stride, p->pool, &p->dsp, &t);
+    p->dof_fn(&v, &p->dof_work, es->out, l0->stride, p->pool, &p->dsp.dof, &t);
     /* the focus estimate is part of the CoC stage (Weier's Table 1 has no row of its own) */
     st->stage_ms[FV_STAGE_COC] = (isnan(t.coc_ms) ? 0.0 : t.coc_ms) + focus_ms;
     st->stage_ms[FV_STAGE_DOF_FILTER] = t.filter_ms;
@@ -311,7 +311,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     prof_stage(p->prof, FV_PROF_CAST, pc0, eye);
     const int64_t pr0 = fv_prof_stage_mark(p->prof, FV_PROF_RECONSTRUCT, 0);
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
-    fv_pullpush_from(pyr, &p->dsp, p->pool, fv_raycast_pulled_levels(pyr));
+    fv_pullpush_from(pyr, &p->dsp.pp, p->pool, fv_raycast_pulled_levels(pyr));
     int64_t t2 = fv_time_ns();
     prof_stage(p->prof, FV_PROF_RECONSTRUCT, pr0, eye);
     st->focus_m = NAN;
@@ -375,7 +375,7 @@ int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale)
 
 float fv_pipeline_fovea_scale(const fv_pipeline *p) { return 1.0f + (float)p->fovea_step / FOVEA_STEPS; }
 fv_pool *fv_pipeline_pool(fv_pipeline *p) { return p->pool; }
-const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p) { return &p->dsp; }
+const fv_render_dsp *fv_pipeline_dsp(const fv_pipeline *p) { return &p->dsp; }
 
 const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride)
 {

@@ -7,6 +7,7 @@
 #include "camera.h"
 #include "pool.h"
 #include "pullpush.h"
+#include "render_dsp.h"
 #include "reproject.h"
 #include "sampling.h"
 #include "scene.h"
@@ -61,6 +62,6 @@ typedef struct fv_raycast_opts {
  * CPU time the workers spent on that, divided by the pool's thread count, goes to *taa_ms
  * (may be NULL). */
 long fv_raycast(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
-                fv_pyramid *pyr, const fv_dsp *dsp, fv_pool *pool, const fv_raycast_opts *opt, double *taa_ms);
+                fv_pyramid *pyr, const fv_render_dsp *dsp, fv_pool *pool, const fv_raycast_opts *opt, double *taa_ms);
 
 #endif

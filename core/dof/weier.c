@@ -112,7 +112,7 @@ static void xtaps_init(xtaps *t, int L, int w, int src_w)
 /* Image `src` (2^L level-0 pixels a texel) bilinearly up-sampled to level-0 row y, columns
  * [0, w). Separable: the two source rows are blended once into tmp, then each pixel reads two
  * texels. */
-static void upsample_row(const fv_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w,
+static void upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w,
                          float *restrict tmp, float *restrict dst)
 {
     const float sc = 1.0f / (float)(1 << L);
@@ -129,7 +129,7 @@ static void upsample_row(const fv_dsp *dsp, const img4 *src, int L, const xtaps 
 typedef struct {
     const fv_dof_view *v;
     fv_dof_work *wk;
-    const fv_dsp *dsp;
+    const fv_dof_dsp *dsp;
     const fv_dof_gauss_tab *tab;
     float *out;
     ptrdiff_t out_stride;
@@ -575,7 +575,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
 }
 
 void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                  const fv_dsp *dsp, fv_dof_times *t)
+                  const fv_dof_dsp *dsp, fv_dof_times *t)
 {
     wctx ctx = {0}, *x = &ctx;
     x->v = v, x->wk = wk, x->dsp = dsp, x->out = out, x->out_stride = out_stride, x->tab = wk->gauss;

@@ -22,7 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dsp.h"
+#include "eyetrack/eyetrack_dsp.h"
 #include "base/util.h"
 #include "eyetrack/eyetrack.h"
 
@@ -38,7 +38,7 @@
 
 struct fv_eye_tracker {
     fv_eye_params p;
-    fv_dsp dsp;
+    fv_eyetrack_dsp dsp;
     uint8_t *mem;
     size_t cap;
     /* history for blink detection (fv_track_frame only) */
@@ -70,7 +70,7 @@ fv_eye_tracker *fv_eye_create(const fv_eye_params *p)
         fv_eye_default_params(&t->p);
     if (t->p.max_glints < 0 || t->p.max_glints > FV_EYE_MAX_GLINTS)
         t->p.max_glints = FV_EYE_MAX_GLINTS;
-    fv_dsp_init(&t->dsp, t->p.isa_mask);
+    fv_eyetrack_dsp_init(&t->dsp, t->p.isa_mask);
     return t;
 }
 
@@ -162,7 +162,7 @@ static int list_nonzero(const uint8_t *m, int w, int y, int *list, int n)
  * background too), replaced by the mean of their unmasked 4-neighbours, ring by ring from the
  * outside in. mask is w*h bytes of scratch, idx and fr w*h ints each; the work is proportional
  * to the masked area, not the image. */
-static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
+static void inpaint_bright(const fv_eyetrack_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
                            int *fr, uint8_t fallback)
 {
     int n = 0;
@@ -316,7 +316,7 @@ typedef struct {
     int ok;
 } candidate;
 
-static void integral(const fv_dsp *d, const uint8_t *img, int w, int h, uint32_t *ii)
+static void integral(const fv_eyetrack_dsp *d, const uint8_t *img, int w, int h, uint32_t *ii)
 {
     /* zero first row and column */
     const int iw = w + 1;
@@ -380,7 +380,7 @@ static void box_clipped(const box_ctx *b, box_hit *best, int k, int ko, int y, i
     }
 }
 
-static void box_search(const fv_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
+static void box_search(const fv_eyetrack_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
                        int x1, int y0, int y1, float dark, float mu, box_hit *best)
 {
     const float rf = 1.5f;
@@ -429,7 +429,7 @@ static candidate coarse_search(fv_eye_tracker *t, const uint8_t *luma, int w, in
                                uint8_t *work, uint8_t *mask, uint8_t *small, uint32_t *ii, int *idx)
 {
     candidate c = { 0 };
-    const fv_dsp *d = &t->dsp;
+    const fv_eyetrack_dsp *d = &t->dsp;
     int sw = w, sh = h, scale = 1;
     const uint8_t *src = luma;
     ptrdiff_t sst = stride;
