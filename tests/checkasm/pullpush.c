@@ -152,6 +152,8 @@ static void test_pull_row(void **state)
             continue;
         fv_pullpush_dsp d;
         fv_pullpush_dsp_init(&d, isa);
+        if (!d.pull_row || d.pull_row == fv_pull_row_c) /* an ISA this build has must implement it: a failure */
+            fail_msg("pull_row: %s has no version of its own", fv_isa_name(isa));
         int runs = 0;
         for (int si = 0; si < NSIZES; si++)
             for (int off = 0; off < 2; off++)
@@ -207,6 +209,8 @@ static void test_push_row(void **state)
             continue;
         fv_pullpush_dsp d;
         fv_pullpush_dsp_init(&d, isa);
+        if (!d.push_row || d.push_row == fv_push_row_c) /* an ISA this build has must implement it: a failure */
+            fail_msg("push_row: %s has no version of its own", fv_isa_name(isa));
         int runs = 0;
         for (int si = 0; si < NSIZES; si++)
             for (int off = 0; off < 2; off++)
