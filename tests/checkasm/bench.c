@@ -607,7 +607,7 @@ int checkasm_bench_main(const char *prog, int argc, char **argv)
     int reps = 7;
     long calls = 0;
     unsigned isa_mask = ~0u;
-    for (int i = 1; i < argc; i++) {
+    for (int i = 1; i < argc; i += 2) { /* every option takes a value */
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(o, "--json") && v)
             json_path = v;
@@ -625,7 +625,6 @@ int checkasm_bench_main(const char *prog, int argc, char **argv)
             else fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", v);
         } else
             fv_usage_error(prog, "'%s': expected --json FILE, --kernel-reps N, --kernel NAME, --calls N or --isa I", o);
-        i++;
     }
     if (calls > 0 && !only)
         fv_usage_error(prog, "--calls N needs --kernel NAME");
