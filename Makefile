@@ -74,6 +74,11 @@ PLATFORM_C := $(wildcard platform/*.c)
 APPS := $(patsubst apps/%.c,$(BUILD)/bin/%,$(wildcard apps/fovea-*.c))
 TOOLS := $(patsubst tools/%.c,$(BUILD)/tools/%,$(wildcard tools/*.c))
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
+# checkasm (tests/checkasm/): every kernel's ISA versions against C, and --bench. fovea-bench
+# --kernels links its bench.o (no cmocka in it).
+CHECKASM := $(BUILD)/tests/checkasm/checkasm
+CHECKASM_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(wildcard tests/checkasm/*.c))
+CHECKASM_BENCH_OBJ := $(BUILD)/tests/checkasm/bench.o
 
 CORE_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(CORE_C) $(CORE_ISA)) $(patsubst %.cpp,$(BUILD)/%.o,$(CORE_CXX))
 PLATFORM_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(PLATFORM_C))
@@ -127,12 +132,20 @@ $(PLIB): $(PLATFORM_OBJ)
 $(BUILD)/bin/%: apps/%.c $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) -o $@
+$(BUILD)/bin/fovea-bench: apps/fovea-bench.c $(CHECKASM_BENCH_OBJ) $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests $< $(CHECKASM_BENCH_OBJ) $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) -o $@
 $(BUILD)/tools/%: tools/%.c $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) -o $@
 $(BUILD)/tests/%: tests/%.c tests/testutil.h tests/testscene.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Itests $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) $(TEST_LIBS) -o $@
+
+$(CHECKASM_OBJ): ALL_CFLAGS += -Itests
+$(CHECKASM): $(CHECKASM_OBJ) $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CHECKASM_OBJ) $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) $(TEST_LIBS) -o $@
 
 $(RANGE): tools/gen_range.c
 	$(MAKE) --no-print-directory $(BUILD)/tools/gen_range
@@ -147,9 +160,9 @@ $(EYE_SYNTH_TRUTH): $(EYE_SYNTH)
 deps:
 	@tools/deps.sh $(if $(CROSS),--cross)
 
-test-bin: $(LIB) $(PLIB) $(APPS) $(TOOLS) $(TESTS) $(RANGE) $(EYE_SYNTH)
+test-bin: $(LIB) $(PLIB) $(APPS) $(TOOLS) $(TESTS) $(CHECKASM) $(RANGE) $(EYE_SYNTH)
 
-# The suite: unit + kernel tests (cmocka) and the command-line tests; one summary line at the end.
+# The suite: unit tests and checkasm (cmocka) and the command-line tests; one summary line at the end.
 test: deps
 	@$(MAKE) --no-print-directory test-bin
 	@BUILD=$(BUILD) SHARED=$(SHARED) tests/run.sh

@@ -12,7 +12,7 @@
 #include "bench.h"
 #include "benchio.h"
 #include "cli.h"
-#include "kbench.h"
+#include "checkasm/bench.h" /* --kernels: tests/checkasm/bench.c */
 #include "output.h"
 #include "pipeline.h"
 #include "prof.h"
@@ -43,156 +43,16 @@ static void usage(FILE *f)
             "  --sweep P=VALUES   repeatable; runs every value of P after the base run, all in the\n"
             "                     JSON: threads=1..N or threads=1,2; size=WxH,WxH; pmin=P,P;\n"
             "                     r0=DEG,DEG; r1=DEG,DEG\n"
-            "  --kernels          time every hand-vectorised kernel (fv_dsp) against its C\n"
-            "                     reference and each ISA this CPU runs at production sizes, print\n"
-            "                     speed-ups (median of --kernel-reps runs, default 7; no scene)\n"
+            "  --kernels          time every hand-vectorised kernel against its C reference and\n"
+            "                     each ISA this CPU runs at production sizes, print speed-ups\n"
+            "                     (median of --kernel-reps runs, default 7; no scene; the same as\n"
+            "                     build/tests/checkasm/checkasm --bench)\n"
             "  --kernel NAME      with --kernels: only that kernel\n"
             "  --calls N          with --kernel: no timing; set NAME up and call it N times with the\n"
             "                     kernels of --isa (instruction counts under qemu:\n"
-            "                     tools/kernel_icount.sh)\n"
+            "                     tools/kernel_icount.py)\n"
             FV_COMMON_HELP "  --help             this text\n");
 }
-/* (for the kernel benchmarks below) */
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static void load_avg(double la[3]) { fv_load_avg(la); }
-
-/* ---- kernel benchmarks ---- */
-typedef struct {
-    const char *name, *shape, *isa;
-    double ms;      /* median per frame of calls */
-    double speedup; /* C reference time / this */
-} kres;
-
-static int run_kernels(const char *json_path, int reps, const char *only, long calls, unsigned isa_mask)
-{
-    if (only && !fv_kbench_find(only))
-        fv_usage_error(prog, "--kernel: '%s' is not a kernel of the table (see --kernels)", only);
-    if (only && calls > 0) { /* instruction counting: one kernel, one ISA, `calls` calls after the set-up */
-        const fv_kbench_kernel *k = fv_kbench_find(only);
-        fv_dsp d;
-        fv_dsp_init(&d, isa_mask);
-        void *st = k->setup();
-        if (!st)
-            fv_fail(prog, FV_EXIT_FAIL, "out of memory setting %s up", k->name);
-        if (k->reset)
-            k->reset(st);
-        k->run(st, &d, 0, (int)calls);
-        k->free(st);
-        /* where the kernels' code is (tools/kernel_icount.py counts the instructions run there) */
-        printf("%s: %s %s x %ld calls; code at", prog, k->name, fv_isa_name(d.isa), calls);
-        for (int i = 0; i < FV_KBENCH_MAX_FIELDS; i++)
-            if (k->field[i]) {
-                void (*fn)(void);
-                uintptr_t a;
-                memcpy(&fn, (const char *)&d + k->field[i], sizeof fn);
-                memcpy(&a, &fn, sizeof a);
-                printf(" 0x%llx", (unsigned long long)a);
-            }
-        printf("\n");
-        return FV_EXIT_OK;
-    }
-    static const unsigned masks[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_SSE41 | FV_ISA_AVX2, FV_ISA_NEON};
-    enum { NM = 4 };
-    fv_dsp ds[NM];
-    int have[NM], nisa = 0;
-    for (int m = 0; m < NM; m++) {
-        fv_dsp_init(&ds[m], masks[m]);
-        have[m] = m == 0 || ds[m].isa != FV_ISA_C; /* that ISA runs on this CPU */
-        nisa += have[m];
-    }
-    double la[3];
-    load_avg(la);
-    printf("%s --kernels: %d ISA%s on this CPU, median of %d runs, each ISA timed back to back; "
-           "load average %.2f %.2f %.2f\n",
-           prog, nisa, nisa == 1 ? "" : "s", reps, la[0], la[1], la[2]);
-    printf("%-20s %-42s %-8s %10s %8s\n", "kernel", "one frame of calls", "isa", "ms/frame", "speedup");
-    kres *out = calloc((size_t)fv_kbench_count * NM, sizeof *out);
-    double *t = calloc((size_t)reps * NM, sizeof *t);
-    if (!out || !t)
-        fv_fail(prog, FV_EXIT_FAIL, "out of memory");
-    int nout = 0;
-    for (int i = 0; i < fv_kbench_count; i++) {
-        const fv_kbench_kernel *k = &fv_kbench_kernels[i];
-        if (only && strcmp(k->name, only))
-            continue;
-        /* the ISAs with their own version (not the C one, not the same as a lower ISA's) */
-        int use[NM];
-        for (int m = 0; m < NM; m++) {
-            use[m] = have[m] && (m == 0 || fv_kbench_differs(k, &ds[m], &ds[0]));
-            for (int q = 1; q < m && use[m]; q++)
-                if (use[q] && !fv_kbench_differs(k, &ds[m], &ds[q]))
-                    use[m] = 0;
-        }
-        void *st = k->setup();
-        if (!st)
-            fv_fail(prog, FV_EXIT_FAIL, "out of memory setting %s up", k->name);
-        /* frames per sample: at least ~20 ms of the C reference (the eye tracker's are small) */
-        if (k->reset)
-            k->reset(st);
-        int64_t t0 = fv_time_ns();
-        k->run(st, &ds[0], 0, k->calls_per_frame);
-        const double once = (double)(fv_time_ns() - t0) * 1e-6;
-        const int nf = once >= 20.0 ? 1 : once <= 0.01 ? 2000 : (int)ceil(20.0 / once);
-        for (int r = 0; r < reps; r++)
-            for (int m = 0; m < NM; m++) {
-                if (!use[m])
-                    continue;
-                double ns = 0.0;
-                for (int f = 0; f < nf; f++) {
-                    if (k->reset)
-                        k->reset(st);
-                    t0 = fv_time_ns();
-                    k->run(st, &ds[m], 0, k->calls_per_frame);
-                    ns += (double)(fv_time_ns() - t0);
-                }
-                t[r * NM + m] = ns * 1e-6 / nf;
-            }
-        double med[NM];
-        for (int m = 0; m < NM; m++) {
-            if (!use[m])
-                continue;
-            double v[64];
-            int n = 0;
-            for (int r = 0; r < reps && n < 64; r++)
-                v[n++] = t[r * NM + m];
-            qsort(v, (size_t)n, sizeof *v, cmp_double);
-            med[m] = n & 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-            kres *o = &out[nout++];
-            o->name = k->name, o->shape = k->shape, o->isa = fv_isa_name(ds[m].isa);
-            o->ms = med[m];
-            o->speedup = med[0] / med[m];
-            printf("%-20s %-42s %-8s %10.3f %7.2fx\n", k->name, k->shape, o->isa, o->ms, o->speedup);
-        }
-        k->free(st);
-    }
-    int status = FV_EXIT_OK;
-    if (json_path) {
-        char err[512];
-        fv_afile a;
-        if (fv_afile_open(&a, json_path, err, sizeof err))
-            fv_fail(prog, FV_EXIT_FAIL, "%s", err);
-        fprintf(a.f, "{\"kernels_bench\": {\"reps\": %d, \"load_avg\": [%.2f, %.2f, %.2f], \"results\": [", reps, la[0],
-                la[1], la[2]);
-        for (int i = 0; i < nout; i++)
-            fprintf(a.f, "%s\n  {\"kernel\": \"%s\", \"shape\": \"%s\", \"isa\": \"%s\", \"ms_per_frame\": %.4f, "
-                         "\"speedup\": %.3f}",
-                    i ? "," : "", out[i].name, out[i].shape, out[i].isa, out[i].ms, out[i].speedup);
-        fprintf(a.f, "]}}\n");
-        if (fv_afile_commit(&a, err, sizeof err)) {
-            fprintf(stderr, "%s: %s\n", prog, err);
-            status = FV_EXIT_FAIL;
-        }
-    }
-    free(out);
-    free(t);
-    return status;
-}
-
 /* The modes --mode asks for (foveated first), each run with cfg into res; their count. On failure
  * frees the scene and exits 1 naming `what` (a sweep point). */
 static int run_modes(fv_scene *scene, const fv_pipeline_config *cfg, const char *mode, const fv_pose *view,
@@ -273,7 +133,7 @@ int main(int argc, char **argv)
             fv_usage_error(prog, "unexpected argument '%s' (see --help)", argv[optind]);
         if (calls > 0 && !kernel)
             fv_usage_error(prog, "--calls N needs --kernel NAME");
-        return run_kernels(json_path, kreps, kernel, calls, cfg.isa_mask);
+        return checkasm_bench_run(prog, json_path, kreps, kernel, calls, cfg.isa_mask);
     }
     if (kernel || calls)
         fv_usage_error(prog, "--kernel and --calls need --kernels");
@@ -298,8 +158,8 @@ int main(int argc, char **argv)
         fv_scene_free(scene);
         fv_fail(prog, FV_EXIT_FAIL, "out of memory for the trace recorder");
     }
-    fv_dsp dsp;
-    fv_dsp_init(&dsp, cfg.isa_mask);
+    fv_render_dsp dsp;
+    fv_render_dsp_init(&dsp, cfg.isa_mask);
     rep.isa = fv_isa_name(dsp.isa);
     fv_load_avg(rep.load_avg);
     rep.copy_gbps_1t = fv_bench_copy_gbps(1);

@@ -11,7 +11,7 @@
 
 #include "base/clock.h"
 #include "cli.h"
-#include "dsp.h"
+#include "cpu.h"
 #include "eyesrc.h"
 #include "eyetrack/eyetrack.h"
 #include "output.h"
@@ -297,10 +297,8 @@ int main(int argc, char **argv)
     for (long k = 0; k < bench; k++)
         run_ns[k] /= (double)frames;
     qsort(run_ns, (size_t)bench, sizeof(double), cmp_double);
-    fv_dsp d;
-    fv_dsp_init(&d, isa_mask);
     printf("time per frame: %.4f ms (median of %ld run%s, one thread, kernels %s)\n", run_ns[bench / 2] * 1e-6, bench,
-           bench > 1 ? "s" : "", fv_isa_name(d.isa));
+           bench > 1 ? "s" : "", fv_isa_name(fv_cpu_best_isa(isa_mask)));
     for (int i = 0; i < ngroups; i++)
         free(groups[i].err);
     free(run_ns);

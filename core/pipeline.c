@@ -30,7 +30,7 @@ struct fv_pipeline {
     const fv_scene *scene;
     fv_pipeline_config cfg;
     fv_pool *pool;
-    fv_dsp dsp;
+    fv_render_dsp dsp;
     fv_sampler smp;
     /* fovea widened (fv_pipeline_set_fovea_scale): step k of FOVEA_STEPS scales r0, r1 by
      * 1 + k / FOVEA_STEPS; wide[k - 1] is built on the step's first use and kept */
@@ -143,7 +143,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         fv_err(err, err_len, "cannot start %d worker threads", cfg->threads);
         goto bad;
     }
-    fv_dsp_init(&p->dsp, cfg->isa_mask);
+    fv_render_dsp_init(&p->dsp, cfg->isa_mask);
     fv_output_conv_init(&p->conv);
     return p;
 bad:
@@ -245,7 +245,7 @@ static void render_dof(fv_pipeline *p, eye_state *es, fv_eye eye, const fv_pyram
     };
     v.e_px_per_mm = fv_retina_px_per_mm(v.focal_px, FV_EYE_IMAGE_DIST_MM) * v.blur_scale;
     fv_dof_times t = {NAN, NAN, NAN};
-    p->dof_fn(&v, &p->dof_work, es->out, l0->stride, p->pool, &p->dsp, &t);
+    p->dof_fn(&v, &p->dof_work, es->out, l0->stride, p->pool, &p->dsp.dof, &t);
     st->stage_ms[FV_STAGE_COC] = (isnan(t.coc_ms) ? 0.0 : t.coc_ms) + focus_ms;
     st->stage_ms[FV_STAGE_DOF_FILTER] = t.filter_ms;
     st->stage_ms[FV_STAGE_COMBINE] = t.combine_ms;
@@ -287,7 +287,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
     const int64_t tr0 = fv_prof_stage_begin(p->prof, FV_STAGE_RECONSTRUCT);
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
-    fv_pullpush_from(pyr, &p->dsp, p->pool, fv_tile_pulled_levels(pyr));
+    fv_pullpush_from(pyr, &p->dsp.pp, p->pool, fv_tile_pulled_levels(pyr));
     const int64_t t2 = fv_prof_stage_end(p->prof, FV_STAGE_RECONSTRUCT, tr0, (int)eye);
     st->focus_m = NAN;
     if (p->dof)
@@ -346,7 +346,7 @@ int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale)
 
 float fv_pipeline_fovea_scale(const fv_pipeline *p) { return 1.0f + (float)p->fovea_step / FOVEA_STEPS; }
 fv_pool *fv_pipeline_pool(fv_pipeline *p) { return p->pool; }
-const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p) { return &p->dsp; }
+const fv_render_dsp *fv_pipeline_dsp(const fv_pipeline *p) { return &p->dsp; }
 
 const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride)
 {

@@ -8,7 +8,7 @@
 #include <stdint.h>
 #include "camera.h"
 #include "dof/dof.h"
-#include "dsp.h"
+#include "render_dsp.h"
 #include "pool.h"
 #include "pullpush.h"
 #include "reproject.h"
@@ -70,7 +70,7 @@ fv_pool *fv_pipeline_pool(fv_pipeline *p);
  * thread (fv_pool_threads(fv_pipeline_pool(p))) and must outlive its use. */
 struct fv_prof;
 void fv_pipeline_set_prof(fv_pipeline *p, struct fv_prof *prof);
-const fv_dsp *fv_pipeline_dsp(const fv_pipeline *p);
+const fv_render_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 
 /* The eye's last image (after depth of field, if on): 4 floats a pixel (linear r, g, b,
  * depth_m), rows *stride pixels apart. */

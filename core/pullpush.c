@@ -8,7 +8,7 @@
  * replicated copy of the edge pixels on every level (so consumers can sample with clamp-to-edge
  * without branching), which is what the push kernels read.
  *
- * The colour of a zero-weight pixel is never used (see dsp.h), so before a frame only the level-0
+ * The colour of a zero-weight pixel is never used (see pullpush_dsp.h), so before a frame only the level-0
  * weights need to be zero; fv_pyramid_clear zeroes colours too, as pullpush.h documents.
  *
  * Pull: level l+1 row Y from level l rows 2Y, 2Y+1 (dsp->pull_row). Push, coarsest first:
@@ -23,55 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
-
-/* ---------------------------------------------------------------- reference kernels */
-
-void fv_pull_row_c(float *restrict dst_rgbd, float *restrict dst_wgt, const float *src0_rgbd,
-                   const float *src0_wgt, const float *src1_rgbd, const float *src1_wgt, int n)
-{
-    for (int x = 0; x < n; x++) {
-        const float wa0 = src0_wgt[2 * x], wa1 = src0_wgt[2 * x + 1];
-        const float wb0 = src1_wgt[2 * x], wb1 = src1_wgt[2 * x + 1];
-        const float *a = src0_rgbd + 8 * x, *b = src1_rgbd + 8 * x;
-        const float sw = (wa0 + wb0) + (wa1 + wb1);
-        for (int c = 0; c < 4; c++) {
-            /* a zero-weight child contributes +0 whatever its colour (never read as a value) */
-            const float ta0 = wa0 > 0.0f ? wa0 * a[c] : 0.0f, tb0 = wb0 > 0.0f ? wb0 * b[c] : 0.0f;
-            const float ta1 = wa1 > 0.0f ? wa1 * a[4 + c] : 0.0f, tb1 = wb1 > 0.0f ? wb1 * b[4 + c] : 0.0f;
-            const float t = (ta0 + tb0) + (ta1 + tb1);
-            dst_rgbd[4 * x + c] = sw > 0.0f ? t / sw : 0.0f;
-        }
-        dst_wgt[x] = sw < 1.0f ? sw : 1.0f;
-    }
-}
-
-void fv_push_row_c(float *restrict fine_rgbd, const float *fine_wgt, const float *coarse_near,
-                   const float *coarse_far, int n)
-{
-    for (int x = 0; x < n; x++) {
-        const float w = fine_wgt[x];
-        const int cx = x >> 1, fx = (x & 1) ? cx + 1 : cx - 1;
-        const int keep = !(w < 1.0f), own = w > 0.0f; /* keep: full confidence, bits unchanged */
-        const float om = 1.0f - w;
-        float *o = fine_rgbd + 4 * x;
-        for (int c = 0; c < 4; c++) {
-            const float n0 = coarse_near[4 * cx + c], f0 = coarse_far[4 * cx + c];
-            const float n1 = coarse_near[4 * fx + c], f1 = coarse_far[4 * fx + c];
-            const float v0 = n0 + 0.25f * (f0 - n0);
-            const float v1 = n1 + 0.25f * (f1 - n1);
-            const float ip = v0 + 0.25f * (v1 - v0);
-            const float cv = own ? o[c] : 0.0f; /* a hole's own colour is never used */
-            const float r = cv + om * (ip - cv);
-            o[c] = keep ? o[c] : r;
-        }
-    }
-}
-
-void fv_pullpush_init_c(fv_dsp *d)
-{
-    d->pull_row = fv_pull_row_c;
-    d->push_row = fv_push_row_c;
-}
 
 /* ---------------------------------------------------------------- pyramid memory */
 
@@ -191,7 +142,7 @@ void fv_pyramid_clear(fv_pyramid *p, fv_pool *pool)
 #define CHUNK_PX 16384 /* target output pixels per work item */
 
 typedef struct {
-    const fv_dsp *dsp;
+    const fv_pullpush_dsp *dsp;
     const fv_pyr_level *src, *dst; /* pull: fine -> coarse; push: coarse -> fine */
     int rows, chunks, reverse;
 } pp_ctx;
@@ -275,7 +226,7 @@ static void run_level(fv_pool *pool, fv_task_fn fn, pp_ctx *c)
     fv_pool_run(pool, c->chunks, fn, c);
 }
 
-void fv_pull_block(fv_pyramid *p, const fv_dsp *dsp, int level, int x0, int y0, int w, int h)
+void fv_pull_block(fv_pyramid *p, const fv_pullpush_dsp *dsp, int level, int x0, int y0, int w, int h)
 {
     const fv_pyr_level *s = &p->lv[level], *d = &p->lv[level + 1];
     /* rows 2Y+1 == s->h and column s->w are the zero-weight border: odd edges need no care */
@@ -286,12 +237,12 @@ void fv_pull_block(fv_pyramid *p, const fv_dsp *dsp, int level, int x0, int y0, 
     }
 }
 
-void fv_pullpush(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool)
+void fv_pullpush(fv_pyramid *p, const fv_pullpush_dsp *dsp, fv_pool *pool)
 {
     fv_pullpush_from(p, dsp, pool, 0);
 }
 
-void fv_pullpush_from(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool, int pulled)
+void fv_pullpush_from(fv_pyramid *p, const fv_pullpush_dsp *dsp, fv_pool *pool, int pulled)
 {
     if (!p->mem || p->levels < 1)
         return;

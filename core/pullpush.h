@@ -7,7 +7,7 @@
 #define FOVEA_PULLPUSH_H
 
 #include <stddef.h>
-#include "dsp.h"
+#include "pullpush_dsp.h"
 #include "pool.h"
 
 #define FV_PYR_MAX_LEVELS 16
@@ -30,12 +30,12 @@ void fv_pyramid_free(fv_pyramid *p);
 /* Level 0: weight 0 and colour/depth 0 everywhere (before writing new samples). */
 void fv_pyramid_clear(fv_pyramid *p, fv_pool *pool);
 /* Fills every hole of level 0 and every level above it. Deterministic for any pool size. */
-void fv_pullpush(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool);
+void fv_pullpush(fv_pyramid *p, const fv_pullpush_dsp *dsp, fv_pool *pool);
 /* The same when levels 1..pulled already hold their pull (fv_pull_block): the ray caster pulls
  * each tile up the first levels while it is still in cache. Same bits as fv_pullpush. */
-void fv_pullpush_from(fv_pyramid *p, const fv_dsp *dsp, fv_pool *pool, int pulled);
+void fv_pullpush_from(fv_pyramid *p, const fv_pullpush_dsp *dsp, fv_pool *pool, int pulled);
 /* Pulls the block [x0, x0+w) x [y0, y0+h) of `level` (x0, y0 even; w, h reaching the level's
  * edge or even) into level + 1. Disjoint blocks may run concurrently. */
-void fv_pull_block(fv_pyramid *p, const fv_dsp *dsp, int level, int x0, int y0, int w, int h);
+void fv_pull_block(fv_pyramid *p, const fv_pullpush_dsp *dsp, int level, int x0, int y0, int w, int h);
 
 #endif

@@ -1,6 +1,5 @@
-/* fovea: temporal reprojection, per-frame / per-tile setup and the plain-C reference kernels
- * (the row loops are in reproject_tmpl.h; the ISA versions in core/x86/, core/arm/ differ only
- * in the 4-channel texel accumulation below). */
+/* fovea: temporal reprojection, per-frame / per-tile setup (the kernels: reproject_dsp.h,
+ * their references in reproject_ref.c). */
 #include "reproject.h"
 
 #include <math.h>
@@ -8,7 +7,6 @@
 
 #include <stdint.h>
 
-#include "dsp.h"
 #include "sampling.h"
 
 void fv_taa_params_default(fv_taa_params *p)
@@ -108,7 +106,7 @@ float fv_taa_project(const fv_taa_frame *f, float px, float py, float d, float *
 }
 
 void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
-                     const fv_pyr_level *l0, const struct fv_dsp *dsp, int x0, int y0, int tw, int th)
+                     const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th)
 {
     fv_taa_tile tt;
     const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
@@ -135,85 +133,6 @@ void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const stru
     tt.flow_x = (int)floorf(fx + 0.5f);
     tt.flow_y = (int)floorf(fy + 0.5f);
     dsp->taa_fill(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
-}
-
-/* ---------------------------------------------------------------- reference kernels */
-
-typedef struct {
-    float c[4];
-} acc4;
-
-static inline acc4 acc_zero(void)
-{
-    acc4 a = {{0.0f, 0.0f, 0.0f, 0.0f}};
-    return a;
-}
-
-static inline void tap(const fv_pyr_level *L, float s, float t, float zexp, float inv_tol, acc4 *acc, float *accw)
-{
-    const float fs = floorf(s), ft = floorf(t);
-    const int i = (int)fs, j = (int)ft;
-    const float fx = s - fs, fy = t - ft, omx = 1.0f - fx, omy = 1.0f - fy;
-    const ptrdiff_t o00 = (ptrdiff_t)j * L->stride + i, o01 = o00 + L->stride;
-    const float *c00 = L->rgbd + 4 * o00, *c10 = c00 + 4, *c01 = L->rgbd + 4 * o01, *c11 = c01 + 4;
-    const float b00 = omx * omy, b01 = omx * fy, b10 = fx * omy, b11 = fx * fy;
-    float a00 = 1.0f - fabsf(c00[3] - zexp) * inv_tol, a01 = 1.0f - fabsf(c01[3] - zexp) * inv_tol;
-    float a10 = 1.0f - fabsf(c10[3] - zexp) * inv_tol, a11 = 1.0f - fabsf(c11[3] - zexp) * inv_tol;
-    a00 = a00 > 0.0f ? a00 : 0.0f;
-    a01 = a01 > 0.0f ? a01 : 0.0f;
-    a10 = a10 > 0.0f ? a10 : 0.0f;
-    a11 = a11 > 0.0f ? a11 : 0.0f;
-    const float w00 = (b00 * L->wgt[o00]) * a00, w01 = (b01 * L->wgt[o01]) * a01;
-    const float w10 = (b10 * L->wgt[o00 + 1]) * a10, w11 = (b11 * L->wgt[o01 + 1]) * a11;
-    for (int c = 0; c < 4; c++)
-        acc->c[c] = acc->c[c] + ((w00 * c00[c] + w01 * c01[c]) + (w10 * c10[c] + w11 * c11[c]));
-    *accw = *accw + ((w00 + w01) + (w10 + w11));
-}
-
-static inline void out_blend(float *px, acc4 acc, float accw, float alpha)
-{
-    for (int c = 0; c < 3; c++) {
-        const float h = acc.c[c] / accw;
-        px[c] = h + alpha * (px[c] - h);
-    }
-}
-
-static inline uint64_t sample_mask(const float *wgt, int n)
-{
-    uint64_t m = 0;
-    for (int i = 0; i < n; i++)
-        m |= (uint64_t)(wgt[i] == 1.0f) << i;
-    return m;
-}
-
-#define TAA_FN(name) name##_c
-#include "reproject_tmpl.h"
-
-void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
-                    ptrdiff_t stride, int x0, int y0, int w, int h, struct fv_taa_flow *flow)
-{
-    taa_blend_c(f, t, rgbd, wgt, stride, x0, y0, w, h, flow);
-}
-
-/* no vector body: the scalar form does every pixel */
-static inline int no_vec(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                         const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
-{
-    (void)f, (void)t, (void)rgbd, (void)wgt, (void)hrow, (void)hw, (void)B, (void)x0, (void)py, (void)ihi;
-    return ilo;
-}
-TAA_FILL_BLOCK(fill_c, no_vec)
-
-void fv_taa_fill_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                   ptrdiff_t stride, int x0, int y0, int w, int h)
-{
-    fill_c(f, t, rgbd, wgt, stride, x0, y0, w, h);
-}
-
-void fv_reproject_init_c(fv_dsp *d)
-{
-    d->taa_blend = fv_taa_blend_c;
-    d->taa_fill = fv_taa_fill_c;
 }
 
 /* The history a tile will read lies around the tile moved by the head motion: guess the move

@@ -30,6 +30,7 @@
 
 #include "camera.h"
 #include "pullpush.h"
+#include "reproject_dsp.h"
 
 typedef struct fv_taa_params {
     int enabled;     /* default 1 (foveated rendering only) */
@@ -79,9 +80,8 @@ void fv_taa_tile_setup(fv_taa_tile *t, const fv_taa_params *prm, float p, float 
  * the blend row by row, then the fill at the tile's mean sample flow (rounded; where no sample
  * reached the previous image, the flow of a far point at the tile centre). */
 struct fv_sampler;
-struct fv_dsp;
 void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
-                     const fv_pyr_level *l0, const struct fv_dsp *dsp, int x0, int y0, int tw, int th);
+                     const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th);
 
 /* Prefetches the level-0 history that fv_taa_tile_run of the tile [x0, x0+tw) x [y0, y0+th) will
  * read, guessing the tile's motion from the history's depth at coarse_level (the level where the

@@ -14,7 +14,7 @@ typedef struct {
     const fv_sampler *smp;
     int gx, gy, tiles_x, tiles_y;
     fv_pyramid *pyr;
-    const fv_dsp *dsp;
+    const fv_render_dsp *dsp;
     int phase;
     const fv_taa_frame *taa;
     const fv_taa_params *taa_prm;
@@ -47,7 +47,7 @@ static void run_tile(void *ctx, int index, int thread_id)
     const long rays = fv_raycast_tile(j->scene, cam, l0, x0, y0, tw, th, rows);
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
-        fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], j->dsp, x0, y0, tw, th);
+        fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th);
         const int64_t t1 = fv_time_ns();
         atomic_fetch_add_explicit(&j->taa_ns, t1 - t0, memory_order_relaxed);
         if (j->prof)
@@ -57,7 +57,7 @@ static void run_tile(void *ctx, int index, int thread_id)
      * 4. Tiles start on multiples of 16, so every block starts on even coordinates. */
     int xl = x0, yl = y0, wl = tw, hl = th;
     for (int l = 0; l < FV_TILE_PULL_LEVELS && l + 1 < j->pyr->levels; l++) {
-        fv_pull_block(j->pyr, j->dsp, l, xl, yl, wl, hl);
+        fv_pull_block(j->pyr, &j->dsp->pp, l, xl, yl, wl, hl);
         xl >>= 1, yl >>= 1, wl = (wl + 1) >> 1, hl = (hl + 1) >> 1;
     }
     atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
@@ -66,7 +66,7 @@ static void run_tile(void *ctx, int index, int thread_id)
 }
 
 long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
-                  const fv_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms)
+                  const fv_render_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms)
 {
     tile_job j = {.scene = scene, .cam = cam, .smp = smp, .gx = gx, .gy = gy, .pyr = pyr, .dsp = dsp};
     if (opt) {

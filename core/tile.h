@@ -10,7 +10,7 @@
 #define FOVEA_TILE_H
 
 #include "camera.h"
-#include "dsp.h"
+#include "render_dsp.h"
 #include "pool.h"
 #include "pullpush.h"
 #include "reproject.h"
@@ -43,6 +43,6 @@ typedef struct fv_tile_opts {
  * time the workers spent reprojecting, divided by the pool's thread count, goes to *taa_ms
  * (NAN without reprojection; taa_ms may be NULL). */
 long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
-                  const fv_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms);
+                  const fv_render_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms);
 
 #endif

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "base/err.h"
-#include "dsp.h"
+#include "cpu.h"
 #include "output.h"
 #include "perfctr.h"
 #include "vsyncpred.h"

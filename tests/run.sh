@@ -1,5 +1,6 @@
 #!/bin/sh
-# Runs fovea's test binaries (cmocka) and the command-line tests, then prints one summary line
+# Runs fovea's test binaries (cmocka: tests/test_*, tests/checkasm/checkasm) and the command-line
+# tests, then prints one summary line
 # "tests: N passed, N failed". Env: BUILD (build dir), SHARED (../shared), RUNNER (e.g.
 # qemu-aarch64 for the cross leg). --core: only the core's test binaries (no app/CLI tests).
 set -u
@@ -10,7 +11,7 @@ core_only=0
 [ "${1:-}" = "--core" ] && core_only=1
 pass=0 fail=0 failed_names=
 log=$(mktemp)
-for t in "$BUILD"/tests/test_*; do
+for t in "$BUILD"/tests/test_* "$BUILD"/tests/checkasm/checkasm; do
     [ -x "$t" ] || continue
     name=$(basename "$t")
     echo "== $name"

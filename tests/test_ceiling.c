@@ -10,7 +10,7 @@
 #include <cmocka.h>
 
 #include "ceiling.h"
-#include "dsp.h"
+#include "render_dsp.h"
 #include "raycast.h"
 #include "testscene.h"
 #include "tile.h"
@@ -42,8 +42,8 @@ static void check_same_rays(const fv_sampler *smp, int packet)
     assert_int_equal(fv_camera_setup(&cam, &d, &origin), 0);
     fv_pool *pool = fv_pool_create(3);
     assert_non_null(pool);
-    fv_dsp dsp;
-    fv_dsp_init(&dsp, FV_ISA_C);
+    fv_render_dsp dsp;
+    fv_render_dsp_init(&dsp, FV_ISA_C);
     fv_pyramid pyr;
     assert_int_equal(fv_pyramid_init(&pyr, W, H), 0);
     const int gx = 30, gy = 20;

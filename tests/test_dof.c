@@ -7,6 +7,7 @@
 #include "testutil.h"
 #include "dof/dof.h"
 #include "dof/weier_impl.h"
+#include "render_dsp.h"
 
 #define W 200
 #define H 160
@@ -14,7 +15,7 @@
 
 typedef struct {
     fv_pyramid pyr;
-    fv_dsp dsp;
+    fv_render_dsp dsp;
     fv_dof_params prm;
     fv_dof_view v;
     fv_dof_work wk;
@@ -33,8 +34,8 @@ static void rig_init(rig *r, scene_fn scene, fv_dof_preset preset, float focus_m
             scene(x, y, l0->rgbd + 4 * ((ptrdiff_t)y * l0->stride + x));
             l0->wgt[(ptrdiff_t)y * l0->stride + x] = 1.0f;
         }
-    fv_dsp_init(&r->dsp, FV_ISA_C);
-    fv_pullpush(&r->pyr, &r->dsp, NULL);
+    fv_render_dsp_init(&r->dsp, FV_ISA_C);
+    fv_pullpush(&r->pyr, &r->dsp.pp, NULL);
     fv_dof_params_default(&r->prm);
     r->prm.preset = preset;
     r->prm.contrast_gain = 0.0f;
@@ -54,9 +55,9 @@ static void rig_init(rig *r, scene_fn scene, fv_dof_preset preset, float focus_m
 
 static void rig_run(rig *r, fv_pool *pool, unsigned isa)
 {
-    fv_dsp_init(&r->dsp, isa);
+    fv_render_dsp_init(&r->dsp, isa);
     fv_dof_times t;
-    fv_dof_weier(&r->v, &r->wk, r->out, r->pyr.lv[0].stride, pool, &r->dsp, &t);
+    fv_dof_weier(&r->v, &r->wk, r->out, r->pyr.lv[0].stride, pool, &r->dsp.dof, &t);
     assert_true(t.coc_ms >= 0.0 && t.filter_ms >= 0.0 && t.combine_ms >= 0.0);
 }
 
@@ -307,8 +308,8 @@ static void test_coc_row_matches_eq3(void **st)
     const float focus = 1.0f, K = 0.00449f * FOCAL;
     const unsigned isas[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_SSE41 | FV_ISA_AVX2, FV_ISA_NEON};
     for (size_t k = 0; k < sizeof isas / sizeof isas[0]; k++) {
-        fv_dsp d;
-        fv_dsp_init(&d, isas[k]);
+        fv_dof_dsp d;
+        fv_dof_dsp_init(&d, isas[k]);
         d.dof_coc_row(coc, rgbd, 64, K, focus - 0.2f, focus + 0.2f);
         for (int i = 0; i < 64; i++) {
             const float e = fv_coc_weier_px(&p, focus, rgbd[4 * i + 3]);

@@ -12,6 +12,7 @@
 #include "dof/dof.h"
 #include "pool.h"
 #include "pullpush.h"
+#include "render_dsp.h"
 
 #define W 90 /* not a multiple of the 16 px tiles or the 8 px blocks */
 #define H 70
@@ -40,7 +41,7 @@ typedef struct fixture {
     fv_dof_work wk;
     fv_dof_params prm;
     fv_dof_view view;
-    fv_dsp dsp;
+    fv_render_dsp dsp;
     float *out, *out2;
 } fixture;
 
@@ -60,7 +61,7 @@ static void fx_init(fixture *f)
     memset(f, 0, sizeof *f);
     assert_int_equal(fv_pyramid_init(&f->pyr, W, H), 0);
     assert_int_equal(fv_dof_work_init(&f->wk, W, H, f->pyr.lv[0].stride), 0);
-    fv_dsp_init(&f->dsp, ~0u);
+    fv_render_dsp_init(&f->dsp, ~0u);
     fv_dof_params_default(&f->prm);
     f->prm.preset = FV_DOF_MEDIUM;
     const float scale = fv_dof_presets[FV_DOF_MEDIUM].e_scale; /* 2 */
@@ -90,7 +91,7 @@ static void fx_scene(fixture *f, scene_fn fn, const void *arg)
             fn(x, y, L->rgbd + 4 * ((ptrdiff_t)y * L->stride + x), arg);
             L->wgt[(ptrdiff_t)y * L->stride + x] = 1.0f;
         }
-    fv_pullpush(&f->pyr, &f->dsp, NULL);
+    fv_pullpush(&f->pyr, &f->dsp.pp, NULL);
 }
 
 static const float *in_px(const fixture *f, int x, int y)
@@ -102,7 +103,7 @@ static float *out_px(float *out, int x, int y) { return out + 4 * ((size_t)y * W
 static void run(fixture *f, int m, fv_pool *pool, float *out)
 {
     fv_dof_times t = {0};
-    models[m].fn(&f->view, &f->wk, out, W, pool, &f->dsp, &t);
+    models[m].fn(&f->view, &f->wk, out, W, pool, &f->dsp.dof, &t);
     assert_true(t.coc_ms >= 0.0 && t.filter_ms >= 0.0);
     assert_true(isnan(t.combine_ms) || t.combine_ms >= 0.0);
 }
@@ -279,7 +280,7 @@ static void test_thread_count_invariant(void **st)
         float *wide = malloc((size_t)os * H * 4 * sizeof(float));
         assert_non_null(wide);
         fv_dof_times t;
-        models[m].fn(&f.view, &f.wk, wide, os, p3, &f.dsp, &t);
+        models[m].fn(&f.view, &f.wk, wide, os, p3, &f.dsp.dof, &t);
         for (int y = 0; y < H; y++)
             assert_memory_equal(wide + 4 * y * os, out_px(f.out, 0, y), (size_t)W * 4 * sizeof(float));
         free(wide);

@@ -318,7 +318,7 @@ static void test_fused_pull_matches_pullpush(void **st)
         memcpy(ref.lv[0].rgbd + 4 * y * ref.lv[0].stride, got->lv[0].rgbd + 4 * y * got->lv[0].stride, 4 * sizeof(float) * 203);
         memcpy(ref.lv[0].wgt + y * ref.lv[0].stride, got->lv[0].wgt + y * got->lv[0].stride, sizeof(float) * 203);
     }
-    fv_pullpush(&ref, fv_pipeline_dsp(p), NULL);
+    fv_pullpush(&ref, &fv_pipeline_dsp(p)->pp, NULL);
     for (int l = 0; l < ref.levels; l++)
         for (int y = 0; y < ref.lv[l].h; y++) {
             assert_memory_equal(ref.lv[l].rgbd + 4 * y * ref.lv[l].stride, got->lv[l].rgbd + 4 * y * got->lv[l].stride,

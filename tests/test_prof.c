@@ -1,11 +1,10 @@
-/* fovea: the trace recorder (core/prof.c) and the kernel benchmark table (core/kbench.c). */
+/* fovea: the trace recorder (core/prof.c). */
 #include <math.h>
 #include <string.h>
 
 #include "base/clock.h"
 #include "testutil.h"
 
-#include "kbench.h"
 #include "pipeline.h"
 #include "pool.h"
 #include "bench.h"
@@ -216,32 +215,6 @@ static void test_stage_bytes(void **state)
     assert_true(r1 > 2.0 * r0 && w1 > 0.76 * 16.0 * 1280 * 1440);
 }
 
-static void test_kbench_table(void **state)
-{
-    (void)state;
-    fv_dsp c, best;
-    fv_dsp_init(&c, FV_ISA_C);
-    fv_dsp_init(&best, ~0u);
-    assert_true(fv_kbench_count >= 10);
-    for (int i = 0; i < fv_kbench_count; i++) {
-        const fv_kbench_kernel *k = &fv_kbench_kernels[i];
-        assert_ptr_equal(fv_kbench_find(k->name), k);
-        assert_false(fv_kbench_differs(k, &c, &c));
-        assert_true(k->field[0] > 0 && k->calls_per_frame > 0);
-    }
-    assert_null(fv_kbench_find("nope"));
-    /* the pull-push kernels have SIMD versions wherever the CPU has an ISA */
-    if (best.isa != FV_ISA_C)
-        assert_true(fv_kbench_differs(fv_kbench_find("pull_row"), &best, &c));
-    /* one kernel end to end (the smallest: the eye tracker's threshold), both tables */
-    const fv_kbench_kernel *k = fv_kbench_find("et_thresh_row");
-    void *st = k->setup();
-    assert_non_null(st);
-    k->run(st, &c, 0, k->calls_per_frame);
-    k->run(st, &best, 0, 3);
-    k->free(st);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -250,7 +223,6 @@ int main(void)
         cmocka_unit_test(test_pipeline_spans),
         cmocka_unit_test(test_pipeline_dof_spans),
         cmocka_unit_test(test_stage_bytes),
-        cmocka_unit_test(test_kbench_table),
     };
     return cmocka_run_group_tests_name("prof", tests, NULL, NULL);
 }

@@ -194,8 +194,8 @@ static void test_constant_with_holes(void **state)
             set_px(&im, w / 2, h / 2, k, 1.0f);
         fv_pyramid p;
         assert_int_equal(fv_pyramid_init(&p, w, h), 0);
-        fv_dsp d;
-        fv_dsp_init(&d, ~0u);
+        fv_pullpush_dsp d;
+        fv_pullpush_dsp_init(&d, ~0u);
         load(&p, &im, NULL);
         poison_holes(&p);
         fv_pullpush(&p, &d, NULL);
@@ -263,8 +263,8 @@ static void test_linear_ramp(void **state)
     }
     fv_pyramid p;
     assert_int_equal(fv_pyramid_init(&p, w, h), 0);
-    fv_dsp d;
-    fv_dsp_init(&d, ~0u);
+    fv_pullpush_dsp d;
+    fv_pullpush_dsp_init(&d, ~0u);
     load(&p, &im, NULL);
     fv_pullpush(&p, &d, NULL);
     const int margin = 1 << (L + 2);
@@ -316,8 +316,8 @@ static void test_ramp_even_grid(void **state)
             continue;
         fv_pyramid p;
         assert_int_equal(fv_pyramid_init(&p, w, h), 0);
-        fv_dsp d;
-        fv_dsp_init(&d, isa);
+        fv_pullpush_dsp d;
+        fv_pullpush_dsp_init(&d, isa);
         load(&p, &im, NULL);
         fv_pullpush(&p, &d, NULL);
         double worst = 0;
@@ -327,14 +327,14 @@ static void test_ramp_even_grid(void **state)
                 const double want = sample ? a + b * x + c * y : a + b * (x - 0.5) + c * (y - 0.5);
                 const double e = fabs(px(&p.lv[0], x, y)[0] - want);
                 if (!(e <= 1e-5))
-                    fail_msg("%s: even-grid ramp pixel (%d,%d) = %.7g, want %.7g", fv_isa_name(d.isa), x, y,
+                    fail_msg("%s: even-grid ramp pixel (%d,%d) = %.7g, want %.7g", fv_isa_name(isa), x, y,
                              (double)px(&p.lv[0], x, y)[0], want);
                 if (e > worst)
                     worst = e;
             }
         tried++;
         fv_pyramid_free(&p);
-        printf("[ pullpush ] even-grid ramp %-6s: worst error %.3g (bound 1e-5)\n", fv_isa_name(d.isa), worst);
+        printf("[ pullpush ] even-grid ramp %-6s: worst error %.3g (bound 1e-5)\n", fv_isa_name(isa), worst);
     }
     assert_true(tried >= 1);
     img_free(&im);
@@ -353,8 +353,8 @@ static void test_hole_free_unchanged(void **state)
         }
     fv_pyramid p;
     assert_int_equal(fv_pyramid_init(&p, w, h), 0);
-    fv_dsp d;
-    fv_dsp_init(&d, ~0u);
+    fv_pullpush_dsp d;
+    fv_pullpush_dsp_init(&d, ~0u);
     load(&p, &im, NULL);
     fv_pullpush(&p, &d, NULL);
     for (int y = 0; y < h; y++) {
@@ -383,8 +383,8 @@ static void test_single_sample(void **state)
             set_px(&im, (int)(fv_test_rand(&rng) % (unsigned)w), (int)(fv_test_rand(&rng) % (unsigned)h), k, sw);
             fv_pyramid p;
             assert_int_equal(fv_pyramid_init(&p, w, h), 0);
-            fv_dsp d;
-            fv_dsp_init(&d, ~0u);
+            fv_pullpush_dsp d;
+            fv_pullpush_dsp_init(&d, ~0u);
             load(&p, &im, NULL);
             poison_holes(&p);
             fv_pullpush(&p, &d, NULL);
@@ -401,8 +401,8 @@ static void test_empty_image(void **state)
     const int w = 37, h = 21;
     fv_pyramid p;
     assert_int_equal(fv_pyramid_init(&p, w, h), 0);
-    fv_dsp d;
-    fv_dsp_init(&d, ~0u);
+    fv_pullpush_dsp d;
+    fv_pullpush_dsp_init(&d, ~0u);
     fv_pyramid_clear(&p, NULL);
     poison_holes(&p);
     fv_pullpush(&p, &d, NULL);
@@ -422,8 +422,8 @@ static void test_thread_count_invariance(void **state)
     const int w = 1281, h = 1441;
     image im = img_new(w, h);
     foveated(&im, 0.55 * w, 0.45 * h, 180, 0.1, 220);
-    fv_dsp d;
-    fv_dsp_init(&d, ~0u);
+    fv_pullpush_dsp d;
+    fv_pullpush_dsp_init(&d, ~0u);
     fv_pyramid ref;
     assert_int_equal(fv_pyramid_init(&ref, w, h), 0);
     load(&ref, &im, NULL);
@@ -460,8 +460,8 @@ static void test_reuse(void **state)
     image a = img_new(w, h), b = img_new(w, h);
     foveated(&a, 30, 40, 20, 0.05, 50);
     foveated(&b, 200, 100, 15, 0.02, 40);
-    fv_dsp d;
-    fv_dsp_init(&d, ~0u);
+    fv_pullpush_dsp d;
+    fv_pullpush_dsp_init(&d, ~0u);
     fv_pyramid fresh, used;
     assert_int_equal(fv_pyramid_init(&fresh, w, h), 0);
     assert_int_equal(fv_pyramid_init(&used, w, h), 0);
@@ -489,8 +489,8 @@ static void test_isa_matches_c(void **state)
         const int w = dims[i][0], h = dims[i][1];
         image im = img_new(w, h);
         foveated(&im, 0.4 * w, 0.6 * h, 0.1 * w, 0.08, 0.2 * w + 1);
-        fv_dsp dc;
-        fv_dsp_init(&dc, FV_ISA_C);
+        fv_pullpush_dsp dc;
+        fv_pullpush_dsp_init(&dc, FV_ISA_C);
         fv_pyramid ref;
         assert_int_equal(fv_pyramid_init(&ref, w, h), 0);
         load(&ref, &im, NULL);
@@ -499,8 +499,8 @@ static void test_isa_matches_c(void **state)
         for (unsigned isa = 1; isa <= FV_ISA_NEON; isa <<= 1) {
             if (!(isas & isa))
                 continue;
-            fv_dsp d;
-            fv_dsp_init(&d, isa);
+            fv_pullpush_dsp d;
+            fv_pullpush_dsp_init(&d, isa);
             fv_pyramid p;
             assert_int_equal(fv_pyramid_init(&p, w, h), 0);
             load(&p, &im, NULL);

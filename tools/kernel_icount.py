@@ -37,8 +37,8 @@ def arg(name, default):
 
 def kernels(bench):
     # the table's names: from a one-rep timing listing would be slow under qemu; ask the source
-    src = open(os.path.join(os.path.dirname(__file__), "..", "core", "kbench.c")).read()
-    tab = src[src.index("const fv_kbench_kernel fv_kbench_kernels[]"):]
+    src = open(os.path.join(os.path.dirname(__file__), "..", "tests", "checkasm", "bench.c")).read()
+    tab = src[src.index("const checkasm_bench_kernel checkasm_bench_kernels[]"):]
     return re.findall(r'^\s*\{"([a-z0-9_+]+)",', tab, re.M)
 
 

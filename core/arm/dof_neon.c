@@ -1,5 +1,5 @@
 /* fovea: depth-of-field kernels, AArch64 Advanced SIMD. Bit-identical to the C references in
- * core/dof/kernels.c: in the Gaussians one pixel = one float32x4_t (the references add channel
+ * core/dof/dof_ref.c: in the Gaussians one pixel = one float32x4_t (the references add channel
  * by channel in the same order); true division (FDIV), multiply then add (no FMLA: the tree is
  * built with -ffp-contract=off). The CoC takes 4 pixels at a time (LD4 deinterleaves the
  * depths); the Gaussians 4 output pixels at a time so 4 independent add chains overlap; the
@@ -17,7 +17,7 @@
 
 #include "dof/weier_impl.h"
 #include "base/util.h"
-#include "dsp.h"
+#include "dof/dof_dsp.h"
 
 #define CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
 
@@ -278,7 +278,7 @@ static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a,
         fv_dof_pyrblur_row_c(blur, a, i, x0 + n - i);
 }
 
-void fv_dof_init_neon(fv_dsp *d)
+void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
     d->dof_upsample_row = upsample_row_neon;
     d->dof_pyrblur_row = pyrblur_row_neon;

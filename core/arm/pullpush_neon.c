@@ -3,7 +3,7 @@
  * (FDIV), multiply-by-element (no FMLA: the tree is built with -ffp-contract=off). */
 #include <arm_neon.h>
 
-#include "dsp.h"
+#include "pullpush_dsp.h"
 
 static inline float32x4_t divmask(float32x4_t t, float32x4_t sw)
 {
@@ -120,7 +120,7 @@ static void push_row_neon(float *restrict fine_rgbd, const float *fine_wgt, cons
         fv_push_row_c(fine_rgbd + 4 * x, fine_wgt + x, coarse_near + 2 * x, coarse_far + 2 * x, n - x);
 }
 
-void fv_pullpush_init_neon(fv_dsp *d)
+void fv_pullpush_dsp_init_neon(fv_pullpush_dsp *d)
 {
     d->pull_row = pull_row_neon;
     d->push_row = push_row_neon;

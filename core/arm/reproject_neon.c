@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "dsp.h"
+#include "reproject_dsp.h"
 #include "reproject.h"
 
 typedef float32x4_t acc4;
@@ -113,7 +113,7 @@ static inline int fill_vec_neon(const struct fv_taa_frame *f, const struct fv_ta
 
 TAA_FILL_BLOCK(taa_fill_neon, fill_vec_neon)
 
-void fv_reproject_init_neon(fv_dsp *d)
+void fv_reproject_dsp_init_neon(fv_reproject_dsp *d)
 {
     d->taa_blend = taa_blend_neon;
     d->taa_fill = taa_fill_neon;

@@ -13,7 +13,7 @@
 
 #include <stddef.h>
 
-#include "../dsp.h"
+#include "dof_dsp.h"
 #include "../pool.h"
 #include "../prof.h"
 #include "../pullpush.h"
@@ -95,17 +95,17 @@ typedef struct fv_dof_times {
 
 /* A model's whole DoF: out (4 floats a pixel, rows out_stride pixels) gets the blurred image. */
 typedef void (*fv_dof_model_fn)(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride,
-                                fv_pool *pool, const fv_dsp *dsp, fv_dof_times *t);
+                                fv_pool *pool, const fv_dof_dsp *dsp, fv_dof_times *t);
 void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                  const fv_dsp *dsp, fv_dof_times *t);
+                  const fv_dof_dsp *dsp, fv_dof_times *t);
 void fv_dof_hussain(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                    const fv_dsp *dsp, fv_dof_times *t);
+                    const fv_dof_dsp *dsp, fv_dof_times *t);
 void fv_dof_mantiuk(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                    const fv_dsp *dsp, fv_dof_times *t);
+                    const fv_dof_dsp *dsp, fv_dof_times *t);
 void fv_dof_konrad(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                   const fv_dsp *dsp, fv_dof_times *t);
+                   const fv_dof_dsp *dsp, fv_dof_times *t);
 void fv_dof_liu(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                const fv_dsp *dsp, fv_dof_times *t);
+                const fv_dof_dsp *dsp, fv_dof_times *t);
 typedef struct fv_dof_model_info {
     const char *name;   /* command line and JSON: "weier", "hussain", ... */
     fv_dof_model_fn run;

@@ -222,7 +222,7 @@ static void hu_combine_row(void *ctx, int y, int tid)
 }
 
 void fv_dof_hussain(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                    const fv_dsp *dsp, fv_dof_times *t)
+                    const fv_dof_dsp *dsp, fv_dof_times *t)
 {
     (void)dsp;
     float lut[HU_LUT_N][HU_HALF + 1];

@@ -126,7 +126,7 @@ static void liu_filter_row(void *ctx, int y, int tid)
 }
 
 void fv_dof_liu(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                const fv_dsp *dsp, fv_dof_times *t)
+                const fv_dof_dsp *dsp, fv_dof_times *t)
 {
     (void)dsp;
     liu_job j = {.v = v, .L = &v->pyr->lv[0], .wk = wk, .out = out, .os = out_stride};

@@ -148,7 +148,7 @@ static void ma_filter_row(void *ctx, int y, int tid)
 }
 
 void fv_dof_mantiuk(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                    const fv_dsp *dsp, fv_dof_times *t)
+                    const fv_dof_dsp *dsp, fv_dof_times *t)
 {
     (void)dsp;
     ma_job j = {.v = v, .L = &v->pyr->lv[0], .wk = wk, .out = out, .os = out_stride};

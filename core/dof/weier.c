@@ -138,7 +138,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
 }
 
 void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
-                  const fv_dsp *dsp, fv_dof_times *t)
+                  const fv_dof_dsp *dsp, fv_dof_times *t)
 {
     fvw_ctx ctx = {0}, *x = &ctx;
     x->v = v, x->wk = wk, x->dsp = dsp, x->out = out, x->out_stride = out_stride, x->tab = wk->gauss;

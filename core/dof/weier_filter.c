@@ -24,7 +24,7 @@ void fvw_xtaps_init(xtaps *t, int L, int w, int src_w)
 /* Image `src` (2^L level-0 pixels a texel) bilinearly up-sampled to level-0 row y, columns
  * [0, w). Separable: the two source rows are blended once into tmp, then each pixel reads two
  * texels. */
-void fvw_upsample_row(const fv_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w,
+void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w,
                          float *restrict tmp, float *restrict dst)
 {
     const float sc = 1.0f / (float)(1 << L);

@@ -37,7 +37,7 @@ typedef struct {
 typedef struct {
     const fv_dof_view *v;
     fv_dof_work *wk;
-    const fv_dsp *dsp;
+    const fv_dof_dsp *dsp;
     const fv_dof_gauss_tab *tab;
     float *out;
     ptrdiff_t out_stride;
@@ -83,7 +83,7 @@ static inline float *fvw_slot(const fvw_ctx *x, int tid, int k) { return x->wk->
 
 /* weier_filter.c: up-sampling helpers */
 void fvw_xtaps_init(xtaps *t, int L, int w, int src_w);
-void fvw_upsample_row(const fv_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w, float *restrict tmp,
+void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w, float *restrict tmp,
                       float *restrict dst);
 /* weier_coc.c: stage "coc" (bands of TILE rows; then the tiles' reach) */
 void fvw_coc_band(void *ctx, int band, int tid);

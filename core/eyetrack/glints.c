@@ -70,7 +70,7 @@ static int list_nonzero(const uint8_t *m, int w, int y, int *list, int n)
  * background too), replaced by the mean of their unmasked 4-neighbours, ring by ring from the
  * outside in. mask is w*h bytes of scratch, idx and fr w*h ints each; the work is proportional
  * to the masked area, not the image. */
-static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
+static void inpaint_bright(const fv_eyetrack_dsp *dsp, uint8_t *img, int w, int h, int thr, int grow, uint8_t *mask, int *idx,
                            int *fr, uint8_t fallback)
 {
     int n = 0;
@@ -158,7 +158,7 @@ static void inpaint_bright(const fv_dsp *dsp, uint8_t *img, int w, int h, int th
     }
 }
 
-int fv_et_inpaint_reflections(const fv_dsp *d, uint8_t *img, int w, int h, int grow_px, uint8_t *mask, int *idx,
+int fv_et_inpaint_reflections(const fv_eyetrack_dsp *d, uint8_t *img, int w, int h, int grow_px, uint8_t *mask, int *idx,
                               int *fr, fv_et_levels *lv)
 {
     uint32_t hist[256];
@@ -173,7 +173,7 @@ int fv_et_inpaint_reflections(const fv_dsp *d, uint8_t *img, int w, int h, int g
     return 1;
 }
 
-int fv_et_find_glints(const fv_dsp *d, const uint8_t *luma, int w, int h, ptrdiff_t stride, const fv_et_pupil *pp,
+int fv_et_find_glints(const fv_eyetrack_dsp *d, const uint8_t *luma, int w, int h, ptrdiff_t stride, const fv_et_pupil *pp,
                       int max_glints, uint8_t *lab, int *stack, fv_eye_glint *g)
 {
     const float rad = fmaxf(2.2f * pp->r, 6.0f);

@@ -20,7 +20,7 @@ static inline uint32_t box_sum(const uint32_t *ii, int iw, int x0, int y0, int x
     return ii[y1 * iw + x1] - ii[y0 * iw + x1] - ii[y1 * iw + x0] + ii[y0 * iw + x0];
 }
 
-static void integral(const fv_dsp *d, const uint8_t *img, int w, int h, uint32_t *ii)
+static void integral(const fv_eyetrack_dsp *d, const uint8_t *img, int w, int h, uint32_t *ii)
 {
     /* zero first row and column */
     const int iw = w + 1;
@@ -84,7 +84,7 @@ static void box_clipped(const box_ctx *b, box_hit *best, int k, int ko, int y, i
     }
 }
 
-static void box_search(const fv_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
+static void box_search(const fv_eyetrack_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
                        int x1, int y0, int y1, float dark, float mu, box_hit *best)
 {
     const float rf = 1.5f;
@@ -129,7 +129,7 @@ static void box_search(const fv_dsp *d, const uint32_t *ii, int sw, int sh, int 
 /* Two levels: F (halved until min side <= SEARCH_MAX_SIDE; reflections inpainted there) and C
  * (F halved again until min side <= SEARCH_C_SIDE). The exhaustive search runs on C;
  * F only refines position and size around C's answer, which costs ~25x less than searching F. */
-fv_et_candidate fv_et_search(const fv_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
+fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
                              ptrdiff_t stride, const fv_et_scratch *s)
 {
     fv_et_candidate c = { 0 };

@@ -39,7 +39,7 @@ fv_eye_tracker *fv_eye_create(const fv_eye_params *p, fv_eye_mode mode)
     t->mode = fv_eye_mode_name(mode) ? mode : FV_EYE_MODE_AUTO;
     if (t->p.max_glints < 0 || t->p.max_glints > FV_EYE_MAX_GLINTS)
         t->p.max_glints = FV_EYE_MAX_GLINTS;
-    fv_dsp_init(&t->dsp, t->p.isa_mask);
+    fv_eyetrack_dsp_init(&t->dsp, t->p.isa_mask);
     return t;
 }
 

@@ -4,14 +4,14 @@
  *             RANSAC, ellipse fit (ellipse.c)
  *   glints.c  bright spots: reflection inpainting, corneal glints, the crop mode's bright spot
  *   blink.c   confidence, loss and blinks against the tracker's running reference
- * Kernels are reached through the dispatch table (const fv_dsp *, dsp->et_*). */
+ * Kernels are reached through the dispatch table (const fv_eyetrack_dsp *, dsp->et_*). */
 #ifndef FOVEA_EYETRACK_TRACK_IMPL_H
 #define FOVEA_EYETRACK_TRACK_IMPL_H
 
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dsp.h"
+#include "eyetrack/eyetrack_dsp.h"
 #include "eyetrack/eyetrack.h"
 
 #define FV_ET_SEARCH_MAX_SIDE 160 /* search image F: min side at most this */
@@ -25,7 +25,7 @@ typedef struct fv_et_history { /* running reference of the pupil (fv_track_frame
 struct fv_eye_tracker {
     fv_eye_params p;
     fv_eye_mode mode; /* as created: AUTO is resolved per frame */
-    fv_dsp dsp;
+    fv_eyetrack_dsp dsp;
     uint8_t *mem;
     size_t cap;
     fv_et_history ref;
@@ -50,7 +50,7 @@ typedef struct fv_et_candidate {
     int ok;
 } fv_et_candidate;
 
-fv_et_candidate fv_et_search(const fv_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
+fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
                              ptrdiff_t stride, const fv_et_scratch *s);
 
 /* ---- glints.c */
@@ -62,7 +62,7 @@ typedef struct fv_et_levels {
 /* Levels of img (w x h, row length w), then its reflections (pixels >= max(median + 40,
  * median + (255 - median) / 2), grown by grow_px) inpainted when its brightest 0.5% reach that.
  * mask: w * h bytes, idx and fr: w * h ints of scratch. 1 when it inpainted. */
-int fv_et_inpaint_reflections(const fv_dsp *d, uint8_t *img, int w, int h, int grow_px, uint8_t *mask, int *idx,
+int fv_et_inpaint_reflections(const fv_eyetrack_dsp *d, uint8_t *img, int w, int h, int grow_px, uint8_t *mask, int *idx,
                               int *fr, fv_et_levels *lv);
 
 typedef struct fv_et_pupil {
@@ -75,7 +75,7 @@ typedef struct fv_et_pupil {
 
 /* Corneal reflections near the pupil, nearest first (at most max_glints). lab: scratch bytes
  * and stack ints for the pupil's window (4.4r + 1 squared). */
-int fv_et_find_glints(const fv_dsp *d, const uint8_t *luma, int w, int h, ptrdiff_t stride, const fv_et_pupil *pp,
+int fv_et_find_glints(const fv_eyetrack_dsp *d, const uint8_t *luma, int w, int h, ptrdiff_t stride, const fv_et_pupil *pp,
                       int max_glints, uint8_t *lab, int *stack, fv_eye_glint *g);
 
 /* The most prominent small reflection within r of (cx, cy): 1 and its pixel centre, or 0. */
@@ -85,7 +85,7 @@ int fv_et_bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float 
 /* ---- refine.c */
 
 typedef struct fv_et_refine_args {
-    const fv_dsp *dsp;
+    const fv_eyetrack_dsp *dsp;
     const fv_eye_mode_settings *set;
     const uint8_t *img; /* the image refined on (the frame, halved, or the search image) */
     int w, h;

@@ -1,12 +1,14 @@
 /* fovea: depth-of-field kernels, AVX2 (built with -mavx2 -mfma but -ffp-contract=off and no FMA
  * intrinsics). The CoC takes 8 pixels at a time; the Gaussians 8 output pixels at a time as four
  * 256-bit accumulators of two pixels each (each 128-bit half with its own pixel's weights), the
- * rest with the 128-bit pieces of core/x86/dof_x86.h, which also has why the bits are the
+ * rest with the 128-bit pieces of core/x86/dof_tmpl.h, which also has why the bits are the
  * references'. The combine takes 8 pixels at a time without branches (see there); the
  * up-sampling and the periphery's level blend 8 at a time as 4 pixel pairs. */
 #include <immintrin.h>
 
-#include "x86/dof_x86.h"
+#define FV_X86_W 8
+#define FV_X86_FN(name) name##_avx2
+#include "x86/dof_tmpl.h"
 
 static void coc_row_avx2(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
 {
@@ -72,8 +74,8 @@ static inline void g8(__m256 a[4], const float *p, const ptrdiff_t *off, const f
 }
 
 /* n pixels from p (output d), 8 at a time, then 4 and 1; norm: times inv[s]. */
-static inline void gauss_8(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
-                           const fv_dof_gauss_tab *tab, int norm)
+static inline void dof_gauss_8(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
+                               const fv_dof_gauss_tab *tab, int norm)
 {
     int i = 0;
     for (; i + 8 <= n; i += 8) {
@@ -90,8 +92,6 @@ static inline void gauss_8(float *d, const float *p, const ptrdiff_t *off, int n
     if (i < n)
         dof_gauss_4(d + 4 * i, p + 4 * i, off, n - i, sig + i, tab, norm);
 }
-
-DOF_GAUSS_ROWS(avx2, gauss_8, 32)
 
 /* a + s (b - a) */
 static inline __m256 lerp8(__m256 a, __m256 b, __m256 s)
@@ -212,7 +212,7 @@ static inline void pb_pair(float *blur, const float *const *up, const int32_t *L
     _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
 }
 
-/* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_x86.h has why the clamped LUT
+/* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_tmpl.h has why the clamped LUT
  * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs
  * (unrolled by hand), each computed for both pixels and kept per pixel by selects; the rest
  * 128-bit. */
@@ -259,7 +259,7 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
 }
 
-void fv_dof_init_avx2(fv_dsp *d)
+void fv_dof_dsp_init_avx2(fv_dof_dsp *d)
 {
     d->dof_upsample_row = upsample_row_avx2;
     d->dof_pyrblur_row = pyrblur_row_avx2;

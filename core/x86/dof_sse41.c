@@ -1,9 +1,11 @@
-/* fovea: depth-of-field kernels, SSE4.1 (core/x86/dof_x86.h has the pieces and why they give
- * the bits of the C references in core/dof/kernels.c). The CoC takes 4 pixels at a time (true
+/* fovea: depth-of-field kernels, SSE4.1 (core/x86/dof_tmpl.h has the pieces and why they give
+ * the bits of the C references in core/dof/dof_ref.c). The CoC takes 4 pixels at a time (true
  * division, the reference's selects); the Gaussians 4 output pixels at a time, one pixel per
  * vector, so 4 independent add chains overlap where the reference waits on one. The up-sampling
  * and the periphery's level blend take one pixel a vector (their per-pixel scalars 4 at a time). */
-#include "x86/dof_x86.h"
+#define FV_X86_W 4
+#define FV_X86_FN(name) name##_sse41
+#include "x86/dof_tmpl.h"
 
 static void coc_row_sse41(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
 {
@@ -14,8 +16,6 @@ static void coc_row_sse41(float *restrict coc, const float *rgbd, int n, float K
     if (x < n)
         fv_dof_coc_row_c(coc + x, rgbd + 4 * x, n - x, K, dn, df);
 }
-
-DOF_GAUSS_ROWS(sse41, dof_gauss_4, 16)
 
 static void combine_row_sse41(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {
@@ -33,7 +33,7 @@ static void pyrblur_row_sse41(float *restrict blur, const fv_dof_pyrblur_args *a
     dof_pyrblur_row_x86(blur, a, x0, n);
 }
 
-void fv_dof_init_sse41(fv_dsp *d)
+void fv_dof_dsp_init_sse41(fv_dof_dsp *d)
 {
     d->dof_upsample_row = upsample_row_sse41;
     d->dof_pyrblur_row = pyrblur_row_sse41;

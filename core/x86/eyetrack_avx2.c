@@ -1,8 +1,8 @@
 /* fovea eye tracker kernels, AVX2. Exact: integer arithmetic, same results as the C references
- * in core/eyetrack/kernels.c for every input. */
+ * in core/eyetrack/eyetrack_ref.c for every input. */
 #include <immintrin.h>
 
-#include "dsp.h"
+#include "eyetrack/eyetrack_dsp.h"
 
 static void down2_row_avx2(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n)
 {
@@ -126,7 +126,7 @@ static void box3_row_avx2(uint8_t *restrict dst, const uint8_t *r0, const uint8_
         dst[x] = fv_et_box3_px(r0, r1, r2, n, x);
 }
 
-void fv_eyetrack_init_avx2(fv_dsp *d)
+void fv_eyetrack_dsp_init_avx2(fv_eyetrack_dsp *d)
 {
     d->et_down2_row = down2_row_avx2;
     d->et_integral_row = integral_row_avx2;

@@ -1,8 +1,8 @@
 /* fovea eye tracker kernels, SSE4.1 (+SSSE3). Exact: integer arithmetic, same results as the C
- * references in core/eyetrack/kernels.c for every input. */
+ * references in core/eyetrack/eyetrack_ref.c for every input. */
 #include <smmintrin.h>
 
-#include "dsp.h"
+#include "eyetrack/eyetrack_dsp.h"
 
 static void down2_row_sse41(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n)
 {
@@ -116,7 +116,7 @@ static void box3_row_sse41(uint8_t *restrict dst, const uint8_t *r0, const uint8
         dst[x] = fv_et_box3_px(r0, r1, r2, n, x);
 }
 
-void fv_eyetrack_init_sse41(fv_dsp *d)
+void fv_eyetrack_dsp_init_sse41(fv_eyetrack_dsp *d)
 {
     d->et_down2_row = down2_row_sse41;
     d->et_integral_row = integral_row_sse41;

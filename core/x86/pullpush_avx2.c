@@ -3,7 +3,7 @@
  * built with -mfma but -ffp-contract=off, and only separate mul/add intrinsics are used). */
 #include <immintrin.h>
 
-#include "dsp.h"
+#include "pullpush_dsp.h"
 
 static inline __m256i pair_idx(int k) /* lanes 0-3 <- element 2k, lanes 4-7 <- element 2k+1 */
 {
@@ -128,7 +128,7 @@ static void push_row_avx2(float *restrict fine_rgbd, const float *fine_wgt, cons
         fv_push_row_c(fine_rgbd + 4 * x, fine_wgt + x, coarse_near + 2 * x, coarse_far + 2 * x, n - x);
 }
 
-void fv_pullpush_init_avx2(fv_dsp *d)
+void fv_pullpush_dsp_init_avx2(fv_pullpush_dsp *d)
 {
     d->pull_row = pull_row_avx2;
     d->push_row = push_row_avx2;

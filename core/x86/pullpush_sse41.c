@@ -2,7 +2,7 @@
  * references in core/pullpush.c: same operations in the same order, true division. */
 #include <smmintrin.h>
 
-#include "dsp.h"
+#include "pullpush_dsp.h"
 
 #define BCAST(v, i) _mm_shuffle_ps((v), (v), _MM_SHUFFLE((i), (i), (i), (i)))
 
@@ -98,7 +98,7 @@ static void push_row_sse41(float *restrict fine_rgbd, const float *fine_wgt, con
         fv_push_row_c(fine_rgbd + 4 * x, fine_wgt + x, coarse_near + 2 * x, coarse_far + 2 * x, n - x);
 }
 
-void fv_pullpush_init_sse41(fv_dsp *d)
+void fv_pullpush_dsp_init_sse41(fv_pullpush_dsp *d)
 {
     d->pull_row = pull_row_sse41;
     d->push_row = push_row_sse41;

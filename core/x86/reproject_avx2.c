@@ -9,9 +9,11 @@
 
 #include <stdint.h>
 
-#include "dsp.h"
+#include "reproject_dsp.h"
 #include "reproject.h"
-#include "x86/reproject_x86.h"
+#define FV_X86_W 8
+#define FV_X86_FN(name) name##_avx2
+#include "x86/reproject_tmpl.h"
 
 static inline void tap(const fv_pyr_level *L, float s, float t, float zexp, float inv_tol, acc4 *acc, float *accw)
 {
@@ -42,8 +44,8 @@ static inline uint64_t sample_mask(const float *wgt, int n)
     return m;
 }
 
-#define TAA_FN(name) name##_avx2
-#include "reproject_tmpl.h"
+#define TAA_FN FV_X86_FN
+#include "../reproject_tmpl.h" /* the row loops every ISA shares */
 
 static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1); }
 
@@ -106,7 +108,7 @@ static inline int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_ta
 
 TAA_FILL_BLOCK(taa_fill_avx2, fill_vec_avx2)
 
-void fv_reproject_init_avx2(fv_dsp *d)
+void fv_reproject_dsp_init_avx2(fv_reproject_dsp *d)
 {
     d->taa_blend = taa_blend_avx2;
     d->taa_fill = taa_fill_avx2;

@@ -5,9 +5,11 @@
 
 #include <stdint.h>
 
-#include "dsp.h"
+#include "reproject_dsp.h"
 #include "reproject.h"
-#include "x86/reproject_x86.h"
+#define FV_X86_W 4
+#define FV_X86_FN(name) name##_sse41
+#include "x86/reproject_tmpl.h"
 
 static inline void tap(const fv_pyr_level *L, float s, float t, float zexp, float inv_tol, acc4 *acc, float *accw)
 {
@@ -36,8 +38,8 @@ static inline uint64_t sample_mask(const float *wgt, int n)
     return m;
 }
 
-#define TAA_FN(name) name##_sse41
-#include "reproject_tmpl.h"
+#define TAA_FN FV_X86_FN
+#include "../reproject_tmpl.h" /* the row loops every ISA shares */
 
 /* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px). */
 static inline int fill_vec_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
@@ -90,7 +92,7 @@ static inline int fill_vec_sse41(const struct fv_taa_frame *f, const struct fv_t
 
 TAA_FILL_BLOCK(taa_fill_sse41, fill_vec_sse41)
 
-void fv_reproject_init_sse41(fv_dsp *d)
+void fv_reproject_dsp_init_sse41(fv_reproject_dsp *d)
 {
     d->taa_blend = taa_blend_sse41;
     d->taa_fill = taa_fill_sse41;

@@ -1,6 +1,8 @@
-/* fovea: the 128-bit pieces of the depth-of-field kernels shared by the SSE4.1 and AVX2 versions
- * (each .c file includes this and is built with its own ISA flags). One pixel = one __m128
- * (r, g, b, depth or weight): the references (core/dof/kernels.c) add channel by channel in the
+/* fovea: the depth-of-field kernels' code shared by the SSE4.1 and AVX2 versions (x86 template:
+ * core/x86/dof_sse41.c and dof_avx2.c each include it once after defining FV_X86_W, their vector
+ * width in floats (4 or 8), and FV_X86_FN(name), their function names; each is built with its
+ * own ISA flags). The 128-bit pieces, and the Gaussian rows around the ISA's block routine. One pixel = one __m128
+ * (r, g, b, depth or weight): the references (core/dof/dof_ref.c) add channel by channel in the
  * same order, so a vector of 4 channel accumulators gives their bits.
  *
  * The Gaussians take blocks of pixels with different sigmas through one loop over the block's
@@ -10,8 +12,9 @@
  * argument lets the horizontal pass add +0 (a masked tap) for a near sample instead of skipping
  * it. The values read for those extra taps lie in the rows / columns the call covers and must be
  * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
-#ifndef FOVEA_DOF_X86_H
-#define FOVEA_DOF_X86_H
+#if !defined(FV_X86_W) || !defined(FV_X86_FN)
+#error "define FV_X86_W and FV_X86_FN before including x86/dof_tmpl.h"
+#endif
 
 #include <smmintrin.h>
 #include <stddef.h>
@@ -19,7 +22,7 @@
 
 #include "dof/weier_impl.h"
 #include "base/util.h"
-#include "dsp.h"
+#include "dof/dof_dsp.h"
 
 #define DOF_CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
 
@@ -325,29 +328,36 @@ static inline void dof_pyrblur_row_x86(float *restrict blur, const fv_dof_pyrblu
 }
 
 
-/* The Gaussian row kernels' set-up (tap offsets, the masked far row of a chunk), shared by the
- * SSE4.1 and AVX2 files; GAUSS is the ISA's block routine (dof_gauss_4 / gauss_8). */
-#define DOF_GAUSS_ROWS(SUFFIX, GAUSS, ALIGN)                                                                  \
-    static void hgauss_row_##SUFFIX(float *restrict dst, const float *rgbd, const float *coc, int w, int x0,   \
-                                    int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)                    \
-    {                                                                                                          \
-        _Alignas(ALIGN) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];                                               \
-        ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;                                        \
-        dof_offsets_h(off, FV_DOF_RMAX);                                                                       \
-        for (int c0 = 0; c0 < n; c0 += DOF_CH) {                                                               \
-            const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);            \
-            dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);                                          \
-            /* output pixel c0 + i from m + 4 (Rc + i) */                                                      \
-            GAUSS(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);                      \
-        }                                                                                                      \
-    }                                                                                                          \
-    static void vgauss_row_##SUFFIX(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo,   \
-                                    int yhi, int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)   \
-    {                                                                                                          \
-        ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;                                        \
-        const int R = dof_span_rad(sig, n, tab);                                                               \
-        dof_offsets_v(off, R, stride, y, ylo, yhi);                                                            \
-        GAUSS(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);                          \
-    }
-
+/* The Gaussian row kernels' set-up (tap offsets, the masked far row of a chunk); DOF_GAUSS is the
+ * ISA's block routine: dof_gauss_4 above, or for AVX2 dof_gauss_8 (core/x86/dof_avx2.c, 8 pixels
+ * a step, then dof_gauss_4). */
+#if FV_X86_W == 8
+static inline void dof_gauss_8(float *d, const float *p, const ptrdiff_t *off, int n, const uint8_t *sig,
+                               const fv_dof_gauss_tab *tab, int norm);
+#define DOF_GAUSS dof_gauss_8
+#else
+#define DOF_GAUSS dof_gauss_4
 #endif
+
+static void FV_X86_FN(hgauss_row)(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                                  const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    _Alignas(4 * FV_X86_W) float m[4 * (DOF_CH + 2 * FV_DOF_RMAX)];
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    dof_offsets_h(off, FV_DOF_RMAX);
+    for (int c0 = 0; c0 < n; c0 += DOF_CH) {
+        const int cn = n - c0 < DOF_CH ? n - c0 : DOF_CH, Rc = dof_span_rad(sig + c0, cn, tab);
+        dof_mask_row(m, rgbd, coc, w, x0 + c0 - Rc, cn + 2 * Rc);
+        /* output pixel c0 + i from m + 4 (Rc + i) */
+        DOF_GAUSS(dst + 4 * (ptrdiff_t)(x0 + c0), m + 4 * Rc, off, cn, sig + c0, tab, 1);
+    }
+}
+
+static void FV_X86_FN(vgauss_row)(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
+                                  int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
+{
+    ptrdiff_t offs[2 * FV_DOF_RMAX + 1], *off = offs + FV_DOF_RMAX;
+    const int R = dof_span_rad(sig, n, tab);
+    dof_offsets_v(off, R, stride, y, ylo, yhi);
+    DOF_GAUSS(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
+}

@@ -1,41 +1,29 @@
-/* fovea: checkasm-style tests of the eye tracker's kernels (fv_dsp et_*): every ISA version this
- * machine runs against the plain-C reference, on random and edge inputs (all 0, all 255,
- * thresholds 0, 1, 255, 256), odd sizes, unaligned rows, with canaries around every output.
- * The bound is exact equality (bits, for the float one too: it rounds the same operations in the
- * same order). The references themselves are checked against the formulas on hand-computed
- * cases (et_box_score_row: against sums straight from the image). Deterministic (fixed-seed splitmix64). */
+/* fovea checkasm: the eye tracker's kernels (eyetrack/eyetrack_dsp.h), every ISA version against
+ * the plain-C reference, on random and edge inputs (all 0, all 255, thresholds 0, 1, 255, 256),
+ * odd sizes, unaligned rows, with canaries around every output. The bound is exact equality
+ * (bits, for the float one too: it rounds the same operations in the same order). The references
+ * themselves are checked against the formulas on hand-computed cases (et_box_score_row: against
+ * sums straight from the image). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "testutil.h"
+#include "checkasm.h"
 
-#include "dsp.h"
+#include "eyetrack/eyetrack_dsp.h"
 
 #define CANARY 32
-static const uint8_t canary8 = 0xa5;
 static const uint32_t canary32 = 0xdeadbeefu;
 
 static const int sizes[] = { 1, 2, 3, 7, 8, 9, 15, 16, 17, 31, 32, 33, 47, 63, 64, 65, 95, 127, 160, 319, 320, 641 };
 #define NSIZES ((int)(sizeof sizes / sizeof sizes[0]))
-
-static const unsigned isa_list[] = {
-#if defined(__x86_64__)
-    FV_ISA_SSE41, FV_ISA_AVX2,
-#elif defined(__aarch64__)
-    FV_ISA_NEON,
-#endif
-    0
-};
-
-static uint64_t rng = 0xe7e5eedull;
 
 enum { M_RANDOM, M_ZERO, M_FULL, M_EXTREME, M_COUNT };
 
 static void fill8(uint8_t *p, int n, int mode)
 {
     for (int i = 0; i < n; i++) {
-        const uint64_t r = fv_test_rand(&rng);
+        const uint64_t r = fv_test_rand(&checkasm_rng);
         p[i] = mode == M_ZERO ? 0 : mode == M_FULL ? 255 : mode == M_EXTREME ? ((r & 1) ? 255 : 0) : (uint8_t)r;
     }
 }
@@ -48,33 +36,51 @@ static uint8_t *in8(int n, int off, uint8_t **base)
     return *base + off;
 }
 
-static uint8_t *out8(int n, int off, uint8_t **base)
+/* ------------------------------------------------------------------ tables */
+
+static const char *const names[] = {"et_down2_row", "et_integral_row", "et_thresh_row", "et_box_score_row", "et_box3_row"};
+
+/* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
+ * holds the references. Also seeds the module's inputs. */
+static void test_tables(void **state)
 {
-    *base = malloc((size_t)n + (size_t)off + 2 * CANARY);
-    assert_non_null(*base);
-    memset(*base, canary8, (size_t)n + (size_t)off + 2 * CANARY);
-    return *base + off + CANARY;
+    (void)state;
+    checkasm_rng = 0xe7e5eedull;
+    fv_eyetrack_dsp ref, own;
+    fv_eyetrack_dsp_init(&ref, FV_ISA_C);
+    assert_true(ref.et_down2_row == fv_et_down2_row_c);
+    assert_true(ref.et_integral_row == fv_et_integral_row_c);
+    assert_true(ref.et_thresh_row == fv_et_thresh_row_c);
+    assert_true(ref.et_box_score_row == fv_et_box_score_row_c);
+    assert_true(ref.et_box3_row == fv_et_box3_row_c);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        memset(&own, 0, sizeof own);
+        switch (isa) {
+#if defined(__x86_64__)
+        case FV_ISA_SSE41: fv_eyetrack_dsp_init_sse41(&own); break;
+        case FV_ISA_AVX2: fv_eyetrack_dsp_init_avx2(&own); break;
+#elif defined(__aarch64__)
+        case FV_ISA_NEON: fv_eyetrack_dsp_init_neon(&own); break;
+#endif
+        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
+        }
+        checkasm_check_table("eyetrack", isa, &own, &ref, sizeof own, names);
+    }
 }
 
-static void canaries8(const uint8_t *p, int n, const char *isa, const char *k)
-{
-    for (int i = 1; i <= CANARY; i++)
-        if (p[-i] != canary8 || p[n + i - 1] != canary8)
-            fail_msg("%s %s n=%d: wrote outside its output (canary %d)", isa, k, n, i);
-}
+typedef void (*runner)(const fv_eyetrack_dsp *d, const char *isa, int n, int off, int mode);
 
-typedef void (*runner)(const fv_dsp *d, const char *isa, int n, int off, int mode);
-
-static void run_down2(const fv_dsp *d, const char *isa, int n, int off, int mode)
+static void run_down2(const fv_eyetrack_dsp *d, const char *isa, int n, int off, int mode)
 {
     uint8_t *ba, *bb, *br, *bt;
     uint8_t *a = in8(2 * n, off, &ba), *b = in8(2 * n, off, &bb);
     fill8(a, 2 * n, mode);
     fill8(b, 2 * n, mode);
-    uint8_t *r = out8(n, off, &br), *t = out8(n, off, &bt);
+    uint8_t *r = checkasm_out_u8(n, off, &br), *t = checkasm_out_u8(n, off, &bt);
     fv_et_down2_row_c(r, a, b, n);
     d->et_down2_row(t, a, b, n);
-    canaries8(t, n, isa, "et_down2_row");
+    checkasm_check_guards(t, (size_t)n, isa, "et_down2_row", n);
     for (int i = 0; i < n; i++) {
         /* the reference against the formula too */
         const int want = (a[2 * i] + a[2 * i + 1] + b[2 * i] + b[2 * i + 1] + 2) >> 2;
@@ -85,7 +91,7 @@ static void run_down2(const fv_dsp *d, const char *isa, int n, int off, int mode
     free(ba), free(bb), free(br), free(bt);
 }
 
-static void run_integral(const fv_dsp *d, const char *isa, int n, int off, int mode)
+static void run_integral(const fv_eyetrack_dsp *d, const char *isa, int n, int off, int mode)
 {
     uint8_t *bs;
     uint8_t *s = in8(n, off, &bs);
@@ -96,7 +102,7 @@ static void run_integral(const fv_dsp *d, const char *isa, int n, int off, int m
     assert_non_null(r);
     assert_non_null(t);
     for (int i = 0; i < n; i++) /* near the top of the range too: the sums wrap mod 2^32 alike */
-        above[i] = mode == M_EXTREME ? 0xffffff00u + (uint32_t)i : (uint32_t)(fv_test_rand(&rng) >> 40);
+        above[i] = mode == M_EXTREME ? 0xffffff00u + (uint32_t)i : (uint32_t)(fv_test_rand(&checkasm_rng) >> 40);
     uint32_t *tp = t + CANARY + (off & 1); /* 4-byte aligned, not 16 */
     for (int i = 0; i < n + 2 * CANARY; i++)
         r[i] = canary32;
@@ -118,17 +124,17 @@ static void run_integral(const fv_dsp *d, const char *isa, int n, int off, int m
     free(bs), free(above), free(r), free(t);
 }
 
-static void run_thresh(const fv_dsp *d, const char *isa, int n, int off, int mode)
+static void run_thresh(const fv_eyetrack_dsp *d, const char *isa, int n, int off, int mode)
 {
     static const int ts[] = { 0, 1, 2, 127, 128, 129, 200, 254, 255, 256, -1 };
     uint8_t *bs, *br, *bt;
     uint8_t *s = in8(n, off, &bs);
     fill8(s, n, mode);
-    uint8_t *r = out8(n, off, &br), *t = out8(n, off, &bt);
+    uint8_t *r = checkasm_out_u8(n, off, &br), *t = checkasm_out_u8(n, off, &bt);
     for (int k = 0; k < (int)(sizeof ts / sizeof ts[0]); k++) {
-        const int th = ts[k] < 0 ? (int)(fv_test_rand(&rng) % 257) : ts[k];
+        const int th = ts[k] < 0 ? (int)(fv_test_rand(&checkasm_rng) % 257) : ts[k];
         const int cr = fv_et_thresh_row_c(r, s, n, th), ct = d->et_thresh_row(t, s, n, th);
-        canaries8(t, n, isa, "et_thresh_row");
+        checkasm_check_guards(t, (size_t)n, isa, "et_thresh_row", n);
         int want = 0;
         for (int i = 0; i < n; i++) {
             assert_int_equal(r[i], s[i] >= th ? 255 : 0);
@@ -146,14 +152,14 @@ static void run_thresh(const fv_dsp *d, const char *isa, int n, int off, int mod
 /* Box and ring scores over the integral image of a random (dout + 1) x (n + dout) image: ring
  * half-size ko >= box half-size k, the box centred in the ring. M_EXTREME offsets the integral
  * image by nearly 2^32 (its sums wrap; the box sums do not). */
-static void run_box_score(const fv_dsp *d, const char *isa, int n, int off, int mode)
+static void run_box_score(const fv_eyetrack_dsp *d, const char *isa, int n, int off, int mode)
 {
-    const int k = (int)(fv_test_rand(&rng) % 12), ko = k + (int)(fv_test_rand(&rng) % 8);
+    const int k = (int)(fv_test_rand(&checkasm_rng) % 12), ko = k + (int)(fv_test_rand(&checkasm_rng) % 8);
     const int din = 2 * k + 1, dout = 2 * ko + 1, iw = n + dout, ih = dout + 1;
     uint8_t *bimg;
     uint8_t *img = in8(iw * ih, off, &bimg);
     fill8(img, iw * ih, mode);
-    const uint32_t base = mode == M_EXTREME ? 0xfffff000u : (uint32_t)(fv_test_rand(&rng) >> 48);
+    const uint32_t base = mode == M_EXTREME ? 0xfffff000u : (uint32_t)(fv_test_rand(&checkasm_rng) >> 48);
     uint32_t *bii = malloc(((size_t)iw * (ih + 1) + (size_t)off) * sizeof *bii);
     assert_non_null(bii);
     uint32_t *ii = bii + off; /* rows (ih + 1) of iw: a zero-sum first row and column */
@@ -164,7 +170,7 @@ static void run_box_score(const fv_dsp *d, const char *isa, int n, int off, int 
                                             : 0);
     const uint32_t *ot = ii, *ob = ii + dout * iw, *it = ii + (ko - k) * iw + (ko - k), *ib = it + din * iw;
     const float inv_a = 1.0f / (float)(din * din), inv_r = 1.0f / (float)(dout * dout - din * din + (ko == k));
-    const float dark = mode == M_ZERO ? 0.0f : 255.0f * fv_test_randf(&rng);
+    const float dark = mode == M_ZERO ? 0.0f : 255.0f * fv_test_randf(&checkasm_rng);
     float *r = malloc(((size_t)n + 2 * CANARY) * sizeof *r), *t = malloc(((size_t)n + 2 * CANARY + 1) * sizeof *t);
     assert_non_null(r);
     assert_non_null(t);
@@ -207,47 +213,43 @@ static void run_box_score(const fv_dsp *d, const char *isa, int n, int off, int 
 static void run_all(const char *kernel, runner fn, size_t member)
 {
     int tested = 0;
-    fv_dsp ref;
-    fv_dsp_init(&ref, FV_ISA_C);
-    for (int k = 0; isa_list[k]; k++) {
-        const unsigned isa = isa_list[k];
-        if (!(fv_cpu_isas() & isa)) {
-            printf("[ kernels  ] %s: %-7s not on this CPU, skipped\n", kernel, fv_isa_name(isa));
+    fv_eyetrack_dsp ref;
+    fv_eyetrack_dsp_init(&ref, FV_ISA_C);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, kernel))
             continue;
-        }
-        fv_dsp d;
-        fv_dsp_init(&d, isa);
+        fv_eyetrack_dsp d;
+        fv_eyetrack_dsp_init(&d, isa);
         void *pr, *pd;
         memcpy(&pr, (char *)&ref + member, sizeof pr);
         memcpy(&pd, (char *)&d + member, sizeof pd);
-        if (pr == pd) {
-            printf("[ kernels  ] %s: %-7s has no version of its own, skipped\n", kernel, fv_isa_name(isa));
-            continue;
-        }
+        if (!pd || pr == pd) /* an ISA this build has must implement the kernel: a failure, not a skip */
+            fail_msg("%s: %s has no version of its own", kernel, fv_isa_name(isa));
         int runs = 0;
         for (int si = 0; si < NSIZES; si++)
             for (int off = 0; off < 3; off++)
                 for (int mode = 0; mode < M_COUNT; mode++, runs++)
                     fn(&d, fv_isa_name(isa), sizes[si], off, mode);
         for (int r = 0; r < 100; r++, runs++)
-            fn(&d, fv_isa_name(isa), 1 + (int)(fv_test_rand(&rng) % 400), (int)(fv_test_rand(&rng) % 17), M_RANDOM);
-        printf("[ kernels  ] %s: %-7s == c on %d rows (exact)\n", kernel, fv_isa_name(isa), runs);
+            fn(&d, fv_isa_name(isa), 1 + (int)(fv_test_rand(&checkasm_rng) % 400), (int)(fv_test_rand(&checkasm_rng) % 17), M_RANDOM);
+        printf("[ checkasm ] %s: %-7s == c on %d rows (exact)\n", kernel, fv_isa_name(isa), runs);
         tested++;
     }
-    printf("[ kernels  ] %s: %d ISA version(s) tested\n", kernel, tested);
+    printf("[ checkasm ] %s: %d ISA version(s) tested\n", kernel, tested);
 }
 
-static void run_box3(const fv_dsp *d, const char *isa, int n, int off, int mode)
+static void run_box3(const fv_eyetrack_dsp *d, const char *isa, int n, int off, int mode)
 {
     uint8_t *b0, *b1, *b2, *br, *bt;
     uint8_t *r0 = in8(n, off, &b0), *r1 = in8(n, off + 1, &b1), *r2 = in8(n, off + 2, &b2);
     fill8(r0, n, mode);
     fill8(r1, n, mode);
     fill8(r2, n, mode);
-    uint8_t *r = out8(n, off, &br), *t = out8(n, off, &bt);
+    uint8_t *r = checkasm_out_u8(n, off, &br), *t = checkasm_out_u8(n, off, &bt);
     fv_et_box3_row_c(r, r0, r1, r2, n);
     d->et_box3_row(t, r0, r1, r2, n);
-    canaries8(t, n, isa, "et_box3_row");
+    checkasm_check_guards(t, (size_t)n, isa, "et_box3_row", n);
     for (int i = 0; i < n; i++) {
         /* the reference against the formula, edges replicated */
         int s = 0;
@@ -265,29 +267,29 @@ static void run_box3(const fv_dsp *d, const char *isa, int n, int off, int mode)
 static void test_down2(void **state)
 {
     (void)state;
-    run_all("et_down2_row", run_down2, offsetof(fv_dsp, et_down2_row));
+    run_all("et_down2_row", run_down2, offsetof(fv_eyetrack_dsp, et_down2_row));
 }
 static void test_integral(void **state)
 {
     (void)state;
-    run_all("et_integral_row", run_integral, offsetof(fv_dsp, et_integral_row));
+    run_all("et_integral_row", run_integral, offsetof(fv_eyetrack_dsp, et_integral_row));
 }
 static void test_thresh(void **state)
 {
     (void)state;
-    run_all("et_thresh_row", run_thresh, offsetof(fv_dsp, et_thresh_row));
+    run_all("et_thresh_row", run_thresh, offsetof(fv_eyetrack_dsp, et_thresh_row));
 }
 
 static void test_box_score(void **state)
 {
     (void)state;
-    run_all("et_box_score_row", run_box_score, offsetof(fv_dsp, et_box_score_row));
+    run_all("et_box_score_row", run_box_score, offsetof(fv_eyetrack_dsp, et_box_score_row));
 }
 
 static void test_box3(void **state)
 {
     (void)state;
-    run_all("et_box3_row", run_box3, offsetof(fv_dsp, et_box3_row));
+    run_all("et_box3_row", run_box3, offsetof(fv_eyetrack_dsp, et_box3_row));
 }
 
 static void test_reference_by_hand(void **state)
@@ -338,15 +340,13 @@ static void test_reference_by_hand(void **state)
     assert_int_equal(bo[2], 0);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_reference_by_hand),
-        cmocka_unit_test(test_down2),
-        cmocka_unit_test(test_integral),
-        cmocka_unit_test(test_thresh),
-        cmocka_unit_test(test_box_score),
-        cmocka_unit_test(test_box3),
-    };
-    return cmocka_run_group_tests_name("kernels_eyetrack", tests, NULL, NULL);
-}
+const struct CMUnitTest checkasm_eyetrack_tests[] = {
+    cmocka_unit_test(test_tables),
+    cmocka_unit_test(test_reference_by_hand),
+    cmocka_unit_test(test_down2),
+    cmocka_unit_test(test_integral),
+    cmocka_unit_test(test_thresh),
+    cmocka_unit_test(test_box_score),
+    cmocka_unit_test(test_box3),
+    {0},
+};

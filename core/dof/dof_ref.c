@@ -1,11 +1,12 @@
-/* fovea: plain-C reference kernels of the layered depth-of-field filter (core/dof/weier.c).
+/* fovea: plain-C reference kernels of the layered depth-of-field filter (core/dof/weier.c;
+ * contracts in dof_dsp.h) and the table's init.
  * The hand-vectorised versions (core/x86/dof_*.c, core/arm/dof_neon.c) give the same bits: the
  * 4-channel sums below are written channel by channel in the order the vector code adds. */
 #include <math.h>
 
 #include "dof/weier_impl.h"
 #include "base/util.h"
-#include "dsp.h"
+#include "dof/dof_dsp.h"
 
 
 void fv_dof_coc_row_c(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
@@ -151,12 +152,24 @@ void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args
     }
 }
 
-void fv_dof_init_c(fv_dsp *d)
+void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
 {
+    const unsigned isas = isa_mask & fv_cpu_isas();
     d->dof_upsample_row = fv_dof_upsample_row_c;
     d->dof_pyrblur_row = fv_dof_pyrblur_row_c;
     d->dof_coc_row = fv_dof_coc_row_c;
     d->dof_hgauss_row = fv_dof_hgauss_row_c;
     d->dof_vgauss_row = fv_dof_vgauss_row_c;
     d->dof_combine_row = fv_dof_combine_row_c;
+#if defined(__x86_64__)
+    if (isas & FV_ISA_SSE41)
+        fv_dof_dsp_init_sse41(d);
+    if (isas & FV_ISA_AVX2)
+        fv_dof_dsp_init_avx2(d);
+#elif defined(__aarch64__)
+    if (isas & FV_ISA_NEON)
+        fv_dof_dsp_init_neon(d);
+#else
+    (void)isas;
+#endif
 }

@@ -1,8 +1,10 @@
-/* fovea: the 128-bit pieces shared by the SSE4.1 and AVX2 reprojection kernels (each .c file
- * includes this and is built with its own ISA flags). Operation order as the reference's tap
- * (core/reproject.c, core/reproject_tmpl.h). */
-#ifndef FOVEA_REPROJECT_X86_H
-#define FOVEA_REPROJECT_X86_H
+/* fovea: the 128-bit pieces shared by the SSE4.1 and AVX2 reprojection kernels (x86 template:
+ * core/x86/reproject_sse41.c and reproject_avx2.c each include it once after defining FV_X86_W,
+ * their vector width in floats, and FV_X86_FN(name); each is built with its own ISA flags).
+ * Operation order as the reference's tap (core/reproject_ref.c, core/reproject_tmpl.h). */
+#if !defined(FV_X86_W) || !defined(FV_X86_FN)
+#error "define FV_X86_W and FV_X86_FN before including x86/reproject_tmpl.h"
+#endif
 
 #include <smmintrin.h>
 #include <stddef.h>
@@ -60,5 +62,3 @@ static inline void out_blend(float *px, acc4 acc, float accw, float alpha)
     const __m128 r = _mm_add_ps(h, _mm_mul_ps(_mm_set1_ps(alpha), _mm_sub_ps(p, h)));
     _mm_storeu_ps(px, _mm_blend_ps(r, p, 8)); /* depth stays the sample's */
 }
-
-#endif

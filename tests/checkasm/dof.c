@@ -1,32 +1,19 @@
-/* fovea: checkasm-style tests of the depth-of-field kernels (dsp.h dof_*): every ISA this machine
- * runs against the plain-C references of core/dof/kernels.c on random and edge-case inputs, bit
- * for bit (so -0 vs +0 counts). Inputs live in exact-size heap buffers starting at odd offsets
- * (ASan catches over-reads); outputs are whole rows pre-filled with canary NaNs, so a write
- * outside [x0, x0 + n) or past the row shows. Deterministic: a fixed-seed PRNG. */
+/* fovea checkasm: the depth-of-field kernels (dof/dof_dsp.h), every ISA version against the
+ * plain-C references of core/dof/dof_ref.c on random and edge-case inputs, bit for bit (so -0 vs
+ * +0 counts). Inputs live in exact-size heap buffers starting at odd offsets (ASan catches
+ * over-reads); outputs are canaried rows (checkasm.h), so a write outside [x0, x0 + n) or past
+ * the row shows. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "testutil.h"
+#include "checkasm.h"
 
+#include "dof/dof_dsp.h"
 #include "dof/weier_impl.h"
-#include "dsp.h"
 
-static const uint32_t canary_bits = 0x7fc0dead; /* a NaN no kernel computes */
-#define CANARY 16
-
-static const unsigned isa_list[] = {
-#if defined(__x86_64__)
-    FV_ISA_SSE41, FV_ISA_AVX2,
-#elif defined(__aarch64__)
-    FV_ISA_NEON,
-#endif
-    0 /* sentinel */
-};
-
-static uint64_t rng = 0xd0f5eed2026ull;
-static float rnd(void) { return fv_test_randf(&rng); }
-static int rndi(int n) { return (int)(fv_test_rand(&rng) % (uint64_t)n); }
+static float rnd(void) { return fv_test_randf(&checkasm_rng); }
+static int rndi(int n) { return (int)(fv_test_rand(&checkasm_rng) % (uint64_t)n); }
 
 static fv_dof_gauss_tab tab;
 
@@ -37,61 +24,83 @@ static float colour(void)
     return rndi(8) == 0 ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : 2.0f * rnd() - 0.25f;
 }
 
-/* exact-size buffers: buf_new in testutil.h */
-/* an output of count floats + CANARY, all canaries */
-static buf out_new(size_t count, int off)
-{
-    buf b = buf_new(count + CANARY, off);
-    for (size_t i = 0; i < count + CANARY; i++)
-        memcpy(b.p + i, &canary_bits, 4);
-    return b;
-}
-
 static unsigned long compared; /* floats compared, all ISAs */
 
 static void compare(const float *ref, const float *got, size_t count, size_t per_px, const char *isa,
                     const char *kernel, const char *what)
 {
-    for (size_t i = 0; i < count; i++) {
-        uint32_t a, b;
-        memcpy(&a, ref + i, 4);
-        memcpy(&b, got + i, 4);
-        if (a != b)
-            fail_msg("%s %s (%s): float %zu (pixel %zu channel %zu): c=%.9g (%a) %s=%.9g (%a)", isa, kernel, what, i,
-                     i / per_px, i % per_px, (double)ref[i], (double)ref[i], isa, (double)got[i], (double)got[i]);
-    }
+    checkasm_compare(ref, got, count, CHECKASM_F32, per_px, CHECKASM_EXACT, "%s %s (%s)", isa, kernel, what);
     compared += count;
 }
 
-typedef void (*runner)(const fv_dsp *d, const char *isa);
+/* an output row (canaried, checkasm.h): its guards, then every float of it (the ones the call
+ * must not write still hold the canary in both) */
+static void compare_out(const buf *r, const buf *t, size_t count, size_t per_px, const char *isa, const char *kernel,
+                        const char *what)
+{
+    checkasm_check_guards_f32(t, count, isa, kernel, (int)count);
+    compare(r->p, t->p, count, per_px, isa, kernel, what);
+}
+
+typedef void (*runner)(const fv_dof_dsp *d, const char *isa);
 
 static void run_all(const char *kernel, runner fn, size_t member)
 {
     int tested = 0;
-    for (int k = 0; isa_list[k]; k++) {
-        const unsigned isa = isa_list[k];
-        if (!(fv_cpu_isas() & isa)) {
-            printf("[ kernels  ] %s: %-7s not on this CPU, skipped\n", kernel, fv_isa_name(isa));
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, kernel))
             continue;
-        }
-        fv_dsp d, c;
-        fv_dsp_init(&d, isa);
-        fv_dsp_init(&c, FV_ISA_C);
-        assert_int_equal(d.isa, isa);
+        fv_dof_dsp d, c;
+        fv_dof_dsp_init(&d, isa);
+        fv_dof_dsp_init(&c, FV_ISA_C);
         void *f, *fc;
         memcpy(&f, (const char *)&d + member, sizeof f);
         memcpy(&fc, (const char *)&c + member, sizeof fc);
-        if (f == fc) {
-            printf("[ kernels  ] %s: %-7s has no version of its own, skipped\n", kernel, fv_isa_name(isa));
-            continue;
-        }
+        if (!f || f == fc) /* an ISA this build has must implement the kernel: a failure, not a skip */
+            fail_msg("%s: %s has no version of its own", kernel, fv_isa_name(isa));
         const unsigned long before = compared;
         fn(&d, fv_isa_name(isa));
-        printf("[ kernels  ] %s: %-7s bit-identical to C (%lu floats)\n", kernel, fv_isa_name(isa), compared - before);
+        printf("[ checkasm ] %s: %-7s bit-identical to C (%lu floats)\n", kernel, fv_isa_name(isa), compared - before);
         tested++;
     }
     if (!tested)
-        printf("[ kernels  ] %s: no ISA version on this machine\n", kernel);
+        printf("[ checkasm ] %s: no ISA version on this machine\n", kernel);
+}
+
+/* ------------------------------------------------------------------ tables */
+
+static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row"};
+
+/* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
+ * holds the references. Also seeds the module's inputs. */
+static void test_tables(void **state)
+{
+    (void)state;
+    checkasm_rng = 0xd0f5eed2026ull;
+    fv_dof_gauss_tab_init(&tab);
+    fv_dof_dsp ref, own;
+    fv_dof_dsp_init(&ref, FV_ISA_C);
+    assert_true(ref.dof_coc_row == fv_dof_coc_row_c);
+    assert_true(ref.dof_hgauss_row == fv_dof_hgauss_row_c);
+    assert_true(ref.dof_vgauss_row == fv_dof_vgauss_row_c);
+    assert_true(ref.dof_combine_row == fv_dof_combine_row_c);
+    assert_true(ref.dof_upsample_row == fv_dof_upsample_row_c);
+    assert_true(ref.dof_pyrblur_row == fv_dof_pyrblur_row_c);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        memset(&own, 0, sizeof own);
+        switch (isa) {
+#if defined(__x86_64__)
+        case FV_ISA_SSE41: fv_dof_dsp_init_sse41(&own); break;
+        case FV_ISA_AVX2: fv_dof_dsp_init_avx2(&own); break;
+#elif defined(__aarch64__)
+        case FV_ISA_NEON: fv_dof_dsp_init_neon(&own); break;
+#endif
+        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
+        }
+        checkasm_check_table("dof", isa, &own, &ref, sizeof own, names);
+    }
 }
 
 /* ------------------------------------------------------------------ coc_row */
@@ -110,7 +119,7 @@ static float depth(int mode, float dn, float df)
     }
 }
 
-static void run_coc(const fv_dsp *d, const char *isa)
+static void run_coc(const fv_dof_dsp *d, const char *isa)
 {
     for (int n = 1; n <= 70 + 2; n++) {
         const int nn = n <= 70 ? n : n == 71 ? 640 : 1281;
@@ -124,10 +133,10 @@ static void run_coc(const fv_dsp *d, const char *isa)
                     in.p[4 * i + c] = colour();
                 in.p[4 * i + 3] = depth(mode, dn, df);
             }
-            buf r = out_new((size_t)nn, off), t = out_new((size_t)nn, off);
+            buf r = checkasm_out_f32((size_t)nn, off), t = checkasm_out_f32((size_t)nn, off);
             fv_dof_coc_row_c(r.p, in.p, nn, K, dn, df);
             d->dof_coc_row(t.p, in.p, nn, K, dn, df);
-            compare(r.p, t.p, (size_t)nn + CANARY, 1, isa, "coc_row", "coc + canaries");
+            compare_out(&r, &t, (size_t)nn, 1, isa, "coc_row", "coc + canaries");
             for (int i = 0; i < nn; i++)
                 assert_true(isfinite(r.p[i]));
             free(in.base), free(r.base), free(t.base);
@@ -138,7 +147,7 @@ static void run_coc(const fv_dsp *d, const char *isa)
 static void test_coc_row(void **state)
 {
     (void)state;
-    run_all("dof_coc_row", run_coc, offsetof(fv_dsp, dof_coc_row));
+    run_all("dof_coc_row", run_coc, offsetof(fv_dof_dsp, dof_coc_row));
 }
 
 /* ------------------------------------------------------------------ sigma indices */
@@ -176,7 +185,7 @@ static void test_gauss_tab(void **state)
 
 /* ------------------------------------------------------------------ hgauss_row */
 
-static void run_hgauss1(const fv_dsp *d, const char *isa, int w, int x0, int n, int smode, int off)
+static void run_hgauss1(const fv_dof_dsp *d, const char *isa, int w, int x0, int n, int smode, int off)
 {
     buf rgbd = buf_new(4 * (size_t)w, off), coc = buf_new((size_t)w, off);
     const int cmode = rndi(5);
@@ -194,16 +203,16 @@ static void run_hgauss1(const fv_dsp *d, const char *isa, int w, int x0, int n, 
     uint8_t *sig = malloc((size_t)n + 1);
     assert_non_null(sig);
     gen_sig(sig, n, smode);
-    buf r = out_new(4 * (size_t)w, off), t = out_new(4 * (size_t)w, off);
+    buf r = checkasm_out_f32(4 * (size_t)w, off), t = checkasm_out_f32(4 * (size_t)w, off);
     fv_dof_hgauss_row_c(r.p, rgbd.p, coc.p, w, x0, n, sig, &tab);
     d->dof_hgauss_row(t.p, rgbd.p, coc.p, w, x0, n, sig, &tab);
-    compare(r.p, t.p, 4 * (size_t)w + CANARY, 4, isa, "hgauss_row", "whole row + canaries");
+    compare_out(&r, &t, 4 * (size_t)w, 4, isa, "hgauss_row", "whole row + canaries");
     for (int i = 4 * x0; i < 4 * (x0 + n); i++)
         assert_true(isfinite(r.p[i]));
     free(sig), free(rgbd.base), free(coc.base), free(r.base), free(t.base);
 }
 
-static void run_hgauss(const fv_dsp *d, const char *isa)
+static void run_hgauss(const fv_dof_dsp *d, const char *isa)
 {
     for (int n = 1; n <= 70; n++)
         for (int smode = 0; smode < 5; smode++) {
@@ -225,12 +234,12 @@ static void run_hgauss(const fv_dsp *d, const char *isa)
 static void test_hgauss_row(void **state)
 {
     (void)state;
-    run_all("dof_hgauss_row", run_hgauss, offsetof(fv_dsp, dof_hgauss_row));
+    run_all("dof_hgauss_row", run_hgauss, offsetof(fv_dof_dsp, dof_hgauss_row));
 }
 
 /* ------------------------------------------------------------------ vgauss_row */
 
-static void run_vgauss1(const fv_dsp *d, const char *isa, int w, int h, int x0, int n, int smode, int off)
+static void run_vgauss1(const fv_dof_dsp *d, const char *isa, int w, int h, int x0, int n, int smode, int off)
 {
     const ptrdiff_t stride = w + rndi(3);
     const size_t count = 4 * (size_t)(stride * (h - 1) + w);
@@ -241,14 +250,14 @@ static void run_vgauss1(const fv_dsp *d, const char *isa, int w, int h, int x0, 
     uint8_t *sig = malloc((size_t)n + 1);
     assert_non_null(sig);
     gen_sig(sig, n, smode);
-    buf r = out_new(4 * (size_t)w, off), t = out_new(4 * (size_t)w, off);
+    buf r = checkasm_out_f32(4 * (size_t)w, off), t = checkasm_out_f32(4 * (size_t)w, off);
     fv_dof_vgauss_row_c(r.p, src.p, stride, y, ylo, yhi, x0, n, sig, &tab);
     d->dof_vgauss_row(t.p, src.p, stride, y, ylo, yhi, x0, n, sig, &tab);
-    compare(r.p, t.p, 4 * (size_t)w + CANARY, 4, isa, "vgauss_row", "whole row + canaries");
+    compare_out(&r, &t, 4 * (size_t)w, 4, isa, "vgauss_row", "whole row + canaries");
     free(sig), free(src.base), free(r.base), free(t.base);
 }
 
-static void run_vgauss(const fv_dsp *d, const char *isa)
+static void run_vgauss(const fv_dof_dsp *d, const char *isa)
 {
     for (int n = 1; n <= 70; n++)
         for (int smode = 0; smode < 5; smode++) {
@@ -266,7 +275,7 @@ static void run_vgauss(const fv_dsp *d, const char *isa)
 static void test_vgauss_row(void **state)
 {
     (void)state;
-    run_all("dof_vgauss_row", run_vgauss, offsetof(fv_dsp, dof_vgauss_row));
+    run_all("dof_vgauss_row", run_vgauss, offsetof(fv_dof_dsp, dof_vgauss_row));
 }
 
 /* ------------------------------------------------------------------ combine_row */
@@ -276,7 +285,7 @@ static long comb_far, comb_lnear, comb_near, comb_enh; /* how often the steps ra
 /* Rows of w pixels; the span [x0, x0 + n). What the reference does not read (far unless coc > 0
  * or coc < 0 < t, lnear where t <= 0, enh where gain t <= 0) holds NaN / Inf: an ISA version may
  * read it but must not let it through. */
-static void run_combine1(const fv_dsp *d, const char *isa, int w, int x0, int n, int off)
+static void run_combine1(const fv_dof_dsp *d, const char *isa, int w, int x0, int n, int off)
 {
     const size_t w4 = 4 * (size_t)w;
     buf sharp = buf_new(w4, off), coc = buf_new((size_t)w, off), far = buf_new(w4, off), near = buf_new(w4, off);
@@ -324,10 +333,10 @@ static void run_combine1(const fv_dsp *d, const char *isa, int w, int x0, int n,
         .enh = rndi(3) ? enh.p : NULL,
         .gain = gain,
     };
-    buf r = out_new(w4, off), o = out_new(w4, off);
+    buf r = checkasm_out_f32(w4, off), o = checkasm_out_f32(w4, off);
     fv_dof_combine_row_c(r.p, &a, x0, n);
     d->dof_combine_row(o.p, &a, x0, n);
-    compare(r.p, o.p, w4 + CANARY, 4, isa, "combine_row", "whole row + canaries");
+    compare_out(&r, &o, w4, 4, isa, "combine_row", "whole row + canaries");
     for (int x = x0; x < x0 + n; x++) {
         for (int c = 0; c < 4; c++)
             assert_true(isfinite(r.p[4 * x + c]));
@@ -340,7 +349,7 @@ static void run_combine1(const fv_dsp *d, const char *isa, int w, int x0, int n,
     free(enh.base), free(r.base), free(o.base);
 }
 
-static void run_combine(const fv_dsp *d, const char *isa)
+static void run_combine(const fv_dof_dsp *d, const char *isa)
 {
     for (int n = 1; n <= 70; n++)
         for (int rep = 0; rep < 6; rep++) {
@@ -357,8 +366,8 @@ static void run_combine(const fv_dsp *d, const char *isa)
 static void test_combine_row(void **state)
 {
     (void)state;
-    run_all("dof_combine_row", run_combine, offsetof(fv_dsp, dof_combine_row));
-    printf("[ kernels  ] combine steps run (all ISAs): far %ld, lnear %ld, near coverage %ld, enhancement %ld\n",
+    run_all("dof_combine_row", run_combine, offsetof(fv_dof_dsp, dof_combine_row));
+    printf("[ checkasm ] combine steps run (all ISAs): far %ld, lnear %ld, near coverage %ld, enhancement %ld\n",
            comb_far, comb_lnear, comb_near, comb_enh);
 }
 
@@ -368,7 +377,7 @@ static const float below1 = 0x1.fffffep-1f; /* the largest float < 1 */
 
 /* n output pixels from a tmp row of sw texels. tmode 0: core/dof/weier.c's taps (by 2^L, borders
  * clamped); 1: random taps, i0 / i1 often at the row's ends or equal; 2: all taps equal. */
-static void run_upsample1(const fv_dsp *d, const char *isa, int n, int tmode, int off)
+static void run_upsample1(const fv_dof_dsp *d, const char *isa, int n, int tmode, int off)
 {
     const int L = 1 + rndi(5);
     const int sw = tmode == 0 ? ((n + (1 << L) - 1) >> L) + rndi(2) : 1 + rndi(rndi(2) ? 4 : n + 8);
@@ -393,14 +402,14 @@ static void run_upsample1(const fv_dsp *d, const char *isa, int n, int tmode, in
             ax.p[x] = k == 0 ? 0.0f : k == 1 ? below1 : k == 2 ? 0.5f : rnd();
         }
     }
-    buf r = out_new(4 * (size_t)n, off), t = out_new(4 * (size_t)n, off);
+    buf r = checkasm_out_f32(4 * (size_t)n, off), t = checkasm_out_f32(4 * (size_t)n, off);
     fv_dof_upsample_row_c(r.p, tmp.p, i0, i1, ax.p, n);
     d->dof_upsample_row(t.p, tmp.p, i0, i1, ax.p, n);
-    compare(r.p, t.p, 4 * (size_t)n + CANARY, 4, isa, "upsample_row", "row + canaries");
+    compare_out(&r, &t, 4 * (size_t)n, 4, isa, "upsample_row", "row + canaries");
     free(tmp.base), free(i0), free(i1), free(ax.base), free(r.base), free(t.base);
 }
 
-static void run_upsample(const fv_dsp *d, const char *isa)
+static void run_upsample(const fv_dof_dsp *d, const char *isa)
 {
     for (int n = 1; n <= 70; n++)
         for (int tmode = 0; tmode < 3; tmode++)
@@ -413,7 +422,7 @@ static void run_upsample(const fv_dsp *d, const char *isa)
 static void test_upsample_row(void **state)
 {
     (void)state;
-    run_all("dof_upsample_row", run_upsample, offsetof(fv_dsp, dof_upsample_row));
+    run_all("dof_upsample_row", run_upsample, offsetof(fv_dof_dsp, dof_upsample_row));
 }
 
 /* ------------------------------------------------------------------ pyrblur_row */
@@ -425,7 +434,7 @@ static long pb_active, pb_mix, pb_beyond, pb_frac; /* how often (reference, all 
  * its end. What the reference does not read (blur and the up rows where it skips a pixel, blur
  * where it does not mix) holds NaN / Inf sometimes: an ISA version may read it but must not let
  * it through; skipped pixels must keep their bits. */
-static void run_pyrblur1(const fv_dsp *d, const char *isa, int w, int x0, int n, int off)
+static void run_pyrblur1(const fv_dof_dsp *d, const char *isa, int w, int x0, int n, int off)
 {
     const size_t w4 = 4 * (size_t)w;
     const int need = rndi(6), prod = rndi(2);
@@ -476,16 +485,14 @@ static void run_pyrblur1(const fv_dsp *d, const char *isa, int w, int x0, int n,
             for (int k = 0; k < 4; k++)
                 up[L].p[4 * i + k] = !act && rndi(3) == 0 ? (rndi(2) ? NAN : -INFINITY) : colour();
     }
-    buf r = buf_new(w4 + CANARY, off), o = buf_new(w4 + CANARY, off);
+    buf r = checkasm_out_f32(w4, off), o = checkasm_out_f32(w4, off);
     for (int i = 0; i < w; i++) {
         const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
         const int mix = m > 0.0f && tt > 0.0f && c > 0.0f && tt < 1.0f;
         for (int k = 0; k < 4; k++)
             r.p[4 * i + k] = !mix && rndi(3) == 0 ? (rndi(2) ? NAN : INFINITY) : colour();
     }
-    for (size_t i = w4; i < w4 + CANARY; i++)
-        memcpy(r.p + i, &canary_bits, 4);
-    memcpy(o.p, r.p, (w4 + CANARY) * sizeof(float));
+    memcpy(o.p, r.p, w4 * sizeof(float));
     const float *ups[6];
     for (int L = 0; L <= need; L++)
         ups[L] = up[L].p;
@@ -493,7 +500,7 @@ static void run_pyrblur1(const fv_dsp *d, const char *isa, int w, int x0, int n,
                                    .lambda_steps = steps, .lambda_max = lmax};
     fv_dof_pyrblur_row_c(r.p, &a, x0, n);
     d->dof_pyrblur_row(o.p, &a, x0, n);
-    compare(r.p, o.p, w4 + CANARY, 4, isa, "pyrblur_row", "whole row + canaries");
+    compare_out(&r, &o, w4, 4, isa, "pyrblur_row", "whole row + canaries");
     for (int i = x0; i < x0 + n; i++) {
         const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
         if (!(m > 0.0f && tt > 0.0f))
@@ -512,7 +519,7 @@ static void run_pyrblur1(const fv_dsp *d, const char *isa, int w, int x0, int n,
     free(lambda), free(coc.base), free(t.base), free(r.base), free(o.base);
 }
 
-static void run_pyrblur(const fv_dsp *d, const char *isa)
+static void run_pyrblur(const fv_dof_dsp *d, const char *isa)
 {
     for (int n = 1; n <= 70; n++)
         for (int rep = 0; rep < 8; rep++) {
@@ -528,29 +535,20 @@ static void run_pyrblur(const fv_dsp *d, const char *isa)
 static void test_pyrblur_row(void **state)
 {
     (void)state;
-    run_all("dof_pyrblur_row", run_pyrblur, offsetof(fv_dsp, dof_pyrblur_row));
-    printf("[ kernels  ] pyrblur pixels blended (all ISAs): %ld, mixed into the blur %ld, past the LUT's end %ld, "
+    run_all("dof_pyrblur_row", run_pyrblur, offsetof(fv_dof_dsp, dof_pyrblur_row));
+    printf("[ checkasm ] pyrblur pixels blended (all ISAs): %ld, mixed into the blur %ld, past the LUT's end %ld, "
            "between two levels %ld\n",
            pb_active, pb_mix, pb_beyond, pb_frac);
 }
 
-static int setup(void **state)
-{
-    (void)state;
-    fv_dof_gauss_tab_init(&tab);
-    return 0;
-}
-
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_gauss_tab),
-        cmocka_unit_test(test_coc_row),
-        cmocka_unit_test(test_hgauss_row),
-        cmocka_unit_test(test_vgauss_row),
-        cmocka_unit_test(test_combine_row),
-        cmocka_unit_test(test_upsample_row),
-        cmocka_unit_test(test_pyrblur_row),
-    };
-    return cmocka_run_group_tests_name("kernels_dof", tests, setup, NULL);
-}
+const struct CMUnitTest checkasm_dof_tests[] = {
+    cmocka_unit_test(test_tables),
+    cmocka_unit_test(test_gauss_tab),
+    cmocka_unit_test(test_coc_row),
+    cmocka_unit_test(test_hgauss_row),
+    cmocka_unit_test(test_vgauss_row),
+    cmocka_unit_test(test_combine_row),
+    cmocka_unit_test(test_upsample_row),
+    cmocka_unit_test(test_pyrblur_row),
+    {0},
+};

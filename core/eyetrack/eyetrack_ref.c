@@ -1,9 +1,9 @@
-/* fovea eye tracker: plain-C reference kernels (the contracts are in dsp.h). The SIMD versions
+/* fovea eye tracker: plain-C reference kernels (the contracts are in eyetrack_dsp.h) and the table's init. The SIMD versions
  * live in core/x86/eyetrack_{sse41,avx2}.c and core/arm/eyetrack_neon.c and must match these
  * exactly (integer arithmetic, or float operations in the same order). */
 #include <math.h>
 
-#include "dsp.h"
+#include "eyetrack/eyetrack_dsp.h"
 
 void fv_et_down2_row_c(uint8_t *restrict dst, const uint8_t *a, const uint8_t *b, int n)
 {
@@ -52,11 +52,23 @@ void fv_et_box3_row_c(uint8_t *restrict dst, const uint8_t *r0, const uint8_t *r
         dst[x] = fv_et_box3_px(r0, r1, r2, n, x);
 }
 
-void fv_eyetrack_init_c(fv_dsp *d)
+void fv_eyetrack_dsp_init(fv_eyetrack_dsp *d, unsigned isa_mask)
 {
+    const unsigned isas = isa_mask & fv_cpu_isas();
     d->et_down2_row = fv_et_down2_row_c;
     d->et_integral_row = fv_et_integral_row_c;
     d->et_thresh_row = fv_et_thresh_row_c;
     d->et_box_score_row = fv_et_box_score_row_c;
     d->et_box3_row = fv_et_box3_row_c;
+#if defined(__x86_64__)
+    if (isas & FV_ISA_SSE41)
+        fv_eyetrack_dsp_init_sse41(d);
+    if (isas & FV_ISA_AVX2)
+        fv_eyetrack_dsp_init_avx2(d);
+#elif defined(__aarch64__)
+    if (isas & FV_ISA_NEON)
+        fv_eyetrack_dsp_init_neon(d);
+#else
+    (void)isas;
+#endif
 }

@@ -1,0 +1,85 @@
+/* fovea: the layered depth-of-field kernels (one table per module, dav1d style; core/cpu.h has
+ * the pattern and the contract every ISA version keeps). C references: core/dof/dof_ref.c;
+ * core/dof/weier_impl.h has the argument structs. */
+#ifndef FOVEA_DOF_DSP_H
+#define FOVEA_DOF_DSP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../cpu.h"
+
+/* Called by core/dof/weier.c.
+ * dof_coc_row: coc[x] = g < dn ? K (1/dn - 1/g) : g > df ? K (1/df - 1/g) : 0 for x in [0, n),
+ *   g = max(depth_m of rgbd[x], 0.05) (the signed CoC of Weier eq. (3), simplified).
+ * dof_hgauss_row: for x in [x0, x0+n): the Gaussian sig[x-x0] over the row's FAR samples
+ *   (coc > 0), taps clamped to [0, w): dst[x] = (sum g rgb, sum g) * inv[sig] (premultiplied).
+ * dof_vgauss_row: for x in [x0, x0+n): dst[x] = sum_j g_j src[clamp(y + j, ylo, yhi - 1)][x]
+ *   (4 channels; src rows stride pixels apart).
+ *   The ISA versions of both Gaussians run blocks of neighbouring pixels to the block's largest
+ *   radius, adding w = 0 taps (the table's zeros) beyond a pixel's own: same bits (an
+ *   accumulator starting at +0 is never -0, so + (+-0) changes nothing), but they read (not
+ *   use) those extra taps, in the row's [0, w) / the rows [ylo, yhi) at columns [x0, x0+n),
+ *   which must hold finite values there (far samples' colours; far_h).
+ * dof_combine_row: out[x] for x in [x0, x0+n): o = sharp; towards far by min(1, coc) where
+ *   coc > 0, by t min(1, -coc) where coc < 0; near n = near (or 0), blended by t towards
+ *   s * lnear where t > 0 (s = 0 for near pixels, else 1); towards n.rgb / n.w by min(1, n.w)
+ *   where n.w > 0; with enh,
+ *   o = max(0, o + gain t (o - enh)) where gain t > 0; depth copied (fv_dof_combine_row_c has
+ *   the order of operations). The ISA versions may read (never use) far, lnear and enh pixels of
+ *   [x0, x0+n) the reference skips: they compute a step for several pixels and keep it by a
+ *   select on the reference's condition. */
+struct fv_dof_gauss_tab;
+struct fv_dof_combine_args;
+struct fv_dof_pyrblur_args;
+/* dof_upsample_row: dst[x] = tmp[i0[x]] + ax[x] (tmp[i1[x]] - tmp[i0[x]]) for x in [0, n)
+ *   (4 channels; the horizontal half of a separable bilinear up-sampling).
+ * dof_pyrblur_row: for x in [x0, x0+n) with coc != 0 and t > 0: the continuous level
+ *   l = min(lambda[min(int(|coc| steps), max)], need), pv = up[L0] + f (up[L1] - up[L0])
+ *   (L0 = int l, L1 = min(L0 + 1, need), f = l - L0), blur[x] = coc > 0 && t < 1 ?
+ *   blur + t (pv - blur) : pv (4 channels); other pixels keep their bits. |coc| lambda_steps must
+ *   stay below 2^31 (the reference's int conversion); lambda holds levels >= 0. The ISA versions
+ *   compute several pixels at once and keep each by a select on the reference's condition: they
+ *   may read (never use) up[0..need] and blur at pixels of [x0, x0+n) the reference skips, and
+ *   store a skipped pixel's blur back unchanged. */
+typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                                       const float *ax, int n);
+typedef void (*fv_dof_pyrblur_row_fn)(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
+typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);
+typedef void (*fv_dof_hgauss_row_fn)(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                                     const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+typedef void (*fv_dof_vgauss_row_fn)(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
+                                     int x0, int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+typedef void (*fv_dof_combine_row_fn)(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
+
+typedef struct fv_dof_dsp {
+    fv_dof_coc_row_fn dof_coc_row;
+    fv_dof_hgauss_row_fn dof_hgauss_row;
+    fv_dof_vgauss_row_fn dof_vgauss_row;
+    fv_dof_combine_row_fn dof_combine_row;
+    fv_dof_upsample_row_fn dof_upsample_row;
+    fv_dof_pyrblur_row_fn dof_pyrblur_row;
+} fv_dof_dsp;
+
+/* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
+ * every allowed ISA overwrites the entries it implements, lowest first. */
+void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask);
+
+/* ---- internal: references and per-ISA fillers (each sets every entry it has) ---- */
+void fv_dof_coc_row_c(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);
+void fv_dof_hgauss_row_c(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
+                         const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi, int x0,
+                         int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
+void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
+void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
+                           const float *ax, int n);
+void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
+#if defined(__x86_64__)
+void fv_dof_dsp_init_sse41(fv_dof_dsp *d);
+void fv_dof_dsp_init_avx2(fv_dof_dsp *d);
+#elif defined(__aarch64__)
+void fv_dof_dsp_init_neon(fv_dof_dsp *d);
+#endif
+
+#endif

@@ -1,0 +1,51 @@
+/* fovea: the temporal reprojection kernels (one table per module, dav1d style; core/cpu.h has
+ * the pattern and the contract every ISA version keeps). C references: core/reproject_ref.c,
+ * with the row loops every ISA shares in core/reproject_tmpl.h. */
+#ifndef FOVEA_REPROJECT_DSP_H
+#define FOVEA_REPROJECT_DSP_H
+
+#include <stddef.h>
+
+#include "cpu.h"
+
+/* Temporal reprojection (core/reproject.h has the model), on a block of level 0: pixels
+ * x0 .. x0+w-1 (w <= 64) of rows y0 .. y0+h-1; rgbd / wgt point at pixel (x0, y0), rows are
+ * stride pixels apart. One call per tile, so the per-call set-up is paid once.
+ * taa_blend: every pixel with weight 1 (a sample) is blended with its reprojected history; the
+ *   sums of its flow to the previous frame are added to *flow in row-major pixel order. Other
+ *   pixels untouched.
+ * taa_fill: every pixel with weight 0 (a hole) takes valid history, if any: colour, depth in
+ *   this frame's view, weight = the history's confidence in (0, 1]. Others untouched.
+ * Both read the history pyramid only at texels [-1, w] x [-1, h] of a level (its border).
+ * All arithmetic outside the 4-channel texel accumulation is scalar and shared
+ * (core/reproject_tmpl.h), so every ISA version gives the reference's bits. */
+struct fv_taa_frame;
+struct fv_taa_tile;
+struct fv_taa_flow;
+typedef void (*fv_taa_blend_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd,
+                                const float *wgt, ptrdiff_t stride, int x0, int y0, int w, int h,
+                                struct fv_taa_flow *flow);
+typedef void (*fv_taa_fill_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                               ptrdiff_t stride, int x0, int y0, int w, int h);
+typedef struct fv_reproject_dsp {
+    fv_taa_blend_fn taa_blend;
+    fv_taa_fill_fn taa_fill;
+} fv_reproject_dsp;
+
+/* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
+ * every allowed ISA overwrites the entries it implements, lowest first. */
+void fv_reproject_dsp_init(fv_reproject_dsp *d, unsigned isa_mask);
+
+/* ---- internal: references and per-ISA fillers (each sets every entry it has) ---- */
+void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, const float *wgt,
+                    ptrdiff_t stride, int x0, int y0, int w, int h, struct fv_taa_flow *flow);
+void fv_taa_fill_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                   ptrdiff_t stride, int x0, int y0, int w, int h);
+#if defined(__x86_64__)
+void fv_reproject_dsp_init_sse41(fv_reproject_dsp *d);
+void fv_reproject_dsp_init_avx2(fv_reproject_dsp *d);
+#elif defined(__aarch64__)
+void fv_reproject_dsp_init_neon(fv_reproject_dsp *d);
+#endif
+
+#endif

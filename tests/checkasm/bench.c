@@ -1,0 +1,632 @@
+/* fovea checkasm --bench: the kernel table (bench.h) and its timing loop. */
+#define _DEFAULT_SOURCE /* getloadavg */
+#include "bench.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/clock.h"
+#include "cli.h"
+#include "output.h"
+
+#include "camera.h"
+#include "dof/weier_impl.h"
+#include "pullpush.h"
+#include "raycast.h"
+#include "reproject.h"
+#include "sampling.h"
+
+#define W 1280 /* the default eye: 1280x1440 */
+#define H 1440
+#define EW 640 /* an eye camera image */
+#define EH 480
+
+/* deterministic inputs */
+static uint32_t rnd(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+static float frand(uint32_t *s, float lo, float hi) { return lo + (hi - lo) * (float)rnd(s) * (1.0f / 16777216.0f); }
+/* a weight: half holes, a third samples, the rest partial */
+static float wrand(uint32_t *s)
+{
+    const float u = frand(s, 0.0f, 1.0f);
+    return u < 0.5f ? 0.0f : u < 0.83f ? 1.0f : frand(s, 0.05f, 0.95f);
+}
+static float *fplane(size_t n) { return malloc(n * sizeof(float)); }
+static void fill_rgbd(float *p, size_t px, uint32_t *s, float dlo, float dhi)
+{
+    for (size_t i = 0; i < px; i++) {
+        p[4 * i] = frand(s, 0.0f, 1.0f);
+        p[4 * i + 1] = frand(s, 0.0f, 1.0f);
+        p[4 * i + 2] = frand(s, 0.0f, 1.0f);
+        p[4 * i + 3] = frand(s, dlo, dhi);
+    }
+}
+
+/* ---- pull-push ---- */
+typedef struct {
+    float *rgbd, *wgt, *drgbd, *dwgt;
+} pull_st;
+static void *pull_setup(void)
+{
+    pull_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    t->rgbd = fplane((size_t)W * H * 4), t->wgt = fplane((size_t)W * H);
+    t->drgbd = fplane((size_t)W / 2 * H / 2 * 4), t->dwgt = fplane((size_t)W / 2 * H / 2);
+    if (!t->rgbd || !t->wgt || !t->drgbd || !t->dwgt)
+        return free(t->rgbd), free(t->wgt), free(t->drgbd), free(t->dwgt), free(t), NULL;
+    uint32_t s = 1;
+    fill_rgbd(t->rgbd, (size_t)W * H, &s, 0.5f, 20.0f);
+    for (size_t i = 0; i < (size_t)W * H; i++)
+        t->wgt[i] = wrand(&s);
+    return t;
+}
+static void pull_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    pull_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const int r = (row0 + k) % (H / 2);
+        const size_t a = (size_t)(2 * r) * W, b = a + W;
+        d->pp.pull_row(t->drgbd + (size_t)r * (W / 2) * 4, t->dwgt + (size_t)r * (W / 2), t->rgbd + 4 * a, t->wgt + a,
+                    t->rgbd + 4 * b, t->wgt + b, W / 2);
+    }
+}
+static void pull_free(void *st)
+{
+    pull_st *t = st;
+    free(t->rgbd), free(t->wgt), free(t->drgbd), free(t->dwgt), free(t);
+}
+
+typedef struct {
+    float *rgbd, *wgt, *coarse; /* coarse: (W/2 + 2) x (H/2 + 2) with a 1-pixel border */
+} push_st;
+#define CW (W / 2 + 2)
+static void *push_setup(void)
+{
+    push_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    t->rgbd = fplane((size_t)W * H * 4), t->wgt = fplane((size_t)W * H);
+    t->coarse = fplane((size_t)CW * (H / 2 + 2) * 4);
+    if (!t->rgbd || !t->wgt || !t->coarse)
+        return free(t->rgbd), free(t->wgt), free(t->coarse), free(t), NULL;
+    uint32_t s = 2;
+    fill_rgbd(t->rgbd, (size_t)W * H, &s, 0.5f, 20.0f);
+    for (size_t i = 0; i < (size_t)W * H; i++)
+        t->wgt[i] = wrand(&s);
+    fill_rgbd(t->coarse, (size_t)CW * (H / 2 + 2), &s, 0.5f, 20.0f);
+    return t;
+}
+static void push_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    push_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const int y = (row0 + k) % H, Y = y >> 1, Yf = y & 1 ? Y + 1 : Y - 1;
+        d->pp.push_row(t->rgbd + (size_t)y * W * 4, t->wgt + (size_t)y * W, t->coarse + ((size_t)(Y + 1) * CW + 1) * 4,
+                    t->coarse + ((size_t)(Yf + 1) * CW + 1) * 4, W);
+    }
+}
+static void push_free(void *st)
+{
+    push_st *t = st;
+    free(t->rgbd), free(t->wgt), free(t->coarse), free(t);
+}
+
+/* ---- temporal reprojection: whole 16x16 tiles through fv_taa_tile_run, a still head ---- */
+typedef struct {
+    fv_camera cam;
+    fv_pyramid hist, cur;
+    float *rgbd0, *wgt0; /* the current level 0 before reprojection */
+    fv_sampler smp;
+    fv_taa_params prm;
+    fv_taa_frame f;
+} taa_st;
+static void taa_free(void *st)
+{
+    taa_st *t = st;
+    fv_pyramid_free(&t->hist), fv_pyramid_free(&t->cur), fv_sampler_free(&t->smp);
+    free(t->rgbd0), free(t->wgt0), free(t);
+}
+static void *taa_setup(void)
+{
+    taa_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    fv_camera_desc cd;
+    fv_camera_desc_default(&cd);
+    cd.width = W, cd.height = H;
+    static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
+    fv_sampling_params sp;
+    fv_sampling_params_default(&sp);
+    sp.rotate = 1;
+    fv_taa_params_default(&t->prm);
+    if (fv_camera_setup(&t->cam, &cd, &origin) || fv_pyramid_init(&t->hist, W, H) || fv_pyramid_init(&t->cur, W, H) ||
+        fv_sampler_init(&t->smp, W, H, t->cam.focal_px, &sp))
+        return taa_free(t), NULL;
+    const fv_pyr_level *h0 = &t->hist.lv[0], *c0 = &t->cur.lv[0];
+    const size_t n = (size_t)c0->stride * H;
+    if (!(t->rgbd0 = fplane(4 * n)) || !(t->wgt0 = fplane(n)))
+        return taa_free(t), NULL;
+    uint32_t s = 3;
+    /* history: a converged image of a wall 5 m away; current: the sampled pixels of the pattern */
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float *p = h0->rgbd + 4 * ((size_t)y * h0->stride + x);
+            fill_rgbd(p, 1, &s, 5.0f, 5.0f);
+            h0->wgt[(size_t)y * h0->stride + x] = 1.0f;
+        }
+    fv_pullpush_dsp c;
+    fv_pullpush_dsp_init(&c, FV_ISA_C);
+    fv_pullpush(&t->hist, &c, NULL);
+    for (int y = 0; y < H; y++) {
+        for (int x0 = 0; x0 < W; x0 += 32) {
+            const uint32_t bits = (uint32_t)fv_sampler_row(&t->smp, x0, y, 32, W / 2, H / 2, 0);
+            for (int x = x0; x < x0 + 32; x++) {
+                const size_t o = (size_t)y * c0->stride + x;
+                fill_rgbd(t->rgbd0 + 4 * o, 1, &s, 4.9f, 5.1f);
+                t->wgt0[o] = (bits >> (x - x0)) & 1u ? 1.0f : 0.0f;
+            }
+        }
+    }
+    fv_taa_frame_setup(&t->f, &t->cam, &t->cam, &t->hist, t->prm.depth_tol);
+    return t;
+}
+static void taa_reset(void *st)
+{
+    taa_st *t = st;
+    const size_t n = (size_t)t->cur.lv[0].stride * H;
+    memcpy(t->cur.lv[0].rgbd, t->rgbd0, 4 * n * sizeof(float));
+    memcpy(t->cur.lv[0].wgt, t->wgt0, n * sizeof(float));
+}
+#define TX ((W + FV_TILE - 1) / FV_TILE)
+#define TY ((H + FV_TILE - 1) / FV_TILE)
+static void taa_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    taa_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const int i = (row0 + k) % (TX * TY), x0 = i % TX * FV_TILE, y0 = i / TX * FV_TILE;
+        const int tw = W - x0 < FV_TILE ? W - x0 : FV_TILE, th = H - y0 < FV_TILE ? H - y0 : FV_TILE;
+        fv_taa_tile_run(&t->f, &t->prm, &t->smp, W / 2, H / 2, &t->cur.lv[0], &d->taa, x0, y0, tw, th);
+    }
+}
+
+/* ---- depth of field ---- */
+typedef struct {
+    float *rgbd, *coc, *a4, *b4, *c4, *out, *t;
+    uint8_t *sig;
+    fv_dof_gauss_tab *tab;
+    int32_t *i0, *i1; /* up-sampling by 2: taps into a 640-pixel coarse row */
+    float *ax, *lambda;
+} dof_st;
+#define LSTEPS 8 /* the level table's steps per pixel of CoC (core/dof/weier.c) */
+#define SPAN 128 /* the Gaussians' span per call in core/dof/weier.c (TILE * 8) */
+static void dof_free(void *st)
+{
+    dof_st *t = st;
+    free(t->rgbd), free(t->coc), free(t->a4), free(t->b4), free(t->c4), free(t->out), free(t->t), free(t->sig);
+    free(t->tab), free(t->i0), free(t->i1), free(t->ax), free(t->lambda), free(t);
+}
+static void *dof_setup(void)
+{
+    dof_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    const size_t n = (size_t)W * H;
+    t->rgbd = fplane(4 * n), t->coc = fplane(n), t->a4 = fplane(4 * n), t->b4 = fplane(4 * n);
+    t->c4 = fplane(4 * n), t->out = fplane(4 * n), t->t = fplane(n), t->sig = malloc(n);
+    t->tab = malloc(sizeof *t->tab);
+    t->i0 = malloc(W * sizeof *t->i0), t->i1 = malloc(W * sizeof *t->i1), t->ax = fplane(W);
+    t->lambda = fplane(64 * LSTEPS + 1);
+    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->tab || !t->i0 ||
+        !t->i1 || !t->ax || !t->lambda)
+        return dof_free(t), NULL;
+    for (int x = 0; x < W; x++) { /* pixel centres: x = 2 X + 0.5 +- 0.25 */
+        const int X = x / 2;
+        t->i0[x] = x & 1 ? X : (X > 0 ? X - 1 : 0);
+        t->i1[x] = x & 1 ? (X + 1 < W / 2 ? X + 1 : X) : X;
+        t->ax[x] = x & 1 ? 0.25f : (X > 0 ? 0.75f : 0.0f);
+    }
+    for (int i = 0; i <= 64 * LSTEPS; i++) /* about log2 of the CoC */
+        t->lambda[i] = i < LSTEPS ? 0.0f : fminf(5.0f, log2f((float)i / LSTEPS));
+    fv_dof_gauss_tab_init(t->tab);
+    uint32_t s = 4;
+    fill_rgbd(t->rgbd, n, &s, 0.3f, 20.0f);
+    fill_rgbd(t->a4, n, &s, 0.0f, 1.0f);
+    fill_rgbd(t->b4, n, &s, 0.0f, 1.0f); /* near layers: coverage in .w */
+    fill_rgbd(t->c4, n, &s, 0.0f, 1.0f);
+    for (size_t i = 0; i < n; i++) {
+        t->coc[i] = frand(&s, -6.0f, 6.0f);
+        t->t[i] = frand(&s, -0.5f, 1.0f) < 0.0f ? 0.0f : frand(&s, 0.0f, 1.0f);
+        t->sig[i] = (uint8_t)(4 + rnd(&s) % 13); /* sigma 1 .. 4 px */
+    }
+    return t;
+}
+static void coc_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        d->dof.dof_coc_row(t->coc + y * W, t->rgbd + 4 * y * W, W, 2.4f, 1.8f, 2.2f);
+    }
+}
+static void hgauss_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        for (int xs = 0; xs < W; xs += SPAN) /* as core/dof/weier.c calls it */
+            d->dof.dof_hgauss_row(t->out + 4 * y * W, t->rgbd + 4 * y * W, t->coc + y * W, W, xs, SPAN,
+                                  t->sig + y * W + xs, t->tab);
+    }
+}
+static void vgauss_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const int y = (row0 + k) % H;
+        for (int xs = 0; xs < W; xs += SPAN)
+            d->dof.dof_vgauss_row(t->out + 4 * (size_t)y * W, t->a4, W, y, 0, H, xs, SPAN, t->sig + (size_t)y * W + xs,
+                                  t->tab);
+    }
+}
+static void upsample_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        d->dof.dof_upsample_row(t->out + 4 * y * W, t->a4 + 4 * (y / 2) * W, t->i0, t->i1, t->ax, W);
+    }
+}
+static void pyrblur_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        const float *up[5] = {t->rgbd + 4 * y * W, t->a4 + 4 * y * W, t->b4 + 4 * y * W, t->c4 + 4 * y * W,
+                              t->a4 + 4 * ((y + 1) % H) * W};
+        const fv_dof_pyrblur_args a = {.coc = t->coc + y * W, .t = t->t + y * W, .up = up, .need = 4,
+                                       .lambda = t->lambda, .lambda_steps = LSTEPS, .lambda_max = 64 * LSTEPS};
+        d->dof.dof_pyrblur_row(t->out + 4 * y * W, &a, 0, W);
+    }
+}
+static void combine_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        const fv_dof_combine_args a = {.sharp = t->rgbd + 4 * y * W, .coc = t->coc + y * W, .far = t->a4 + 4 * y * W,
+                                       .near = t->b4 + 4 * y * W, .lnear = t->c4 + 4 * y * W, .t = t->t + y * W,
+                                       .enh = t->a4 + 4 * y * W, .gain = 0.5f};
+        d->dof.dof_combine_row(t->out + 4 * y * W, &a, 0, W);
+    }
+}
+
+/* ---- eye tracker (a 640x480 eye camera image) ---- */
+typedef struct {
+    uint8_t *img, *half, *bin;
+    uint32_t *ii;
+    float *score;
+} et_st;
+static void et_free(void *st)
+{
+    et_st *t = st;
+    free(t->img), free(t->half), free(t->bin), free(t->ii), free(t->score), free(t);
+}
+static void *et_setup(void)
+{
+    et_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    t->img = malloc((size_t)EW * EH), t->half = malloc((size_t)EW * EH / 4), t->bin = malloc((size_t)EW * EH);
+    t->ii = malloc(((size_t)EW + 1) * (EH + 1) * sizeof *t->ii);
+    if (!t->img || !t->half || !t->bin || !t->ii)
+        return et_free(t), NULL;
+    uint32_t s = 5;
+    for (size_t i = 0; i < (size_t)EW * EH; i++)
+        t->img[i] = (uint8_t)(rnd(&s) & 255u);
+    memset(t->ii, 0, ((size_t)EW + 1) * sizeof *t->ii);
+    return t;
+}
+static void down2_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    et_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % (EH / 2));
+        d->et.et_down2_row(t->half + y * (EW / 2), t->img + 2 * y * EW, t->img + (2 * y + 1) * EW, EW / 2);
+    }
+}
+static void integral_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    et_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % EH);
+        d->et.et_integral_row(t->ii + (y + 1) * (EW + 1) + 1, t->ii + y * (EW + 1) + 1, t->img + y * EW, EW);
+    }
+}
+/* box search scores: box half-size 8, ring 12 (the tracker's 1.5), every centre whose ring is
+ * inside the image */
+enum { ET_K = 8, ET_KO = 12 };
+static void *box_setup(void)
+{
+    et_st *t = et_setup();
+    if (!t)
+        return NULL;
+    t->score = malloc((size_t)EW * sizeof *t->score);
+    if (!t->score)
+        return et_free(t), NULL;
+    for (int y = 0; y < EH; y++)
+        fv_et_integral_row_c(t->ii + (y + 1) * (EW + 1) + 1, t->ii + y * (EW + 1) + 1, t->img + y * EW, EW);
+    return t;
+}
+static volatile float et_fsink;
+static void box_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    et_st *t = st;
+    const int iw = EW + 1, n = EW - 2 * ET_KO, na = (2 * ET_K + 1) * (2 * ET_K + 1);
+    const float inv_a = 1.0f / (float)na, inv_r = 1.0f / (float)((2 * ET_KO + 1) * (2 * ET_KO + 1) - na);
+    float m = 0;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % (EH - 2 * ET_KO));
+        const uint32_t *ot = t->ii + y * iw, *it = ot + (ET_KO - ET_K) * (iw + 1);
+        m += d->et.et_box_score_row(t->score, it, it + (2 * ET_K + 1) * iw, 2 * ET_K + 1, ot, ot + (2 * ET_KO + 1) * iw,
+                                 2 * ET_KO + 1, n, inv_a, inv_r, 30.0f);
+    }
+    et_fsink = m;
+}
+static void box3_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    et_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % (EH - 2)) + 1;
+        d->et.et_box3_row(t->bin + y * EW, t->img + (y - 1) * EW, t->img + y * EW, t->img + (y + 1) * EW, EW);
+    }
+}
+static volatile int et_sink;
+static void thresh_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    et_st *t = st;
+    int c = 0;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % EH);
+        c += d->et.et_thresh_row(t->bin + y * EW, t->img + y * EW, EW, 60);
+    }
+    et_sink = c;
+}
+
+#define F(x) offsetof(checkasm_dsp, x)
+const checkasm_bench_kernel checkasm_bench_kernels[] = {
+    {"pull_row", "1280x1440 -> 640x720, 720 rows", {F(pp.pull_row), 0}, H / 2, pull_setup, NULL, pull_run, pull_free},
+    {"push_row", "1280x1440, 1440 rows", {F(pp.push_row), 0}, H, push_setup, NULL, push_run, push_free},
+    {"taa_blend+taa_fill", "1280x1440, 7200 16x16 tiles, still head", {F(taa.taa_blend), F(taa.taa_fill)}, TX * TY, taa_setup,
+     taa_reset, taa_run, taa_free},
+    {"dof_coc_row", "1280x1440, 1440 rows", {F(dof.dof_coc_row), 0}, H, dof_setup, NULL, coc_run, dof_free},
+    {"dof_hgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_hgauss_row), 0}, H, dof_setup, NULL,
+     hgauss_run, dof_free},
+    {"dof_vgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_vgauss_row), 0}, H, dof_setup, NULL,
+     vgauss_run, dof_free},
+    {"dof_upsample_row", "1280x1440, 1440 rows, by 2 from 640", {F(dof.dof_upsample_row), 0}, H, dof_setup, NULL,
+     upsample_run, dof_free},
+    {"dof_pyrblur_row", "1280x1440, 1440 rows, 5 levels", {F(dof.dof_pyrblur_row), 0}, H, dof_setup, NULL, pyrblur_run,
+     dof_free},
+    {"dof_combine_row", "1280x1440, 1440 rows, all layers", {F(dof.dof_combine_row), 0}, H, dof_setup, NULL, combine_run,
+     dof_free},
+    {"et_down2_row", "640x480 -> 320x240, 240 rows", {F(et.et_down2_row), 0}, EH / 2, et_setup, NULL, down2_run, et_free},
+    {"et_integral_row", "640x480, 480 rows", {F(et.et_integral_row), 0}, EH, et_setup, NULL, integral_run, et_free},
+    {"et_thresh_row", "640x480, 480 rows", {F(et.et_thresh_row), 0}, EH, et_setup, NULL, thresh_run, et_free},
+    {"et_box_score_row", "640x480 integral, k 8 ring 12, 456 rows", {F(et.et_box_score_row), 0}, EH - 2 * ET_KO,
+     box_setup, NULL, box_run, et_free},
+    {"et_box3_row", "640x480, 478 rows", {F(et.et_box3_row), 0}, EH - 2, et_setup, NULL, box3_run, et_free},
+};
+const int checkasm_bench_count = (int)(sizeof checkasm_bench_kernels / sizeof checkasm_bench_kernels[0]);
+
+int checkasm_bench_differs(const checkasm_bench_kernel *k, const checkasm_dsp *d, const checkasm_dsp *ref)
+{
+    for (int i = 0; i < CHECKASM_BENCH_MAX_FIELDS; i++) {
+        if (k->field[i] == 0)
+            continue;
+        void (*a)(void), (*b)(void);
+        memcpy(&a, (const char *)d + k->field[i], sizeof a);
+        memcpy(&b, (const char *)ref + k->field[i], sizeof b);
+        if (a != b)
+            return 1;
+    }
+    return 0;
+}
+
+const checkasm_bench_kernel *checkasm_bench_find(const char *name)
+{
+    for (int i = 0; i < checkasm_bench_count; i++)
+        if (!strcmp(checkasm_bench_kernels[i].name, name))
+            return &checkasm_bench_kernels[i];
+    return NULL;
+}
+
+void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask)
+{
+    d->isa = fv_cpu_best_isa(isa_mask);
+    fv_pullpush_dsp_init(&d->pp, isa_mask);
+    fv_reproject_dsp_init(&d->taa, isa_mask);
+    fv_dof_dsp_init(&d->dof, isa_mask);
+    fv_eyetrack_dsp_init(&d->et, isa_mask);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void load_avg(double la[3])
+{
+    if (getloadavg(la, 3) != 3)
+        la[0] = la[1] = la[2] = NAN;
+}
+
+/* ---- the timing loop ---- */
+typedef struct {
+    const char *name, *shape, *isa;
+    double ms;      /* median per frame of calls */
+    double speedup; /* C reference time / this */
+} kres;
+
+int checkasm_bench_run(const char *prog, const char *json_path, int reps, const char *only, long calls,
+                       unsigned isa_mask)
+{
+    if (only && !checkasm_bench_find(only))
+        fv_usage_error(prog, "--kernel: '%s' is not a kernel of the table (see --kernels)", only);
+    if (only && calls > 0) { /* instruction counting: one kernel, one ISA, `calls` calls after the set-up */
+        const checkasm_bench_kernel *k = checkasm_bench_find(only);
+        checkasm_dsp d;
+        checkasm_dsp_init(&d, isa_mask);
+        void *st = k->setup();
+        if (!st)
+            fv_fail(prog, FV_EXIT_FAIL, "out of memory setting %s up", k->name);
+        if (k->reset)
+            k->reset(st);
+        k->run(st, &d, 0, (int)calls);
+        k->free(st);
+        /* where the kernels' code is (tools/kernel_icount.py counts the instructions run there) */
+        printf("%s: %s %s x %ld calls; code at", prog, k->name, fv_isa_name(d.isa), calls);
+        for (int i = 0; i < CHECKASM_BENCH_MAX_FIELDS; i++)
+            if (k->field[i]) {
+                void (*fn)(void);
+                uintptr_t a;
+                memcpy(&fn, (const char *)&d + k->field[i], sizeof fn);
+                memcpy(&a, &fn, sizeof a);
+                printf(" 0x%llx", (unsigned long long)a);
+            }
+        printf("\n");
+        return FV_EXIT_OK;
+    }
+    static const unsigned masks[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_SSE41 | FV_ISA_AVX2, FV_ISA_NEON};
+    enum { NM = 4 };
+    checkasm_dsp ds[NM];
+    int have[NM], nisa = 0;
+    for (int m = 0; m < NM; m++) {
+        checkasm_dsp_init(&ds[m], masks[m]);
+        have[m] = m == 0 || ds[m].isa != FV_ISA_C; /* that ISA runs on this CPU */
+        nisa += have[m];
+    }
+    double la[3];
+    load_avg(la);
+    printf("%s (kernel bench): %d ISA%s on this CPU, median of %d runs, each ISA timed back to back; "
+           "load average %.2f %.2f %.2f\n",
+           prog, nisa, nisa == 1 ? "" : "s", reps, la[0], la[1], la[2]);
+    printf("%-20s %-42s %-8s %10s %8s\n", "kernel", "one frame of calls", "isa", "ms/frame", "speedup");
+    kres *out = calloc((size_t)checkasm_bench_count * NM, sizeof *out);
+    double *t = calloc((size_t)reps * NM, sizeof *t);
+    if (!out || !t)
+        fv_fail(prog, FV_EXIT_FAIL, "out of memory");
+    int nout = 0;
+    for (int i = 0; i < checkasm_bench_count; i++) {
+        const checkasm_bench_kernel *k = &checkasm_bench_kernels[i];
+        if (only && strcmp(k->name, only))
+            continue;
+        /* the ISAs with their own version (not the C one, not the same as a lower ISA's) */
+        int use[NM];
+        for (int m = 0; m < NM; m++) {
+            use[m] = have[m] && (m == 0 || checkasm_bench_differs(k, &ds[m], &ds[0]));
+            for (int q = 1; q < m && use[m]; q++)
+                if (use[q] && !checkasm_bench_differs(k, &ds[m], &ds[q]))
+                    use[m] = 0;
+        }
+        void *st = k->setup();
+        if (!st)
+            fv_fail(prog, FV_EXIT_FAIL, "out of memory setting %s up", k->name);
+        /* frames per sample: at least ~20 ms of the C reference (the eye tracker's are small) */
+        if (k->reset)
+            k->reset(st);
+        int64_t t0 = fv_time_ns();
+        k->run(st, &ds[0], 0, k->calls_per_frame);
+        const double once = (double)(fv_time_ns() - t0) * 1e-6;
+        const int nf = once >= 20.0 ? 1 : once <= 0.01 ? 2000 : (int)ceil(20.0 / once);
+        for (int r = 0; r < reps; r++)
+            for (int m = 0; m < NM; m++) {
+                if (!use[m])
+                    continue;
+                double ns = 0.0;
+                for (int f = 0; f < nf; f++) {
+                    if (k->reset)
+                        k->reset(st);
+                    t0 = fv_time_ns();
+                    k->run(st, &ds[m], 0, k->calls_per_frame);
+                    ns += (double)(fv_time_ns() - t0);
+                }
+                t[r * NM + m] = ns * 1e-6 / nf;
+            }
+        double med[NM];
+        for (int m = 0; m < NM; m++) {
+            if (!use[m])
+                continue;
+            double v[64];
+            int n = 0;
+            for (int r = 0; r < reps && n < 64; r++)
+                v[n++] = t[r * NM + m];
+            qsort(v, (size_t)n, sizeof *v, cmp_double);
+            med[m] = n & 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+            kres *o = &out[nout++];
+            o->name = k->name, o->shape = k->shape, o->isa = fv_isa_name(ds[m].isa);
+            o->ms = med[m];
+            o->speedup = med[0] / med[m];
+            printf("%-20s %-42s %-8s %10.3f %7.2fx\n", k->name, k->shape, o->isa, o->ms, o->speedup);
+        }
+        k->free(st);
+    }
+    int status = FV_EXIT_OK;
+    if (json_path) {
+        char err[512];
+        fv_afile a;
+        if (fv_afile_open(&a, json_path, err, sizeof err))
+            fv_fail(prog, FV_EXIT_FAIL, "%s", err);
+        fprintf(a.f, "{\"kernels_bench\": {\"reps\": %d, \"load_avg\": [%.2f, %.2f, %.2f], \"results\": [", reps, la[0],
+                la[1], la[2]);
+        for (int i = 0; i < nout; i++)
+            fprintf(a.f, "%s\n  {\"kernel\": \"%s\", \"shape\": \"%s\", \"isa\": \"%s\", \"ms_per_frame\": %.4f, "
+                         "\"speedup\": %.3f}",
+                    i ? "," : "", out[i].name, out[i].shape, out[i].isa, out[i].ms, out[i].speedup);
+        fprintf(a.f, "]}}\n");
+        if (fv_afile_commit(&a, err, sizeof err)) {
+            fprintf(stderr, "%s: %s\n", prog, err);
+            status = FV_EXIT_FAIL;
+        }
+    }
+    free(out);
+    free(t);
+    return status;
+}
+
+int checkasm_bench_main(const char *prog, int argc, char **argv)
+{
+    const char *json_path = NULL, *only = NULL;
+    int reps = 7;
+    long calls = 0;
+    unsigned isa_mask = ~0u;
+    for (int i = 1; i < argc; i += 2) { /* every option takes a value */
+        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(o, "--json") && v)
+            json_path = v;
+        else if (!strcmp(o, "--kernel-reps") && v)
+            reps = (int)fv_arg_long(prog, o, v, 1, 64);
+        else if (!strcmp(o, "--kernel") && v)
+            only = v;
+        else if (!strcmp(o, "--calls") && v)
+            calls = fv_arg_long(prog, o, v, 0, 100000000);
+        else if (!strcmp(o, "--isa") && v) {
+            if (!strcmp(v, "c")) isa_mask = FV_ISA_C;
+            else if (!strcmp(v, "sse41")) isa_mask = FV_ISA_SSE41;
+            else if (!strcmp(v, "avx2")) isa_mask = FV_ISA_SSE41 | FV_ISA_AVX2;
+            else if (!strcmp(v, "neon")) isa_mask = FV_ISA_NEON;
+            else fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", v);
+        } else
+            fv_usage_error(prog, "'%s': expected --json FILE, --kernel-reps N, --kernel NAME, --calls N or --isa I", o);
+    }
+    if (calls > 0 && !only)
+        fv_usage_error(prog, "--calls N needs --kernel NAME");
+    return checkasm_bench_run(prog, json_path, reps, only, calls, isa_mask);
+}

@@ -1,0 +1,253 @@
+/* fovea checkasm: the temporal reprojection kernels (reproject_dsp.h), every ISA version against
+ * the C reference on random histories, cameras and blocks, bit for bit. Outputs are canaried
+ * (checkasm.h). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "checkasm.h"
+
+#include "camera.h"
+#include "reproject.h"
+#include "reproject_dsp.h"
+
+static const int sizes[] = { 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 16, 17, 31, 32, 33, 63, 64, 65, 640, 641, 1281 };
+#define NSIZES ((int)(sizeof sizes / sizeof sizes[0]))
+
+static float rnd(void) { return checkasm_randf(); }
+
+static void assert_finite(const float *v, size_t count, const char *kernel, int n)
+{
+    for (size_t i = 0; i < count; i++)
+        if (!isfinite(v[i]))
+            fail_msg("c %s n=%d: reference output %zu is %g although every used input is finite", kernel, n, i,
+                     (double)v[i]);
+}
+
+static void compare(const float *ref, const float *got, size_t count, int per_px, const char *isa,
+                    const char *kernel, const char *what, int n, int off, int mode)
+{
+    checkasm_compare(ref, got, count, CHECKASM_F32, (size_t)per_px, CHECKASM_EXACT, "%s %s (%s) n=%d offset=%d mode=%d",
+                     isa, kernel, what, n, off, mode);
+}
+
+/* ------------------------------------------------------------------ tables */
+
+static const char *const names[] = {"taa_blend", "taa_fill"};
+
+/* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
+ * holds the references. Also seeds the module's inputs. */
+static void test_tables(void **state)
+{
+    (void)state;
+    checkasm_rng = 0x7aa2018ull;
+    fv_reproject_dsp ref, own;
+    fv_reproject_dsp_init(&ref, FV_ISA_C);
+    assert_true(ref.taa_blend == fv_taa_blend_c);
+    assert_true(ref.taa_fill == fv_taa_fill_c);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        memset(&own, 0, sizeof own);
+        switch (isa) {
+#if defined(__x86_64__)
+        case FV_ISA_SSE41: fv_reproject_dsp_init_sse41(&own); break;
+        case FV_ISA_AVX2: fv_reproject_dsp_init_avx2(&own); break;
+#elif defined(__aarch64__)
+        case FV_ISA_NEON: fv_reproject_dsp_init_neon(&own); break;
+#endif
+        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
+        }
+        checkasm_check_table("reproject", isa, &own, &ref, sizeof own, names);
+    }
+}
+
+/* ------------------------------------------------------------------ reprojection */
+
+/* A history pyramid with random content on every level (borders included): colours in [0, 1],
+ * depths in [0.3, 30] m with some at the miss depth, weights per mode (0/1, random, all 0). */
+static void random_history(fv_pyramid *h, int w, int hgt, int wmode)
+{
+    assert_int_equal(fv_pyramid_init(h, w, hgt), 0);
+    for (int l = 0; l < h->levels; l++) {
+        fv_pyr_level *L = &h->lv[l];
+        for (int y = -1; y <= L->h; y++)
+            for (int x = -1; x <= L->w; x++) {
+                float *c = L->rgbd + 4 * ((ptrdiff_t)y * L->stride + x);
+                for (int k = 0; k < 3; k++)
+                    c[k] = rnd();
+                const float u = rnd(), r1 = rnd(), r2 = rnd(); /* drawn in a fixed order */
+                /* mostly one surface near 3 m (so history agrees with the samples and the blend
+                 * and the fill really run), some texels elsewhere and some misses */
+                c[3] = u < 0.05f ? 1000.0f : u < 0.3f ? 0.3f + 30.0f * r1 * r2 : 3.0f * (1.0f + 0.04f * (r1 - 0.5f));
+                const int border = x < 0 || y < 0 || x >= L->w || y >= L->h;
+                float wt = wmode == 0 ? (float)(fv_test_rand(&checkasm_rng) & 1) : wmode == 1 ? (rnd() < 0.2f ? 0.0f : rnd()) : 0.0f;
+                L->wgt[(ptrdiff_t)y * L->stride + x] = border ? 0.0f : wt;
+            }
+    }
+}
+
+/* Cameras of the current and previous frame: equal (identity), a small head motion, or a large
+ * one that sends much of the image outside the previous frame. */
+static void random_cameras(fv_camera *cur, fv_camera *prev, int w, int h, int motion)
+{
+    fv_camera_desc d;
+    fv_camera_desc_default(&d);
+    d.width = w;
+    d.height = h;
+    fv_pose a = {{0.1f, 1.6f, 0.2f}, {0, 0, 0, 1}}, b = a;
+    const float amt = motion == 1 ? 0.02f : 0.4f;
+    if (motion) {
+        for (int k = 0; k < 3; k++)
+            b.pos[k] += amt * (rnd() - 0.5f);
+        b.quat[0] = amt * (rnd() - 0.5f);
+        b.quat[1] = amt * (rnd() - 0.5f);
+        b.quat[2] = 0.3f * amt * (rnd() - 0.5f);
+        fv_quat_normalize(b.quat);
+    }
+    assert_int_equal(fv_camera_setup(cur, &d, &a), 0);
+    assert_int_equal(fv_camera_setup(prev, &d, &b), 0);
+}
+
+/* A row of n current pixels: samples (weight 1) with depths, holes (weight 0), and pixels of
+ * other weights that both kernels must leave alone. */
+static void random_row(float *rgbd, float *wgt, int n)
+{
+    static const float depths[] = { 1000.0f, 1e-3f, 0.31f, 2.0f, 7.5f };
+    for (int i = 0; i < n; i++) {
+        const float u = rnd();
+        wgt[i] = u < 0.4f ? 1.0f : u < 0.9f ? 0.0f : rnd();
+        for (int k = 0; k < 3; k++)
+            rgbd[4 * i + k] = rnd();
+        const float v = rnd(), r1 = rnd(), r2 = rnd(); /* drawn in a fixed order */
+        rgbd[4 * i + 3] = v < 0.1f ? depths[fv_test_rand(&checkasm_rng) % 5] : v < 0.3f ? 0.3f + 30.0f * r1 * r2
+                                                                          : 3.0f * (1.0f + 0.04f * (r1 - 0.5f));
+    }
+}
+
+static const char *motion_name[3] = { "identity", "small", "large" };
+static long taa_blended, taa_quincunx, taa_filled; /* how often the paths really ran */
+
+/* One block of w pixels by h rows (rows stride pixels apart; the padding between rows is part of
+ * the buffer and must come back untouched) at a random place of the image. */
+static int run_taa(const fv_reproject_dsp *d, const char *isa, const fv_taa_frame *f, int w, int h, int pad, int off, int motion)
+{
+    const int W = (int)f->prev_w, H = (int)f->prev_h;
+    const int x0 = (int)(fv_test_rand(&checkasm_rng) % (unsigned)(W - w + 1)), y0 = (int)(fv_test_rand(&checkasm_rng) % (unsigned)(H - h + 1));
+    const ptrdiff_t stride = w + pad;
+    const size_t n = (size_t)(h - 1) * (size_t)stride + (size_t)w; /* pixels in the buffer */
+    /* footprints of one texel, of several levels, and wide enough for quincunx taps */
+    static const float widen[] = { 1.0f, 1.0f, 1.3f, 2.2360680f, 2.6f, 3.0f, 4.0f, 9.0f };
+    fv_taa_tile t = { 1.0f, 1.0f, 0, 0 };
+    t.widen = widen[fv_test_rand(&checkasm_rng) % 8]; /* one statement each: the draws' order is fixed */
+    t.alpha = 0.05f + 0.95f * rnd();
+    /* fill flow: small, or far enough that rows / runs leave the previous image */
+    const int big = fv_test_rand(&checkasm_rng) % 8 == 0;
+    t.flow_x = (int)(fv_test_rand(&checkasm_rng) % 7) - 3;
+    if (big)
+        t.flow_x += (int)(fv_test_rand(&checkasm_rng) % (unsigned)(2 * W)) - W;
+    t.flow_y = (int)(fv_test_rand(&checkasm_rng) % 7) - 3;
+    if (big)
+        t.flow_y += (int)(fv_test_rand(&checkasm_rng) % (unsigned)(2 * H)) - H;
+    buf rc = checkasm_out_f32(4 * n, off), rw = checkasm_out_f32(n, off);
+    buf tc = checkasm_out_f32(4 * n, off), tw = checkasm_out_f32(n, off);
+    random_row(rc.p, rw.p, (int)n);
+    memcpy(tc.p, rc.p, 4 * n * sizeof(float));
+    memcpy(tw.p, rw.p, n * sizeof(float));
+    fv_taa_flow fr = { 0.5f, -0.25f, 3.0f }, ft = fr; /* sums continue from earlier calls */
+    float *before = malloc(4 * n * sizeof(float)), *wbefore = malloc(n * sizeof(float));
+    assert_non_null(before);
+    assert_non_null(wbefore);
+    memcpy(before, rc.p, 4 * n * sizeof(float));
+    fv_taa_blend_c(f, &t, rc.p, rw.p, stride, x0, y0, w, h, &fr);
+    for (size_t i = 0; i < n; i++)
+        if (memcmp(before + 4 * i, rc.p + 4 * i, 3 * sizeof(float))) {
+            if ((ptrdiff_t)(i % (size_t)stride) >= w)
+                fail_msg("c taa_blend wrote into the padding between rows (pixel %zu)", i);
+            taa_blended++;
+            taa_quincunx += t.widen >= 2.6f;
+        }
+    d->taa_blend(f, &t, tc.p, tw.p, stride, x0, y0, w, h, &ft);
+    checkasm_check_guards_f32(&tc, 4 * n, isa, "taa_blend", w);
+    checkasm_check_guards_f32(&tw, n, isa, "taa_blend", w);
+    compare(rc.p, tc.p, 4 * n, 4, isa, "taa_blend", motion_name[motion], w, off, 0);
+    compare(rw.p, tw.p, n, 1, isa, "taa_blend", "weight", w, off, 0);
+    compare(&fr.dx, &ft.dx, 3, 3, isa, "taa_blend", "flow sums", w, off, 0);
+    assert_finite(rc.p, 4 * n, "taa_blend", w);
+    memcpy(wbefore, rw.p, n * sizeof(float));
+    fv_taa_fill_c(f, &t, rc.p, rw.p, stride, x0, y0, w, h);
+    for (size_t i = 0; i < n; i++)
+        if (wbefore[i] == 0.0f && rw.p[i] > 0.0f) {
+            if ((ptrdiff_t)(i % (size_t)stride) >= w)
+                fail_msg("c taa_fill wrote into the padding between rows (pixel %zu)", i);
+            taa_filled++;
+        } else if (wbefore[i] != rw.p[i]) { /* only holes are filled */
+            fail_msg("c taa_fill changed the weight of pixel %zu from %g", i, (double)wbefore[i]);
+        }
+    free(before);
+    free(wbefore);
+    d->taa_fill(f, &t, tc.p, tw.p, stride, x0, y0, w, h);
+    checkasm_check_guards_f32(&tc, 4 * n, isa, "taa_fill", w);
+    checkasm_check_guards_f32(&tw, n, isa, "taa_fill", w);
+    compare(rc.p, tc.p, 4 * n, 4, isa, "taa_fill", motion_name[motion], w, off, 0);
+    compare(rw.p, tw.p, n, 1, isa, "taa_fill", "weight", w, off, 0);
+    assert_finite(rc.p, 4 * n, "taa_fill", w);
+    for (size_t i = 0; i < n; i++)
+        assert_true(rw.p[i] >= 0.0f && rw.p[i] <= 1.0f);
+    free(rc.base), free(rw.base), free(tc.base), free(tw.base);
+    return 1;
+}
+
+static void test_taa_blocks(void **state)
+{
+    (void)state;
+    int tested = 0;
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "taa"))
+            continue;
+        fv_reproject_dsp d;
+        fv_reproject_dsp_init(&d, isa);
+        if (!d.taa_blend || !d.taa_fill || d.taa_blend == fv_taa_blend_c || d.taa_fill == fv_taa_fill_c)
+            fail_msg("taa: %s has no version of its own", fv_isa_name(isa)); /* a failure, not a skip */
+        int runs = 0;
+        checkasm_rng = 0x7aa2018ull; /* the same inputs for every ISA and every compiler */
+        static const int dims[][2] = { { 67, 53 }, { 160, 180 }, { 9, 7 }, { 1, 1 } };
+        for (int di = 0; di < 4; di++)
+            for (int wmode = 0; wmode < 3; wmode++)
+                for (int motion = 0; motion < 3; motion++) {
+                    const int W = dims[di][0], H = dims[di][1];
+                    fv_pyramid hist;
+                    random_history(&hist, W, H, wmode);
+                    fv_camera cur, prev;
+                    random_cameras(&cur, &prev, W, H, motion);
+                    fv_taa_frame f;
+                    fv_taa_frame_setup(&f, &cur, &prev, &hist, 0.03f);
+                    assert_int_equal(f.identity, motion == 0);
+                    const int wmax = W < 64 ? W : 64;
+                    for (int r = 0; r < 40; r++) {
+                        /* single rows of the edge-case widths first, then random blocks up to 64x16 */
+                        int w = 1 + (int)(fv_test_rand(&checkasm_rng) % (unsigned)wmax);
+                        int h = r < 20 ? 1 : 1 + (int)(fv_test_rand(&checkasm_rng) % (unsigned)(H < 16 ? H : 16));
+                        if (r < NSIZES && sizes[r] <= wmax)
+                            w = sizes[r];
+                        const int pad = (int)(fv_test_rand(&checkasm_rng) % 6), off = (int)(fv_test_rand(&checkasm_rng) % 4);
+                        runs += run_taa(&d, fv_isa_name(isa), &f, w, h, pad, off, motion);
+                    }
+                    fv_pyramid_free(&hist);
+                }
+        printf("[ checkasm ] taa_blend, taa_fill: %-7s == c on %d blocks (bit-exact); %ld samples blended "
+               "(%ld with wide footprints), %ld holes filled\n", fv_isa_name(isa), runs, taa_blended, taa_quincunx,
+               taa_filled);
+        /* the inputs must really exercise the blend, the quincunx taps and the fill */
+        assert_true(taa_blended > 1000 && taa_quincunx > 100 && taa_filled > 500);
+        taa_blended = taa_quincunx = taa_filled = 0;
+        tested++;
+    }
+    printf("[ checkasm ] taa: %d ISA version(s) tested\n", tested);
+}
+
+const struct CMUnitTest checkasm_reproject_tests[] = {
+    cmocka_unit_test(test_tables),
+    cmocka_unit_test(test_taa_blocks),
+    {0},
+};
