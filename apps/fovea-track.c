@@ -14,6 +14,7 @@
 #include "cpu.h"
 #include "eyesrc.h"
 #include "eyetrack/eyetrack.h"
+#include "eyetrack/labelstats.h"
 #include "output.h"
 
 static const char *prog = "fovea-track";
@@ -61,59 +62,14 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Label statistics for one group (all images, or one MRL sensor). */
-typedef struct {
-    char name[16];
-    long n, within[4];
-    double *err;
-} group;
-static const double radii[4] = { 1, 2, 3, 5 };
-
-static group *find_group(group *g, int *ng, const char *name, long cap)
-{
-    for (int i = 0; i < *ng; i++)
-        if (!strcmp(g[i].name, name))
-            return &g[i];
-    if (*ng == 8)
-        return NULL;
-    group *n = &g[(*ng)++];
-    memset(n, 0, sizeof *n);
-    snprintf(n->name, sizeof n->name, "%s", name);
-    n->err = malloc((size_t)cap * sizeof(double));
-    if (!n->err)
-        fv_fail(prog, FV_EXIT_FAIL, "out of memory");
-    return n;
-}
-
-/* The MRL file-name field for the sensor (subject_image_gender_glasses_eye_refl_light_SENSOR.png). */
-static int mrl_sensor(const char *path, char out[16])
-{
-    const char *b = strrchr(path, '/');
-    b = b ? b + 1 : path;
-    int us = 0;
-    const char *last = NULL;
-    for (const char *p = b; *p; p++)
-        if (*p == '_')
-            us++, last = p + 1;
-    if (us != 7 || !last)
-        return 0;
-    const char *dot = strchr(last, '.');
-    const int len = dot ? (int)(dot - last) : (int)strlen(last);
-    if (len < 1 || len > 8)
-        return 0;
-    snprintf(out, 16, "%.*s", len, last);
-    return 1;
-}
-
-static void print_group(const group *g)
+static void print_group(fv_eye_label_group *g)
 {
     if (!g->n)
         return;
-    qsort(g->err, (size_t)g->n, sizeof(double), cmp_double);
-    const double med = g->n % 2 ? g->err[g->n / 2] : 0.5 * (g->err[g->n / 2 - 1] + g->err[g->n / 2]);
+    const double med = fv_eye_label_median(g);
     printf("  %-10s %6ld labelled:", g->name, g->n);
-    for (int k = 0; k < 4; k++)
-        printf("  <=%gpx %5.1f%%", radii[k], 100.0 * g->within[k] / g->n);
+    for (int k = 0; k < FV_EYE_LABEL_RADII; k++)
+        printf("  <=%gpx %5.1f%%", fv_eye_label_radii_px[k], 100.0 * g->within[k] / g->n);
     if (isfinite(med))
         printf("  median error %.2f px\n", med);
     else
@@ -147,11 +103,8 @@ int main(int argc, char **argv)
         case OPT_FRAMES: max_frames = fv_arg_long(prog, "--frames", optarg, 1, 100000000); break;
         case OPT_BENCH: bench = fv_arg_long(prog, "--bench", optarg, 1, 1000); break;
         case OPT_ISA:
-            if (!strcmp(optarg, "c")) isa_mask = FV_ISA_C;
-            else if (!strcmp(optarg, "sse41")) isa_mask = FV_ISA_SSE41;
-            else if (!strcmp(optarg, "avx2")) isa_mask = FV_ISA_SSE41 | FV_ISA_AVX2;
-            else if (!strcmp(optarg, "neon")) isa_mask = FV_ISA_NEON;
-            else fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", optarg);
+            if (fv_isa_mask_parse(optarg, &isa_mask))
+                fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", optarg);
             break;
         case OPT_MODE:
             if (fv_eye_mode_parse(optarg, &mode))
@@ -212,9 +165,10 @@ int main(int argc, char **argv)
 
     const long count = fv_eyesrc_count(src);
     const long cap = count > 0 ? count : 1;
-    group groups[8];
-    int ngroups = 0;
-    group *all = fv_eyesrc_has_labels(src) ? find_group(groups, &ngroups, "all", cap) : NULL;
+    fv_eye_label_stats labels;
+    const int labelled = fv_eyesrc_has_labels(src);
+    if (labelled && fv_eye_label_stats_init(&labels, cap))
+        fv_fail(prog, FV_EXIT_FAIL, "out of memory");
     double *run_ns = calloc((size_t)bench, sizeof(double));
     if (!run_ns)
         fv_fail(prog, FV_EXIT_FAIL, "out of memory");
@@ -252,22 +206,10 @@ int main(int argc, char **argv)
             else
                 fprintf(out.f, ",,%.3f\n", (double)r.confidence);
         }
-        if (all && fr.has_label) {
-            const double e = r.found ? hypot(r.pupil_x - fr.label_x, r.pupil_y - fr.label_y) : INFINITY;
-            char sensor[16];
-            group *gs[2] = { all, NULL };
-            if (mrl_sensor(fr.name, sensor)) {
-                char gname[16];
-                snprintf(gname, sizeof gname, "sensor %.6s", sensor);
-                gs[1] = find_group(groups, &ngroups, gname, cap);
-            }
-            for (int i = 0; i < 2; i++)
-                if (gs[i]) {
-                    gs[i]->err[gs[i]->n++] = e;
-                    for (int k = 0; k < 4; k++)
-                        gs[i]->within[k] += e <= radii[k];
-                }
-        }
+        if (labelled && fr.has_label &&
+            fv_eye_label_stats_add(&labels, fr.name,
+                                   r.found ? hypot(r.pupil_x - fr.label_x, r.pupil_y - fr.label_y) : INFINITY))
+            fv_fail(prog, FV_EXIT_FAIL, "out of memory");
         if (!quiet)
             fv_progress_update(&prog_bar, frames);
     }
@@ -289,18 +231,18 @@ int main(int argc, char **argv)
     printf("%s: %ld %s, pupil found in %ld (%.1f%%), glints in %ld (%.1f%%), blinks %ld, mean confidence %.3f\n",
            prog, frames, images ? "images" : "frames", found, 100.0 * found / frames, with_glints,
            100.0 * with_glints / frames, blinks, conf_sum / frames);
-    if (ngroups) {
+    if (labelled) {
         printf("detection rate (error = distance to the label, not found = miss):\n");
-        for (int i = 0; i < ngroups; i++)
-            print_group(&groups[i]);
+        for (int i = 0; i < labels.n; i++)
+            print_group(&labels.g[i]);
     }
     for (long k = 0; k < bench; k++)
         run_ns[k] /= (double)frames;
     qsort(run_ns, (size_t)bench, sizeof(double), cmp_double);
     printf("time per frame: %.4f ms (median of %ld run%s, one thread, kernels %s)\n", run_ns[bench / 2] * 1e-6, bench,
            bench > 1 ? "s" : "", fv_isa_name(fv_cpu_best_isa(isa_mask)));
-    for (int i = 0; i < ngroups; i++)
-        free(groups[i].err);
+    if (labelled)
+        fv_eye_label_stats_free(&labels);
     free(run_ns);
     fv_eye_destroy(trk);
     fv_eyesrc_close(src);

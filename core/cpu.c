@@ -1,6 +1,8 @@
 /* fovea: run-time CPU detection (cpu.h has the kernel pattern). */
 #include "cpu.h"
 
+#include <string.h>
+
 unsigned fv_cpu_isas(void)
 {
     unsigned isas = 0;
@@ -35,4 +37,18 @@ const char *fv_isa_name(unsigned isa)
     case FV_ISA_NEON: return "neon";
     default: return "?";
     }
+}
+
+int fv_isa_mask_parse(const char *name, unsigned *mask)
+{
+    static const struct {
+        const char *name;
+        unsigned mask;
+    } caps[] = {{"c", FV_ISA_C}, {"sse41", FV_ISA_SSE41}, {"avx2", FV_ISA_SSE41 | FV_ISA_AVX2}, {"neon", FV_ISA_NEON}};
+    for (size_t i = 0; i < sizeof caps / sizeof caps[0]; i++)
+        if (!strcmp(name, caps[i].name)) {
+            *mask = caps[i].mask;
+            return 0;
+        }
+    return -1;
 }

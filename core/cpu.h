@@ -32,5 +32,8 @@ unsigned fv_cpu_isas(void); /* FV_ISA_* bits this CPU runs (and this build has k
  * FV_ISA_C if none. */
 unsigned fv_cpu_best_isa(unsigned isa_mask);
 const char *fv_isa_name(unsigned isa); /* "c", "sse4.1", "avx2", "neon"; "?" otherwise */
+/* The --isa cap by name: "c", "sse41", "avx2" (with SSE4.1), "neon" -> the mask of the ISAs it
+ * allows. 0, or -1 for another name. */
+int fv_isa_mask_parse(const char *name, unsigned *mask);
 
 #endif

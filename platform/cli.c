@@ -102,15 +102,7 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
         cfg->samp.p_min = fv_arg_float(prog, "--pmin", arg, 0.01f, 1.0f);
         return 1;
     case FV_OPT_ISA:
-        if (!strcmp(arg, "c"))
-            cfg->isa_mask = FV_ISA_C;
-        else if (!strcmp(arg, "sse41"))
-            cfg->isa_mask = FV_ISA_SSE41;
-        else if (!strcmp(arg, "avx2"))
-            cfg->isa_mask = FV_ISA_SSE41 | FV_ISA_AVX2;
-        else if (!strcmp(arg, "neon"))
-            cfg->isa_mask = FV_ISA_NEON;
-        else
+        if (fv_isa_mask_parse(arg, &cfg->isa_mask))
             fv_usage_error(prog, "--isa: '%s' is not one of c, sse41, avx2, neon", arg);
         return 1;
     case FV_OPT_REPROJECT:
