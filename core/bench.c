@@ -102,7 +102,7 @@ void fv_bench_ctrs_mean(const fv_bench_ctrs *c, int frames, fv_bench_run *r)
 }
 
 const int fv_bench_roof_stages[FV_BENCH_NROOF] = {FV_STAGE_REPROJECT, FV_STAGE_RECONSTRUCT, FV_STAGE_COC,
-                                                  FV_STAGE_DOF_FILTER, FV_STAGE_COMBINE};
+                                                  FV_STAGE_DOF_FILTER, FV_STAGE_COMBINE, FV_STAGE_OUTPUT};
 
 double fv_bench_holes(long samples, int w, int h)
 {
@@ -314,6 +314,10 @@ int fv_bench_stage_bytes(int stage, int w, int h, double holes, double *rd, doub
     case FV_STAGE_COMBINE: /* sharp, CoC, the blurred layer read; the output written */
         *rd = (px + wt + px) * N;
         *wr = px * N;
+        return 0;
+    case FV_STAGE_OUTPUT: /* the final float image read; 8-bit RGB written */
+        *rd = px * N;
+        *wr = 3.0 * N;
         return 0;
     default:
         return -1;

@@ -64,8 +64,8 @@ void fv_bench_ctrs_hook(void *ctx, int stage, int end);
 void fv_bench_ctrs_mean(const fv_bench_ctrs *c, int frames, fv_bench_run *r);
 
 /* ---- roofline ---- */
-#define FV_BENCH_NROOF 5
-extern const int fv_bench_roof_stages[FV_BENCH_NROOF]; /* reproject .. combine: the memory-bound passes */
+#define FV_BENCH_NROOF 6
+extern const int fv_bench_roof_stages[FV_BENCH_NROOF]; /* reproject .. output: the memory-bound passes */
 typedef struct fv_roof {
     double read_bytes, written_bytes; /* compulsory bytes per frame (fv_bench_stage_bytes) */
     double gbps;                      /* their sum over the stage's mean time */

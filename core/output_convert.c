@@ -5,9 +5,12 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
-void fv_output_conv_init(fv_output_conv *p)
+void fv_output_conv_init(fv_output_conv *p, unsigned isa_mask)
 {
+    fv_output_dsp_init(&p->dsp, isa_mask);
+    memset(p->srgb, 0, sizeof p->srgb);
     for (int i = 0; i <= FV_SRGB_LUT; i++) {
         double v = (double)i / FV_SRGB_LUT;
         double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
@@ -48,17 +51,17 @@ static float sample_ch(const float *img, ptrdiff_t stride, int w, int h, float f
 static inline uint8_t to_srgb8(const fv_output_conv *p, float v)
 {
     /* clamp before converting: NaN-free by construction, but never index out of range */
-    const int i = v > 0.0f ? (v < 1.0f ? (int)(v * FV_SRGB_LUT + 0.5f) : FV_SRGB_LUT) : 0;
-    return p->srgb[i];
+    return p->srgb[fv_srgb_index(v)];
 }
 
-void fv_output_convert(const fv_output_conv *p, const float *img, ptrdiff_t stride, int w, int h,
-                       const fv_camera *c, const fv_lens_lca *lca, uint8_t *dst, ptrdiff_t dst_stride)
+/* Rows [y0, y0+n) of the image; the lens resampling reads any row of img. */
+static void convert_rows(const fv_output_conv *p, const float *img, ptrdiff_t stride, int w, int h, const fv_camera *c,
+                         const fv_lens_lca *lca, uint8_t *dst, ptrdiff_t dst_stride, int y0, int n)
 {
     if (lca && lca->on) {
         /* red and blue read where green's rays carry their directions (core/lens.h) */
         const float inv = 1.0f / c->px_tan;
-        for (int y = 0; y < h; y++) {
+        for (int y = y0; y < y0 + n; y++) {
             const float *s = img + 4 * y * stride, ty = c->tan_top - ((float)y + 0.5f) * c->px_tan;
             uint8_t *o = dst + y * dst_stride;
             for (int x = 0; x < w; x++) {
@@ -75,11 +78,40 @@ void fv_output_convert(const fv_output_conv *p, const float *img, ptrdiff_t stri
         }
         return;
     }
-    for (int y = 0; y < h; y++) {
-        const float *s = img + 4 * y * stride;
-        uint8_t *o = dst + y * dst_stride;
-        for (int x = 0; x < w; x++)
-            for (int c = 0; c < 3; c++)
-                o[3 * x + c] = to_srgb8(p, s[4 * x + c]);
-    }
+    for (int y = y0; y < y0 + n; y++)
+        p->dsp.rgb8_row(dst + y * dst_stride, img + 4 * y * stride, w, p->srgb);
+}
+
+void fv_output_convert(const fv_output_conv *p, const float *img, ptrdiff_t stride, int w, int h,
+                       const fv_camera *c, const fv_lens_lca *lca, uint8_t *dst, ptrdiff_t dst_stride)
+{
+    convert_rows(p, img, stride, w, h, c, lca, dst, dst_stride, 0, h);
+}
+
+typedef struct {
+    const fv_output_conv *c;
+    const float *img;
+    ptrdiff_t stride, dst_stride;
+    int w, h;
+    const fv_camera *cam;
+    const fv_lens_lca *lca;
+    uint8_t *dst;
+} band_job;
+
+#define BAND_ROWS 32
+
+static void band(void *ctx, int b, int tid)
+{
+    (void)tid;
+    const band_job *j = ctx;
+    const int y0 = b * BAND_ROWS, n = j->h - y0 < BAND_ROWS ? j->h - y0 : BAND_ROWS;
+    convert_rows(j->c, j->img, j->stride, j->w, j->h, j->cam, j->lca, j->dst, j->dst_stride, y0, n);
+}
+
+void fv_output_convert_pool(const fv_output_conv *c, const float *img, ptrdiff_t stride, int w, int h,
+                            const fv_camera *cam, const fv_lens_lca *lca, uint8_t *dst, ptrdiff_t dst_stride,
+                            fv_pool *pool)
+{
+    band_job j = {c, img, stride, dst_stride, w, h, cam, lca, dst};
+    fv_pool_run(pool, (h + BAND_ROWS - 1) / BAND_ROWS, band, &j);
 }

@@ -24,6 +24,7 @@ typedef struct {
     float *out;        /* depth of field: the final image (level 0's layout) */
     int64_t last_t_ns; /* the time of its last frame (focus filter) */
     fv_lens_lca *lca;  /* lateral chromatic aberration tables (a lens with per-channel scales) */
+    uint8_t *rgb8;     /* the last frame in the display format: sRGB 8-bit RGB, rows 3 w bytes */
 } eye_state;
 
 struct fv_pipeline {
@@ -97,6 +98,11 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
                 fv_err(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
                 goto bad;
             }
+    for (int e = 0; e < 2; e++)
+        if (!(p->eyes[e].rgb8 = calloc((size_t)cfg->cam.width * (size_t)cfg->cam.height, 3))) {
+            fv_err(err, err_len, "out of memory for a %dx%d output image", cfg->cam.width, cfg->cam.height);
+            goto bad;
+        }
     p->t_ns = INT64_MIN;
     p->eyes[0].last_t_ns = p->eyes[1].last_t_ns = INT64_MIN;
     p->dof = cfg->dof.preset != FV_DOF_NONE;
@@ -144,7 +150,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         goto bad;
     }
     fv_render_dsp_init(&p->dsp, cfg->isa_mask);
-    fv_output_conv_init(&p->conv);
+    fv_output_conv_init(&p->conv, cfg->isa_mask);
     return p;
 bad:
     fv_pipeline_destroy(p);
@@ -164,6 +170,7 @@ void fv_pipeline_destroy(fv_pipeline *p)
             fv_pyramid_free(&p->eyes[e].pyr[b]);
         free(p->eyes[e].out);
         free(p->eyes[e].lca);
+        free(p->eyes[e].rgb8);
     }
     fv_dof_work_free(&p->dof_work);
     free(p->enh_fp);
@@ -292,6 +299,13 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     st->focus_m = NAN;
     if (p->dof)
         render_dof(p, es, eye, pyr, gaze_x, gaze_y, st);
+    /* output: the display format, every frame (a headset pays for it each refresh) */
+    const int64_t to0 = fv_prof_stage_begin(p->prof, FV_STAGE_OUTPUT);
+    const fv_pyr_level *l0 = &pyr->lv[0];
+    const float *img = p->dof ? es->out : l0->rgbd;
+    fv_output_convert_pool(&p->conv, img, l0->stride, l0->w, l0->h, &es->cam, es->lca, es->rgb8,
+                           (ptrdiff_t)l0->w * 3, p->pool);
+    st->stage_ms[FV_STAGE_OUTPUT] = (double)(fv_prof_stage_end(p->prof, FV_STAGE_OUTPUT, to0, (int)eye) - to0) * 1e-6;
     const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, (int)eye);
     es->cur = dst;
     es->prev_cam = es->cam;
@@ -355,11 +369,16 @@ const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stri
     return p->dof ? p->eyes[slot(eye)].out : l0->rgbd;
 }
 
+const uint8_t *fv_pipeline_rgb8(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride)
+{
+    *stride = (ptrdiff_t)p->cfg.cam.width * 3;
+    return p->eyes[slot(eye)].rgb8;
+}
+
 void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride)
 {
-    const eye_state *es = &p->eyes[slot(eye)];
-    const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
     ptrdiff_t stride;
-    const float *img = fv_pipeline_image(p, eye, &stride);
-    fv_output_convert(&p->conv, img, stride, l0->w, l0->h, &es->cam, es->lca, dst, dst_stride);
+    const uint8_t *src = fv_pipeline_rgb8(p, eye, &stride);
+    for (int y = 0; y < p->cfg.cam.height; y++)
+        memcpy(dst + y * dst_stride, src + y * stride, (size_t)stride);
 }

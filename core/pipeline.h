@@ -75,7 +75,11 @@ const fv_render_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 /* The eye's last image (after depth of field, if on): 4 floats a pixel (linear r, g, b,
  * depth_m), rows *stride pixels apart. */
 const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride);
-/* The eye's last image as sRGB-encoded 8-bit RGB, rows of dst_stride bytes. */
+/* The eye's last frame in the display format (the output stage: sRGB-encoded 8-bit RGB, the
+ * lens's chromatic aberration resampled where set), rows *stride bytes apart; valid until the
+ * eye's next render. */
+const uint8_t *fv_pipeline_rgb8(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride);
+/* A copy of it, rows of dst_stride bytes. */
 void fv_pipeline_to_rgb8(const fv_pipeline *p, fv_eye eye, uint8_t *dst, ptrdiff_t dst_stride);
 
 #endif

@@ -10,10 +10,11 @@ typedef enum fv_stage {
     FV_STAGE_COC,         /* focus depth and circles of confusion (core/dof/focus.c, coc.c) */
     FV_STAGE_DOF_FILTER,  /* the depth-of-field model's filter (core/dof/<model>.c) */
     FV_STAGE_COMBINE,     /* sharp and blurred layers combined (core/dof/combine.c) */
+    FV_STAGE_OUTPUT,      /* conversion to the display format (core/output_convert.c) */
     FV_STAGE_COUNT
 } fv_stage;
 
-/* JSON / CSV / table names: trace, reproject, reconstruct, coc, dof_filter, combine */
+/* JSON / CSV / table names: trace, reproject, reconstruct, coc, dof_filter, combine, output */
 extern const char *const fv_stage_names[FV_STAGE_COUNT];
 
 #endif

@@ -135,9 +135,10 @@ void fv_bench_print_setup(FILE *f, const char *prog, const fv_bench_report *rep)
 
 void fv_bench_print_table(FILE *f, const fv_bench_run *res, int nres, int frames)
 {
-    fprintf(f, "\n%-10s %11s %13s %15s %8s %8s %8s %9s %10s %9s\n", "Mode", "Ray Tracing", "Reprojection",
-            "Reconstruction", "CoC", "Filter", "Combine", "Total", "# Samples", "Mrays/s");
-    fprintf(f, "%-10s %11s %13s %15s %8s %8s %8s %9s %10s %9s\n", "", "", "(TAA)", "(PPI)", "", "", "", "", "", "");
+    fprintf(f, "\n%-10s %11s %13s %15s %8s %8s %8s %8s %9s %10s %9s\n", "Mode", "Ray Tracing", "Reprojection",
+            "Reconstruction", "CoC", "Filter", "Combine", "Output", "Total", "# Samples", "Mrays/s");
+    fprintf(f, "%-10s %11s %13s %15s %8s %8s %8s %8s %9s %10s %9s\n", "", "", "(TAA)", "(PPI)", "", "", "", "(sRGB)", "",
+            "", "");
     for (int i = 0; i < nres; i++) {
         const fv_bench_run *r = &res[i];
         fprintf(f, "%-10s", r->mode);
@@ -147,6 +148,7 @@ void fv_bench_print_table(FILE *f, const fv_bench_run *res, int nres, int frames
         cell(f, r->stage_mean[FV_STAGE_COC], 9, 2);
         cell(f, r->stage_mean[FV_STAGE_DOF_FILTER], 9, 2);
         cell(f, r->stage_mean[FV_STAGE_COMBINE], 9, 2);
+        cell(f, r->stage_mean[FV_STAGE_OUTPUT], 9, 2);
         cell(f, r->total_mean, 10, 2);
         fprintf(f, " %10ld", r->samples);
         cell(f, r->mrays, 10, 1);

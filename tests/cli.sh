@@ -79,7 +79,7 @@ if $R --scene $SCENE --trace "$T/good.csv" --frames 3 --size 96x108 --out "$T/ru
     n=$(ls "$T/run" | grep -c '^frame_0000[0-2]\.png$')
     head=$(head -n 1 "$T/run/stats.csv")
     rows=$(wc -l <"$T/run/stats.csv")
-    want="frame,t_ms,gaze_x,gaze_y,samples,trace_ms,reproject_ms,reconstruct_ms,coc_ms,dof_filter_ms,combine_ms,total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph,focus_m"
+    want="frame,t_ms,gaze_x,gaze_y,samples,trace_ms,reproject_ms,reconstruct_ms,coc_ms,dof_filter_ms,combine_ms,output_ms,total_ms,dluma_periph,psnr_all,psnr_fovea,psnr_periph,flicker_periph,focus_m"
     [ "$n" -eq 3 ] && ok || bad "replay wrote $n frames, expected 3"
     [ "$head" = "$want" ] && ok || bad "stats.csv header: $head"
     [ "$rows" -eq 4 ] && ok || bad "stats.csv has $rows lines, expected 4"
@@ -90,8 +90,8 @@ fi
 # --vs-full: every frame also rendered fully sampled; PSNR columns filled from the first frame,
 # the frame-to-frame columns from the second; a static view converges (PSNR rises)
 if $R --scene $SCENE --frames 6 --size 96x108 --vs-full --out "$T/vs" --quiet 2>"$T/err"; then
-    awk -F, 'NR == 2 && $14 != "" && $13 == "" {ok++} NR == 3 && $13 != "" && $17 != "" {ok++}
-             NR == 2 {first = $14} NR == 7 {last = $14} END {exit !(ok == 2 && (last == "inf" || last > first + 10))}' \
+    awk -F, 'NR == 2 && $15 != "" && $14 == "" {ok++} NR == 3 && $14 != "" && $18 != "" {ok++}
+             NR == 2 {first = $15} NR == 7 {last = $15} END {exit !(ok == 2 && (last == "inf" || last > first + 10))}' \
         "$T/vs/stats.csv" && ok || bad "--vs-full columns: $(sed -n '2p;3p;7p' "$T/vs/stats.csv")"
 else
     bad "replay --vs-full failed: $(cat "$T/err")"
@@ -121,7 +121,7 @@ done
 # same bytes for 1 and 2 threads
 if $R --scene $SCENE --frames 2 --size 48x54 --reference 4 --out "$T/ref" --quiet 2>"$T/err"; then
     [ "$(head -n 1 "$T/ref/stats.csv")" = "$(head -n 1 "$T/run/stats.csv")" ] && ok || bad "reference stats header differs"
-    awk -F, 'NR == 2 && $5 == 48 * 54 * 5 && $6 == "" && $11 == "" && $12 > 0 {ok = 1} END {exit !ok}' "$T/ref/stats.csv" \
+    awk -F, 'NR == 2 && $5 == 48 * 54 * 5 && $6 == "" && $11 == "" && $12 == "" && $13 > 0 {ok = 1} END {exit !ok}' "$T/ref/stats.csv" \
         && ok || bad "reference stats row: $(sed -n 2p "$T/ref/stats.csv")"
     [ -e "$T/ref/frame_00001.png" ] && ok || bad "reference frames missing"
 else
@@ -201,12 +201,12 @@ if $R --scene $SCENE --frames 2 --size 96x108 --dof strong --out "$T/dof" --quie
     $R --scene $SCENE --frames 2 --size 96x108 --dof strong --threads 3 --out "$T/dof3" --quiet 2>>"$T/err" &&
     $R --scene $SCENE --frames 2 --size 96x108 --dof strong --focus-m 1.5 --out "$T/doff" --quiet 2>>"$T/err" &&
     $R --scene $SCENE --frames 2 --size 96x108 --out "$T/nodof" --quiet 2>>"$T/err"; then
-    awk -F, 'NR == 3 && $9 != "" && $10 != "" && $11 != "" && $18 > 0 {ok = 1} END {exit !ok}' "$T/dof/stats.csv" && ok ||
+    awk -F, 'NR == 3 && $9 != "" && $10 != "" && $11 != "" && $12 != "" && $19 > 0 {ok = 1} END {exit !ok}' "$T/dof/stats.csv" && ok ||
         bad "--dof stats: $(sed -n 3p "$T/dof/stats.csv")"
-    awk -F, 'NR == 3 && $9 == "" && $18 == "" {ok = 1} END {exit !ok}' "$T/nodof/stats.csv" && ok ||
+    awk -F, 'NR == 3 && $9 == "" && $12 != "" && $19 == "" {ok = 1} END {exit !ok}' "$T/nodof/stats.csv" && ok ||
         bad "--dof none stats: $(sed -n 3p "$T/nodof/stats.csv")"
-    awk -F, 'NR >= 2 && $18 != "1.5000" {bad = 1} END {exit bad}' "$T/doff/stats.csv" && ok ||
-        bad "--focus-m 1.5 not reported: $(cut -d, -f18 "$T/doff/stats.csv" | tr '\n' ' ')"
+    awk -F, 'NR >= 2 && $19 != "1.5000" {bad = 1} END {exit bad}' "$T/doff/stats.csv" && ok ||
+        bad "--focus-m 1.5 not reported: $(cut -d, -f19 "$T/doff/stats.csv" | tr '\n' ' ')"
     cmp -s "$T/dof/frame_00001.png" "$T/nodof/frame_00001.png" && bad "--dof strong changed nothing" || ok
     cmp -s "$T/dof/frame_00001.png" "$T/dof3/frame_00001.png" && ok || bad "--dof frames differ between 1 and 3 threads"
 else

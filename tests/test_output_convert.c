@@ -23,7 +23,7 @@ static void test_srgb_values(void **state)
 {
     (void)state;
     static fv_output_conv c;
-    fv_output_conv_init(&c);
+    fv_output_conv_init(&c, FV_ISA_C);
     /* 3 pixels a row, 2 rows, a padded stride; depth is ignored */
     const float in[2][4][4] = {{{0.0f, 1.0f, 0.5f, 9.0f}, {0.2140411f, 0.0031308f, 0.75f, 1.0f}, {-1.0f, 2.0f, NAN, 1.0f}},
                                {{0.001f, 0.04f, 0.9f, 1.0f}, {1.0f / 4096.0f, 0.25f, 0.999f, 1.0f}, {0.1f, 0.3f, 0.6f, 1.0f}}};

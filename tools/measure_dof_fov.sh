@@ -17,7 +17,8 @@ for dof in none weak medium strong; do
     echo "measure_dof_fov: --dof $dof" >&2
     "$BUILD/bin/fovea-replay" --scene "$SCENE" --trace assets/gaze_sweep.csv --frames "$FRAMES" --size "$SIZE" \
         --vs-full --dof "$dof" --quiet --out "$OUT/$dof"
-    awk -F, -v d="$dof" 'NR > 11 && $16 != "" {p += $16; a += $14; f += $17; n++}
+    awk -F, -v d="$dof" 'NR == 1 {for (i = 1; i <= NF; i++) c[$i] = i; next}
+        NR > 11 && $c["psnr_periph"] != "" {p += $c["psnr_periph"]; a += $c["psnr_all"]; f += $c["flicker_periph"]; n++}
         END {printf "| %s | %.2f | %.2f | %.4f |\n", d, p / n, a / n, f / n}' "$OUT/$dof/stats.csv" >> "$OUT/table.md"
 done
 cat "$OUT/table.md"

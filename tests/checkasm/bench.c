@@ -399,6 +399,39 @@ static void thresh_run(void *st, const checkasm_dsp *d, int row0, int rows)
     et_sink = c;
 }
 
+/* ---- output ---- */
+typedef struct {
+    float *rgbd;
+    uint8_t *rgb, lut[FV_SRGB_LUT + 1 + FV_SRGB_LUT_PAD];
+} out_st;
+static void *out_setup(void)
+{
+    out_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    t->rgbd = fplane((size_t)W * H * 4), t->rgb = malloc((size_t)W * H * 3);
+    if (!t->rgbd || !t->rgb)
+        return free(t->rgbd), free(t->rgb), free(t), NULL;
+    uint32_t s = 7;
+    fill_rgbd(t->rgbd, (size_t)W * H, &s, 0.5f, 20.0f);
+    for (int i = 0; i <= FV_SRGB_LUT; i++)
+        t->lut[i] = (uint8_t)(255.0 * pow(i / (double)FV_SRGB_LUT, 1.0 / 2.2) + 0.5);
+    return t;
+}
+static void out_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    out_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        d->out.rgb8_row(t->rgb + y * W * 3, t->rgbd + y * W * 4, W, t->lut);
+    }
+}
+static void out_free(void *st)
+{
+    out_st *t = st;
+    free(t->rgbd), free(t->rgb), free(t);
+}
+
 #define F(x) offsetof(checkasm_dsp, x)
 const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"pull_row", "1280x1440 -> 640x720, 720 rows", {F(pp.pull_row), 0}, H / 2, pull_setup, NULL, pull_run, pull_free},
@@ -422,6 +455,7 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"et_box_score_row", "640x480 integral, k 8 ring 12, 456 rows", {F(et.et_box_score_row), 0}, EH - 2 * ET_KO,
      box_setup, NULL, box_run, et_free},
     {"et_box3_row", "640x480, 478 rows", {F(et.et_box3_row), 0}, EH - 2, et_setup, NULL, box3_run, et_free},
+    {"rgb8_row", "1280x1440, 1440 rows", {F(out.rgb8_row), 0}, H, out_setup, NULL, out_run, out_free},
 };
 const int checkasm_bench_count = (int)(sizeof checkasm_bench_kernels / sizeof checkasm_bench_kernels[0]);
 
@@ -454,6 +488,7 @@ void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask)
     fv_reproject_dsp_init(&d->taa, isa_mask);
     fv_dof_dsp_init(&d->dof, isa_mask);
     fv_eyetrack_dsp_init(&d->et, isa_mask);
+    fv_output_dsp_init(&d->out, isa_mask);
 }
 
 static int cmp_double(const void *a, const void *b)

@@ -18,6 +18,7 @@
 
 #include "dof/dof_dsp.h"
 #include "eyetrack/eyetrack_dsp.h"
+#include "output_dsp.h"
 #include "pullpush_dsp.h"
 #include "reproject_dsp.h"
 
@@ -28,6 +29,7 @@ typedef struct checkasm_dsp {
     fv_reproject_dsp taa;
     fv_dof_dsp dof;
     fv_eyetrack_dsp et;
+    fv_output_dsp out;
 } checkasm_dsp;
 void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask);
 

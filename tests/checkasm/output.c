@@ -1,0 +1,108 @@
+/* fovea checkasm: the output kernel (output_dsp.h), every ISA version against the C reference
+ * on random and edge-case values (negative, zero, the table's step edges, 1 and above, NaN, Inf,
+ * huge), bit for bit; outputs canaried, inputs exact-size. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "checkasm.h"
+
+#include "output_dsp.h"
+
+static const char *const names[] = {"rgb8_row"};
+static const int sizes[] = {1, 2, 3, 7, 8, 9, 15, 16, 17, 31, 33, 64, 641, 1280, 1281};
+#define NSIZES ((int)(sizeof sizes / sizeof sizes[0]))
+
+/* a table with every entry distinct enough that a wrong index shows, padded as the contract says */
+static uint8_t lut[FV_SRGB_LUT + 1 + FV_SRGB_LUT_PAD];
+
+static void test_tables(void **state)
+{
+    (void)state;
+    checkasm_rng = 0x7b8c0de5ull;
+    fv_output_dsp ref, own;
+    fv_output_dsp_init(&ref, FV_ISA_C);
+    assert_true(ref.rgb8_row == fv_rgb8_row_c);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        memset(&own, 0, sizeof own);
+        switch (isa) {
+#if defined(__x86_64__)
+        case FV_ISA_SSE41: fv_output_dsp_init_sse41(&own); break;
+        case FV_ISA_AVX2: fv_output_dsp_init_avx2(&own); break;
+#elif defined(__aarch64__)
+        case FV_ISA_NEON: fv_output_dsp_init_neon(&own); break;
+#endif
+        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
+        }
+        checkasm_check_table("output", isa, &own, &ref, sizeof own, names);
+    }
+}
+
+static float gen(int mode)
+{
+    static const float edge[] = {0.0f, -0.0f, 1.0f, 0.99999994f, 1.0000001f, -1.0f, 2.0f, 1e30f, -1e30f,
+                                 1.4e-45f, 1e-38f, 0.5f / 4096.0f, 1.5f / 4096.0f, 0.49999997f / 4096.0f,
+                                 4095.5f / 4096.0f, 4095.4999f / 4096.0f, NAN, -NAN, INFINITY, -INFINITY};
+    const float u = checkasm_randf();
+    if (mode == 1)
+        return edge[checkasm_rand() % (sizeof edge / sizeof edge[0])];
+    if (mode == 2) /* exactly on and around the table's rounding edges */
+        return ((float)(checkasm_rand() % 4097) + (checkasm_rand() & 1 ? 0.5f : 0.4999f)) / 4096.0f;
+    return u * 1.2f - 0.1f;
+}
+
+static void test_rgb8_row(void **state)
+{
+    (void)state;
+    for (int i = 0; i < (int)sizeof lut; i++)
+        lut[i] = (uint8_t)(i * 7 + (i >> 8));
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "rgb8_row"))
+            continue;
+        fv_output_dsp d;
+        fv_output_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+        for (int mode = 0; mode < 3; mode++)
+            for (int s = 0; s < NSIZES; s++)
+                for (int off = 0; off < 3; off++) {
+                    const int n = sizes[s];
+                    buf in = buf_new(4 * (size_t)n, off);
+                    for (int i = 0; i < 4 * n; i++)
+                        in.p[i] = gen(mode);
+                    uint8_t *rb, *tb;
+                    uint8_t *r = checkasm_out_u8(3 * (size_t)n, off, &rb), *t = checkasm_out_u8(3 * (size_t)n, off, &tb);
+                    fv_rgb8_row_c(r, in.p, n, lut);
+                    d.rgb8_row(t, in.p, n, lut);
+                    checkasm_check_guards(t, 3 * (size_t)n, fv_isa_name(isa), "rgb8_row", n);
+                    checkasm_compare(r, t, 3 * (size_t)n, CHECKASM_U8, 3, CHECKASM_EXACT, "%s rgb8_row n=%d off=%d mode=%d",
+                                     fv_isa_name(isa), n, off, mode);
+                    free(rb), free(tb), free(in.base);
+                }
+    }
+}
+
+/* the reference against the formula: index = round-half-up of v * 4096, clamped, NaN -> 0 */
+static void test_reference(void **state)
+{
+    (void)state;
+    for (int i = 0; i < (int)sizeof lut; i++)
+        lut[i] = (uint8_t)i; /* low byte of the index */
+    const float v[] = {-1.0f, 0.0f, 0.25f / 4096.0f, 0.5f / 4096.0f, 0.5f, 1.0f, 7.0f, NAN};
+    const int want[] = {0, 0, 0, 1, 2048, 4096, 4096, 0};
+    float in[4 * 8];
+    for (int i = 0; i < 8; i++)
+        in[4 * i] = in[4 * i + 1] = in[4 * i + 2] = v[i], in[4 * i + 3] = NAN; /* depth never read */
+    uint8_t out[24];
+    fv_rgb8_row_c(out, in, 8, lut);
+    for (int i = 0; i < 8; i++)
+        for (int c = 0; c < 3; c++)
+            assert_int_equal(out[3 * i + c], (uint8_t)want[i]);
+}
+
+const struct CMUnitTest checkasm_output_tests[] = {
+    cmocka_unit_test(test_tables),
+    cmocka_unit_test(test_reference),
+    cmocka_unit_test(test_rgb8_row),
+    {0},
+};
