@@ -30,16 +30,22 @@ static fv_scene *scene_make(void)
     return s;
 }
 
+/* the default eye at W x H at the origin */
+static void camera_make(fv_camera *cam)
+{
+    fv_camera_desc d;
+    fv_camera_desc_default(&d);
+    d.width = W, d.height = H;
+    static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
+    assert_int_equal(fv_camera_setup(cam, &d, &origin), 0);
+}
+
 /* the real stage's level 0 for the same camera, sampler and gaze against the ceiling's depth */
 static void check_same_rays(const fv_sampler *smp, int packet)
 {
     fv_scene *s = scene_make();
-    fv_camera_desc d;
-    fv_camera_desc_default(&d);
-    d.width = W, d.height = H;
     fv_camera cam;
-    static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
-    assert_int_equal(fv_camera_setup(&cam, &d, &origin), 0);
+    camera_make(&cam);
     fv_pool *pool = fv_pool_create(3);
     assert_non_null(pool);
     fv_render_dsp dsp;
@@ -106,12 +112,8 @@ static void test_sampled(void **state)
     fv_sampling_params p;
     fv_sampling_params_default(&p);
     p.r0_deg = 5.0f, p.r1_deg = 12.0f, p.p_min = 0.3f;
-    fv_camera_desc d;
-    fv_camera_desc_default(&d);
-    d.width = W, d.height = H;
     fv_camera cam;
-    static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
-    assert_int_equal(fv_camera_setup(&cam, &d, &origin), 0);
+    camera_make(&cam);
     fv_sampler smp;
     assert_int_equal(fv_sampler_init(&smp, W, H, cam.focal_px, &p), 0);
     check_same_rays(&smp, 16);

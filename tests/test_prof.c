@@ -82,28 +82,46 @@ static void hook(void *ctx, int stage, int end)
     (void)ctx;
     hook_calls[stage][end]++;
 }
-/* a pipeline with a recorder: stage spans on the stage tracks, tiles on the workers', the hook
- * at each stage boundary; without one nothing is recorded */
-static void test_pipeline_spans(void **state)
+/* a grey quad 2 m in front of the eye */
+static fv_scene *quad_scene(void)
 {
-    (void)state;
     fv_scene *scene = fv_scene_create();
     assert_non_null(scene);
     static const float grey[3] = {0.5f, 0.5f, 0.5f};
     fv_test_add_quad(scene, -2.0f, -2.0f, 2.0f, 2.0f, -2.0f, grey, -1);
     char cerr[256];
     assert_int_equal(fv_scene_commit(scene, cerr, sizeof cerr), 0);
+    return scene;
+}
+
+/* a 64x48, 2-thread pipeline (depth of field: preset, model) recording into a new recorder
+ * whose stage hook counts calls into hook_calls (cleared) */
+static fv_pipeline *recorded_pipeline(const fv_scene *scene, fv_dof_preset preset, fv_dof_model model, fv_prof **prof)
+{
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
     cfg.cam.width = 64, cfg.cam.height = 48, cfg.threads = 2;
+    cfg.dof.preset = preset;
+    cfg.dof.model = model;
     char err[256];
     fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
     assert_non_null(pl);
-    fv_prof *p = fv_prof_create(2, 1 << 14);
-    assert_non_null(p);
+    *prof = fv_prof_create(2, 1 << 14);
+    assert_non_null(*prof);
     memset(hook_calls, 0, sizeof hook_calls);
-    fv_prof_set_stage_hook(p, hook, NULL);
-    fv_pipeline_set_prof(pl, p);
+    fv_prof_set_stage_hook(*prof, hook, NULL);
+    fv_pipeline_set_prof(pl, *prof);
+    return pl;
+}
+
+/* a pipeline with a recorder: stage spans on the stage tracks, tiles on the workers', the hook
+ * at each stage boundary; without one nothing is recorded */
+static void test_pipeline_spans(void **state)
+{
+    (void)state;
+    fv_scene *scene = quad_scene();
+    fv_prof *p;
+    fv_pipeline *pl = recorded_pipeline(scene, FV_DOF_NONE, FV_DOF_MODEL_WEIER, &p);
     static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
     fv_frame_stats st;
     for (int f = 0; f < 3; f++)
@@ -137,26 +155,10 @@ static void test_pipeline_spans(void **state)
 static void test_pipeline_dof_spans(void **state)
 {
     (void)state;
-    fv_scene *scene = fv_scene_create();
-    assert_non_null(scene);
-    static const float grey[3] = {0.5f, 0.5f, 0.5f};
-    fv_test_add_quad(scene, -2.0f, -2.0f, 2.0f, 2.0f, -2.0f, grey, -1);
-    char cerr[256];
-    assert_int_equal(fv_scene_commit(scene, cerr, sizeof cerr), 0);
+    fv_scene *scene = quad_scene();
     for (int model = 0; model < FV_DOF_MODEL_COUNT; model++) {
-        fv_pipeline_config cfg;
-        fv_pipeline_config_default(&cfg);
-        cfg.cam.width = 64, cfg.cam.height = 48, cfg.threads = 2;
-        cfg.dof.preset = FV_DOF_MEDIUM;
-        cfg.dof.model = (fv_dof_model)model;
-        char err[256];
-        fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
-        assert_non_null(pl);
-        fv_prof *p = fv_prof_create(2, 1 << 14);
-        assert_non_null(p);
-        memset(hook_calls, 0, sizeof hook_calls);
-        fv_prof_set_stage_hook(p, hook, NULL);
-        fv_pipeline_set_prof(pl, p);
+        fv_prof *p;
+        fv_pipeline *pl = recorded_pipeline(scene, FV_DOF_MEDIUM, (fv_dof_model)model, &p);
         static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
         fv_frame_stats st;
         assert_int_equal(fv_pipeline_render(pl, FV_EYE_RIGHT, &origin, 0.5f, 0.5f, &st), 0);
