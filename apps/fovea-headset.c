@@ -106,10 +106,7 @@ static int a_wait_edge(void *c, int64_t deadline, int64_t *t)
 }
 static double trace_t_ms(const app *a, int64_t t_ns)
 {
-    const fv_trace *tr = a->trace;
-    double t = (double)(t_ns - a->t_start_ns) * 1e-6;
-    const double span = tr->s[tr->n - 1].t_ms - tr->s[0].t_ms;
-    return tr->s[0].t_ms + (span > 0 ? fmod(t, span) : 0.0); /* looped */
+    return fv_trace_loop_ms(a->trace, (double)(t_ns - a->t_start_ns) * 1e-6);
 }
 static void a_sample_gaze(void *c, int64_t now)
 {

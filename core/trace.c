@@ -182,3 +182,9 @@ void fv_trace_at(const fv_trace *tr, double t_ms, fv_trace_sample *out)
         out->head.pos[i] = a->head.pos[i] + u * (b->head.pos[i] - a->head.pos[i]);
     fv_quat_slerp(a->head.quat, b->head.quat, u, out->head.quat);
 }
+
+double fv_trace_loop_ms(const fv_trace *tr, double elapsed_ms)
+{
+    const double span = tr->s[tr->n - 1].t_ms - tr->s[0].t_ms;
+    return tr->s[0].t_ms + (span > 0 ? fmod(elapsed_ms, span) : 0.0);
+}

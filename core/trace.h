@@ -28,5 +28,9 @@ void fv_trace_free(fv_trace *tr);
 
 /* State at time t_ms: linear gaze and position, slerped rotation; held at the ends. */
 void fv_trace_at(const fv_trace *tr, double t_ms, fv_trace_sample *out);
+/* The trace time elapsed_ms after its start when it is played in a loop (a live headset runs
+ * longer than a recorded trace): the first sample's time plus elapsed_ms modulo the trace's
+ * span (the first sample's time for a trace of one instant). */
+double fv_trace_loop_ms(const fv_trace *tr, double elapsed_ms);
 
 #endif

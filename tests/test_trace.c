@@ -160,10 +160,30 @@ static void test_load(void **st)
     fv_trace_free(&t);
 }
 
+/* a trace played in a loop: 100..400 ms is a 300 ms span */
+static void test_loop(void **state)
+{
+    (void)state;
+    static const char text[] = "t_ms,gaze_x,gaze_y\n100,0.5,0.5\n250,0.4,0.5\n400,0.6,0.5\n";
+    fv_trace tr;
+    char err[256];
+    assert_int_equal(fv_trace_parse(&tr, text, sizeof text - 1, "loop", err, sizeof err), 0);
+    assert_float_equal(fv_trace_loop_ms(&tr, 0.0), 100.0, 1e-9);
+    assert_float_equal(fv_trace_loop_ms(&tr, 299.0), 399.0, 1e-9);
+    assert_float_equal(fv_trace_loop_ms(&tr, 300.0), 100.0, 1e-9);
+    assert_float_equal(fv_trace_loop_ms(&tr, 1000.0), 200.0, 1e-9);
+    fv_trace_free(&tr);
+    static const char one[] = "t_ms,gaze_x,gaze_y\n42,0.5,0.5\n";
+    assert_int_equal(fv_trace_parse(&tr, one, sizeof one - 1, "one", err, sizeof err), 0);
+    assert_float_equal(fv_trace_loop_ms(&tr, 1234.0), 42.0, 0.0);
+    fv_trace_free(&tr);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good),
+        cmocka_unit_test(test_loop),
         cmocka_unit_test(test_head),
         cmocka_unit_test(test_bad),
         cmocka_unit_test(test_messages),
