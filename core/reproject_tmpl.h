@@ -41,44 +41,12 @@ static inline int taa_level(float f, int max_level)
 static const float taa_pow2[8] = {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f, 128.0f};
 static const float taa_inv_pow2[8] = {1.0f, 0.5f, 0.25f, 0.125f, 0.0625f, 0.03125f, 0.015625f, 0.0078125f};
 
-/* One sample's taps and blend, from its previous pixel (u, v), previous depth z and rz = 1 / z
- * (the sample's flow already counted). Shared by the row loop below and by the vectorised
- * blends (core/reproject_vec.h) for the samples they leave to it (quincunx footprints). */
-static inline void TAA_FN(taa_blend_px)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *px,
-                                        float d, float u, float v, float z, float rz)
-{
-    const float umax = f->prev_w - 0.015625f, vmax = f->prev_h - 0.015625f; /* taps stay inside */
-    const float fp = (d * rz) * t->widen;
-    const int l = taa_level(fp, f->max_level);
-    const fv_pyr_level *L = &f->hist->lv[l];
-    const float ts = taa_pow2[l], inv_ts = taa_inv_pow2[l]; /* l <= max_level <= 5 */
-    float o = (fp - ts) * 0.5f;
-    o = o < 0.5f * ts ? o : 0.5f * ts;
-    const float inv_tol = rz * f->inv_depth_tol;
-    acc4 acc = acc_zero();
-    float accw = 0.0f;
-    int taps = 1;
-    tap(L, u * inv_ts - 0.5f, v * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
-    if (o >= 0.125f) { /* quincunx: the footprint's four corners at half extent */
-        const float ul = fv_clampf(u - o, 0.0f, umax), ur = fv_clampf(u + o, 0.0f, umax);
-        const float vt = fv_clampf(v - o, 0.0f, vmax), vb = fv_clampf(v + o, 0.0f, vmax);
-        tap(L, ul * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
-        tap(L, ur * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
-        tap(L, ul * inv_ts - 0.5f, vb * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
-        tap(L, ur * inv_ts - 0.5f, vb * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
-        taps = 5;
-    }
-    if (!(accw > 0.0f))
-        return; /* no valid history: the sample stands alone */
-    const float a1 = 1.0f - (taps == 1 ? accw : accw / 5.0f); /* accw / 1 is accw */
-    out_blend(px, acc, accw, a1 > t->alpha ? a1 : t->alpha);
-}
-
 #ifndef TAA_OWN_BLEND /* an ISA may vectorise the blend across samples instead */
 static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
                               const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
                               struct fv_taa_flow *flow)
 {
+    const float umax = f->prev_w - 0.015625f, vmax = f->prev_h - 0.015625f; /* taps stay inside */
     float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
     for (int r = 0; r < h; r++) {
         const int y = y0 + r;
@@ -113,7 +81,30 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
             fdx = fdx + (u - pxc);
             fdy = fdy + (v - py);
             fn = fn + 1.0f;
-            TAA_FN(taa_blend_px)(f, t, px, d, u, v, z, rz);
+            const float fp = (d * rz) * t->widen;
+            const int l = taa_level(fp, f->max_level);
+            const fv_pyr_level *L = &f->hist->lv[l];
+            const float ts = taa_pow2[l], inv_ts = taa_inv_pow2[l]; /* l <= max_level <= 5 */
+            float o = (fp - ts) * 0.5f;
+            o = o < 0.5f * ts ? o : 0.5f * ts;
+            const float inv_tol = rz * f->inv_depth_tol;
+            acc4 acc = acc_zero();
+            float accw = 0.0f;
+            int taps = 1;
+            tap(L, u * inv_ts - 0.5f, v * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+            if (o >= 0.125f) { /* quincunx: the footprint's four corners at half extent */
+                const float ul = fv_clampf(u - o, 0.0f, umax), ur = fv_clampf(u + o, 0.0f, umax);
+                const float vt = fv_clampf(v - o, 0.0f, vmax), vb = fv_clampf(v + o, 0.0f, vmax);
+                tap(L, ul * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                tap(L, ur * inv_ts - 0.5f, vt * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                tap(L, ul * inv_ts - 0.5f, vb * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                tap(L, ur * inv_ts - 0.5f, vb * inv_ts - 0.5f, z, inv_tol, &acc, &accw);
+                taps = 5;
+            }
+            if (!(accw > 0.0f))
+                continue; /* no valid history: the sample stands alone */
+            const float a1 = 1.0f - (taps == 1 ? accw : accw / 5.0f); /* accw / 1 is accw */
+            out_blend(px, acc, accw, a1 > t->alpha ? a1 : t->alpha);
         }
     }
     flow->dx = fdx;

@@ -63,12 +63,7 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 }
 
 #define TAA_FN(name) name##_neon
-#define TAA_OWN_BLEND
 #include "reproject_tmpl.h"
-#define VW 4
-static inline float32x4_t vfloor_q(float32x4_t x) { return vrndmq_f32(x); }
-#define vfloor(x) ((vf)vfloor_q((float32x4_t)(x)))
-#include "reproject_vec.h" /* the blend, four samples at a time */
 
 /* The fill, four pixels at a time (vld4 / vst4 de-interleave r, g, b, depth): each lane does the
  * reference's operations (taa_fill_px). */

@@ -45,78 +45,7 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 }
 
 #define TAA_FN FV_X86_FN
-#define TAA_OWN_BLEND
 #include "../reproject_tmpl.h" /* the row loops every ISA shares */
-#define VW 8
-/* the taps' texels of eight lanes: per lane one 256-bit load per texel row (texels 00|10 and
- * 01|11), an 8x8 transpose to planes; weights as 64-bit pairs (00, 10) and (01, 11) */
-#define TAA_VEC_TAP_LOAD
-static inline void transpose8(__m256 r[8])
-{
-    __m256 t[8], u[8];
-    for (int k = 0; k < 8; k += 2) {
-        t[k] = _mm256_unpacklo_ps(r[k], r[k + 1]);
-        t[k + 1] = _mm256_unpackhi_ps(r[k], r[k + 1]);
-    }
-    for (int k = 0; k < 8; k += 4) {
-        u[k] = _mm256_shuffle_ps(t[k], t[k + 2], 0x44);
-        u[k + 1] = _mm256_shuffle_ps(t[k], t[k + 2], 0xee);
-        u[k + 2] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0x44);
-        u[k + 3] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0xee);
-    }
-    for (int k = 0; k < 4; k++) {
-        r[k] = _mm256_permute2f128_ps(u[k], u[k + 4], 0x20);
-        r[k + 4] = _mm256_permute2f128_ps(u[k], u[k + 4], 0x31);
-    }
-}
-static inline __m256 pairs4(const float *const *p) /* (p[k][0], p[k][1]) for k = 0..3 */
-{
-    const __m128 lo = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)p[0])), (const __m64 *)p[1]);
-    const __m128 hi = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)p[2])), (const __m64 *)p[3]);
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
-}
-static inline void deinterleave8(__m256 a, __m256 b, __m256 *even, __m256 *odd)
-{
-    *even = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(a, b, 0x88)), 0xd8));
-    *odd = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(a, b, 0xdd)), 0xd8));
-}
-typedef float vf_ __attribute__((vector_size(32)));
-#define TAA_VEC_PX_LOAD
-static inline void vpx_load(float *const px[8], vf_ p[4])
-{
-    __m128 r0 = _mm_loadu_ps(px[0]), g0 = _mm_loadu_ps(px[1]), b0 = _mm_loadu_ps(px[2]), z0 = _mm_loadu_ps(px[3]);
-    __m128 r1 = _mm_loadu_ps(px[4]), g1 = _mm_loadu_ps(px[5]), b1 = _mm_loadu_ps(px[6]), z1 = _mm_loadu_ps(px[7]);
-    _MM_TRANSPOSE4_PS(r0, g0, b0, z0);
-    _MM_TRANSPOSE4_PS(r1, g1, b1, z1);
-    p[0] = (vf_)_mm256_insertf128_ps(_mm256_castps128_ps256(r0), r1, 1);
-    p[1] = (vf_)_mm256_insertf128_ps(_mm256_castps128_ps256(g0), g1, 1);
-    p[2] = (vf_)_mm256_insertf128_ps(_mm256_castps128_ps256(b0), b1, 1);
-    p[3] = (vf_)_mm256_insertf128_ps(_mm256_castps128_ps256(z0), z1, 1);
-}
-static inline void vtap_load(const float *const t0[8], const float *const t1[8], const float *const w0[8],
-                             const float *const w1[8], vf_ c[4][4], vf_ cw[4])
-{
-    __m256 top[8], bot[8];
-    for (int k = 0; k < 8; k++) {
-        top[k] = _mm256_loadu_ps(t0[k]);
-        bot[k] = _mm256_loadu_ps(t1[k]);
-    }
-    transpose8(top);
-    transpose8(bot);
-    for (int ch = 0; ch < 4; ch++) {
-        c[0][ch] = (vf_)top[ch];
-        c[2][ch] = (vf_)top[4 + ch];
-        c[1][ch] = (vf_)bot[ch];
-        c[3][ch] = (vf_)bot[4 + ch];
-    }
-    __m256 e, o;
-    deinterleave8(pairs4(w0), pairs4(w0 + 4), &e, &o);
-    cw[0] = (vf_)e, cw[2] = (vf_)o;
-    deinterleave8(pairs4(w1), pairs4(w1 + 4), &e, &o);
-    cw[1] = (vf_)e, cw[3] = (vf_)o;
-}
-#define vfloor(x) ((vf)_mm256_floor_ps((__m256)(x)))
-#include "../reproject_vec.h" /* the blend, eight samples at a time */
 
 static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1); }
 

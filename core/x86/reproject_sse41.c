@@ -39,11 +39,7 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 }
 
 #define TAA_FN FV_X86_FN
-#define TAA_OWN_BLEND
 #include "../reproject_tmpl.h" /* the row loops every ISA shares */
-#define VW 4
-#define vfloor(x) ((vf)_mm_floor_ps((__m128)(x)))
-#include "../reproject_vec.h" /* the blend, four samples at a time */
 
 /* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px). */
 static inline int fill_vec_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
