@@ -169,7 +169,11 @@ void fv_taa_prefetch(const fv_taa_frame *f, int coarse_level, int x0, int y0, in
         for (int x = 0; x <= 4 * (xb - xa); x += 16) /* one 64-byte line = 4 pixels */
             __builtin_prefetch(r + x);
         __builtin_prefetch(r + 4 * (xb - xa));
-        __builtin_prefetch(h0->wgt + (ptrdiff_t)y * h0->stride + xa);
-        __builtin_prefetch(h0->wgt + (ptrdiff_t)y * h0->stride + xb);
+        /* every line of the weights: 19 floats from x0 - 1 span three lines, and the middle
+         * one (the tile's own) was missed when only the ends were fetched */
+        const float *wr = h0->wgt + (ptrdiff_t)y * h0->stride + xa;
+        for (int x = 0; x <= xb - xa; x += 16)
+            __builtin_prefetch(wr + x);
+        __builtin_prefetch(wr + (xb - xa));
     }
 }
