@@ -278,8 +278,31 @@ static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a,
         fv_dof_pyrblur_row_c(blur, a, i, x0 + n - i);
 }
 
+/* one block of 4 pixels a step: the reference's (q0 + q2) + (q1 + q3), min / max across the
+ * vector (FMIN orders -0 below +0, x86 does not: the + 0 makes both +0) */
+static void nearblk_row_neon(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
+{
+    int b = 0;
+    for (; 4 * b + 4 <= n; b++) {
+        const float *p = rgbd + 16 * b;
+        const float32x4_t c = vld1q_f32(coc + 4 * b);
+        const uint32x4_t m = vcltq_f32(c, vdupq_n_f32(0.0f));
+#define NB_Q(k) vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(vsetq_lane_f32(1.0f, vld1q_f32(p + 4 * (k)), 3)), \
+                                                vdupq_laneq_u32(m, k)))
+        const float32x4_t q = vaddq_f32(vaddq_f32(NB_Q(0), NB_Q(2)), vaddq_f32(NB_Q(1), NB_Q(3)));
+#undef NB_Q
+        vst1q_f32(sum + 4 * b, vaddq_f32(vld1q_f32(sum + 4 * b), q));
+        const float lo = vminvq_f32(c), hi = vmaxvq_f32(c);
+        ext[2 * b] = (lo < ext[2 * b] ? lo : ext[2 * b]) + 0.0f;
+        ext[2 * b + 1] = (hi > ext[2 * b + 1] ? hi : ext[2 * b + 1]) + 0.0f;
+    }
+    if (4 * b < n)
+        fv_dof_nearblk_row_c(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b, n - 4 * b);
+}
+
 void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
+    d->dof_nearblk_row = nearblk_row_neon;
     d->dof_upsample_row = upsample_row_neon;
     d->dof_pyrblur_row = pyrblur_row_neon;
     d->dof_coc_row = coc_row_neon;

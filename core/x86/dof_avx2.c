@@ -166,12 +166,24 @@ static inline __m256 ld2(const float *lo, const float *hi)
 #define PAIR(v, p) _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(2 * (p), 2 * (p), 2 * (p), 2 * (p), 2 * (p) + 1, \
                                                                  2 * (p) + 1, 2 * (p) + 1, 2 * (p) + 1))
 
+/* texels i and j as one vector: up-sampling by 2^L reads neighbouring or equal texels for
+ * neighbouring pixels, one load instead of two and an insert */
+static inline __m256 ld_tex2(const float *tmp, int32_t i, int32_t j)
+{
+    const float *a = tmp + 4 * (ptrdiff_t)i;
+    if (j == i + 1)
+        return _mm256_loadu_ps(a);
+    if (j == i)
+        return _mm256_broadcast_ps((const __m128 *)(const void *)a);
+    return ld2(a, tmp + 4 * (ptrdiff_t)j);
+}
+
 /* pixels xp, xp + 1 (pair p of the 8 whose weights are a8) */
 static inline void up_pair(float *dst, const float *tmp, const int32_t *i0, const int32_t *i1, __m256 a8, int xp,
                            int p)
 {
-    const __m256 p0 = ld2(tmp + 4 * (ptrdiff_t)i0[xp], tmp + 4 * (ptrdiff_t)i0[xp + 1]);
-    const __m256 p1 = ld2(tmp + 4 * (ptrdiff_t)i1[xp], tmp + 4 * (ptrdiff_t)i1[xp + 1]);
+    const __m256 p0 = ld_tex2(tmp, i0[xp], i0[xp + 1]);
+    const __m256 p1 = ld_tex2(tmp, i1[xp], i1[xp + 1]);
     _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
 }
 
@@ -200,7 +212,9 @@ static inline void pb_pair(float *blur, const float *const *up, const int32_t *L
     const int k = 2 * p;
     const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
     float *b = blur + o;
-    const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
+    /* both pixels mostly read the same levels: then one load each */
+    const __m256 u0 = L0[k] == L0[k + 1] ? _mm256_loadu_ps(up[L0[k]] + o) : ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4);
+    const __m256 u1 = L1[k] == L1[k + 1] ? _mm256_loadu_ps(up[L1[k]] + o) : ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
     const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
     if (!sel) {
         _mm256_storeu_ps(b, pv);
@@ -259,8 +273,37 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
 }
 
+/* two blocks (8 pixels): pixel pairs as vectors, the pairs of a block added crosswise so that
+ * each half holds (q0 + q2) / (q1 + q3) as the reference; min / max within each 128-bit half */
+static void nearblk_row_avx2(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
+{
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    int b = 0;
+    for (; 4 * b + 8 <= n; b += 2) {
+        const float *p = rgbd + 16 * b;
+        const __m256 c = _mm256_loadu_ps(coc + 4 * b), m = _mm256_cmp_ps(c, zero, _CMP_LT_OQ);
+#define NB_Q(k) _mm256_and_ps(_mm256_blend_ps(_mm256_loadu_ps(p + 8 * (k)), one, 0x88), PAIR(m, k))
+        const __m256 t0 = _mm256_add_ps(NB_Q(0), NB_Q(1)), t1 = _mm256_add_ps(NB_Q(2), NB_Q(3));
+#undef NB_Q
+        const __m256 s = _mm256_add_ps(_mm256_permute2f128_ps(t0, t1, 0x20), _mm256_permute2f128_ps(t0, t1, 0x31));
+        _mm256_storeu_ps(sum + 4 * b, _mm256_add_ps(_mm256_loadu_ps(sum + 4 * b), s));
+        __m256 lo = _mm256_min_ps(c, _mm256_shuffle_ps(c, c, 0xb1)), hi = _mm256_max_ps(c, _mm256_shuffle_ps(c, c, 0xb1));
+        lo = _mm256_min_ps(lo, _mm256_shuffle_ps(lo, lo, 0x4e)), hi = _mm256_max_ps(hi, _mm256_shuffle_ps(hi, hi, 0x4e));
+        /* (lo, hi) of block 0 in lanes 0, 1, of block 1 in lanes 2, 3 */
+        const __m128 v = _mm256_castps256_ps128(
+            _mm256_permutevar8x32_ps(_mm256_unpacklo_ps(lo, hi), _mm256_setr_epi32(0, 1, 4, 5, 0, 1, 4, 5)));
+        const __m128 e = _mm_loadu_ps(ext + 2 * b);
+        _mm_storeu_ps(ext + 2 * b, _mm_add_ps(_mm_blend_ps(_mm_min_ps(v, e), _mm_max_ps(v, e), 10), _mm_setzero_ps()));
+    }
+    for (; 4 * b + 4 <= n; b++)
+        dof_nearblk4(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b);
+    if (4 * b < n)
+        fv_dof_nearblk_row_c(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b, n - 4 * b);
+}
+
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d)
 {
+    d->dof_nearblk_row = nearblk_row_avx2;
     d->dof_upsample_row = upsample_row_avx2;
     d->dof_pyrblur_row = pyrblur_row_avx2;
     d->dof_coc_row = coc_row_avx2;

@@ -27,6 +27,21 @@
 #define DOF_CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
 
 
+/* ---- nearblk_row: one block of 4 pixels (q, the +0 of skipped pixels, as the reference) ---- */
+static inline void dof_nearblk4(float *sum, float *ext, const float *coc, const float *rgbd)
+{
+    const __m128 c = _mm_loadu_ps(coc), m = _mm_cmplt_ps(c, _mm_setzero_ps()), one = _mm_set1_ps(1.0f);
+#define DOF_NB_Q(k) _mm_and_ps(_mm_blend_ps(_mm_loadu_ps(rgbd + 4 * (k)), one, 8), _mm_shuffle_ps(m, m, (k) * 0x55))
+    const __m128 s = _mm_add_ps(_mm_add_ps(DOF_NB_Q(0), DOF_NB_Q(2)), _mm_add_ps(DOF_NB_Q(1), DOF_NB_Q(3)));
+#undef DOF_NB_Q
+    _mm_storeu_ps(sum, _mm_add_ps(_mm_loadu_ps(sum), s));
+    __m128 lo = _mm_min_ps(c, _mm_shuffle_ps(c, c, 0xb1)), hi = _mm_max_ps(c, _mm_shuffle_ps(c, c, 0xb1));
+    lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, 0x4e)), hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, 0x4e));
+    const __m128 e = _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)ext));
+    const __m128 r = _mm_add_ps(_mm_blend_ps(_mm_min_ps(lo, e), _mm_max_ps(hi, e), 2), _mm_setzero_ps());
+    _mm_storel_epi64((__m128i *)(void *)ext, _mm_castps_si128(r));
+}
+
 /* ---- coc_row: 4 pixels ---- */
 typedef struct {
     __m128 K, idn, idf, dn, df;

@@ -255,6 +255,15 @@ static void coc_run(void *st, const checkasm_dsp *d, int row0, int rows)
         d->dof.dof_coc_row(t->coc + y * W, t->rgbd + 4 * y * W, W, 2.4f, 1.8f, 2.2f);
     }
 }
+static void nearblk_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) { /* 4 rows into one block row's sums, as core/dof/weier_coc.c */
+        const size_t y = (size_t)((row0 + k) % H);
+        d->dof.dof_nearblk_row(t->out + 4 * (y / 4) * (W / 4), t->t + (y / 4) * (W / 2), t->coc + y * W,
+                               t->rgbd + 4 * y * W, W);
+    }
+}
 static void hgauss_run(void *st, const checkasm_dsp *d, int row0, int rows)
 {
     dof_st *t = st;
@@ -406,6 +415,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"taa_blend+taa_fill", "1280x1440, 7200 16x16 tiles, still head", {F(taa.taa_blend), F(taa.taa_fill)}, TX * TY, taa_setup,
      taa_reset, taa_run, taa_free},
     {"dof_coc_row", "1280x1440, 1440 rows", {F(dof.dof_coc_row), 0}, H, dof_setup, NULL, coc_run, dof_free},
+    {"dof_nearblk_row", "1280x1440, 1440 rows, 4x4 blocks", {F(dof.dof_nearblk_row), 0}, H, dof_setup, NULL,
+     nearblk_run, dof_free},
     {"dof_hgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_hgauss_row), 0}, H, dof_setup, NULL,
      hgauss_run, dof_free},
     {"dof_vgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_vgauss_row), 0}, H, dof_setup, NULL,
