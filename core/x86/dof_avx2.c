@@ -212,9 +212,7 @@ static inline void pb_pair(float *blur, const float *const *up, const int32_t *L
     const int k = 2 * p;
     const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
     float *b = blur + o;
-    /* both pixels mostly read the same levels: then one load each */
-    const __m256 u0 = L0[k] == L0[k + 1] ? _mm256_loadu_ps(up[L0[k]] + o) : ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4);
-    const __m256 u1 = L1[k] == L1[k + 1] ? _mm256_loadu_ps(up[L1[k]] + o) : ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
+    const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
     const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
     if (!sel) {
         _mm256_storeu_ps(b, pv);
@@ -226,12 +224,63 @@ static inline void pb_pair(float *blur, const float *const *up, const int32_t *L
     _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
 }
 
+/* need == 1 (the periphery beyond the transition ring, whose level 1 is the half-resolution
+ * blur): L1 = 1 and L0 = 0 or 1 per pixel, so both levels load whole pairs and L0 is a select
+ * (no per-pixel pointers, no branches on the levels) */
+static inline void pb_pair1(float *blur, const float *up0, const float *up1, __m256 is1, __m256 f, __m256 t,
+                            __m256 mix, __m256 act, int i, int p, int sel)
+{
+    const ptrdiff_t o = 4 * (ptrdiff_t)(i + 2 * p);
+    float *b = blur + o;
+    const __m256 u1 = _mm256_loadu_ps(up1 + o), u0 = _mm256_blendv_ps(_mm256_loadu_ps(up0 + o), u1, PAIR(is1, p));
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    if (!sel) {
+        _mm256_storeu_ps(b, pv);
+        return;
+    }
+    const __m256 bv = _mm256_loadu_ps(b);
+    const __m256 r =
+        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+}
+
+static void pyrblur1_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), msign = _mm256_set1_ps(-0.0f);
+    const float *up0 = a->up[0], *up1 = a->up[1];
+    int i = x0;
+    for (; i + 8 <= x0 + n; i += 8) {
+        const __m256 c = _mm256_loadu_ps(a->coc + i), t = _mm256_loadu_ps(a->t + i);
+        const __m256 m = _mm256_andnot_ps(msign, c);
+        const __m256 act = _mm256_and_ps(_mm256_cmp_ps(m, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
+        const int bits = _mm256_movemask_ps(act);
+        if (!bits)
+            continue;
+        const __m256 v = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(m, steps), zero), lmax);
+        const __m256 l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, _mm256_cvttps_epi32(v), 4), one);
+        const __m256 is1 = _mm256_cmp_ps(l, one, _CMP_GE_OQ); /* L0 = int l = 1 */
+        const __m256 f = _mm256_sub_ps(l, _mm256_and_ps(is1, one));
+        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        const int sel = !(bits == 255 && !_mm256_movemask_ps(mix));
+        for (int p = 0; p < 4; p++)
+            if (!sel || (bits >> (2 * p) & 3))
+                pb_pair1(blur, up0, up1, is1, f, t, mix, act, i, p, sel);
+    }
+    if (i < x0 + n)
+        dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
+}
+
 /* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_tmpl.h has why the clamped LUT
  * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs
  * (unrolled by hand), each computed for both pixels and kept per pixel by selects; the rest
  * 128-bit. */
 static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
+    if (a->need == 1) {
+        pyrblur1_row_avx2(blur, a, x0, n);
+        return;
+    }
     const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
     const __m256 need = _mm256_set1_ps((float)a->need), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     const __m256 msign = _mm256_set1_ps(-0.0f);
