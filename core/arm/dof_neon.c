@@ -300,8 +300,41 @@ static void nearblk_row_neon(float *restrict sum, float *restrict ext, const flo
         fv_dof_nearblk_row_c(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b, n - 4 * b);
 }
 
+/* 4 outputs a step whose taps all lie in the row (the SSE4.1 scheme, core/x86/dof_tmpl.h):
+ * FMAX of +0 and a radius >= +0 is the radius, as on x86 */
+static void nearbox_row_neon(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                             const float *r, const float *wgt, int w, int x0, int n, int reach)
+{
+    const float32x4_t one = vdupq_n_f32(1.0f);
+    int i = x0;
+    while (i < x0 + n) {
+        if (!(i >= reach && i + 3 + reach < w && i + 4 <= x0 + n)) { /* the row's ends */
+            fv_dof_nearbox_row_c(out, out_r, out_w, src, r, wgt, w, i, 1, reach), i++;
+            continue;
+        }
+        float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0, rm = a0;
+        for (int j = -reach; j <= reach; j++) {
+            const float32x4_t r4 = vld1q_f32(r + i + j);
+            const uint32x4_t m = vcgeq_f32(r4, vdupq_n_f32((float)(j < 0 ? -j : j)));
+            const float32x4_t w4 = vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(vld1q_f32(wgt + i + j)), m));
+            rm = vmaxq_f32(vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(r4), m)), rm);
+            const float *p = src + 4 * (ptrdiff_t)(i + j);
+            a0 = vaddq_f32(a0, vmulq_f32(vdupq_laneq_f32(w4, 0), vld1q_f32(p)));
+            a1 = vaddq_f32(a1, vmulq_f32(vdupq_laneq_f32(w4, 1), vld1q_f32(p + 4)));
+            a2 = vaddq_f32(a2, vmulq_f32(vdupq_laneq_f32(w4, 2), vld1q_f32(p + 8)));
+            a3 = vaddq_f32(a3, vmulq_f32(vdupq_laneq_f32(w4, 3), vld1q_f32(p + 12)));
+        }
+        float *o = out + 4 * (ptrdiff_t)i;
+        vst1q_f32(o, a0), vst1q_f32(o + 4, a1), vst1q_f32(o + 8, a2), vst1q_f32(o + 12, a3);
+        vst1q_f32(out_r + i, rm);
+        vst1q_f32(out_w + i, vdivq_f32(one, vaddq_f32(vaddq_f32(rm, rm), one)));
+        i += 4;
+    }
+}
+
 void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
+    d->dof_nearbox_row = nearbox_row_neon;
     d->dof_nearblk_row = nearblk_row_neon;
     d->dof_upsample_row = upsample_row_neon;
     d->dof_pyrblur_row = pyrblur_row_neon;

@@ -49,6 +49,15 @@ struct fv_dof_pyrblur_args;
  *   ISA's min of signed zeros gives). coc and ext finite. */
 typedef void (*fv_dof_nearblk_row_fn)(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd,
                                       int n);
+/* dof_nearbox_row: the near layer's horizontal scatter-as-gather box, for i in [x0, x0+n):
+ *   out[i] = sum over j in [max(-reach, -i), min(reach, w - 1 - i)], ascending, with r[i+j] >= |j|
+ *   of wgt[i+j] * src[i+j] (4 channels, each a running sum from +0 in that order);
+ *   out_r[i] = the largest such r[i+j] (+0 if none), out_w[i] = 1 / (2 out_r[i] + 1). r holds -1
+ *   (not near) or whole numbers +0 .. FV_DOF_RMAX; wgt >= +0 and src finite over [0, w) (the ISA
+ *   versions add +0 products for the taps the reference skips). */
+typedef void (*fv_dof_nearbox_row_fn)(float *restrict out, float *restrict out_r, float *restrict out_w,
+                                      const float *src, const float *r, const float *wgt, int w, int x0, int n,
+                                      int reach);
 typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                                        const float *ax, int n);
 typedef void (*fv_dof_pyrblur_row_fn)(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
@@ -67,6 +76,7 @@ typedef struct fv_dof_dsp {
     fv_dof_upsample_row_fn dof_upsample_row;
     fv_dof_pyrblur_row_fn dof_pyrblur_row;
     fv_dof_nearblk_row_fn dof_nearblk_row;
+    fv_dof_nearbox_row_fn dof_nearbox_row;
 } fv_dof_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -84,6 +94,8 @@ void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t 
                            const float *ax, int n);
 void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
 void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n);
+void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                          const float *r, const float *wgt, int w, int x0, int n, int reach);
 #if defined(__x86_64__)
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d);
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d);

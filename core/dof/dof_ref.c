@@ -170,6 +170,28 @@ void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float 
     }
 }
 
+void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                          const float *r, const float *wgt, int w, int x0, int n, int reach)
+{
+    for (int i = x0; i < x0 + n; i++) {
+        float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f}, rmax = 0.0f;
+        const int jlo = i - reach > 0 ? -reach : -i, jhi = i + reach < w ? reach : w - 1 - i;
+        for (int j = jlo; j <= jhi; j++) {
+            const float rs = r[i + j];
+            if (rs < (float)(j < 0 ? -j : j)) /* not near (-1), or does not reach */
+                continue;
+            const float ws = wgt[i + j], *p = src + 4 * (ptrdiff_t)(i + j);
+            for (int c = 0; c < 4; c++)
+                acc[c] += ws * p[c];
+            rmax = rs > rmax ? rs : rmax;
+        }
+        for (int c = 0; c < 4; c++)
+            out[4 * (ptrdiff_t)i + c] = acc[c];
+        out_r[i] = rmax;
+        out_w[i] = 1.0f / (2.0f * rmax + 1.0f);
+    }
+}
+
 void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
 {
     const unsigned isas = isa_mask & fv_cpu_isas();
@@ -180,6 +202,7 @@ void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
     d->dof_vgauss_row = fv_dof_vgauss_row_c;
     d->dof_combine_row = fv_dof_combine_row_c;
     d->dof_nearblk_row = fv_dof_nearblk_row_c;
+    d->dof_nearbox_row = fv_dof_nearbox_row_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_dof_dsp_init_sse41(d);

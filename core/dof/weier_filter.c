@@ -45,12 +45,12 @@ void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps
     dsp->dof_upsample_row(dst + 4 * xa, tmp, xt->i0 + xa, xt->i1 + xa, xt->ax + xa, xb - xa);
 }
 
-/* The scatter-as-gather box of one row: out[i] = sum over samples s within `reach` whose radius
- * r[s] >= |i - s| of wgt[s] * src[s] (4 channels); the largest such radius and its box weight. */
-static void near_box_row(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
-                         ptrdiff_t step, const float *r, const float *wgt, ptrdiff_t rstep, int i, int n, int reach)
+/* The scatter-as-gather box down a column (the horizontal one is the kernel dof_nearbox_row):
+ * out = sum over samples s within `reach` whose radius r[s] >= |i - s| of wgt[s] * src[s]. */
+static void near_box_col(float *restrict out, const float *src, ptrdiff_t step, const float *r, const float *wgt,
+                         ptrdiff_t rstep, int i, int n, int reach)
 {
-    float acc[4] = {0, 0, 0, 0}, rmax = 0.0f;
+    float acc[4] = {0, 0, 0, 0};
     const int jlo = i - reach > 0 ? -reach : -i, jhi = i + reach < n ? reach : n - 1 - i;
     for (int j = jlo; j <= jhi; j++) {
         const float rs = r[(i + j) * rstep];
@@ -59,13 +59,8 @@ static void near_box_row(float *restrict out, float *restrict out_r, float *rest
         const float ws = wgt[(i + j) * rstep], *p = src + (i + j) * step;
         for (int c = 0; c < 4; c++)
             acc[c] += ws * p[c];
-        rmax = rs > rmax ? rs : rmax;
     }
     memcpy(out, acc, sizeof acc);
-    if (out_r) {
-        *out_r = rmax;
-        *out_w = 1.0f / (2.0f * rmax + 1.0f);
-    }
 }
 
 /* Horizontal pass of one band: far_h (p4[1]) and near_h (p4[3], radius p1[2], weight p1[1]) in
@@ -113,8 +108,8 @@ void fvw_hpass_band(void *ctx, int band, int tid)
                 }
                 prepped = 1;
             }
-            for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++)
-                near_box_row(nh + 4 * i, nr + i, nw + i, s4, 4, sr, sw, 1, i, x->w, reach);
+            const int i0 = tx * TILE > x->cx0 ? tx * TILE : x->cx0, i1 = fv_mini((tx + 1) * TILE, x->cx1);
+            x->dsp->dof_nearbox_row(nh, nr, nw, s4, sr, sw, x->w, i0, i1 - i0, reach);
         }
         /* near radius / weight of the horizontal result moved into p1[1] / p1[2] for the
          * vertical pass (the per-sample arrays are no longer needed) */
@@ -130,9 +125,8 @@ void fvw_hpass_band(void *ctx, int band, int tid)
     if (x->l_reach >= 0)
         for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
             const ptrdiff_t o = (ptrdiff_t)by * x->lw;
-            for (int i = 0; i < x->lw; i++)
-                near_box_row(x->l_h + 4 * (o + i), x->l_hr + o + i, x->l_hw + o + i, x->l_src + 4 * o, 4, x->l_r + o,
-                             x->l_w + o, 1, i, x->lw, x->l_reach);
+            x->dsp->dof_nearbox_row(x->l_h + 4 * o, x->l_hr + o, x->l_hw + o, x->l_src + 4 * o, x->l_r + o, x->l_w + o,
+                                    x->lw, 0, x->lw, x->l_reach);
         }
 }
 
@@ -143,8 +137,8 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
     fvw_ctx *x = ctx;
     for (int by = band * (TILE / LOW); by < fv_mini((band + 1) * (TILE / LOW), x->lh); by++)
         for (int i = 0; i < x->lw; i++)
-            near_box_row(x->l_v + 4 * ((ptrdiff_t)by * x->lw + i), NULL, NULL, x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw,
-                         x->l_hr + i, x->l_hw + i, x->lw, by, x->lh, x->l_reach);
+            near_box_col(x->l_v + 4 * ((ptrdiff_t)by * x->lw + i), x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw, x->l_hr + i,
+                         x->l_hw + i, x->lw, by, x->lh, x->l_reach);
 }
 
 /* The deepest pyramid level the pixels of [xa, xb) with t > 0 read: lambda grows with |c|, so

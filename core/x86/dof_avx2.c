@@ -350,8 +350,44 @@ static void nearblk_row_avx2(float *restrict sum, float *restrict ext, const flo
         fv_dof_nearblk_row_c(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b, n - 4 * b);
 }
 
+/* 8 outputs a step whose taps all lie in the row: per tap the 8 radii / weights as one vector
+ * (masked to +0 where the tap does not reach), spread over the 4 pixel pairs */
+static void nearbox_row_avx2(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                             const float *r, const float *wgt, int w, int x0, int n, int reach)
+{
+    const __m256 one = _mm256_set1_ps(1.0f);
+    int i = x0;
+    while (i < x0 + n) {
+        if (i >= reach && i + 7 + reach < w && i + 8 <= x0 + n) {
+            __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0, rm = a0;
+            for (int j = -reach; j <= reach; j++) {
+                const __m256 r8 = _mm256_loadu_ps(r + i + j);
+                const __m256 m = _mm256_cmp_ps(r8, _mm256_set1_ps((float)(j < 0 ? -j : j)), _CMP_GE_OQ);
+                const __m256 w8 = _mm256_and_ps(_mm256_loadu_ps(wgt + i + j), m);
+                rm = _mm256_max_ps(_mm256_and_ps(r8, m), rm);
+                const float *p = src + 4 * (ptrdiff_t)(i + j);
+                a0 = _mm256_add_ps(a0, _mm256_mul_ps(PAIR(w8, 0), _mm256_loadu_ps(p)));
+                a1 = _mm256_add_ps(a1, _mm256_mul_ps(PAIR(w8, 1), _mm256_loadu_ps(p + 8)));
+                a2 = _mm256_add_ps(a2, _mm256_mul_ps(PAIR(w8, 2), _mm256_loadu_ps(p + 16)));
+                a3 = _mm256_add_ps(a3, _mm256_mul_ps(PAIR(w8, 3), _mm256_loadu_ps(p + 24)));
+            }
+            float *o = out + 4 * (ptrdiff_t)i;
+            _mm256_storeu_ps(o, a0), _mm256_storeu_ps(o + 8, a1), _mm256_storeu_ps(o + 16, a2);
+            _mm256_storeu_ps(o + 24, a3);
+            _mm256_storeu_ps(out_r + i, rm);
+            _mm256_storeu_ps(out_w + i, _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(rm, rm), one)));
+            i += 8;
+        } else if (i >= reach && i + 3 + reach < w && i + 4 <= x0 + n) {
+            dof_nearbox4(out, out_r, out_w, src, r, wgt, i, reach), i += 4;
+        } else { /* the row's ends */
+            fv_dof_nearbox_row_c(out, out_r, out_w, src, r, wgt, w, i, 1, reach), i++;
+        }
+    }
+}
+
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d)
 {
+    d->dof_nearbox_row = nearbox_row_avx2;
     d->dof_nearblk_row = nearblk_row_avx2;
     d->dof_upsample_row = upsample_row_avx2;
     d->dof_pyrblur_row = pyrblur_row_avx2;

@@ -42,6 +42,30 @@ static inline void dof_nearblk4(float *sum, float *ext, const float *coc, const 
     _mm_storel_epi64((__m128i *)(void *)ext, _mm_castps_si128(r));
 }
 
+/* ---- nearbox_row: 4 outputs i.. i+3 whose taps all lie in the row (i >= reach, i + 3 + reach
+ * < w): per tap the 4 radii / weights as one vector, masked to +0 where the tap does not reach
+ * (the reference skips it; + (+0 x finite) leaves a sum that started at +0 unchanged) ---- */
+static inline void dof_nearbox4(float *out, float *out_r, float *out_w, const float *src, const float *r,
+                                const float *wgt, int i, int reach)
+{
+    __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0, rm = a0;
+    for (int j = -reach; j <= reach; j++) {
+        const __m128 r4 = _mm_loadu_ps(r + i + j), m = _mm_cmpge_ps(r4, _mm_set1_ps((float)(j < 0 ? -j : j)));
+        const __m128 w4 = _mm_and_ps(_mm_loadu_ps(wgt + i + j), m);
+        rm = _mm_max_ps(_mm_and_ps(r4, m), rm);
+        const float *p = src + 4 * (ptrdiff_t)(i + j);
+        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0x00), _mm_loadu_ps(p)));
+        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0x55), _mm_loadu_ps(p + 4)));
+        a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0xaa), _mm_loadu_ps(p + 8)));
+        a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0xff), _mm_loadu_ps(p + 12)));
+    }
+    float *o = out + 4 * (ptrdiff_t)i;
+    _mm_storeu_ps(o, a0), _mm_storeu_ps(o + 4, a1), _mm_storeu_ps(o + 8, a2), _mm_storeu_ps(o + 12, a3);
+    _mm_storeu_ps(out_r + i, rm);
+    const __m128 one = _mm_set1_ps(1.0f);
+    _mm_storeu_ps(out_w + i, _mm_div_ps(one, _mm_add_ps(_mm_add_ps(rm, rm), one)));
+}
+
 /* ---- coc_row: 4 pixels ---- */
 typedef struct {
     __m128 K, idn, idf, dn, df;

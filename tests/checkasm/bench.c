@@ -264,6 +264,24 @@ static void nearblk_run(void *st, const checkasm_dsp *d, int row0, int rows)
                                t->rgbd + 4 * y * W, W);
     }
 }
+static void nearbox_reset(void *st) /* radii (t) and box weights (c4) from the CoC, as core/dof/weier_filter.c */
+{
+    dof_st *t = st;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        const float r = t->coc[i] < 0.0f ? floorf(-t->coc[i] * 0.5f) : -1.0f;
+        t->t[i] = r;
+        t->c4[i] = 1.0f / (2.0f * (r > 0.0f ? r : 0.0f) + 1.0f);
+    }
+}
+static void nearbox_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        d->dof.dof_nearbox_row(t->out + 4 * y * W, t->b4 + y * W, t->b4 + (size_t)W * H + y * W, t->rgbd + 4 * y * W,
+                               t->t + y * W, t->c4 + y * W, W, 0, W, 3);
+    }
+}
 static void hgauss_run(void *st, const checkasm_dsp *d, int row0, int rows)
 {
     dof_st *t = st;
@@ -417,6 +435,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"dof_coc_row", "1280x1440, 1440 rows", {F(dof.dof_coc_row), 0}, H, dof_setup, NULL, coc_run, dof_free},
     {"dof_nearblk_row", "1280x1440, 1440 rows, 4x4 blocks", {F(dof.dof_nearblk_row), 0}, H, dof_setup, NULL,
      nearblk_run, dof_free},
+    {"dof_nearbox_row", "1280x1440, 1440 rows, reach 3", {F(dof.dof_nearbox_row), 0}, H, dof_setup, nearbox_reset,
+     nearbox_run, dof_free},
     {"dof_hgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_hgauss_row), 0}, H, dof_setup, NULL,
      hgauss_run, dof_free},
     {"dof_vgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_vgauss_row), 0}, H, dof_setup, NULL,

@@ -71,7 +71,7 @@ static void run_all(const char *kernel, runner fn, size_t member)
 /* ------------------------------------------------------------------ tables */
 
 static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row",
-                                     "dof_nearblk_row"};
+                                     "dof_nearblk_row", "dof_nearbox_row"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -89,6 +89,7 @@ static void test_tables(void **state)
     assert_true(ref.dof_upsample_row == fv_dof_upsample_row_c);
     assert_true(ref.dof_pyrblur_row == fv_dof_pyrblur_row_c);
     assert_true(ref.dof_nearblk_row == fv_dof_nearblk_row_c);
+    assert_true(ref.dof_nearbox_row == fv_dof_nearbox_row_c);
     for (int k = 0; checkasm_isas[k]; k++) {
         const unsigned isa = checkasm_isas[k];
         memset(&own, 0, sizeof own);
@@ -588,6 +589,46 @@ static void test_nearblk_row(void **state)
     run_all("dof_nearblk_row", run_nearblk, offsetof(fv_dof_dsp, dof_nearblk_row));
 }
 
+/* ------------------------------------------------------------------ nearbox_row */
+
+/* Rows of 1-60 pixels and 640, spans anywhere in them (the row's ends take the reference's path in
+ * the ISA versions), reaches 0-24; radii -1 (not near) or 0-24, mostly small so that taps both
+ * reach and do not; weights the box's 1 / (2r + 1) or arbitrary (>= +0, zeros among them). */
+static void run_nearbox(const fv_dof_dsp *d, const char *isa)
+{
+    for (int w = 1; w <= 60 + 1; w++) {
+        const int ww = w <= 60 ? w : 640;
+        for (int rep = 0; rep < 6; rep++) {
+            const int off = rndi(4), reach = rndi(5) == 0 ? FV_DOF_RMAX : rndi(12);
+            const int x0 = rndi(ww), n = 1 + rndi(ww - x0);
+            buf src = buf_new(4 * (size_t)ww, off), r = buf_new((size_t)ww, off), wg = buf_new((size_t)ww, off);
+            for (int i = 0; i < ww; i++) {
+                for (int k = 0; k < 4; k++)
+                    src.p[4 * i + k] = colour();
+                r.p[i] = rndi(4) == 0 ? -1.0f : (float)(rndi(6) == 0 ? rndi(FV_DOF_RMAX + 1) : rndi(6));
+                wg.p[i] = rndi(3) ? 1.0f / (2.0f * (r.p[i] > 0.0f ? r.p[i] : 0.0f) + 1.0f)
+                                  : (rndi(4) == 0 ? 0.0f : 2.0f * rnd());
+            }
+            buf ro = checkasm_out_f32(4 * (size_t)ww, off), to = checkasm_out_f32(4 * (size_t)ww, off);
+            buf rr = checkasm_out_f32((size_t)ww, off), tr = checkasm_out_f32((size_t)ww, off);
+            buf rw = checkasm_out_f32((size_t)ww, off), tw = checkasm_out_f32((size_t)ww, off);
+            fv_dof_nearbox_row_c(ro.p, rr.p, rw.p, src.p, r.p, wg.p, ww, x0, n, reach);
+            d->dof_nearbox_row(to.p, tr.p, tw.p, src.p, r.p, wg.p, ww, x0, n, reach);
+            compare_out(&ro, &to, 4 * (size_t)ww, 4, isa, "nearbox_row", "box sums + canaries");
+            compare_out(&rr, &tr, (size_t)ww, 1, isa, "nearbox_row", "largest radius + canaries");
+            compare_out(&rw, &tw, (size_t)ww, 1, isa, "nearbox_row", "box weight + canaries");
+            free(src.base), free(r.base), free(wg.base), free(ro.base), free(to.base), free(rr.base), free(tr.base);
+            free(rw.base), free(tw.base);
+        }
+    }
+}
+
+static void test_nearbox_row(void **state)
+{
+    (void)state;
+    run_all("dof_nearbox_row", run_nearbox, offsetof(fv_dof_dsp, dof_nearbox_row));
+}
+
 const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_gauss_tab),
@@ -598,5 +639,6 @@ const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_upsample_row),
     cmocka_unit_test(test_pyrblur_row),
     cmocka_unit_test(test_nearblk_row),
+    cmocka_unit_test(test_nearbox_row),
     {0},
 };
