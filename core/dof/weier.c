@@ -18,6 +18,10 @@
  *        with five quincunx taps per pixel; up-sampling whole rows of two levels gives a smoother
  *        result at a fraction of the cost (measured in docs/dof.md). Across the transition
  *        region both are computed and blended linearly in eccentricity (Weier's vertical pass).
+ *        Beyond the transition disc (one ray per ~5 pixels there) the levels >= 1 part runs on
+ *        the level 1 grid with a 2x2-mean |c| (fvw_hblur_band) and each row reads it up-sampled as
+ *        its level 1, so a pixel below level 1 still mixes its own sharp colour at full resolution
+ *        (tests/test_dof.c bounds the difference to the full-resolution path).
  *   near (c < 0): scatter-as-gather box: a near sample of radius r = min(floor(|c| / 2), 24)
  *        covers 2r + 1 pixels with weight 1 / (2r + 1) each, so it spreads over whatever lies
  *        around it (the focused background included) and the sum of the weights is the layer's
@@ -35,6 +39,9 @@
  *
  * The filter's vertical pass and the combine run fused per row (the layers never go to memory
  * as full images); their times are the workers' time in each, scaled to the pass's wall time.
+ * Pass order: CoC (+ per-block statistics, kernel dof_nearblk_row) -> horizontal pass (centre
+ * rectangle; near boxes by dof_nearbox_row) -> quarter-resolution vertical pass -> the
+ * periphery's half-resolution blur -> fused vertical pass + combine.
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *
