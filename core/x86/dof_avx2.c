@@ -187,14 +187,54 @@ static inline void up_pair(float *dst, const float *tmp, const int32_t *i0, cons
     _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
 }
 
+/* lanes 2p of d (the pairs' first pixels) all 1 / all 0: a bit mask of the 4 pairs whose two
+ * taps are neighbouring / the same texel */
+static inline int pair_steps(__m256i idx, int step)
+{
+    const __m256i d = _mm256_sub_epi32(_mm256_shuffle_epi32(idx, 0xb1), idx); /* lane 2p: idx[2p+1] - idx[2p] */
+    return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(d, _mm256_set1_epi32(step)))) & 0x55;
+}
+
 /* 8 pixels at a time as 4 pairs (unrolled by hand: the pairs' lane indices are constants), the
- * rest with the 128-bit version */
+ * rest with the 128-bit version. Up-sampling by 2 reads neighbouring texels for each pair, by
+ * 4 or more the same texel twice: when all 4 pairs of both taps do, whole-pair or broadcast
+ * loads without the per-pair tests. */
 static void upsample_row_avx2(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                               const float *ax, int n)
 {
     int x = 0;
     for (; x + 8 <= n; x += 8) {
         const __m256 a8 = _mm256_loadu_ps(ax + x);
+        const __m256i j0 = _mm256_loadu_si256((const __m256i *)(const void *)(i0 + x));
+        const __m256i j1 = _mm256_loadu_si256((const __m256i *)(const void *)(i1 + x));
+        if ((pair_steps(j0, 1) & pair_steps(j1, 1)) == 0x55) {
+#define UP_NB(p)                                                                                                     \
+    do {                                                                                                             \
+        const __m256 q0 = _mm256_loadu_ps(tmp + 4 * (ptrdiff_t)i0[x + 2 * (p)]);                                     \
+        const __m256 q1 = _mm256_loadu_ps(tmp + 4 * (ptrdiff_t)i1[x + 2 * (p)]);                                     \
+        _mm256_storeu_ps(dst + 4 * (x + 2 * (p)), _mm256_add_ps(q0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(q1, q0)))); \
+    } while (0)
+            UP_NB(0);
+            UP_NB(1);
+            UP_NB(2);
+            UP_NB(3);
+#undef UP_NB
+            continue;
+        }
+        if ((pair_steps(j0, 0) & pair_steps(j1, 0)) == 0x55) {
+#define UP_BC(p)                                                                                                     \
+    do {                                                                                                             \
+        const __m256 q0 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)i0[x + 2 * (p)])); \
+        const __m256 q1 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)i1[x + 2 * (p)])); \
+        _mm256_storeu_ps(dst + 4 * (x + 2 * (p)), _mm256_add_ps(q0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(q1, q0)))); \
+    } while (0)
+            UP_BC(0);
+            UP_BC(1);
+            UP_BC(2);
+            UP_BC(3);
+#undef UP_BC
+            continue;
+        }
         up_pair(dst, tmp, i0, i1, a8, x, 0);
         up_pair(dst, tmp, i0, i1, a8, x + 2, 1);
         up_pair(dst, tmp, i0, i1, a8, x + 4, 2);
