@@ -289,6 +289,15 @@ static void pyrblur1_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a
     const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), msign = _mm256_set1_ps(-0.0f);
     const float *up0 = a->up[0], *up1 = a->up[1];
+    /* The level table in registers instead of a gather: l = min(lambda[k], 1) is 1 for every k
+     * from sat on; when sat <= 32 the first 32 entries are all a lookup needs. */
+    int sat = a->lambda_max + 1;
+    while (sat > 0 && a->lambda[sat - 1] >= 1.0f)
+        sat--;
+    const int regs = sat <= 32 && a->lambda_max >= 31; /* (never read past a shorter table) */
+    __m256 lut[4];
+    for (int q = 0; q < 4; q++)
+        lut[q] = regs ? _mm256_min_ps(_mm256_loadu_ps(a->lambda + 8 * q), one) : zero;
     int i = x0;
     for (; i + 8 <= x0 + n; i += 8) {
         const __m256 c = _mm256_loadu_ps(a->coc + i), t = _mm256_loadu_ps(a->t + i);
@@ -298,7 +307,18 @@ static void pyrblur1_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a
         if (!bits)
             continue;
         const __m256 v = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(m, steps), zero), lmax);
-        const __m256 l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, _mm256_cvttps_epi32(v), 4), one);
+        const __m256i k = _mm256_cvttps_epi32(v);
+        __m256 l;
+        if (regs) {
+            const __m256 b3 = _mm256_castsi256_ps(_mm256_slli_epi32(k, 28)); /* bit 3 -> sign */
+            const __m256 b4 = _mm256_castsi256_ps(_mm256_slli_epi32(k, 27)); /* bit 4 -> sign */
+            const __m256 lo = _mm256_blendv_ps(_mm256_permutevar8x32_ps(lut[0], k), _mm256_permutevar8x32_ps(lut[1], k), b3);
+            const __m256 hi = _mm256_blendv_ps(_mm256_permutevar8x32_ps(lut[2], k), _mm256_permutevar8x32_ps(lut[3], k), b3);
+            l = _mm256_blendv_ps(_mm256_blendv_ps(lo, hi, b4), one,
+                                 _mm256_castsi256_ps(_mm256_cmpgt_epi32(k, _mm256_set1_epi32(31))));
+        } else {
+            l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, k, 4), one);
+        }
         const __m256 is1 = _mm256_cmp_ps(l, one, _CMP_GE_OQ); /* L0 = int l = 1 */
         const __m256 f = _mm256_sub_ps(l, _mm256_and_ps(is1, one));
         const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
