@@ -275,11 +275,14 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
     float *enh = x->enh_on ? fvw_slot(x, tid, 10) : NULL;
     uint8_t sig[TILE * 8];
     double filter_ns = 0.0, combine_ns = 0.0;
+    /* t is 1 outside the disc of radius r1: the row holds 1 except across the disc's span, which
+     * each row writes and puts back */
+    for (int i = 0; i < x->w; i++)
+        trow[i] = 1.0f;
     for (int y = y0; y < y1; y++) {
         const int64_t ta = fv_time_ns();
         const float fy = (float)y + 0.5f;
         const float *coc = x->wk->p1[0] + y * st, *sharp = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
-        /* t is 1 outside the disc of radius r1: compute it only across the disc's span */
         const float dyr = fy - v->gaze_y, r1 = v->r1_px;
         int tx0 = x->w, tx1 = x->w;
         if (dyr * dyr < r1 * r1) {
@@ -287,12 +290,8 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
             tx0 = fv_clampi((int)floorf(v->gaze_x - half) - 1, 0, x->w);
             tx1 = fv_clampi((int)ceilf(v->gaze_x + half) + 1, 0, x->w);
         }
-        for (int i = 0; i < tx0; i++)
-            trow[i] = 1.0f;
         for (int i = tx0; i < tx1; i++)
             trow[i] = fvw_t_of(x, (float)i + 0.5f, fy);
-        for (int i = tx1; i < x->w; i++)
-            trow[i] = 1.0f;
         /* far: the centre's Gaussian (normalised), then the periphery's pyramid blended in */
         const int centre_row = y >= x->cy0 && y < x->cy1;
         if (centre_row) {
@@ -358,6 +357,8 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         const int64_t tb = fv_time_ns();
         fvw_combine_row(x, y, sharp, coc, far, nfull, lup, trow, enh);
         const int64_t tc = fv_time_ns();
+        for (int i = tx0; i < tx1; i++)
+            trow[i] = 1.0f;
         filter_ns += (double)(tb - ta);
         combine_ns += (double)(tc - tb);
     }
