@@ -108,9 +108,6 @@ static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, 
 {
     const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps(), gain = _mm256_set1_ps(a->gain);
     const __m256 msign = _mm256_set1_ps(-0.0f);
-    /* The output image (29.5 MB an eye) is written once here and read by a later stage, beyond
-     * the caches: for long spans non-temporal stores skip reading each line before writing it. */
-    const int nt = n >= 512 && !((uintptr_t)(out + 4 * x0) & 31);
     int x = x0;
     for (; x + 8 <= x0 + n; x += 8) {
         const __m256 c8 = _mm256_loadu_ps(a->coc + x), t8 = _mm256_loadu_ps(a->t + x);
@@ -152,15 +149,9 @@ static void combine_row_avx2(float *restrict out, const fv_dof_combine_args *a, 
                 /* max: v > 0 ? v : +0 */
                 o = _mm256_blendv_ps(o, _mm256_max_ps(v, zero), _mm256_cmp_ps(g, zero, _CMP_GT_OQ));
             }
-            const __m256 r = _mm256_blend_ps(o, s, 0x88);
-            if (nt)
-                _mm256_stream_ps(out + 4 * xp, r);
-            else
-                _mm256_storeu_ps(out + 4 * xp, r);
+            _mm256_storeu_ps(out + 4 * xp, _mm256_blend_ps(o, s, 0x88));
         }
     }
-    if (nt)
-        _mm_sfence(); /* the streamed rows are visible before anything after the call */
     if (x < x0 + n)
         dof_combine_row_x86(out, a, x, x0 + n - x);
 }
