@@ -278,8 +278,91 @@ static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a,
         fv_dof_pyrblur_row_c(blur, a, i, x0 + n - i);
 }
 
+/* Two blocks (8 pixels) a step. vld4q de-interleaves a block into r, g, b, depth vectors (lane k
+ * = pixel k), so the near mask applies as it is and the reference's (q0 + q2) + (q1 + q3) is a
+ * half add then a pairwise add; min / max pairwise (FMIN orders -0 below +0, x86 does not: the
+ * + 0 makes both +0). */
+static inline float32x4_t nb_sum(const float *p, uint32x4_t m)
+{
+    const float32x4x4_t v = vld4q_f32(p);
+#define NB_H(x) vadd_f32(vget_low_f32(x), vget_high_f32(x))
+#define NB_M(x) vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(x), m))
+    const float32x2_t r = NB_H(NB_M(v.val[0])), g = NB_H(NB_M(v.val[1])), b = NB_H(NB_M(v.val[2]));
+    const float32x2_t w = NB_H(NB_M(vdupq_n_f32(1.0f)));
+#undef NB_M
+#undef NB_H
+    return vcombine_f32(vpadd_f32(r, g), vpadd_f32(b, w));
+}
+
+static void nearblk_row_neon(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
+{
+    const float32x4_t zero = vdupq_n_f32(0.0f);
+    const uint32x4_t odd = vreinterpretq_u32_u64(vdupq_n_u64(0xffffffff00000000ull)); /* lanes 1, 3 */
+    int b = 0;
+    for (; 4 * b + 8 <= n; b += 2) {
+        const float32x4_t c0 = vld1q_f32(coc + 4 * b), c1 = vld1q_f32(coc + 4 * b + 4);
+        vst1q_f32(sum + 4 * b, vaddq_f32(vld1q_f32(sum + 4 * b), nb_sum(rgbd + 16 * b, vcltq_f32(c0, zero))));
+        vst1q_f32(sum + 4 * b + 4, vaddq_f32(vld1q_f32(sum + 4 * b + 4), nb_sum(rgbd + 16 * b + 16, vcltq_f32(c1, zero))));
+        float32x4_t lo = vpminq_f32(c0, c1), hi = vpmaxq_f32(c0, c1);
+        lo = vpminq_f32(lo, lo), hi = vpmaxq_f32(hi, hi); /* lanes 0, 1: blocks b, b + 1 */
+        const float32x4_t v = vzip1q_f32(lo, hi), e = vld1q_f32(ext + 2 * b);
+        vst1q_f32(ext + 2 * b, vaddq_f32(vbslq_f32(odd, vmaxq_f32(v, e), vminq_f32(v, e)), zero));
+    }
+    if (4 * b < n)
+        fv_dof_nearblk_row_c(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b, n - 4 * b);
+}
+
+/* 4 outputs a step whose taps all lie in the row (the SSE4.1 scheme, core/x86/dof_tmpl.h):
+ * FMAX of +0 and a radius >= +0 is the radius, as on x86. |j| runs as a float vector (whole
+ * numbers: exact), down to 0 over the left taps and up over the right ones. */
+typedef struct {
+    float32x4_t a0, a1, a2, a3, rm;
+} nbox4;
+
+static inline void nbox_tap(nbox4 *k, const float *src, const float *r, const float *wgt, int t, float32x4_t aj)
+{
+    const float32x4_t r4 = vld1q_f32(r + t);
+    const uint32x4_t m = vcgeq_f32(r4, aj);
+    const float32x4_t w4 = vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(vld1q_f32(wgt + t)), m));
+    k->rm = vmaxq_f32(vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(r4), m)), k->rm);
+    const float *p = src + 4 * (ptrdiff_t)t;
+    /* by-lane products: w * p as the reference (the product commutes) */
+    k->a0 = vaddq_f32(k->a0, vmulq_laneq_f32(vld1q_f32(p), w4, 0));
+    k->a1 = vaddq_f32(k->a1, vmulq_laneq_f32(vld1q_f32(p + 4), w4, 1));
+    k->a2 = vaddq_f32(k->a2, vmulq_laneq_f32(vld1q_f32(p + 8), w4, 2));
+    k->a3 = vaddq_f32(k->a3, vmulq_laneq_f32(vld1q_f32(p + 12), w4, 3));
+}
+
+static void nearbox_row_neon(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                             const float *r, const float *wgt, int w, int x0, int n, int reach)
+{
+    const float32x4_t one = vdupq_n_f32(1.0f);
+    int i = x0;
+    while (i < x0 + n) {
+        if (!(i >= reach && i + 3 + reach < w && i + 4 <= x0 + n)) { /* the row's ends */
+            fv_dof_nearbox_row_c(out, out_r, out_w, src, r, wgt, w, i, 1, reach), i++;
+            continue;
+        }
+        const float32x4_t z = vdupq_n_f32(0.0f);
+        nbox4 k = {z, z, z, z, z};
+        float32x4_t aj = vdupq_n_f32((float)reach);
+        for (int j = -reach; j < 0; j++, aj = vsubq_f32(aj, one))
+            nbox_tap(&k, src, r, wgt, i + j, aj);
+        aj = z;
+        for (int j = 0; j <= reach; j++, aj = vaddq_f32(aj, one))
+            nbox_tap(&k, src, r, wgt, i + j, aj);
+        float *o = out + 4 * (ptrdiff_t)i;
+        vst1q_f32(o, k.a0), vst1q_f32(o + 4, k.a1), vst1q_f32(o + 8, k.a2), vst1q_f32(o + 12, k.a3);
+        vst1q_f32(out_r + i, k.rm);
+        vst1q_f32(out_w + i, vdivq_f32(one, vaddq_f32(vaddq_f32(k.rm, k.rm), one)));
+        i += 4;
+    }
+}
+
 void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
+    d->dof_nearbox_row = nearbox_row_neon;
+    d->dof_nearblk_row = nearblk_row_neon;
     d->dof_upsample_row = upsample_row_neon;
     d->dof_pyrblur_row = pyrblur_row_neon;
     d->dof_coc_row = coc_row_neon;

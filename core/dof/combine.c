@@ -35,7 +35,7 @@ void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const
         const fv_pyr_level *lv = &v->pyr->lv[L];
         const img4 im = {lv->rgbd, lv->w, lv->h, lv->stride};
         up[L] = fvw_slot(x, tid, 4 + L);
-        fvw_upsample_row(x->dsp, &im, L, &x->xt[L], y, x->w, fvw_slot(x, tid, 11), up[L]);
+        fvw_upsample_row(x->dsp, &im, L, &x->xt[L], y, 0, x->w, fvw_slot(x, tid, 11), up[L]);
     }
     const fv_dof_pyrblur_args ea = {.coc = ecoc, .t = ones, .up = (const float *const *)up, .need = need,
                                     .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS,

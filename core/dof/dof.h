@@ -38,6 +38,8 @@ typedef struct fv_dof_params {
     float tolerance_m;     /* Weier's t: 0.2 m */
     float contrast_gain;   /* Patney 2016 peripheral contrast enhancement, 0 = off (the default) */
     int chroma;            /* liu: longitudinal chromatic aberration (Liu sec. 3.3.2), default 0 */
+    int full_res_periphery; /* weier: 1 = the periphery's pyramid blur at full resolution (the path
+                             * the half-resolution one replaced; tests compare them), default 0 */
     fv_focus_params focus; /* focus estimation; focus.fixed_m > 0 fixes it */
 } fv_dof_params;
 void fv_dof_params_default(fv_dof_params *p);

@@ -42,6 +42,22 @@ struct fv_dof_pyrblur_args;
  *   compute several pixels at once and keep each by a select on the reference's condition: they
  *   may read (never use) up[0..need] and blur at pixels of [x0, x0+n) the reference skips, and
  *   store a skipped pixel's blur back unchanged. */
+/* dof_nearblk_row: the CoC pass's per-block statistics of one row, blocks of 4 pixels b in
+ *   [0, ceil(n / 4)): sum[4b..4b+3] += (q0 + q2) + (q1 + q3), q_k = (r, g, b, 1) of pixel 4b + k if
+ *   its coc < 0, else +0 (also for pixels past n); ext[2b] = min(ext[2b], the block's coc) + 0,
+ *   ext[2b + 1] = max(ext[2b + 1], the block's coc) + 0 (+ 0: a zero result is +0 whatever the
+ *   ISA's min of signed zeros gives). coc and ext finite. */
+typedef void (*fv_dof_nearblk_row_fn)(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd,
+                                      int n);
+/* dof_nearbox_row: the near layer's horizontal scatter-as-gather box, for i in [x0, x0+n):
+ *   out[i] = sum over j in [max(-reach, -i), min(reach, w - 1 - i)], ascending, with r[i+j] >= |j|
+ *   of wgt[i+j] * src[i+j] (4 channels, each a running sum from +0 in that order);
+ *   out_r[i] = the largest such r[i+j] (+0 if none), out_w[i] = 1 / (2 out_r[i] + 1). r holds -1
+ *   (not near) or whole numbers +0 .. FV_DOF_RMAX; wgt >= +0 and src finite over [0, w) (the ISA
+ *   versions add +0 products for the taps the reference skips). */
+typedef void (*fv_dof_nearbox_row_fn)(float *restrict out, float *restrict out_r, float *restrict out_w,
+                                      const float *src, const float *r, const float *wgt, int w, int x0, int n,
+                                      int reach);
 typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                                        const float *ax, int n);
 typedef void (*fv_dof_pyrblur_row_fn)(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
@@ -59,6 +75,8 @@ typedef struct fv_dof_dsp {
     fv_dof_combine_row_fn dof_combine_row;
     fv_dof_upsample_row_fn dof_upsample_row;
     fv_dof_pyrblur_row_fn dof_pyrblur_row;
+    fv_dof_nearblk_row_fn dof_nearblk_row;
+    fv_dof_nearbox_row_fn dof_nearbox_row;
 } fv_dof_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -75,6 +93,9 @@ void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args 
 void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                            const float *ax, int n);
 void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
+void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n);
+void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                          const float *r, const float *wgt, int w, int x0, int n, int reach);
 #if defined(__x86_64__)
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d);
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d);

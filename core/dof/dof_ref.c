@@ -152,6 +152,46 @@ void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args
     }
 }
 
+void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
+{
+    for (int b = 0; 4 * b < n; b++) {
+        float q[4][4] = {{0.0f}}, lo = ext[2 * b], hi = ext[2 * b + 1];
+        for (int k = 0; k < 4 && 4 * b + k < n; k++) {
+            const int i = 4 * b + k;
+            const float c = coc[i];
+            if (c < 0.0f)
+                q[k][0] = rgbd[4 * i], q[k][1] = rgbd[4 * i + 1], q[k][2] = rgbd[4 * i + 2], q[k][3] = 1.0f;
+            lo = c < lo ? c : lo;
+            hi = c > hi ? c : hi;
+        }
+        for (int j = 0; j < 4; j++)
+            sum[4 * b + j] += (q[0][j] + q[2][j]) + (q[1][j] + q[3][j]);
+        ext[2 * b] = lo + 0.0f, ext[2 * b + 1] = hi + 0.0f;
+    }
+}
+
+void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                          const float *r, const float *wgt, int w, int x0, int n, int reach)
+{
+    for (int i = x0; i < x0 + n; i++) {
+        float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f}, rmax = 0.0f;
+        const int jlo = i - reach > 0 ? -reach : -i, jhi = i + reach < w ? reach : w - 1 - i;
+        for (int j = jlo; j <= jhi; j++) {
+            const float rs = r[i + j];
+            if (rs < (float)(j < 0 ? -j : j)) /* not near (-1), or does not reach */
+                continue;
+            const float ws = wgt[i + j], *p = src + 4 * (ptrdiff_t)(i + j);
+            for (int c = 0; c < 4; c++)
+                acc[c] += ws * p[c];
+            rmax = rs > rmax ? rs : rmax;
+        }
+        for (int c = 0; c < 4; c++)
+            out[4 * (ptrdiff_t)i + c] = acc[c];
+        out_r[i] = rmax;
+        out_w[i] = 1.0f / (2.0f * rmax + 1.0f);
+    }
+}
+
 void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
 {
     const unsigned isas = isa_mask & fv_cpu_isas();
@@ -161,6 +201,8 @@ void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
     d->dof_hgauss_row = fv_dof_hgauss_row_c;
     d->dof_vgauss_row = fv_dof_vgauss_row_c;
     d->dof_combine_row = fv_dof_combine_row_c;
+    d->dof_nearblk_row = fv_dof_nearblk_row_c;
+    d->dof_nearbox_row = fv_dof_nearbox_row_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_dof_dsp_init_sse41(d);

@@ -18,6 +18,10 @@
  *        with five quincunx taps per pixel; up-sampling whole rows of two levels gives a smoother
  *        result at a fraction of the cost (measured in docs/dof.md). Across the transition
  *        region both are computed and blended linearly in eccentricity (Weier's vertical pass).
+ *        Beyond the transition disc (one ray per ~5 pixels there) the levels >= 1 part runs on
+ *        the level 1 grid with a 2x2-mean |c| (fvw_hblur_band) and each row reads it up-sampled as
+ *        its level 1, so a pixel below level 1 still mixes its own sharp colour at full resolution
+ *        (tests/test_dof.c bounds the difference to the full-resolution path).
  *   near (c < 0): scatter-as-gather box: a near sample of radius r = min(floor(|c| / 2), 24)
  *        covers 2r + 1 pixels with weight 1 / (2r + 1) each, so it spreads over whatever lies
  *        around it (the focused background included) and the sum of the weights is the layer's
@@ -35,6 +39,9 @@
  *
  * The filter's vertical pass and the combine run fused per row (the layers never go to memory
  * as full images); their times are the workers' time in each, scaled to the pass's wall time.
+ * Pass order: CoC (+ per-block statistics, kernel dof_nearblk_row) -> horizontal pass (centre
+ * rectangle; near boxes by dof_nearbox_row) -> quarter-resolution vertical pass -> the
+ * periphery's half-resolution blur -> fused vertical pass + combine.
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *
@@ -94,16 +101,29 @@ static void lambda_init(float *lambda)
 
 /* The constant tables at the start of aux (the level LUT, then the up-sampling taps of levels
  * 1..MAX_UP_LEVEL for the work's width), followed by the per-frame scratch. */
-static size_t tables_len(int w) { return LAMBDA_N + 3 * (size_t)MAX_UP_LEVEL * (size_t)w; }
+static int half_w(int w) { return (w + 1) / 2; } /* the pyramid's level 1 */
 
-static void tables_at(float *a, int w, const float **lambda, xtaps xt[MAX_UP_LEVEL + 1])
+static size_t tables_len(int w)
+{
+    return 2 * (size_t)LAMBDA_N + 3 * (size_t)MAX_UP_LEVEL * (size_t)w + 3 * (size_t)(MAX_UP_LEVEL - 1) * half_w(w);
+}
+
+static void taps_at(xtaps *t, float **a, int n)
+{
+    t->i0 = (int32_t *)(void *)*a, *a += n; /* int32 and float have the same size */
+    t->i1 = (int32_t *)(void *)*a, *a += n;
+    t->ax = *a, *a += n;
+}
+
+static void tables_at(float *a, int w, const float **lambda, const float **lambda_h, xtaps xt[MAX_UP_LEVEL + 1],
+                      xtaps xh[MAX_UP_LEVEL])
 {
     *lambda = a, a += LAMBDA_N;
-    for (int L = 1; L <= MAX_UP_LEVEL; L++) {
-        xt[L].i0 = (int32_t *)(void *)a, a += w; /* int32 and float have the same size */
-        xt[L].i1 = (int32_t *)(void *)a, a += w;
-        xt[L].ax = a, a += w;
-    }
+    *lambda_h = a, a += LAMBDA_N;
+    for (int L = 1; L <= MAX_UP_LEVEL; L++)
+        taps_at(&xt[L], &a, w);
+    for (int L = 1; L < MAX_UP_LEVEL; L++)
+        taps_at(&xh[L], &a, half_w(w));
 }
 
 /* Scratch beyond the planes, allocated on first use and kept: the tables (built then), tiles,
@@ -113,19 +133,24 @@ static int ensure_aux(fv_dof_work *wk, int threads)
     const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 2 * (size_t)th;
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 2 * (size_t)th +
+                       4 * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
         if (!(wk->aux = malloc(aux * sizeof(float))))
             return wk->aux_len = 0, -1;
         wk->aux_len = aux;
-        const float *lambda;
-        xtaps xt[MAX_UP_LEVEL + 1];
-        tables_at(wk->aux, w, &lambda, xt);
+        const float *lambda, *lambda_h;
+        xtaps xt[MAX_UP_LEVEL + 1], xh[MAX_UP_LEVEL];
+        tables_at(wk->aux, w, &lambda, &lambda_h, xt, xh);
         lambda_init(wk->aux);
+        for (int i = 0; i < LAMBDA_N; i++) /* the half grid's level 0 is level 1 */
+            wk->aux[LAMBDA_N + i] = fmaxf(wk->aux[i] - 1.0f, 0.0f);
         for (int L = 1; L <= MAX_UP_LEVEL; L++) /* level L's width, ceil(w / 2^L): for L = 2 also
                                                  * the quarter-resolution layer's */
             fvw_xtaps_init(&xt[L], L, w, (w + (1 << L) - 1) >> L);
+        for (int L = 1; L < MAX_UP_LEVEL; L++) /* level L + 1 onto the level 1 grid */
+            fvw_xtaps_init(&xh[L], L, half_w(w), (half_w(w) + (1 << L) - 1) >> L);
     }
     const size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
     if (wk->rows_len < rows) {
@@ -153,7 +178,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->lw = (x->w + LOW - 1) / LOW, x->lh = (x->h + LOW - 1) / LOW;
     const ptrdiff_t nl = (ptrdiff_t)x->lw * x->lh;
     float *a = wk->aux;
-    tables_at(a, x->w, &x->lambda, x->xt);
+    tables_at(a, x->w, &x->lambda, &x->lambda_h, x->xt, x->xh);
     a += tables_len(x->w);
     x->t_near = a, x->t_fsig = a + nt, x->t_near_own = a + 2 * nt, x->t_fsig_own = a + 3 * nt, a += 4 * nt;
     x->l_src = a, a += 4 * nl;
@@ -164,11 +189,14 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_hw = a, a += nl;
     x->l_v = a, a += 4 * nl;
     x->band_ms = a, a += 2 * x->th;
+    x->hw = half_w(x->w), x->hh = half_w(x->h);
+    x->hblur = a, a += 4 * (ptrdiff_t)x->hw * x->hh;
     /* the centre rectangle: the transition disc plus the kernels' reach */
     const float reach = v->r1_px + 2.0f * FV_DOF_RMAX;
     x->cx0 = fv_clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = fv_clampi((int)ceilf(v->gaze_x + reach), 0, x->w);
     x->cy0 = fv_clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = fv_clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
     x->up_levels = fv_mini(MAX_UP_LEVEL, v->pyr->levels - 1);
+    x->half_on = !v->prm->full_res_periphery && x->up_levels >= 1 && v->pyr->lv[1].w == x->hw && v->pyr->lv[1].h == x->hh;
     x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
     const int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, x->th, fvw_coc_band, x);
@@ -179,6 +207,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     const int64_t tf = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     fv_pool_run(pool, x->th, fvw_hpass_band, x);
     fv_pool_run(pool, x->th, fvw_lvpass_band, x);
+    fv_pool_run(pool, x->th, fvw_hblur_band, x);
     const int64_t t2 = fv_time_ns();
     fv_pool_run(pool, x->th, fvw_vcombine_band, x);
     const int64_t t3 = fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, tf);

@@ -10,58 +10,43 @@
 
 void fvw_coc_band(void *ctx, int band, int tid)
 {
-    (void)tid;
     fvw_ctx *x = ctx;
     const fv_pyr_level *l0 = &x->v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
     const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
     for (int y = y0; y < y1; y++)
         x->dsp->dof_coc_row(x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w, x->K, x->dn, x->df);
-    /* one sweep for the tile statistics and the quarter-resolution near source: per 4x4 block
-     * the near pixels' colour sum, count and largest |c|; per tile the largest near and far c */
+    /* the tile statistics and the quarter-resolution near source in one kernel sweep per row: per
+     * 4x4 block the near pixels' colour sum and count (dof_nearblk_row), the smallest and largest
+     * c (ext: the largest near radius, the largest far c) */
     const float inv_blk = 1.0f / (LOW * LOW);
+    float *ext = fvw_slot(x, tid, 0);
     for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
-        float *src = x->l_src + 4 * (ptrdiff_t)by * x->lw, *rr = x->l_r + (ptrdiff_t)by * x->lw;
+        float *src = x->l_src + 4 * (ptrdiff_t)by * x->lw;
         memset(src, 0, (size_t)x->lw * 4 * sizeof(float));
-        for (int i = 0; i < x->lw; i++)
-            rr[i] = 0.0f; /* the largest |c| of the block's near pixels, for now */
-        for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++) {
-            const float *c = x->wk->p1[0] + y * st, *p = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
-            for (int i = 0; i < x->w; i++) {
-                if (!(c[i] < 0.0f))
-                    continue;
-                float *b = src + 4 * (i / LOW);
-                b[0] += p[4 * i], b[1] += p[4 * i + 1], b[2] += p[4 * i + 2], b[3] += 1.0f;
-                rr[i / LOW] = -c[i] > rr[i / LOW] ? -c[i] : rr[i / LOW];
-            }
-        }
+        memset(ext, 0, (size_t)x->lw * 2 * sizeof(float));
+        for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++)
+            x->dsp->dof_nearblk_row(src, ext, x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w);
         for (int i = 0; i < x->lw; i++) {
-            const float cmax = rr[i], *b = src + 4 * i;
-            float r = floorf(cmax * 0.5f); /* the largest near radius in pixels, capped */
+            const int xa = i * LOW;
+            float r = floorf(-ext[2 * i] * 0.5f); /* the largest near radius in pixels, capped */
             r = r < (float)FV_DOF_RMAX ? r : (float)FV_DOF_RMAX;
-            /* the tile's largest near radius (first block of the tile in the band: reset) */
-            float *tn = &x->t_near_own[band * x->tw + i * LOW / TILE];
-            if (by == y0 / LOW && i * LOW % TILE == 0)
-                *tn = 0.0f;
+            /* the tile's largest near radius and far c (first block of the tile in the band: reset) */
+            float *tn = &x->t_near_own[band * x->tw + xa / TILE], *tf = &x->t_fsig_own[band * x->tw + xa / TILE];
+            if (by == y0 / LOW && xa % TILE == 0)
+                *tn = 0.0f, *tf = 0.0f;
             *tn = r > *tn ? r : *tn;
-            /* radius in whole blocks (the up-sampling adds about one); -1: no near pixel (rr[i]
-             * becomes it) */
-            const float rb = b[3] > 0.0f ? floorf(r / LOW) : -1.0f;
-            rr[i] = rb;
+            *tf = ext[2 * i + 1] > *tf ? ext[2 * i + 1] : *tf;
+            /* radius in whole blocks (the up-sampling adds about one); -1: no near pixel */
+            const float rb = src[4 * i + 3] > 0.0f ? floorf(r / LOW) : -1.0f;
+            x->l_r[(ptrdiff_t)by * x->lw + i] = rb;
             x->l_w[(ptrdiff_t)by * x->lw + i] = 1.0f / (2.0f * (rb > 0.0f ? rb : 0.0f) + 1.0f);
             for (int k = 0; k < 4; k++)
                 src[4 * i + k] *= inv_blk;
         }
     }
-    for (int tx = 0; tx < x->tw; tx++) {
-        float fc = 0.0f;
-        for (int y = y0; y < y1; y++) {
-            const float *c = x->wk->p1[0] + y * st;
-            for (int i = tx * TILE; i < fv_mini((tx + 1) * TILE, x->w); i++)
-                fc = c[i] > fc ? c[i] : fc;
-        }
-        x->t_fsig_own[band * x->tw + tx] = fc * 0.25f;
-    }
+    for (int tx = 0; tx < x->tw; tx++) /* far c -> sigma */
+        x->t_fsig_own[band * x->tw + tx] *= 0.25f;
 }
 
 /* Each tile learns the largest near radius / far sigma of the tiles within reach. */

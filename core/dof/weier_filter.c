@@ -21,27 +21,36 @@ void fvw_xtaps_init(xtaps *t, int L, int w, int src_w)
     }
 }
 
-/* Image `src` (2^L level-0 pixels a texel) bilinearly up-sampled to level-0 row y, columns
- * [0, w). Separable: the two source rows are blended once into tmp, then each pixel reads two
- * texels. */
-void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w,
-                         float *restrict tmp, float *restrict dst)
+/* a + t (b - a) over n floats (restrict-qualified so the compiler vectorises it) */
+static void vlerp(float *restrict d, const float *restrict a, const float *restrict b, float t, int n)
 {
+    for (int i = 0; i < n; i++)
+        d[i] = a[i] + t * (b[i] - a[i]);
+}
+
+/* Image `src` (2^L destination pixels a texel) bilinearly up-sampled to destination row y,
+ * columns [xa, xb) (dst indexed from 0). Separable: the two source rows are blended once into
+ * tmp over the texels those columns read, then each pixel reads two texels. */
+void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int xa, int xb,
+                      float *restrict tmp, float *restrict dst)
+{
+    if (xa >= xb)
+        return;
     const float sc = 1.0f / (float)(1 << L);
     const float v = ((float)y + 0.5f) * sc - 0.5f, fv = floorf(v), ay = v - fv;
     const float *ra = src->px + 4 * (ptrdiff_t)fv_clampi((int)fv, 0, src->h - 1) * src->stride;
     const float *rb = src->px + 4 * (ptrdiff_t)fv_clampi((int)fv + 1, 0, src->h - 1) * src->stride;
-    for (int i = 0; i < 4 * src->w; i++)
-        tmp[i] = ra[i] + ay * (rb[i] - ra[i]);
-    dsp->dof_upsample_row(dst, tmp, xt->i0, xt->i1, xt->ax, w);
+    const int t0 = xt->i0[xa], t1 = xt->i1[xb - 1] + 1; /* the taps grow with x */
+    vlerp(tmp + 4 * t0, ra + 4 * t0, rb + 4 * t0, ay, 4 * (t1 - t0));
+    dsp->dof_upsample_row(dst + 4 * xa, tmp, xt->i0 + xa, xt->i1 + xa, xt->ax + xa, xb - xa);
 }
 
-/* The scatter-as-gather box of one row: out[i] = sum over samples s within `reach` whose radius
- * r[s] >= |i - s| of wgt[s] * src[s] (4 channels); the largest such radius and its box weight. */
-static void near_box_row(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
-                         ptrdiff_t step, const float *r, const float *wgt, ptrdiff_t rstep, int i, int n, int reach)
+/* The scatter-as-gather box down a column (the horizontal one is the kernel dof_nearbox_row):
+ * out = sum over samples s within `reach` whose radius r[s] >= |i - s| of wgt[s] * src[s]. */
+static void near_box_col(float *restrict out, const float *src, ptrdiff_t step, const float *r, const float *wgt,
+                         ptrdiff_t rstep, int i, int n, int reach)
 {
-    float acc[4] = {0, 0, 0, 0}, rmax = 0.0f;
+    float acc[4] = {0, 0, 0, 0};
     const int jlo = i - reach > 0 ? -reach : -i, jhi = i + reach < n ? reach : n - 1 - i;
     for (int j = jlo; j <= jhi; j++) {
         const float rs = r[(i + j) * rstep];
@@ -50,13 +59,8 @@ static void near_box_row(float *restrict out, float *restrict out_r, float *rest
         const float ws = wgt[(i + j) * rstep], *p = src + (i + j) * step;
         for (int c = 0; c < 4; c++)
             acc[c] += ws * p[c];
-        rmax = rs > rmax ? rs : rmax;
     }
     memcpy(out, acc, sizeof acc);
-    if (out_r) {
-        *out_r = rmax;
-        *out_w = 1.0f / (2.0f * rmax + 1.0f);
-    }
 }
 
 /* Horizontal pass of one band: far_h (p4[1]) and near_h (p4[3], radius p1[2], weight p1[1]) in
@@ -104,8 +108,8 @@ void fvw_hpass_band(void *ctx, int band, int tid)
                 }
                 prepped = 1;
             }
-            for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++)
-                near_box_row(nh + 4 * i, nr + i, nw + i, s4, 4, sr, sw, 1, i, x->w, reach);
+            const int i0 = tx * TILE > x->cx0 ? tx * TILE : x->cx0, i1 = fv_mini((tx + 1) * TILE, x->cx1);
+            x->dsp->dof_nearbox_row(nh, nr, nw, s4, sr, sw, x->w, i0, i1 - i0, reach);
         }
         /* near radius / weight of the horizontal result moved into p1[1] / p1[2] for the
          * vertical pass (the per-sample arrays are no longer needed) */
@@ -121,9 +125,8 @@ void fvw_hpass_band(void *ctx, int band, int tid)
     if (x->l_reach >= 0)
         for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
             const ptrdiff_t o = (ptrdiff_t)by * x->lw;
-            for (int i = 0; i < x->lw; i++)
-                near_box_row(x->l_h + 4 * (o + i), x->l_hr + o + i, x->l_hw + o + i, x->l_src + 4 * o, 4, x->l_r + o,
-                             x->l_w + o, 1, i, x->lw, x->l_reach);
+            x->dsp->dof_nearbox_row(x->l_h + 4 * o, x->l_hr + o, x->l_hw + o, x->l_src + 4 * o, x->l_r + o, x->l_w + o,
+                                    x->lw, 0, x->lw, x->l_reach);
         }
 }
 
@@ -134,28 +137,38 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
     fvw_ctx *x = ctx;
     for (int by = band * (TILE / LOW); by < fv_mini((band + 1) * (TILE / LOW), x->lh); by++)
         for (int i = 0; i < x->lw; i++)
-            near_box_row(x->l_v + 4 * ((ptrdiff_t)by * x->lw + i), NULL, NULL, x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw,
-                         x->l_hr + i, x->l_hw + i, x->lw, by, x->lh, x->l_reach);
+            near_box_col(x->l_v + 4 * ((ptrdiff_t)by * x->lw + i), x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw, x->l_hr + i,
+                         x->l_hw + i, x->lw, by, x->lh, x->l_reach);
 }
 
-/* The periphery's blur of every out-of-focus pixel of row y with t > 0, by its own |c|: the two
- * nearest up-sampled pyramid levels, interpolated (level 0 is the sharp row). Far pixels blend
- * it into the centre's Gaussian by t; near pixels' own blur is this alone (the combine fades it
- * in by t), the quarter-resolution near layer only spreading them over their surroundings. */
-void fvw_blur_periphery(const fvw_ctx *x, int tid, int y, const float *coc, const float *trow, const float *sharp,
-                           float *restrict blur)
+/* The deepest pyramid level the pixels of [xa, xb) with t > 0 read: lambda grows with |c|, so
+ * it is the largest |c|'s. */
+static int levels_needed(const float *lambda, const float *coc, const float *trow, int xa, int xb)
 {
-    const fv_pyramid *pyr = x->v->pyr;
-    int need = 0; /* the levels this row needs */
-    for (int i = 0; i < x->w; i++) {
-        const float a = coc[i] < 0.0f ? -coc[i] : coc[i];
-        if (a > 0.0f && trow[i] > 0.0f) {
-            const float l = x->lambda[fv_mini((int)(a * LAMBDA_STEPS), (LAMBDA_N - 1))];
-            const int L = (int)l + (l > (float)(int)l);
-            need = L > need ? L : need;
-        }
+    float amax = 0.0f;
+    for (int i = xa; i < xb; i++) {
+        const float a = fabsf(coc[i]);
+        amax = trow[i] > 0.0f && a > amax ? a : amax;
     }
-    need = fv_mini(need, x->up_levels);
+    if (!(amax > 0.0f))
+        return 0;
+    const float l = lambda[fv_mini((int)(amax * LAMBDA_STEPS), (LAMBDA_N - 1))];
+    return (int)l + (l > (float)(int)l);
+}
+
+/* The periphery's blur of every out-of-focus pixel of row y, columns [xa, xb), with t > 0, by its
+ * own |c|: the two nearest up-sampled pyramid levels, interpolated (level 0 is the sharp row).
+ * Far pixels blend it into the centre's Gaussian by t; near pixels' own blur is this alone (the
+ * combine fades it in by t), the quarter-resolution near layer only spreading them over their
+ * surroundings. Used in the transition region; beyond it fvw_hblur_band's half-resolution
+ * result stands in for levels >= 1. */
+static void blur_periphery(const fvw_ctx *x, int tid, int y, const float *coc, const float *trow, const float *sharp,
+                           float *restrict blur, int xa, int xb)
+{
+    if (xa >= xb)
+        return;
+    const fv_pyramid *pyr = x->v->pyr;
+    const int need = fv_mini(levels_needed(x->lambda, coc, trow, xa, xb), x->up_levels);
     float *up[MAX_UP_LEVEL + 1];
     up[0] = (float *)sharp;
     float *tmp = fvw_slot(x, tid, 2);
@@ -163,11 +176,87 @@ void fvw_blur_periphery(const fvw_ctx *x, int tid, int y, const float *coc, cons
         const fv_pyr_level *lv = &pyr->lv[L];
         const img4 im = {lv->rgbd, lv->w, lv->h, lv->stride};
         up[L] = fvw_slot(x, tid, 2 + L);
-        fvw_upsample_row(x->dsp, &im, L, &x->xt[L], y, x->w, tmp, up[L]);
+        fvw_upsample_row(x->dsp, &im, L, &x->xt[L], y, xa, xb, tmp, up[L]);
     }
     const fv_dof_pyrblur_args pa = {.coc = coc, .t = trow, .up = (const float *const *)up, .need = need,
                                     .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS, .lambda_max = (LAMBDA_N - 1)};
-    x->dsp->dof_pyrblur_row(blur, &pa, 0, x->w);
+    x->dsp->dof_pyrblur_row(blur, &pa, xa, xb - xa);
+}
+
+/* Beyond the transition disc the sampler shoots about one ray per five pixels and the blur
+ * comes from the depth-blind pyramid anyway, so the levels >= 1 part of it is computed once on
+ * the level 1 grid (this pass: half-resolution |c|, the 2x2 mean; levels 2.. up-sampled to that
+ * grid and interpolated like blur_periphery, level 1 standing for the sharp row) and each
+ * full-resolution row reads it up-sampled as its "level 1" (periphery_row): a pixel whose level
+ * is below 1 still mixes in its own sharp colour at full resolution, so small CoCs stay exact.
+ * Half rows of one band (TILE / 2); texels that feed no pixel outside the disc are skipped. */
+void fvw_hblur_band(void *ctx, int band, int tid)
+{
+    fvw_ctx *x = ctx;
+    if (!x->half_on)
+        return;
+    const fv_dof_view *v = x->v;
+    const fv_pyr_level *l1 = &v->pyr->lv[1];
+    const ptrdiff_t st = x->wk->stride;
+    float *ch = fvw_slot(x, tid, 1), *tmp = fvw_slot(x, tid, 2), *ones = fvw_slot(x, tid, 8);
+    for (int i = 0; i < x->hw; i++)
+        ones[i] = 1.0f;
+    /* a texel's centre is within 2 px per axis of every pixel it feeds, pixels outside the disc
+     * are farther than r1 from the gaze: texels nearer than r1 - 3 feed none */
+    const float rin = v->r1_px - 3.0f;
+    for (int vy = band * (TILE / 2); vy < fv_mini((band + 1) * (TILE / 2), x->hh); vy++) {
+        int u0 = x->hw, u1 = x->hw; /* the skipped texels [u0, u1) */
+        const float dy = 2.0f * (float)vy + 1.0f - v->gaze_y;
+        if (rin > 0.0f && dy * dy < rin * rin) {
+            const float half = sqrtf(rin * rin - dy * dy);
+            u0 = fv_clampi((int)ceilf((v->gaze_x - half - 1.0f) * 0.5f) + 1, 0, x->hw);
+            u1 = fv_clampi((int)floorf((v->gaze_x + half - 1.0f) * 0.5f), 0, x->hw);
+            if (u1 <= u0)
+                u0 = u1 = x->hw;
+        }
+        const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
+        const float *sharp = l1->rgbd + 4 * (ptrdiff_t)vy * l1->stride;
+        float *blur = x->hblur + 4 * (ptrdiff_t)vy * x->hw;
+        const int seg[2][2] = {{0, u0}, {u1, x->hw}};
+        for (int k = 0; k < 2; k++) {
+            const int a = seg[k][0], b = seg[k][1];
+            if (a >= b)
+                continue;
+            for (int u = a; u < b; u++) {
+                const int i0 = 2 * u, i1 = fv_mini(2 * u + 1, x->w - 1);
+                ch[u] = 0.25f * ((fabsf(ca[i0]) + fabsf(ca[i1])) + (fabsf(cb[i0]) + fabsf(cb[i1])));
+            }
+            memcpy(blur + 4 * a, sharp + 4 * a, (size_t)(b - a) * 4 * sizeof(float));
+            const int need = fv_mini(levels_needed(x->lambda_h, ch, ones, a, b), x->up_levels - 1);
+            float *up[MAX_UP_LEVEL];
+            up[0] = (float *)sharp;
+            for (int L = 1; L <= need; L++) {
+                const fv_pyr_level *lv = &v->pyr->lv[L + 1];
+                const img4 im = {lv->rgbd, lv->w, lv->h, lv->stride};
+                up[L] = fvw_slot(x, tid, 2 + L);
+                fvw_upsample_row(x->dsp, &im, L, &x->xh[L], vy, a, b, tmp, up[L]);
+            }
+            const fv_dof_pyrblur_args pa = {.coc = ch, .t = ones, .up = (const float *const *)up, .need = need,
+                                            .lambda = x->lambda_h, .lambda_steps = LAMBDA_STEPS,
+                                            .lambda_max = (LAMBDA_N - 1)};
+            x->dsp->dof_pyrblur_row(blur, &pa, a, b - a);
+        }
+    }
+}
+
+/* Columns [xa, xb) of row y beyond the transition disc: the half-resolution blur up-sampled is
+ * the row's level 1 for the pyramid blur kernel (levels 0 and 1 only). */
+static void periphery_row(const fvw_ctx *x, int tid, int y, const float *coc, const float *trow, const float *sharp,
+                          float *restrict blur, int xa, int xb)
+{
+    if (xa >= xb)
+        return;
+    const img4 im = {x->hblur, x->hw, x->hh, x->hw};
+    float *up[2] = {(float *)sharp, fvw_slot(x, tid, 9)};
+    fvw_upsample_row(x->dsp, &im, 1, &x->xt[1], y, xa, xb, fvw_slot(x, tid, 2), up[1]);
+    const fv_dof_pyrblur_args pa = {.coc = coc, .t = trow, .up = (const float *const *)up, .need = 1,
+                                    .lambda = x->lambda, .lambda_steps = LAMBDA_STEPS, .lambda_max = (LAMBDA_N - 1)};
+    x->dsp->dof_pyrblur_row(blur, &pa, xa, xb - xa);
 }
 
 /* The fused vertical pass and combine of one band. */
@@ -180,16 +269,20 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
     const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
     /* slots: 0 far, 1 near, 2..7 the far periphery's temporary and up-sampled levels, reused
      * afterwards by the near layer's up-sampling (3, 4) and the enhancement's levels (5..7);
-     * 8 t; the enhancement's CoC-like width (9), result (10), temporary (11), ones (12) */
+     * 8 t; the half-resolution blur up-sampled (9), then the enhancement's CoC-like width (9),
+     * result (10), temporary (11), ones (12) */
     float *far = fvw_slot(x, tid, 0), *near = fvw_slot(x, tid, 1), *trow = fvw_slot(x, tid, 8);
     float *enh = x->enh_on ? fvw_slot(x, tid, 10) : NULL;
     uint8_t sig[TILE * 8];
     double filter_ns = 0.0, combine_ns = 0.0;
+    /* t is 1 outside the disc of radius r1: the row holds 1 except across the disc's span, which
+     * each row writes and puts back */
+    for (int i = 0; i < x->w; i++)
+        trow[i] = 1.0f;
     for (int y = y0; y < y1; y++) {
         const int64_t ta = fv_time_ns();
         const float fy = (float)y + 0.5f;
         const float *coc = x->wk->p1[0] + y * st, *sharp = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
-        /* t is 1 outside the disc of radius r1: compute it only across the disc's span */
         const float dyr = fy - v->gaze_y, r1 = v->r1_px;
         int tx0 = x->w, tx1 = x->w;
         if (dyr * dyr < r1 * r1) {
@@ -197,12 +290,8 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
             tx0 = fv_clampi((int)floorf(v->gaze_x - half) - 1, 0, x->w);
             tx1 = fv_clampi((int)ceilf(v->gaze_x + half) + 1, 0, x->w);
         }
-        for (int i = 0; i < tx0; i++)
-            trow[i] = 1.0f;
         for (int i = tx0; i < tx1; i++)
             trow[i] = fvw_t_of(x, (float)i + 0.5f, fy);
-        for (int i = tx1; i < x->w; i++)
-            trow[i] = 1.0f;
         /* far: the centre's Gaussian (normalised), then the periphery's pyramid blended in */
         const int centre_row = y >= x->cy0 && y < x->cy1;
         if (centre_row) {
@@ -217,7 +306,12 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
                     for (int k = 0; k < 3; k++)
                         far[4 * i + k] /= far[4 * i + 3];
         }
-        fvw_blur_periphery(x, tid, y, coc, trow, sharp, far);
+        if (x->half_on) {
+            periphery_row(x, tid, y, coc, trow, sharp, far, 0, tx0);
+            periphery_row(x, tid, y, coc, trow, sharp, far, tx1, x->w);
+            blur_periphery(x, tid, y, coc, trow, sharp, far, tx0, tx1);
+        } else
+            blur_periphery(x, tid, y, coc, trow, sharp, far, 0, x->w);
         /* near: full resolution in the centre rectangle (pixels with t < 1); the quarter-
          * resolution layer up-sampled is blended in by t in the combine */
         float *nfull = NULL;
@@ -256,13 +350,15 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         if (x->l_reach >= 0) {
             lup = fvw_slot(x, tid, 3);
             const img4 im = {x->l_v, x->lw, x->lh, x->lw};
-            fvw_upsample_row(x->dsp, &im, 2, &x->xt[2], y, x->w, fvw_slot(x, tid, 4), lup); /* LOW = 2^2 */
+            fvw_upsample_row(x->dsp, &im, 2, &x->xt[2], y, 0, x->w, fvw_slot(x, tid, 4), lup); /* LOW = 2^2 */
         }
         if (enh)
             fvw_enhance_row(x, tid, y, sharp, trow, enh);
         const int64_t tb = fv_time_ns();
         fvw_combine_row(x, y, sharp, coc, far, nfull, lup, trow, enh);
         const int64_t tc = fv_time_ns();
+        for (int i = tx0; i < tx1; i++)
+            trow[i] = 1.0f;
         filter_ns += (double)(tb - ta);
         combine_ns += (double)(tc - tb);
     }

@@ -59,6 +59,12 @@ typedef struct {
     int enh_on;                /* contrast enhancement runs */
     float *band_ms;            /* per band: worker time (ms) in the filter and the combine (pairs) */
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
+    /* the periphery's far blur at half resolution (the level 1 grid), up-sampled once per row */
+    int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
+    int hw, hh;                /* level 1's size */
+    float *hblur;              /* hw x hh x 4: level 1 blurred by the half-resolution CoC */
+    const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
+    xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
 } fvw_ctx;
 
 
@@ -83,14 +89,15 @@ static inline float *fvw_slot(const fvw_ctx *x, int tid, int k) { return x->wk->
 
 /* weier_filter.c: up-sampling helpers */
 void fvw_xtaps_init(xtaps *t, int L, int w, int src_w);
-void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int w, float *restrict tmp,
-                      float *restrict dst);
+void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps *xt, int y, int xa, int xb,
+                      float *restrict tmp, float *restrict dst);
 /* weier_coc.c: stage "coc" (bands of TILE rows; then the tiles' reach) */
 void fvw_coc_band(void *ctx, int band, int tid);
 void fvw_dilate_tiles(fvw_ctx *x);
 /* weier_filter.c: stage "dof_filter" (bands); the vertical pass runs the combine row by row */
 void fvw_hpass_band(void *ctx, int band, int tid);
 void fvw_lvpass_band(void *ctx, int band, int tid);
+void fvw_hblur_band(void *ctx, int band, int tid);
 void fvw_vcombine_band(void *ctx, int band, int tid);
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);

@@ -166,23 +166,75 @@ static inline __m256 ld2(const float *lo, const float *hi)
 #define PAIR(v, p) _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(2 * (p), 2 * (p), 2 * (p), 2 * (p), 2 * (p) + 1, \
                                                                  2 * (p) + 1, 2 * (p) + 1, 2 * (p) + 1))
 
+/* texels i and j as one vector: up-sampling by 2^L reads neighbouring or equal texels for
+ * neighbouring pixels, one load instead of two and an insert */
+static inline __m256 ld_tex2(const float *tmp, int32_t i, int32_t j)
+{
+    const float *a = tmp + 4 * (ptrdiff_t)i;
+    if (j == i + 1)
+        return _mm256_loadu_ps(a);
+    if (j == i)
+        return _mm256_broadcast_ps((const __m128 *)(const void *)a);
+    return ld2(a, tmp + 4 * (ptrdiff_t)j);
+}
+
 /* pixels xp, xp + 1 (pair p of the 8 whose weights are a8) */
 static inline void up_pair(float *dst, const float *tmp, const int32_t *i0, const int32_t *i1, __m256 a8, int xp,
                            int p)
 {
-    const __m256 p0 = ld2(tmp + 4 * (ptrdiff_t)i0[xp], tmp + 4 * (ptrdiff_t)i0[xp + 1]);
-    const __m256 p1 = ld2(tmp + 4 * (ptrdiff_t)i1[xp], tmp + 4 * (ptrdiff_t)i1[xp + 1]);
+    const __m256 p0 = ld_tex2(tmp, i0[xp], i0[xp + 1]);
+    const __m256 p1 = ld_tex2(tmp, i1[xp], i1[xp + 1]);
     _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
 }
 
+/* lanes 2p of d (the pairs' first pixels) all 1 / all 0: a bit mask of the 4 pairs whose two
+ * taps are neighbouring / the same texel */
+static inline int pair_steps(__m256i idx, int step)
+{
+    const __m256i d = _mm256_sub_epi32(_mm256_shuffle_epi32(idx, 0xb1), idx); /* lane 2p: idx[2p+1] - idx[2p] */
+    return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(d, _mm256_set1_epi32(step)))) & 0x55;
+}
+
 /* 8 pixels at a time as 4 pairs (unrolled by hand: the pairs' lane indices are constants), the
- * rest with the 128-bit version */
+ * rest with the 128-bit version. Up-sampling by 2 reads neighbouring texels for each pair, by
+ * 4 or more the same texel twice: when all 4 pairs of both taps do, whole-pair or broadcast
+ * loads without the per-pair tests. */
 static void upsample_row_avx2(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                               const float *ax, int n)
 {
     int x = 0;
     for (; x + 8 <= n; x += 8) {
         const __m256 a8 = _mm256_loadu_ps(ax + x);
+        const __m256i j0 = _mm256_loadu_si256((const __m256i *)(const void *)(i0 + x));
+        const __m256i j1 = _mm256_loadu_si256((const __m256i *)(const void *)(i1 + x));
+        if ((pair_steps(j0, 1) & pair_steps(j1, 1)) == 0x55) {
+#define UP_NB(p)                                                                                                     \
+    do {                                                                                                             \
+        const __m256 q0 = _mm256_loadu_ps(tmp + 4 * (ptrdiff_t)i0[x + 2 * (p)]);                                     \
+        const __m256 q1 = _mm256_loadu_ps(tmp + 4 * (ptrdiff_t)i1[x + 2 * (p)]);                                     \
+        _mm256_storeu_ps(dst + 4 * (x + 2 * (p)), _mm256_add_ps(q0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(q1, q0)))); \
+    } while (0)
+            UP_NB(0);
+            UP_NB(1);
+            UP_NB(2);
+            UP_NB(3);
+#undef UP_NB
+            continue;
+        }
+        if ((pair_steps(j0, 0) & pair_steps(j1, 0)) == 0x55) {
+#define UP_BC(p)                                                                                                     \
+    do {                                                                                                             \
+        const __m256 q0 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)i0[x + 2 * (p)])); \
+        const __m256 q1 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)i1[x + 2 * (p)])); \
+        _mm256_storeu_ps(dst + 4 * (x + 2 * (p)), _mm256_add_ps(q0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(q1, q0)))); \
+    } while (0)
+            UP_BC(0);
+            UP_BC(1);
+            UP_BC(2);
+            UP_BC(3);
+#undef UP_BC
+            continue;
+        }
         up_pair(dst, tmp, i0, i1, a8, x, 0);
         up_pair(dst, tmp, i0, i1, a8, x + 2, 1);
         up_pair(dst, tmp, i0, i1, a8, x + 4, 2);
@@ -212,12 +264,83 @@ static inline void pb_pair(float *blur, const float *const *up, const int32_t *L
     _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
 }
 
+/* need == 1 (the periphery beyond the transition ring, whose level 1 is the half-resolution
+ * blur): L1 = 1 and L0 = 0 or 1 per pixel, so both levels load whole pairs and L0 is a select
+ * (no per-pixel pointers, no branches on the levels) */
+static inline void pb_pair1(float *blur, const float *up0, const float *up1, __m256 is1, __m256 f, __m256 t,
+                            __m256 mix, __m256 act, int i, int p, int sel)
+{
+    const ptrdiff_t o = 4 * (ptrdiff_t)(i + 2 * p);
+    float *b = blur + o;
+    const __m256 u1 = _mm256_loadu_ps(up1 + o), u0 = _mm256_blendv_ps(_mm256_loadu_ps(up0 + o), u1, PAIR(is1, p));
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    if (!sel) {
+        _mm256_storeu_ps(b, pv);
+        return;
+    }
+    const __m256 bv = _mm256_loadu_ps(b);
+    const __m256 r =
+        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+}
+
+static void pyrblur1_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+{
+    const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), msign = _mm256_set1_ps(-0.0f);
+    const float *up0 = a->up[0], *up1 = a->up[1];
+    /* The level table in registers instead of a gather: l = min(lambda[k], 1) is 1 for every k
+     * from sat on; when sat <= 32 the first 32 entries are all a lookup needs. */
+    int sat = a->lambda_max + 1;
+    while (sat > 0 && a->lambda[sat - 1] >= 1.0f)
+        sat--;
+    const int regs = sat <= 32 && a->lambda_max >= 31; /* (never read past a shorter table) */
+    __m256 lut[4];
+    for (int q = 0; q < 4; q++)
+        lut[q] = regs ? _mm256_min_ps(_mm256_loadu_ps(a->lambda + 8 * q), one) : zero;
+    int i = x0;
+    for (; i + 8 <= x0 + n; i += 8) {
+        const __m256 c = _mm256_loadu_ps(a->coc + i), t = _mm256_loadu_ps(a->t + i);
+        const __m256 m = _mm256_andnot_ps(msign, c);
+        const __m256 act = _mm256_and_ps(_mm256_cmp_ps(m, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
+        const int bits = _mm256_movemask_ps(act);
+        if (!bits)
+            continue;
+        const __m256 v = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(m, steps), zero), lmax);
+        const __m256i k = _mm256_cvttps_epi32(v);
+        __m256 l;
+        if (regs) {
+            const __m256 b3 = _mm256_castsi256_ps(_mm256_slli_epi32(k, 28)); /* bit 3 -> sign */
+            const __m256 b4 = _mm256_castsi256_ps(_mm256_slli_epi32(k, 27)); /* bit 4 -> sign */
+            const __m256 lo = _mm256_blendv_ps(_mm256_permutevar8x32_ps(lut[0], k), _mm256_permutevar8x32_ps(lut[1], k), b3);
+            const __m256 hi = _mm256_blendv_ps(_mm256_permutevar8x32_ps(lut[2], k), _mm256_permutevar8x32_ps(lut[3], k), b3);
+            l = _mm256_blendv_ps(_mm256_blendv_ps(lo, hi, b4), one,
+                                 _mm256_castsi256_ps(_mm256_cmpgt_epi32(k, _mm256_set1_epi32(31))));
+        } else {
+            l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, k, 4), one);
+        }
+        const __m256 is1 = _mm256_cmp_ps(l, one, _CMP_GE_OQ); /* L0 = int l = 1 */
+        const __m256 f = _mm256_sub_ps(l, _mm256_and_ps(is1, one));
+        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        const int sel = !(bits == 255 && !_mm256_movemask_ps(mix));
+        for (int p = 0; p < 4; p++)
+            if (!sel || (bits >> (2 * p) & 3))
+                pb_pair1(blur, up0, up1, is1, f, t, mix, act, i, p, sel);
+    }
+    if (i < x0 + n)
+        dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
+}
+
 /* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_tmpl.h has why the clamped LUT
  * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs
  * (unrolled by hand), each computed for both pixels and kept per pixel by selects; the rest
  * 128-bit. */
 static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
+    if (a->need == 1) {
+        pyrblur1_row_avx2(blur, a, x0, n);
+        return;
+    }
     const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
     const __m256 need = _mm256_set1_ps((float)a->need), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     const __m256 msign = _mm256_set1_ps(-0.0f);
@@ -259,8 +382,73 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
 }
 
+/* two blocks (8 pixels): pixel pairs as vectors, the pairs of a block added crosswise so that
+ * each half holds (q0 + q2) / (q1 + q3) as the reference; min / max within each 128-bit half */
+static void nearblk_row_avx2(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
+{
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    int b = 0;
+    for (; 4 * b + 8 <= n; b += 2) {
+        const float *p = rgbd + 16 * b;
+        const __m256 c = _mm256_loadu_ps(coc + 4 * b), m = _mm256_cmp_ps(c, zero, _CMP_LT_OQ);
+#define NB_Q(k) _mm256_and_ps(_mm256_blend_ps(_mm256_loadu_ps(p + 8 * (k)), one, 0x88), PAIR(m, k))
+        const __m256 t0 = _mm256_add_ps(NB_Q(0), NB_Q(1)), t1 = _mm256_add_ps(NB_Q(2), NB_Q(3));
+#undef NB_Q
+        const __m256 s = _mm256_add_ps(_mm256_permute2f128_ps(t0, t1, 0x20), _mm256_permute2f128_ps(t0, t1, 0x31));
+        _mm256_storeu_ps(sum + 4 * b, _mm256_add_ps(_mm256_loadu_ps(sum + 4 * b), s));
+        __m256 lo = _mm256_min_ps(c, _mm256_shuffle_ps(c, c, 0xb1)), hi = _mm256_max_ps(c, _mm256_shuffle_ps(c, c, 0xb1));
+        lo = _mm256_min_ps(lo, _mm256_shuffle_ps(lo, lo, 0x4e)), hi = _mm256_max_ps(hi, _mm256_shuffle_ps(hi, hi, 0x4e));
+        /* (lo, hi) of block 0 in lanes 0, 1, of block 1 in lanes 2, 3 */
+        const __m128 v = _mm256_castps256_ps128(
+            _mm256_permutevar8x32_ps(_mm256_unpacklo_ps(lo, hi), _mm256_setr_epi32(0, 1, 4, 5, 0, 1, 4, 5)));
+        const __m128 e = _mm_loadu_ps(ext + 2 * b);
+        _mm_storeu_ps(ext + 2 * b, _mm_add_ps(_mm_blend_ps(_mm_min_ps(v, e), _mm_max_ps(v, e), 10), _mm_setzero_ps()));
+    }
+    for (; 4 * b + 4 <= n; b++)
+        dof_nearblk4(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b);
+    if (4 * b < n)
+        fv_dof_nearblk_row_c(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b, n - 4 * b);
+}
+
+/* 8 outputs a step whose taps all lie in the row: per tap the 8 radii / weights as one vector
+ * (masked to +0 where the tap does not reach), spread over the 4 pixel pairs */
+static void nearbox_row_avx2(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                             const float *r, const float *wgt, int w, int x0, int n, int reach)
+{
+    const __m256 one = _mm256_set1_ps(1.0f);
+    int i = x0;
+    while (i < x0 + n) {
+        if (i >= reach && i + 7 + reach < w && i + 8 <= x0 + n) {
+            __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0, rm = a0;
+            for (int j = -reach; j <= reach; j++) {
+                const __m256 r8 = _mm256_loadu_ps(r + i + j);
+                const __m256 m = _mm256_cmp_ps(r8, _mm256_set1_ps((float)(j < 0 ? -j : j)), _CMP_GE_OQ);
+                const __m256 w8 = _mm256_and_ps(_mm256_loadu_ps(wgt + i + j), m);
+                rm = _mm256_max_ps(_mm256_and_ps(r8, m), rm);
+                const float *p = src + 4 * (ptrdiff_t)(i + j);
+                a0 = _mm256_add_ps(a0, _mm256_mul_ps(PAIR(w8, 0), _mm256_loadu_ps(p)));
+                a1 = _mm256_add_ps(a1, _mm256_mul_ps(PAIR(w8, 1), _mm256_loadu_ps(p + 8)));
+                a2 = _mm256_add_ps(a2, _mm256_mul_ps(PAIR(w8, 2), _mm256_loadu_ps(p + 16)));
+                a3 = _mm256_add_ps(a3, _mm256_mul_ps(PAIR(w8, 3), _mm256_loadu_ps(p + 24)));
+            }
+            float *o = out + 4 * (ptrdiff_t)i;
+            _mm256_storeu_ps(o, a0), _mm256_storeu_ps(o + 8, a1), _mm256_storeu_ps(o + 16, a2);
+            _mm256_storeu_ps(o + 24, a3);
+            _mm256_storeu_ps(out_r + i, rm);
+            _mm256_storeu_ps(out_w + i, _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(rm, rm), one)));
+            i += 8;
+        } else if (i >= reach && i + 3 + reach < w && i + 4 <= x0 + n) {
+            dof_nearbox4(out, out_r, out_w, src, r, wgt, i, reach), i += 4;
+        } else { /* the row's ends */
+            fv_dof_nearbox_row_c(out, out_r, out_w, src, r, wgt, w, i, 1, reach), i++;
+        }
+    }
+}
+
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d)
 {
+    d->dof_nearbox_row = nearbox_row_avx2;
+    d->dof_nearblk_row = nearblk_row_avx2;
     d->dof_upsample_row = upsample_row_avx2;
     d->dof_pyrblur_row = pyrblur_row_avx2;
     d->dof_coc_row = coc_row_avx2;

@@ -33,8 +33,29 @@ static void pyrblur_row_sse41(float *restrict blur, const fv_dof_pyrblur_args *a
     dof_pyrblur_row_x86(blur, a, x0, n);
 }
 
+static void nearblk_row_sse41(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
+{
+    int b = 0;
+    for (; 4 * b + 4 <= n; b++)
+        dof_nearblk4(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b);
+    if (4 * b < n)
+        fv_dof_nearblk_row_c(sum + 4 * b, ext + 2 * b, coc + 4 * b, rgbd + 16 * b, n - 4 * b);
+}
+
+static void nearbox_row_sse41(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
+                              const float *r, const float *wgt, int w, int x0, int n, int reach)
+{
+    for (int i = x0; i < x0 + n;)
+        if (i >= reach && i + 3 + reach < w && i + 4 <= x0 + n)
+            dof_nearbox4(out, out_r, out_w, src, r, wgt, i, reach), i += 4;
+        else /* the row's ends */
+            fv_dof_nearbox_row_c(out, out_r, out_w, src, r, wgt, w, i, 1, reach), i++;
+}
+
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d)
 {
+    d->dof_nearbox_row = nearbox_row_sse41;
+    d->dof_nearblk_row = nearblk_row_sse41;
     d->dof_upsample_row = upsample_row_sse41;
     d->dof_pyrblur_row = pyrblur_row_sse41;
     d->dof_coc_row = coc_row_sse41;

@@ -27,6 +27,45 @@
 #define DOF_CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
 
 
+/* ---- nearblk_row: one block of 4 pixels (q, the +0 of skipped pixels, as the reference) ---- */
+static inline void dof_nearblk4(float *sum, float *ext, const float *coc, const float *rgbd)
+{
+    const __m128 c = _mm_loadu_ps(coc), m = _mm_cmplt_ps(c, _mm_setzero_ps()), one = _mm_set1_ps(1.0f);
+#define DOF_NB_Q(k) _mm_and_ps(_mm_blend_ps(_mm_loadu_ps(rgbd + 4 * (k)), one, 8), _mm_shuffle_ps(m, m, (k) * 0x55))
+    const __m128 s = _mm_add_ps(_mm_add_ps(DOF_NB_Q(0), DOF_NB_Q(2)), _mm_add_ps(DOF_NB_Q(1), DOF_NB_Q(3)));
+#undef DOF_NB_Q
+    _mm_storeu_ps(sum, _mm_add_ps(_mm_loadu_ps(sum), s));
+    __m128 lo = _mm_min_ps(c, _mm_shuffle_ps(c, c, 0xb1)), hi = _mm_max_ps(c, _mm_shuffle_ps(c, c, 0xb1));
+    lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, 0x4e)), hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, 0x4e));
+    const __m128 e = _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)ext));
+    const __m128 r = _mm_add_ps(_mm_blend_ps(_mm_min_ps(lo, e), _mm_max_ps(hi, e), 2), _mm_setzero_ps());
+    _mm_storel_epi64((__m128i *)(void *)ext, _mm_castps_si128(r));
+}
+
+/* ---- nearbox_row: 4 outputs i.. i+3 whose taps all lie in the row (i >= reach, i + 3 + reach
+ * < w): per tap the 4 radii / weights as one vector, masked to +0 where the tap does not reach
+ * (the reference skips it; + (+0 x finite) leaves a sum that started at +0 unchanged) ---- */
+static inline void dof_nearbox4(float *out, float *out_r, float *out_w, const float *src, const float *r,
+                                const float *wgt, int i, int reach)
+{
+    __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0, a3 = a0, rm = a0;
+    for (int j = -reach; j <= reach; j++) {
+        const __m128 r4 = _mm_loadu_ps(r + i + j), m = _mm_cmpge_ps(r4, _mm_set1_ps((float)(j < 0 ? -j : j)));
+        const __m128 w4 = _mm_and_ps(_mm_loadu_ps(wgt + i + j), m);
+        rm = _mm_max_ps(_mm_and_ps(r4, m), rm);
+        const float *p = src + 4 * (ptrdiff_t)(i + j);
+        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0x00), _mm_loadu_ps(p)));
+        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0x55), _mm_loadu_ps(p + 4)));
+        a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0xaa), _mm_loadu_ps(p + 8)));
+        a3 = _mm_add_ps(a3, _mm_mul_ps(_mm_shuffle_ps(w4, w4, 0xff), _mm_loadu_ps(p + 12)));
+    }
+    float *o = out + 4 * (ptrdiff_t)i;
+    _mm_storeu_ps(o, a0), _mm_storeu_ps(o + 4, a1), _mm_storeu_ps(o + 8, a2), _mm_storeu_ps(o + 12, a3);
+    _mm_storeu_ps(out_r + i, rm);
+    const __m128 one = _mm_set1_ps(1.0f);
+    _mm_storeu_ps(out_w + i, _mm_div_ps(one, _mm_add_ps(_mm_add_ps(rm, rm), one)));
+}
+
 /* ---- coc_row: 4 pixels ---- */
 typedef struct {
     __m128 K, idn, idf, dn, df;

@@ -70,7 +70,8 @@ static void run_all(const char *kernel, runner fn, size_t member)
 
 /* ------------------------------------------------------------------ tables */
 
-static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row"};
+static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row",
+                                     "dof_nearblk_row", "dof_nearbox_row"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -87,6 +88,8 @@ static void test_tables(void **state)
     assert_true(ref.dof_combine_row == fv_dof_combine_row_c);
     assert_true(ref.dof_upsample_row == fv_dof_upsample_row_c);
     assert_true(ref.dof_pyrblur_row == fv_dof_pyrblur_row_c);
+    assert_true(ref.dof_nearblk_row == fv_dof_nearblk_row_c);
+    assert_true(ref.dof_nearbox_row == fv_dof_nearbox_row_c);
     for (int k = 0; checkasm_isas[k]; k++) {
         const unsigned isa = checkasm_isas[k];
         memset(&own, 0, sizeof own);
@@ -541,6 +544,91 @@ static void test_pyrblur_row(void **state)
            pb_active, pb_mix, pb_beyond, pb_frac);
 }
 
+/* ------------------------------------------------------------------ nearblk_row */
+
+/* Rows of every length mod 8 (partial blocks, the AVX2 pair loop's tail), CoCs mixing near, far,
+ * signed zeros and all-near / all-far runs; the accumulators start from earlier rows' values
+ * (signed zeros among them), and each case runs the kernel on 1-4 rows in a row as the CoC pass
+ * does. */
+static void run_nearblk(const fv_dof_dsp *d, const char *isa)
+{
+    static const float zc[] = {0.0f, -0.0f, -1e-30f, 1e-30f, -24.0f, 64.0f};
+    for (int n = 1; n <= 40 + 2; n++) {
+        const int nn = n <= 40 ? n : n == 41 ? 640 : 1283;
+        const int nb = (nn + 3) / 4;
+        for (int mode = 0; mode < 6; mode++) {
+            const int off = rndi(4), rows = 1 + rndi(4);
+            buf in = buf_new(4 * (size_t)nn * rows, off), c = buf_new((size_t)nn * rows, off);
+            for (int i = 0; i < nn * rows; i++) {
+                for (int k = 0; k < 4; k++)
+                    in.p[4 * i + k] = colour();
+                const int sel = mode == 1 ? 0 : mode == 2 ? 1 : mode == 3 ? 2 + rndi(4) : rndi(mode == 4 ? 2 : 8);
+                c.p[i] = sel == 0 ? -(0.01f + 30.0f * rnd()) : sel == 1 ? 0.01f + 30.0f * rnd()
+                                                             : sel < 8 ? zc[sel - 2] : 0.0f;
+            }
+            buf rs = checkasm_out_f32(4 * (size_t)nb, off), ts = checkasm_out_f32(4 * (size_t)nb, off);
+            buf re = checkasm_out_f32(2 * (size_t)nb, off), te = checkasm_out_f32(2 * (size_t)nb, off);
+            for (int i = 0; i < 4 * nb; i++)
+                rs.p[i] = ts.p[i] = rndi(3) == 0 ? 0.0f : 4.0f * rnd();
+            for (int i = 0; i < 2 * nb; i++)
+                re.p[i] = te.p[i] = rndi(3) == 0 ? (rndi(2) ? -0.0f : 0.0f) : (i & 1 ? 20.0f : -20.0f) * rnd();
+            for (int y = 0; y < rows; y++) {
+                fv_dof_nearblk_row_c(rs.p, re.p, c.p + y * nn, in.p + 4 * (size_t)y * nn, nn);
+                d->dof_nearblk_row(ts.p, te.p, c.p + y * nn, in.p + 4 * (size_t)y * nn, nn);
+            }
+            compare_out(&rs, &ts, 4 * (size_t)nb, 4, isa, "nearblk_row", "block sums + canaries");
+            compare_out(&re, &te, 2 * (size_t)nb, 2, isa, "nearblk_row", "block min / max + canaries");
+            free(in.base), free(c.base), free(rs.base), free(ts.base), free(re.base), free(te.base);
+        }
+    }
+}
+
+static void test_nearblk_row(void **state)
+{
+    (void)state;
+    run_all("dof_nearblk_row", run_nearblk, offsetof(fv_dof_dsp, dof_nearblk_row));
+}
+
+/* ------------------------------------------------------------------ nearbox_row */
+
+/* Rows of 1-60 pixels and 640, spans anywhere in them (the row's ends take the reference's path in
+ * the ISA versions), reaches 0-24; radii -1 (not near) or 0-24, mostly small so that taps both
+ * reach and do not; weights the box's 1 / (2r + 1) or arbitrary (>= +0, zeros among them). */
+static void run_nearbox(const fv_dof_dsp *d, const char *isa)
+{
+    for (int w = 1; w <= 60 + 1; w++) {
+        const int ww = w <= 60 ? w : 640;
+        for (int rep = 0; rep < 6; rep++) {
+            const int off = rndi(4), reach = rndi(5) == 0 ? FV_DOF_RMAX : rndi(12);
+            const int x0 = rndi(ww), n = 1 + rndi(ww - x0);
+            buf src = buf_new(4 * (size_t)ww, off), r = buf_new((size_t)ww, off), wg = buf_new((size_t)ww, off);
+            for (int i = 0; i < ww; i++) {
+                for (int k = 0; k < 4; k++)
+                    src.p[4 * i + k] = colour();
+                r.p[i] = rndi(4) == 0 ? -1.0f : (float)(rndi(6) == 0 ? rndi(FV_DOF_RMAX + 1) : rndi(6));
+                wg.p[i] = rndi(3) ? 1.0f / (2.0f * (r.p[i] > 0.0f ? r.p[i] : 0.0f) + 1.0f)
+                                  : (rndi(4) == 0 ? 0.0f : 2.0f * rnd());
+            }
+            buf ro = checkasm_out_f32(4 * (size_t)ww, off), to = checkasm_out_f32(4 * (size_t)ww, off);
+            buf rr = checkasm_out_f32((size_t)ww, off), tr = checkasm_out_f32((size_t)ww, off);
+            buf rw = checkasm_out_f32((size_t)ww, off), tw = checkasm_out_f32((size_t)ww, off);
+            fv_dof_nearbox_row_c(ro.p, rr.p, rw.p, src.p, r.p, wg.p, ww, x0, n, reach);
+            d->dof_nearbox_row(to.p, tr.p, tw.p, src.p, r.p, wg.p, ww, x0, n, reach);
+            compare_out(&ro, &to, 4 * (size_t)ww, 4, isa, "nearbox_row", "box sums + canaries");
+            compare_out(&rr, &tr, (size_t)ww, 1, isa, "nearbox_row", "largest radius + canaries");
+            compare_out(&rw, &tw, (size_t)ww, 1, isa, "nearbox_row", "box weight + canaries");
+            free(src.base), free(r.base), free(wg.base), free(ro.base), free(to.base), free(rr.base), free(tr.base);
+            free(rw.base), free(tw.base);
+        }
+    }
+}
+
+static void test_nearbox_row(void **state)
+{
+    (void)state;
+    run_all("dof_nearbox_row", run_nearbox, offsetof(fv_dof_dsp, dof_nearbox_row));
+}
+
 const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_gauss_tab),
@@ -550,5 +638,7 @@ const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_combine_row),
     cmocka_unit_test(test_upsample_row),
     cmocka_unit_test(test_pyrblur_row),
+    cmocka_unit_test(test_nearblk_row),
+    cmocka_unit_test(test_nearbox_row),
     {0},
 };
