@@ -6,6 +6,7 @@
 #define FOVEA_SCENE_IMPL_H
 
 #include "scene.h"
+#include "shade_dsp.h" /* fv_light_rec: the lights as the shading kernels read them */
 
 #include <math.h>
 #include <pthread.h>
@@ -32,11 +33,6 @@ typedef struct fv_mesh_rec {
     float base_color[4];
     int texture;
 } fv_mesh_rec;
-
-typedef struct fv_light_rec {
-    fv_light l;
-    float cos_inner, cos_outer; /* spot only */
-} fv_light_rec;
 
 struct fv_scene {
     RTCDevice device;

@@ -20,6 +20,7 @@
 #include "eyetrack/eyetrack_dsp.h"
 #include "pullpush_dsp.h"
 #include "reproject_dsp.h"
+#include "shade_dsp.h"
 
 /* Every module's table, for one ISA mask. */
 typedef struct checkasm_dsp {
@@ -28,6 +29,7 @@ typedef struct checkasm_dsp {
     fv_reproject_dsp taa;
     fv_dof_dsp dof;
     fv_eyetrack_dsp et;
+    fv_shade_dsp shade;
 } checkasm_dsp;
 void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask);
 
