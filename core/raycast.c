@@ -1,75 +1,128 @@
 #include "raycast.h"
 
 #include <math.h>
+#include <stdatomic.h>
+
+#include "shade_dsp.h"
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
 
-/* Pixels of a tile in 4x2 blocks, so a full packet of 8 is a compact 4x2 footprint and a
- * sparse tile's packets still gather nearby pixels (coherent rays). */
-static const unsigned char *tile_order(void)
+int fv_raycast_packet_width(void)
 {
-    static const unsigned char order[FV_TILE * FV_TILE][2] = {
-#define B(bx, by) {bx*4+0,by*2+0},{bx*4+1,by*2+0},{bx*4+2,by*2+0},{bx*4+3,by*2+0}, \
-                  {bx*4+0,by*2+1},{bx*4+1,by*2+1},{bx*4+2,by*2+1},{bx*4+3,by*2+1}
-#define R(by) B(0,by),B(1,by),B(2,by),B(3,by)
-        R(0), R(1), R(2), R(3), R(4), R(5), R(6), R(7)
-#undef R
-#undef B
-    };
-    return &order[0][0];
+    static atomic_int width; /* 0: not asked yet; every device of one library answers the same */
+    int w = atomic_load_explicit(&width, memory_order_relaxed);
+    if (!w) {
+        RTCDevice d = rtcNewDevice(NULL);
+        w = d && rtcGetDeviceProperty(d, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
+        if (d)
+            rtcReleaseDevice(d);
+        atomic_store_explicit(&width, w, memory_order_relaxed);
+    }
+    return w;
 }
 
-long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_pyr_level *l0, int x0, int y0, int tw, int th,
-                     const uint32_t rows[FV_TILE])
+/* The sampled pixels of a tile as (y << 4 | x) in 4x2-block order, so a full packet of 8 is a
+ * compact 4x2 footprint (16: 8x2) and a sparse tile's packets still gather nearby pixels
+ * (coherent rays). Walks the set bits of each block's 8-bit mask. */
+static int compact(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_TILE * FV_TILE])
 {
-    const unsigned char *order = tile_order();
-    struct RTCIntersectContext ictx;
-    rtcInitIntersectContext(&ictx);
-    ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    struct RTCRayHit8 rh;
-    int valid[8];
-    int px[8], py[8];
-    long rays = 0;
-    int k = 0;
-    for (int i = 0; i <= FV_TILE * FV_TILE; i++) {
-        if (i < FV_TILE * FV_TILE) {
-            int lx = order[2 * i], ly = order[2 * i + 1];
-            if (lx >= tw || ly >= th || !((rows[ly] >> lx) & 1u))
-                continue;
-            px[k] = x0 + lx;
-            py[k] = y0 + ly;
-            float d[3];
-            fv_camera_ray(cam, (float)px[k] + 0.5f, (float)py[k] + 0.5f, d);
-            fv_ray8_set(&rh, k, cam->eye_pos, d);
-            valid[k] = -1;
-            if (++k < 8)
-                continue;
-        }
-        if (k == 0)
-            break;
-        for (int q = k; q < 8; q++)
-            valid[q] = 0;
-        rtcIntersect8(valid, fv_scene_rtc(scene), &ictx, &rh);
-        for (int q = 0; q < k; q++) {
-            float *dst = l0->rgbd + 4 * (py[q] * l0->stride + px[q]);
-            if (rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID) {
-                dst[0] = fv_background_rgb[0];
-                dst[1] = fv_background_rgb[1];
-                dst[2] = fv_background_rgb[2];
-                dst[3] = FV_DEPTH_MISS_M;
-            } else {
-                float org[3] = {rh.ray.org_x[q], rh.ray.org_y[q], rh.ray.org_z[q]};
-                float dir[3] = {rh.ray.dir_x[q], rh.ray.dir_y[q], rh.ray.dir_z[q]};
-                float len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-                float t = rh.ray.tfar[q];
-                fv_scene_shade(scene, rh.hit.geomID[q], rh.hit.primID[q], rh.hit.u[q], rh.hit.v[q], org, dir, t,
-                               cam->px_tan / len, cam->eye_pos, dst);
-                dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M; /* t is the view depth: dir.z_eye = -1 */
+    const uint32_t keep = tw >= 32 ? ~0u : (1u << tw) - 1u;
+    int n = 0;
+    for (int by = 0; by < FV_TILE / 2; by++) {
+        const uint32_t r0 = 2 * by < th ? rows[2 * by] & keep : 0, r1 = 2 * by + 1 < th ? rows[2 * by + 1] & keep : 0;
+        for (int bx = 0; bx < FV_TILE / 4; bx++) {
+            unsigned m = (r0 >> (4 * bx) & 15u) | (r1 >> (4 * bx) & 15u) << 4;
+            for (; m; m &= m - 1) {
+                const unsigned b = (unsigned)__builtin_ctz(m);
+                px[n++] = (uint8_t)((2 * by + (b >> 2)) << 4 | (4 * bx + (b & 3)));
             }
-            l0->wgt[py[q] * l0->stride + px[q]] = 1.0f;
         }
-        rays += k;
-        k = 0;
     }
-    return rays;
+    return n;
+}
+
+/* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths): camera rays through the
+ * pixel centres, as fv_camera_ray computes them, lane by lane into the SoA packet (the padding
+ * lanes repeat the first pixel and are invalid); after the hits, the packet's shading. */
+#define DEF_PACKETS(N)                                                                                            \
+    static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,                 \
+                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                      \
+    {                                                                                                             \
+        struct RTCIntersectContext ictx;                                                                          \
+        rtcInitIntersectContext(&ictx);                                                                           \
+        ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                                         \
+        RTCScene rs = fv_scene_rtc(scene);                                                                        \
+        _Alignas(64) struct RTCRayHit##N rh;                                                                      \
+        _Alignas(64) int valid[N];                                                                                \
+        _Alignas(64) float rgb[3][16];                                                                            \
+        for (int q = 0; q < N; q++) { /* what no lane changes */                                                 \
+            rh.ray.org_x[q] = cam->eye_pos[0], rh.ray.org_y[q] = cam->eye_pos[1], rh.ray.org_z[q] = cam->eye_pos[2]; \
+            rh.ray.tnear[q] = 0.0f, rh.ray.time[q] = 0.0f, rh.ray.mask[q] = ~0u, rh.ray.flags[q] = 0;            \
+            rh.ray.id[q] = (unsigned)q;                                                                           \
+        }                                                                                                         \
+        const fv_hit_packet hp = {rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar,                \
+                                  {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z}};                                    \
+        for (int i = 0; i < n; i += N) {                                                                          \
+            const int k = n - i < N ? n - i : N;                                                                  \
+            _Alignas(64) float fx[N], fy[N];                                                                      \
+            for (int q = 0; q < N; q++) {                                                                         \
+                const int p = px[q < k ? i + q : i];                                                              \
+                fx[q] = (float)(x0 + (p & 15)), fy[q] = (float)(y0 + (p >> 4));                                   \
+                valid[q] = q < k ? -1 : 0;                                                                        \
+            }                                                                                                     \
+            /* branch-free lanes (vectorised by the compiler); the lens, if any, lane by lane */                 \
+            for (int q = 0; q < N; q++) {                                                                         \
+                fx[q] = cam->tan_left + (fx[q] + 0.5f) * cam->px_tan;                                             \
+                fy[q] = cam->tan_top - (fy[q] + 0.5f) * cam->px_tan;                                              \
+            }                                                                                                     \
+            if (cam->lens_on)                                                                                     \
+                for (int q = 0; q < N; q++)                                                                       \
+                    fv_lens_distort(cam->lens_k1, cam->lens_k2, cam->lens_scale, cam->lens_cx, cam->lens_cy,      \
+                                    fx[q], fy[q], &fx[q], &fy[q]);                                                \
+            for (int q = 0; q < N; q++) {                                                                         \
+                rh.ray.dir_x[q] = fx[q] * cam->right[0] + fy[q] * cam->up[0] - cam->back[0];                      \
+                rh.ray.dir_y[q] = fx[q] * cam->right[1] + fy[q] * cam->up[1] - cam->back[1];                      \
+                rh.ray.dir_z[q] = fx[q] * cam->right[2] + fy[q] * cam->up[2] - cam->back[2];                      \
+                rh.ray.tfar[q] = INFINITY;                                                                        \
+                rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;                                                       \
+                rh.hit.instID[0][q] = RTC_INVALID_GEOMETRY_ID;                                                    \
+            }                                                                                                     \
+            rtcIntersect##N(valid, rs, &ictx, &rh);                                                               \
+            fv_scene_shade_packet(scene, dsp, &hp, k, cam->px_tan, cam->eye_pos, rgb);                            \
+            for (int q = 0; q < k; q++) {                                                                         \
+                const int p = px[i + q];                                                                          \
+                float *dst = l0->rgbd + 4 * ((y0 + (p >> 4)) * l0->stride + x0 + (p & 15));                       \
+                if (rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID) {                                                      \
+                    dst[0] = fv_background_rgb[0], dst[1] = fv_background_rgb[1], dst[2] = fv_background_rgb[2];  \
+                    dst[3] = FV_DEPTH_MISS_M;                                                                     \
+                } else { /* t is the view depth: dir.z_eye = -1 */                                                \
+                    const float t = rh.ray.tfar[q];                                                                      \
+                    dst[0] = rgb[0][q], dst[1] = rgb[1][q], dst[2] = rgb[2][q];                                   \
+                    dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;                                           \
+                }                                                                                                 \
+            }                                                                                                     \
+        }                                                                                                         \
+    }
+DEF_PACKETS(8)
+DEF_PACKETS(16)
+
+long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp, const fv_pyr_level *l0,
+                     int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE])
+{
+    /* every pixel's weight, from the rows' bits (pull-push never reads the colour of a zero-weight
+     * pixel, so the others' colours are left alone) */
+    for (int y = 0; y < th; y++) {
+        float *w = l0->wgt + (ptrdiff_t)(y0 + y) * l0->stride + x0;
+        for (int x = 0; x < tw; x++)
+            w[x] = (float)(rows[y] >> x & 1u);
+    }
+    uint8_t px[FV_TILE * FV_TILE];
+    const int n = compact(rows, tw, th, px);
+    if (n == 0)
+        return 0;
+    if (fv_raycast_packet_width() == 16)
+        packets_16(scene, cam, dsp, l0, x0, y0, px, n);
+    else
+        packets_8(scene, cam, dsp, l0, x0, y0, px, n);
+    return n;
 }

@@ -4,11 +4,39 @@
 
 #include <math.h>
 
+_Static_assert(FV_SHADE_LANES == 16, "fv_hit_packet (scene.h) holds 16 lanes");
+
 static float smoothstepf(float e0, float e1, float x)
 {
     if (e1 <= e0) return x >= e1 ? 1.0f : 0.0f;
     const float t = fv_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
     return t * t * (3.0f - 2.0f * t);
+}
+
+/* The material's base colour at the hit, times its texture (trilinear, mip level from the ray
+ * footprint): shared by the scalar and the packet paths so both give the same bits. */
+static void base_colour(const fv_scene *s, const fv_mesh_rec *m, const uint32_t *tri, unsigned prim_id, float u,
+                        float v, float w, const float dir[3], float t, float footprint_rad, float base[3])
+{
+    base[0] = m->base_color[0], base[1] = m->base_color[1], base[2] = m->base_color[2];
+    if (m->texture < 0)
+        return;
+    const float *a = m->uvs + 2 * (size_t)tri[0], *b = m->uvs + 2 * (size_t)tri[1], *c = m->uvs + 2 * (size_t)tri[2];
+    const float tu = w * a[0] + u * b[0] + v * c[0], tv = w * a[1] + u * b[1] + v * c[1];
+    const float density = m->texel_density[prim_id];
+    float lod = 0.0f;
+    if (footprint_rad > 0.0f && t > 0.0f && density > 0.0f) {
+        float e1[3], e2[3], ng[3];
+        tri_edges(m->pos, tri, e1, e2);
+        cross3(e1, e2, ng);
+        const float ng_len = len3(ng), dir_len = len3(dir);
+        const float cos_theta = ng_len > 0.0f && dir_len > 0.0f ? fabsf(dot3(ng, dir)) / (ng_len * dir_len) : 1.0f;
+        const float width_m = t * dir_len * footprint_rad / fmaxf(cos_theta, 0.1f);
+        lod = log2f(width_m * density);
+    }
+    float texel[4];
+    fv_texture_sample(&s->textures[m->texture], tu, tv, lod, texel);
+    for (int k = 0; k < 3; k++) base[k] *= texel[k];
 }
 
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
@@ -43,25 +71,8 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     if (dot3(n, dir) > 0.0f)
         for (int k = 0; k < 3; k++) n[k] = -n[k];
 
-    float base[3] = {m->base_color[0], m->base_color[1], m->base_color[2]};
-    if (m->texture >= 0) {
-        const float *a = m->uvs + 2 * (size_t)tri[0], *b = m->uvs + 2 * (size_t)tri[1], *c = m->uvs + 2 * (size_t)tri[2];
-        const float tu = w * a[0] + u * b[0] + v * c[0], tv = w * a[1] + u * b[1] + v * c[1];
-        const float density = m->texel_density[prim_id];
-        float lod = 0.0f;
-        if (footprint_rad > 0.0f && t > 0.0f && density > 0.0f) {
-            float e1[3], e2[3], ng[3];
-            tri_edges(m->pos, tri, e1, e2);
-            cross3(e1, e2, ng);
-            const float ng_len = len3(ng), dir_len = len3(dir);
-            const float cos_theta = ng_len > 0.0f && dir_len > 0.0f ? fabsf(dot3(ng, dir)) / (ng_len * dir_len) : 1.0f;
-            const float width_m = t * dir_len * footprint_rad / fmaxf(cos_theta, 0.1f);
-            lod = log2f(width_m * density);
-        }
-        float texel[4];
-        fv_texture_sample(&s->textures[m->texture], tu, tv, lod, texel);
-        for (int k = 0; k < 3; k++) base[k] *= texel[k];
-    }
+    float base[3];
+    base_colour(s, m, tri, prim_id, u, v, w, dir, t, footprint_rad, base);
 
     const float p[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
     float light[3] = {FV_SCENE_AMBIENT, FV_SCENE_AMBIENT, FV_SCENE_AMBIENT};
@@ -97,4 +108,63 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         }
     }
     for (int k = 0; k < 3; k++) rgb[k] = base[k] * light[k];
+}
+
+void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_hit_packet *h, int n,
+                           float px_tan, const float eye_pos[3], float rgb[3][FV_SHADE_LANES])
+{
+    _Alignas(64) fv_shade_packet pk;
+    unsigned hits = 0, black = 0;
+    /* the lanes' vertex normals are scattered cache misses behind their index loads: ask for all
+     * of them first, so they overlap */
+    for (int q = 0; q < n; q++) {
+        const unsigned g = h->geom[q], prim = h->prim[q];
+        if (g < s->mesh_count && prim < s->meshes[g].tri_count) {
+            const fv_mesh_rec *m = &s->meshes[g];
+            const uint32_t *tri = m->tri + 3 * (size_t)prim;
+            for (int c = 0; c < 3; c++)
+                __builtin_prefetch(m->normals + 3 * (size_t)tri[c]);
+        }
+    }
+    for (int q = 0; q < FV_SHADE_LANES; q++) {
+        const unsigned g = q < n ? h->geom[q] : RTC_INVALID_GEOMETRY_ID, prim = q < n ? h->prim[q] : 0;
+        const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
+        if (!m || prim >= m->tri_count) { /* a miss, padding, or no such triangle: harmless values */
+            if (g != RTC_INVALID_GEOMETRY_ID)
+                black |= 1u << q;
+            for (int k = 0; k < 9; k++) pk.nrm[k][q] = k % 3 == 2 ? 1.0f : 0.0f;
+            pk.u[q] = pk.v[q] = pk.t[q] = 0.0f;
+            for (int k = 0; k < 3; k++) pk.dir[k][q] = k == 2 ? -1.0f : 0.0f, pk.base[k][q] = 0.0f;
+            continue;
+        }
+        hits |= 1u << q;
+        const uint32_t *tri = m->tri + 3 * (size_t)prim;
+        for (int c = 0; c < 3; c++) {
+            const float *nv = m->normals + 3 * (size_t)tri[c];
+            pk.nrm[3 * c][q] = nv[0], pk.nrm[3 * c + 1][q] = nv[1], pk.nrm[3 * c + 2][q] = nv[2];
+        }
+        const float u = h->u[q], v = h->v[q], t = h->t[q];
+        const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
+        pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
+        for (int k = 0; k < 3; k++) pk.dir[k][q] = dir[k];
+        float base[3];
+        /* the scalar path's footprint: px_tan over |dir| (only textures need it) */
+        const float fp = m->texture >= 0 ? px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]) : 0.0f;
+        base_colour(s, m, tri, prim, u, v, 1.0f - u - v, dir, t, fp, base);
+        for (int k = 0; k < 3; k++) pk.base[k][q] = base[k];
+    }
+    const fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
+                              .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
+    unsigned rest = dsp->lambert(&pk, &env, rgb) & hits;
+    while (rest) { /* degenerate smooth normals: the scalar path's face normal */
+        const int q = __builtin_ctz(rest);
+        rest &= rest - 1;
+        const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
+        const float len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        float c[3];
+        fv_scene_shade(s, h->geom[q], h->prim[q], h->u[q], h->v[q], eye_pos, dir, h->t[q], px_tan / len, eye_pos, c);
+        for (int k = 0; k < 3; k++) rgb[k][q] = c[k];
+    }
+    for (; black; black &= black - 1)
+        for (int k = 0; k < 3; k++) rgb[k][__builtin_ctz(black)] = 0.0f;
 }
