@@ -42,8 +42,10 @@ static int compact(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_T
 }
 
 /* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths): camera rays through the
- * pixel centres, as fv_camera_ray computes them, lane by lane into the SoA packet (the padding
- * lanes repeat the first pixel and are invalid); after the hits, the packet's shading. */
+ * pixel centres, as fv_camera_ray computes them, straight into the SoA packet (the padding lanes
+ * repeat the last pixel and are invalid; a first version stored the pixel coordinates lane by
+ * lane and reloaded them as vectors, and the failed store forwarding was a third of this file's
+ * time); after the hits, the packet's shading. */
 #define DEF_PACKETS(N)                                                                                            \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,                 \
                             const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                      \
@@ -64,28 +66,33 @@ static int compact(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_T
                                   {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z}};                                    \
         for (int i = 0; i < n; i += N) {                                                                          \
             const int k = n - i < N ? n - i : N;                                                                  \
-            _Alignas(64) float fx[N], fy[N];                                                                      \
-            for (int q = 0; q < N; q++) {                                                                         \
-                const int p = px[q < k ? i + q : i];                                                              \
-                fx[q] = (float)(x0 + (p & 15)), fy[q] = (float)(y0 + (p >> 4));                                   \
-                valid[q] = q < k ? -1 : 0;                                                                        \
+            /* px has N copies of its last pixel past n: no branch, the loop vectorises */                      \
+            if (!cam->lens_on) {                                                                                  \
+                for (int q = 0; q < N; q++) {                                                                     \
+                    const int p = px[i + q];                                                                      \
+                    const float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;               \
+                    const float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                \
+                    rh.ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                        \
+                    rh.ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                        \
+                    rh.ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                        \
+                }                                                                                                 \
+            } else {                                                                                              \
+                for (int q = 0; q < N; q++) {                                                                     \
+                    const int p = px[i + q];                                                                      \
+                    float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;                     \
+                    float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                      \
+                    fv_lens_distort(cam->lens_k1, cam->lens_k2, cam->lens_scale, cam->lens_cx, cam->lens_cy, tx,  \
+                                    ty, &tx, &ty);                                                                \
+                    rh.ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                        \
+                    rh.ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                        \
+                    rh.ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                        \
+                }                                                                                                 \
             }                                                                                                     \
-            /* branch-free lanes (vectorised by the compiler); the lens, if any, lane by lane */                 \
             for (int q = 0; q < N; q++) {                                                                         \
-                fx[q] = cam->tan_left + (fx[q] + 0.5f) * cam->px_tan;                                             \
-                fy[q] = cam->tan_top - (fy[q] + 0.5f) * cam->px_tan;                                              \
-            }                                                                                                     \
-            if (cam->lens_on)                                                                                     \
-                for (int q = 0; q < N; q++)                                                                       \
-                    fv_lens_distort(cam->lens_k1, cam->lens_k2, cam->lens_scale, cam->lens_cx, cam->lens_cy,      \
-                                    fx[q], fy[q], &fx[q], &fy[q]);                                                \
-            for (int q = 0; q < N; q++) {                                                                         \
-                rh.ray.dir_x[q] = fx[q] * cam->right[0] + fy[q] * cam->up[0] - cam->back[0];                      \
-                rh.ray.dir_y[q] = fx[q] * cam->right[1] + fy[q] * cam->up[1] - cam->back[1];                      \
-                rh.ray.dir_z[q] = fx[q] * cam->right[2] + fy[q] * cam->up[2] - cam->back[2];                      \
                 rh.ray.tfar[q] = INFINITY;                                                                        \
                 rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;                                                       \
                 rh.hit.instID[0][q] = RTC_INVALID_GEOMETRY_ID;                                                    \
+                valid[q] = q < k ? -1 : 0;                                                                        \
             }                                                                                                     \
             rtcIntersect##N(valid, rs, &ictx, &rh);                                                               \
             fv_scene_shade_packet(scene, dsp, &hp, k, cam->px_tan, cam->eye_pos, rgb);                            \
@@ -116,10 +123,12 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_shade
         for (int x = 0; x < tw; x++)
             w[x] = (float)(rows[y] >> x & 1u);
     }
-    uint8_t px[FV_TILE * FV_TILE];
+    uint8_t px[FV_TILE * FV_TILE + 16];
     const int n = compact(rows, tw, th, px);
     if (n == 0)
         return 0;
+    for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
+        px[q] = px[n - 1];
     if (fv_raycast_packet_width() == 16)
         packets_16(scene, cam, dsp, l0, x0, y0, px, n);
     else
