@@ -1,7 +1,9 @@
 #include "raycast.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
+#include <string.h>
 
 #include "shade_dsp.h"
 
@@ -21,25 +23,49 @@ int fv_raycast_packet_width(void)
     return w;
 }
 
+/* Block mask (bit i: pixel i & 3, i >> 2 of a 4x2 block) -> its set pixels' offsets (y << 4 | x)
+ * in bit order, 8 bytes (the unused ones 0), as one little-endian word. */
+static uint64_t block_lut[256];
+static uint8_t block_count[256]; /* popcount: a call into libgcc without -mpopcnt */
+static pthread_once_t block_lut_once = PTHREAD_ONCE_INIT;
+static void block_lut_init(void)
+{
+    for (unsigned m = 0; m < 256; m++) {
+        uint64_t v = 0;
+        int n = 0;
+        for (unsigned b = 0; b < 8; b++)
+            if (m >> b & 1u)
+                v |= (uint64_t)((b >> 2) << 4 | (b & 3)) << (8 * n++);
+        block_lut[m] = v;
+        block_count[m] = (uint8_t)n;
+    }
+}
+
 /* The sampled pixels of a tile as (y << 4 | x) in 4x2-block order, so a full packet of 8 is a
  * compact 4x2 footprint (16: 8x2) and a sparse tile's packets still gather nearby pixels
- * (coherent rays). Walks the set bits of each block's 8-bit mask. */
-static int compact(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_TILE * FV_TILE])
+ * (coherent rays). Each block's 8-bit mask looks its offsets up; the block's corner is added to
+ * all 8 bytes at once (no carries: corner + offset < 256) and the word stored whole, n advancing
+ * by the mask's pixel count: no branch per pixel. px needs 8 bytes of slack. */
+static int compact(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_TILE * FV_TILE + 8])
 {
     const uint32_t keep = tw >= 32 ? ~0u : (1u << tw) - 1u;
     int n = 0;
     for (int by = 0; by < FV_TILE / 2; by++) {
         const uint32_t r0 = 2 * by < th ? rows[2 * by] & keep : 0, r1 = 2 * by + 1 < th ? rows[2 * by + 1] & keep : 0;
         for (int bx = 0; bx < FV_TILE / 4; bx++) {
-            unsigned m = (r0 >> (4 * bx) & 15u) | (r1 >> (4 * bx) & 15u) << 4;
-            for (; m; m &= m - 1) {
-                const unsigned b = (unsigned)__builtin_ctz(m);
-                px[n++] = (uint8_t)((2 * by + (b >> 2)) << 4 | (4 * bx + (b & 3)));
-            }
+            const unsigned m = (r0 >> (4 * bx) & 15u) | (r1 >> (4 * bx) & 15u) << 4;
+            const uint64_t v = block_lut[m] + (uint64_t)(2 * by << 4 | 4 * bx) * 0x0101010101010101ull;
+            memcpy(px + n, &v, 8);
+            n += block_count[m];
         }
     }
     return n;
 }
+
+/* 4 weights from 4 bits */
+static const float nibble_w[16][4] = {
+    {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {1, 1, 0, 0}, {0, 0, 1, 0}, {1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, 1, 0},
+    {0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}, {1, 1, 0, 1}, {0, 0, 1, 1}, {1, 0, 1, 1}, {0, 1, 1, 1}, {1, 1, 1, 1}};
 
 /* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths): camera rays through the
  * pixel centres, as fv_camera_ray computes them, straight into the SoA packet (the padding lanes
@@ -120,9 +146,14 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_shade
      * pixel, so the others' colours are left alone) */
     for (int y = 0; y < th; y++) {
         float *w = l0->wgt + (ptrdiff_t)(y0 + y) * l0->stride + x0;
-        for (int x = 0; x < tw; x++)
-            w[x] = (float)(rows[y] >> x & 1u);
+        if (tw == FV_TILE)
+            for (int x = 0; x < FV_TILE; x += 4)
+                memcpy(w + x, nibble_w[rows[y] >> x & 15u], sizeof nibble_w[0]);
+        else
+            for (int x = 0; x < tw; x++)
+                w[x] = (float)(rows[y] >> x & 1u);
     }
+    pthread_once(&block_lut_once, block_lut_init);
     uint8_t px[FV_TILE * FV_TILE + 16];
     const int n = compact(rows, tw, th, px);
     if (n == 0)

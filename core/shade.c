@@ -113,7 +113,9 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
 void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_hit_packet *h, int n,
                            float px_tan, const float eye_pos[3], float rgb[3][FV_SHADE_LANES])
 {
-    _Alignas(64) fv_shade_packet pk;
+    /* Per thread, zero at start: lanes of misses keep whatever an earlier packet left there
+     * (finite, initialised: their results are not used), so a miss costs no stores. */
+    static _Thread_local _Alignas(64) fv_shade_packet pk;
     unsigned hits = 0, black = 0;
     /* the lanes' vertex normals are scattered cache misses behind their index loads: ask for all
      * of them first, so they overlap */
@@ -126,15 +128,12 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
                 __builtin_prefetch(m->normals + 3 * (size_t)tri[c]);
         }
     }
-    for (int q = 0; q < FV_SHADE_LANES; q++) {
-        const unsigned g = q < n ? h->geom[q] : RTC_INVALID_GEOMETRY_ID, prim = q < n ? h->prim[q] : 0;
+    for (int q = 0; q < n; q++) {
+        const unsigned g = h->geom[q], prim = h->prim[q];
         const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
-        if (!m || prim >= m->tri_count) { /* a miss, padding, or no such triangle: harmless values */
+        if (!m || prim >= m->tri_count) { /* a miss, or no such triangle (black) */
             if (g != RTC_INVALID_GEOMETRY_ID)
                 black |= 1u << q;
-            for (int k = 0; k < 9; k++) pk.nrm[k][q] = k % 3 == 2 ? 1.0f : 0.0f;
-            pk.u[q] = pk.v[q] = pk.t[q] = 0.0f;
-            for (int k = 0; k < 3; k++) pk.dir[k][q] = k == 2 ? -1.0f : 0.0f, pk.base[k][q] = 0.0f;
             continue;
         }
         hits |= 1u << q;
@@ -152,6 +151,11 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const float fp = m->texture >= 0 ? px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]) : 0.0f;
         base_colour(s, m, tri, prim, u, v, 1.0f - u - v, dir, t, fp, base);
         for (int k = 0; k < 3; k++) pk.base[k][q] = base[k];
+    }
+    if (!hits) { /* all misses: nothing to shade */
+        for (; black; black &= black - 1)
+            for (int k = 0; k < 3; k++) rgb[k][__builtin_ctz(black)] = 0.0f;
+        return;
     }
     const fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
                               .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
