@@ -67,74 +67,94 @@ static const float nibble_w[16][4] = {
     {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {1, 1, 0, 0}, {0, 0, 1, 0}, {1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, 1, 0},
     {0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}, {1, 1, 0, 1}, {0, 0, 1, 1}, {1, 0, 1, 1}, {0, 1, 1, 1}, {1, 1, 1, 1}};
 
-/* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths): camera rays through the
- * pixel centres, as fv_camera_ray computes them, straight into the SoA packet (the padding lanes
- * repeat the last pixel and are invalid; a first version stored the pixel coordinates lane by
- * lane and reloaded them as vectors, and the failed store forwarding was a third of this file's
- * time); after the hits, the packet's shading. */
+/* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths), double-buffered: packet
+ * b + 1 is traced before packet b is shaded, so the triangle records of b's hits, prefetched
+ * when b was traced, arrive while Embree works (they were the shading's main cost). */
 #define DEF_PACKETS(N)                                                                                            \
-    static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,                 \
-                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                      \
-    {                                                                                                             \
-        struct RTCIntersectContext ictx;                                                                          \
-        rtcInitIntersectContext(&ictx);                                                                           \
-        ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                                         \
-        RTCScene rs = fv_scene_rtc(scene);                                                                        \
-        _Alignas(64) struct RTCRayHit##N rh;                                                                      \
-        _Alignas(64) int valid[N];                                                                                \
-        _Alignas(64) float rgb[3][16];                                                                            \
-        for (int q = 0; q < N; q++) { /* what no lane changes */                                                 \
-            rh.ray.org_x[q] = cam->eye_pos[0], rh.ray.org_y[q] = cam->eye_pos[1], rh.ray.org_z[q] = cam->eye_pos[2]; \
-            rh.ray.tnear[q] = 0.0f, rh.ray.time[q] = 0.0f, rh.ray.mask[q] = ~0u, rh.ray.flags[q] = 0;            \
-            rh.ray.id[q] = (unsigned)q;                                                                           \
-        }                                                                                                         \
-        const fv_hit_packet hp = {rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar,                \
-                                  {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z}};                                    \
-        for (int i = 0; i < n; i += N) {                                                                          \
-            const int k = n - i < N ? n - i : N;                                                                  \
-            /* px has N copies of its last pixel past n: no branch, the loop vectorises */                      \
-            if (!cam->lens_on) {                                                                                  \
-                for (int q = 0; q < N; q++) {                                                                     \
-                    const int p = px[i + q];                                                                      \
-                    const float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;               \
-                    const float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                \
-                    rh.ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                        \
-                    rh.ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                        \
-                    rh.ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                        \
-                }                                                                                                 \
-            } else {                                                                                              \
-                for (int q = 0; q < N; q++) {                                                                     \
-                    const int p = px[i + q];                                                                      \
-                    float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;                     \
-                    float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                      \
-                    fv_lens_distort(cam->lens_k1, cam->lens_k2, cam->lens_scale, cam->lens_cx, cam->lens_cy, tx,  \
-                                    ty, &tx, &ty);                                                                \
-                    rh.ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                        \
-                    rh.ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                        \
-                    rh.ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                        \
-                }                                                                                                 \
-            }                                                                                                     \
-            for (int q = 0; q < N; q++) {                                                                         \
-                rh.ray.tfar[q] = INFINITY;                                                                        \
-                rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;                                                       \
-                rh.hit.instID[0][q] = RTC_INVALID_GEOMETRY_ID;                                                    \
-                valid[q] = q < k ? -1 : 0;                                                                        \
-            }                                                                                                     \
-            rtcIntersect##N(valid, rs, &ictx, &rh);                                                               \
-            fv_scene_shade_packet(scene, dsp, &hp, k, cam->px_tan, cam->eye_pos, rgb);                            \
-            for (int q = 0; q < k; q++) {                                                                         \
-                const int p = px[i + q];                                                                          \
-                float *dst = l0->rgbd + 4 * ((y0 + (p >> 4)) * l0->stride + x0 + (p & 15));                       \
-                if (rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID) {                                                      \
-                    dst[0] = fv_background_rgb[0], dst[1] = fv_background_rgb[1], dst[2] = fv_background_rgb[2];  \
-                    dst[3] = FV_DEPTH_MISS_M;                                                                     \
-                } else { /* t is the view depth: dir.z_eye = -1 */                                                \
-                    const float t = rh.ray.tfar[q];                                                                      \
-                    dst[0] = rgb[0][q], dst[1] = rgb[1][q], dst[2] = rgb[2][q];                                   \
-                    dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;                                           \
-                }                                                                                                 \
-            }                                                                                                     \
-        }                                                                                                         \
+    /* Camera rays through the pixel centres px[i .. i+N) (as fv_camera_ray computes them) straight          \
+     * into the SoA packet, lanes from k on invalid. px holds N copies of its last pixel past the            \
+     * end, so every lane reads a real pixel and the loop has no branch: it vectorises. (A first             \
+     * version stored pixel coordinates lane by lane and reloaded them as vectors: the failed store          \
+     * forwarding was a third of this file's time.) */                                                      \
+    static void trace_##N(const fv_scene *scene, const fv_camera *cam, struct RTCIntersectContext *ictx,      \
+                          struct RTCRayHit##N *rh, int *valid, const uint8_t *px, int k, int x0, int y0)       \
+    {                                                                                                         \
+        if (!cam->lens_on) {                                                                                  \
+            for (int q = 0; q < N; q++) {                                                                     \
+                const int p = px[q];                                                                          \
+                const float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;               \
+                const float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                \
+                rh->ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                       \
+                rh->ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                       \
+                rh->ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                       \
+            }                                                                                                 \
+        } else {                                                                                              \
+            for (int q = 0; q < N; q++) {                                                                     \
+                const int p = px[q];                                                                          \
+                float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;                     \
+                float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                      \
+                fv_lens_distort(cam->lens_k1, cam->lens_k2, cam->lens_scale, cam->lens_cx, cam->lens_cy, tx, ty, \
+                                &tx, &ty);                                                                    \
+                rh->ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                       \
+                rh->ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                       \
+                rh->ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                       \
+            }                                                                                                 \
+        }                                                                                                     \
+        for (int q = 0; q < N; q++) {                                                                         \
+            rh->ray.tfar[q] = INFINITY;                                                                       \
+            rh->hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;                                                      \
+            rh->hit.instID[0][q] = RTC_INVALID_GEOMETRY_ID;                                                   \
+            valid[q] = q < k ? -1 : 0;                                                                        \
+        }                                                                                                     \
+        rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
+        fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                      \
+    }                                                                                                         \
+    /* Shades lanes 0 .. k-1 and writes them to level 0. */                                                 \
+    static void finish_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,              \
+                           const fv_pyr_level *l0, const struct RTCRayHit##N *rh, const uint8_t *px, int k,    \
+                           int x0, int y0)                                                                    \
+    {                                                                                                         \
+        _Alignas(64) float rgb[3][16];                                                                        \
+        const fv_hit_packet hp = {rh->hit.geomID, rh->hit.primID, rh->hit.u, rh->hit.v, rh->ray.tfar,         \
+                                  {rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z}};                             \
+        fv_scene_shade_packet(scene, dsp, &hp, k, cam->px_tan, cam->eye_pos, rgb);                            \
+        for (int q = 0; q < k; q++) {                                                                         \
+            const int p = px[q];                                                                              \
+            float *dst = l0->rgbd + 4 * ((y0 + (p >> 4)) * l0->stride + x0 + (p & 15));                       \
+            if (rh->hit.geomID[q] == RTC_INVALID_GEOMETRY_ID) {                                               \
+                dst[0] = fv_background_rgb[0], dst[1] = fv_background_rgb[1], dst[2] = fv_background_rgb[2];  \
+                dst[3] = FV_DEPTH_MISS_M;                                                                     \
+            } else { /* t is the view depth: dir.z_eye = -1 */                                                \
+                const float t = rh->ray.tfar[q];                                                              \
+                dst[0] = rgb[0][q], dst[1] = rgb[1][q], dst[2] = rgb[2][q];                                   \
+                dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;                                           \
+            }                                                                                                 \
+        }                                                                                                     \
+    }                                                                                                         \
+    static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,             \
+                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                  \
+    {                                                                                                         \
+        struct RTCIntersectContext ictx;                                                                      \
+        rtcInitIntersectContext(&ictx);                                                                       \
+        ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                                     \
+        _Alignas(64) struct RTCRayHit##N rh[2];                                                               \
+        _Alignas(64) int valid[2][N];                                                                         \
+        for (int b = 0; b < 2; b++)                                                                           \
+            for (int q = 0; q < N; q++) { /* what no lane changes */                                         \
+                rh[b].ray.org_x[q] = cam->eye_pos[0], rh[b].ray.org_y[q] = cam->eye_pos[1];                   \
+                rh[b].ray.org_z[q] = cam->eye_pos[2], rh[b].ray.tnear[q] = 0.0f, rh[b].ray.time[q] = 0.0f;    \
+                rh[b].ray.mask[q] = ~0u, rh[b].ray.flags[q] = 0, rh[b].ray.id[q] = (unsigned)q;               \
+            }                                                                                                 \
+        const int np = (n + N - 1) / N;                                                                       \
+        trace_##N(scene, cam, &ictx, &rh[0], valid[0], px, n < N ? n : N, x0, y0);                               \
+        for (int b = 0; b < np; b++) {                                                                        \
+            const int i = (b + 1) * N;                                                                        \
+            if (b + 1 < np)                                                                                   \
+                trace_##N(scene, cam, &ictx, &rh[(b + 1) & 1], valid[(b + 1) & 1], px + i, n - i < N ? n - i : N, \
+                          x0, y0);                                                                            \
+            const int k = n - b * N < N ? n - b * N : N;                                                      \
+            finish_##N(scene, cam, dsp, l0, &rh[b & 1], px + b * N, k, x0, y0);                               \
+        }                                                                                                     \
     }
 DEF_PACKETS(8)
 DEF_PACKETS(16)

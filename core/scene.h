@@ -84,6 +84,9 @@ typedef struct fv_hit_packet {
     const float *u, *v, *t;
     const float *dir[3];
 } fv_hit_packet;
+/* Asks for the shading data of n hits (geometry and primitive IDs as Embree returns them) to
+ * be brought into the cache: call it as soon as a packet is traced, shade it later. */
+void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n);
 struct fv_shade_dsp;
 /* fv_scene_shade for lanes 0 .. n-1 of a packet of camera rays from eye_pos, each with
  * footprint px_tan / |dir| (the camera's pixel angle), with the shading kernels of dsp: the same

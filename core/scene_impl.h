@@ -1,7 +1,7 @@
 /* fovea: the scene's private parts, shared by the files that implement core/scene.h (scene.c:
  * lifecycle, lights, views; scene_mesh.c: Embree geometry; texture.c; shade.c). Not a public
  * API; gltf_import.c needs none of it (it uses the builder API). Mesh records (normals, uvs,
- * material, per-triangle texel density) stay here for shading, indexed by Embree geometry ID. */
+ * material, per-triangle texel density: fv_tri_attr) stay here for shading, indexed by Embree geometry ID. */
 #ifndef FOVEA_SCENE_IMPL_H
 #define FOVEA_SCENE_IMPL_H
 
@@ -23,12 +23,19 @@ typedef struct fv_texture {
     float *data;
 } fv_texture;
 
+/* A triangle's shading inputs, one cache line: its corners' normals (world, unit or zero if
+ * degenerate) and uvs (0 without), mip-0 texels per metre (0 without texture). */
+typedef struct fv_tri_attr {
+    float n[9];  /* corner 0 x y z, corner 1, corner 2 */
+    float uv[6]; /* corner 0 u v, corner 1, corner 2 */
+    float texel_density;
+} fv_tri_attr;
+_Static_assert(sizeof(fv_tri_attr) == 64, "one cache line per triangle");
+
 typedef struct fv_mesh_rec {
     const float *pos;      /* world positions, 3 per vertex: Embree's vertex buffer */
     const uint32_t *tri;   /* 3 per triangle: Embree's index buffer */
-    float *normals;        /* world, unit (or zero if degenerate), 3 per vertex */
-    float *uvs;            /* 2 per vertex, or NULL */
-    float *texel_density;  /* per triangle, mip-0 texels per metre; NULL without texture */
+    fv_tri_attr *attr;     /* per triangle, 64-byte aligned */
     size_t vertex_count, tri_count;
     float base_color[4];
     int texture;

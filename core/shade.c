@@ -15,15 +15,15 @@ static float smoothstepf(float e0, float e1, float x)
 
 /* The material's base colour at the hit, times its texture (trilinear, mip level from the ray
  * footprint): shared by the scalar and the packet paths so both give the same bits. */
-static void base_colour(const fv_scene *s, const fv_mesh_rec *m, const uint32_t *tri, unsigned prim_id, float u,
-                        float v, float w, const float dir[3], float t, float footprint_rad, float base[3])
+static void base_colour(const fv_scene *s, const fv_mesh_rec *m, const fv_tri_attr *at, const uint32_t *tri,
+                        float u, float v, float w, const float dir[3], float t, float footprint_rad, float base[3])
 {
     base[0] = m->base_color[0], base[1] = m->base_color[1], base[2] = m->base_color[2];
     if (m->texture < 0)
         return;
-    const float *a = m->uvs + 2 * (size_t)tri[0], *b = m->uvs + 2 * (size_t)tri[1], *c = m->uvs + 2 * (size_t)tri[2];
+    const float *a = at->uv, *b = at->uv + 2, *c = at->uv + 4;
     const float tu = w * a[0] + u * b[0] + v * c[0], tv = w * a[1] + u * b[1] + v * c[1];
-    const float density = m->texel_density[prim_id];
+    const float density = at->texel_density;
     float lod = 0.0f;
     if (footprint_rad > 0.0f && t > 0.0f && density > 0.0f) {
         float e1[3], e2[3], ng[3];
@@ -54,8 +54,8 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
      * unnormalised and the Lambert term divides by |n||L| once. Scalar sqrt/div chains were
      * most of the shading time. */
     float n[3];
-    const float *n0 = m->normals + 3 * (size_t)tri[0], *n1 = m->normals + 3 * (size_t)tri[1],
-                *n2 = m->normals + 3 * (size_t)tri[2];
+    const fv_tri_attr *at = &m->attr[prim_id];
+    const float *n0 = at->n, *n1 = at->n + 3, *n2 = at->n + 6;
     /* written out: a 3-iteration loop left n[] on the stack and the 8-byte reload of two
      * 4-byte stores stalled store forwarding on every call */
     n[0] = w * n0[0] + u * n1[0] + v * n2[0];
@@ -72,7 +72,7 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         for (int k = 0; k < 3; k++) n[k] = -n[k];
 
     float base[3];
-    base_colour(s, m, tri, prim_id, u, v, w, dir, t, footprint_rad, base);
+    base_colour(s, m, at, tri, u, v, w, dir, t, footprint_rad, base);
 
     const float p[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
     float light[3] = {FV_SCENE_AMBIENT, FV_SCENE_AMBIENT, FV_SCENE_AMBIENT};
@@ -110,6 +110,13 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     for (int k = 0; k < 3; k++) rgb[k] = base[k] * light[k];
 }
 
+void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
+{
+    for (int q = 0; q < n; q++)
+        if (geom[q] < s->mesh_count && prim[q] < s->meshes[geom[q]].tri_count)
+            __builtin_prefetch(&s->meshes[geom[q]].attr[prim[q]]);
+}
+
 void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_hit_packet *h, int n,
                            float px_tan, const float eye_pos[3], float rgb[3][FV_SHADE_LANES])
 {
@@ -117,17 +124,6 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
      * (finite, initialised: their results are not used), so a miss costs no stores. */
     static _Thread_local _Alignas(64) fv_shade_packet pk;
     unsigned hits = 0, black = 0;
-    /* the lanes' vertex normals are scattered cache misses behind their index loads: ask for all
-     * of them first, so they overlap */
-    for (int q = 0; q < n; q++) {
-        const unsigned g = h->geom[q], prim = h->prim[q];
-        if (g < s->mesh_count && prim < s->meshes[g].tri_count) {
-            const fv_mesh_rec *m = &s->meshes[g];
-            const uint32_t *tri = m->tri + 3 * (size_t)prim;
-            for (int c = 0; c < 3; c++)
-                __builtin_prefetch(m->normals + 3 * (size_t)tri[c]);
-        }
-    }
     for (int q = 0; q < n; q++) {
         const unsigned g = h->geom[q], prim = h->prim[q];
         const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
@@ -137,11 +133,9 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             continue;
         }
         hits |= 1u << q;
-        const uint32_t *tri = m->tri + 3 * (size_t)prim;
-        for (int c = 0; c < 3; c++) {
-            const float *nv = m->normals + 3 * (size_t)tri[c];
-            pk.nrm[3 * c][q] = nv[0], pk.nrm[3 * c + 1][q] = nv[1], pk.nrm[3 * c + 2][q] = nv[2];
-        }
+        const fv_tri_attr *at = &m->attr[prim];
+        for (int k = 0; k < 9; k++)
+            pk.nrm[k][q] = at->n[k];
         const float u = h->u[q], v = h->v[q], t = h->t[q];
         const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
         pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
@@ -149,7 +143,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         float base[3];
         /* the scalar path's footprint: px_tan over |dir| (only textures need it) */
         const float fp = m->texture >= 0 ? px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]) : 0.0f;
-        base_colour(s, m, tri, prim, u, v, 1.0f - u - v, dir, t, fp, base);
+        base_colour(s, m, at, m->tri + 3 * (size_t)prim, u, v, 1.0f - u - v, dir, t, fp, base);
         for (int k = 0; k < 3; k++) pk.base[k][q] = base[k];
     }
     if (!hits) { /* all misses: nothing to shade */
