@@ -32,10 +32,16 @@ typedef struct fv_tri_attr {
 } fv_tri_attr;
 _Static_assert(sizeof(fv_tri_attr) == 64, "one cache line per triangle");
 
+/* A textured triangle's face normal, unnormalised (cross of its edges), and its length. */
+typedef struct fv_tri_face {
+    float ng[3], ng_len;
+} fv_tri_face;
+
 typedef struct fv_mesh_rec {
     const float *pos;      /* world positions, 3 per vertex: Embree's vertex buffer */
     const uint32_t *tri;   /* 3 per triangle: Embree's index buffer */
     fv_tri_attr *attr;     /* per triangle, 64-byte aligned */
+    fv_tri_face *face;     /* per triangle of a textured mesh (the mip level), else NULL */
     size_t vertex_count, tri_count;
     float base_color[4];
     int texture;
@@ -68,6 +74,19 @@ int fv_scene_grow(void **p, size_t *cap, size_t n, size_t elem);
 int fv_scene_take_rtc_error(fv_scene *s, char *err, size_t err_len);
 /* Trilinear between the two mip levels around lod (lod 0 = full resolution), REPEAT addressing. */
 void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4]);
+/* fv_texture_sample in two steps, so a packet's texel fetches can be asked for before they are
+ * used: the taps (texel addresses and weights), then the blend; the same bits. */
+typedef struct fv_tex_tap {
+    const float *p[4]; /* texels 00, 10, 01, 11 */
+    float fx, fy;
+} fv_tex_tap;
+typedef struct fv_tex_taps {
+    fv_tex_tap tap[2]; /* the finer level, the coarser one when f > 0 */
+    float f;           /* weight of the coarser level */
+} fv_tex_taps;
+void fv_texture_taps(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp);
+void fv_texture_taps_prefetch(const fv_tex_taps *tp);
+void fv_texture_blend(const fv_tex_taps *tp, float out[4]);
 
 static inline void cross3(const float a[3], const float b[3], float o[3])
 {

@@ -82,8 +82,9 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     float *uvs = m->uvs ? malloc(nv * 2 * sizeof(float)) : NULL;
     float *density = m->texture >= 0 ? malloc(nt * sizeof(float)) : NULL;
     r.attr = aligned_alloc(64, nt * sizeof *r.attr);
+    r.face = m->texture >= 0 ? malloc(nt * sizeof *r.face) : NULL;
     RTCGeometry g = NULL;
-    if (!pos || !tri || !normals || !r.attr || (m->uvs && !uvs) || (m->texture >= 0 && !density)) {
+    if (!pos || !tri || !normals || !r.attr || (m->texture >= 0 && !r.face) || (m->uvs && !uvs) || (m->texture >= 0 && !density)) {
         fv_err(err, err_len, "out of memory");
         goto fail;
     }
@@ -160,6 +161,8 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
             const double world_area2 = len3(fn);
             const double d = world_area2 > 0.0 ? sqrt(uv_area2 * texels / world_area2) : 0.0;
             density[t] = isfinite(d) && d < FLT_MAX ? (float)d : 0.0f;
+            for (int k = 0; k < 3; k++) r.face[t].ng[k] = fn[k];
+            r.face[t].ng_len = len3(fn);
         }
     }
 
@@ -216,5 +219,6 @@ fail:
     free(uvs);
     free(density);
     free(r.attr);
+    free(r.face);
     return -1;
 }
