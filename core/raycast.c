@@ -5,7 +5,7 @@
 #include <stdatomic.h>
 #include <string.h>
 
-#include "shade_dsp.h"
+#include "render_dsp.h"
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
 
@@ -71,23 +71,15 @@ static const float nibble_w[16][4] = {
  * b + 1 is traced before packet b is shaded, so the triangle records of b's hits, prefetched
  * when b was traced, arrive while Embree works (they were the shading's main cost). */
 #define DEF_PACKETS(N)                                                                                            \
-    /* Camera rays through the pixel centres px[i .. i+N) (as fv_camera_ray computes them) straight          \
-     * into the SoA packet, lanes from k on invalid. px holds N copies of its last pixel past the            \
-     * end, so every lane reads a real pixel and the loop has no branch: it vectorises. (A first             \
-     * version stored pixel coordinates lane by lane and reloaded them as vectors: the failed store          \
-     * forwarding was a third of this file's time.) */                                                      \
-    static void trace_##N(const fv_scene *scene, const fv_camera *cam, struct RTCIntersectContext *ictx,      \
-                          struct RTCRayHit##N *rh, int *valid, const uint8_t *px, int k, int x0, int y0)       \
+    /* Camera rays through the pixel centres px[0 .. N) (as fv_camera_ray computes them) straight into      \
+     * the SoA packet, lanes from k on invalid; px holds N copies of its last pixel past the end. The        \
+     * pinhole by the ray kernel; a lens lane by lane. */                                                    \
+    static void trace_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,             \
+                          const fv_raygen_cam *rc, struct RTCIntersectContext *ictx, struct RTCRayHit##N *rh,  \
+                          int *valid, const uint8_t *px, int k, int x0, int y0)                               \
     {                                                                                                         \
         if (!cam->lens_on) {                                                                                  \
-            for (int q = 0; q < N; q++) {                                                                     \
-                const int p = px[q];                                                                          \
-                const float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;               \
-                const float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                \
-                rh->ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                       \
-                rh->ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                       \
-                rh->ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                       \
-            }                                                                                                 \
+            dsp->ray.camera_rays(rc, px, x0, y0, rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z, N);             \
         } else {                                                                                              \
             for (int q = 0; q < N; q++) {                                                                     \
                 const int p = px[q];                                                                          \
@@ -110,7 +102,7 @@ static const float nibble_w[16][4] = {
         fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                      \
     }                                                                                                         \
     /* Shades lanes 0 .. k-1 and writes them to level 0. */                                                 \
-    static void finish_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,              \
+    static void finish_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,               \
                            const fv_pyr_level *l0, const struct RTCRayHit##N *rh, const uint8_t *px, int k,    \
                            int x0, int y0)                                                                    \
     {                                                                                                         \
@@ -131,7 +123,7 @@ static const float nibble_w[16][4] = {
             }                                                                                                 \
         }                                                                                                     \
     }                                                                                                         \
-    static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,             \
+    static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
                             const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                  \
     {                                                                                                         \
         struct RTCIntersectContext ictx;                                                                      \
@@ -139,6 +131,9 @@ static const float nibble_w[16][4] = {
         ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                                     \
         _Alignas(64) struct RTCRayHit##N rh[2];                                                               \
         _Alignas(64) int valid[2][N];                                                                         \
+        const fv_raygen_cam rc = {cam->tan_left, cam->tan_top, cam->px_tan, {cam->right[0], cam->right[1],    \
+                                  cam->right[2]}, {cam->up[0], cam->up[1], cam->up[2]},                       \
+                                  {cam->back[0], cam->back[1], cam->back[2]}};                                \
         for (int b = 0; b < 2; b++)                                                                           \
             for (int q = 0; q < N; q++) { /* what no lane changes */                                         \
                 rh[b].ray.org_x[q] = cam->eye_pos[0], rh[b].ray.org_y[q] = cam->eye_pos[1];                   \
@@ -146,20 +141,20 @@ static const float nibble_w[16][4] = {
                 rh[b].ray.mask[q] = ~0u, rh[b].ray.flags[q] = 0, rh[b].ray.id[q] = (unsigned)q;               \
             }                                                                                                 \
         const int np = (n + N - 1) / N;                                                                       \
-        trace_##N(scene, cam, &ictx, &rh[0], valid[0], px, n < N ? n : N, x0, y0);                               \
+        trace_##N(scene, cam, dsp, &rc, &ictx, &rh[0], valid[0], px, n < N ? n : N, x0, y0);                 \
         for (int b = 0; b < np; b++) {                                                                        \
             const int i = (b + 1) * N;                                                                        \
             if (b + 1 < np)                                                                                   \
-                trace_##N(scene, cam, &ictx, &rh[(b + 1) & 1], valid[(b + 1) & 1], px + i, n - i < N ? n - i : N, \
-                          x0, y0);                                                                            \
+                trace_##N(scene, cam, dsp, &rc, &ictx, &rh[(b + 1) & 1], valid[(b + 1) & 1], px + i,           \
+                          n - i < N ? n - i : N, x0, y0);                                                     \
             const int k = n - b * N < N ? n - b * N : N;                                                      \
-            finish_##N(scene, cam, dsp, l0, &rh[b & 1], px + b * N, k, x0, y0);                               \
+            finish_##N(scene, cam, &dsp->shade, l0, &rh[b & 1], px + b * N, k, x0, y0);                       \
         }                                                                                                     \
     }
 DEF_PACKETS(8)
 DEF_PACKETS(16)
 
-long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp, const fv_pyr_level *l0,
+long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
                      int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE])
 {
     /* every pixel's weight, from the rows' bits (pull-push never reads the colour of a zero-weight

@@ -41,7 +41,7 @@ static void run_tile(void *ctx, int index, int thread_id)
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
 
     /* writes every weight of the tile: pixels without a sample get 0 */
-    const long rays = fv_raycast_tile(j->scene, cam, &j->dsp->shade, l0, x0, y0, tw, th, rows);
+    const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
         fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th);

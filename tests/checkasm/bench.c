@@ -440,8 +440,37 @@ static void shade_run_n(void *st, const checkasm_dsp *d, int row0, int rows, int
 static void shade_head_run(void *st, const checkasm_dsp *d, int row0, int rows) { shade_run_n(st, d, row0, rows, 0); }
 static void shade_lights_run(void *st, const checkasm_dsp *d, int row0, int rows) { shade_run_n(st, d, row0, rows, 2); }
 
+/* ---- ray generation: every pixel of a 1280x1440 eye in packets of 16 (8x2 pixels) ---- */
+typedef struct {
+    uint8_t px[FV_TILE * FV_TILE];
+    float d[3][16];
+} ray_st;
+static void *ray_setup(void)
+{
+    ray_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    for (int i = 0; i < FV_TILE * FV_TILE; i++) /* 4x2 blocks, as core/raycast.c orders a full tile */
+        t->px[i] = (uint8_t)(((i >> 5) * 2 + (i >> 2 & 1)) << 4 | ((i >> 3 & 3) * 4 + (i & 3)));
+    return t;
+}
+static volatile float ray_sink;
+static void ray_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    ray_st *t = st;
+    const fv_raygen_cam c = {-1.19f, 1.19f, 0.00186f, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int k = 0; k < rows; k++) {
+        const int p = (row0 + k) % (W * H / 16), tile = p / 16;
+        d->ray.camera_rays(&c, t->px + 16 * (p % 16), tile % (W / 16) * 16, tile / (W / 16) * 16, t->d[0], t->d[1],
+                           t->d[2], 16);
+    }
+    ray_sink = t->d[0][0];
+}
+
 #define F(x) offsetof(checkasm_dsp, x)
 const checkasm_bench_kernel checkasm_bench_kernels[] = {
+    {"camera_rays", "1280x1440 rays, 115200 packets of 16", {F(ray.camera_rays), 0}, W * H / 16, ray_setup, NULL,
+     ray_run, free},
     {"lambert", "1280x1440 hits, 115200 packets of 16, head light", {F(shade.lambert), 0}, SH_PACKETS, shade_setup,
      NULL, shade_head_run, free},
     {"lambert_lights", "1280x1440 hits, 115200 packets of 16, 2 KHR lights", {F(shade.lambert), 0}, SH_PACKETS,
@@ -500,6 +529,7 @@ void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask)
     fv_dof_dsp_init(&d->dof, isa_mask);
     fv_eyetrack_dsp_init(&d->et, isa_mask);
     fv_shade_dsp_init(&d->shade, isa_mask);
+    fv_raygen_dsp_init(&d->ray, isa_mask);
 }
 
 static int cmp_double(const void *a, const void *b)

@@ -19,6 +19,7 @@
 #include "dof/dof_dsp.h"
 #include "eyetrack/eyetrack_dsp.h"
 #include "pullpush_dsp.h"
+#include "raygen_dsp.h"
 #include "reproject_dsp.h"
 #include "shade_dsp.h"
 
@@ -30,6 +31,7 @@ typedef struct checkasm_dsp {
     fv_dof_dsp dof;
     fv_eyetrack_dsp et;
     fv_shade_dsp shade;
+    fv_raygen_dsp ray;
 } checkasm_dsp;
 void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask);
 
