@@ -67,6 +67,13 @@ static const float nibble_w[16][4] = {
     {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {1, 1, 0, 0}, {0, 0, 1, 0}, {1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, 1, 0},
     {0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}, {1, 1, 0, 1}, {0, 0, 1, 1}, {1, 0, 1, 1}, {0, 1, 1, 1}, {1, 1, 1, 1}};
 
+_Static_assert(RTC_INVALID_GEOMETRY_ID == 0xffffffffu, "memset to all ones");
+static const float lane_inf[16] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY,
+                                   INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY};
+/* lane_valid(16 - k): a valid mask with the first k lanes on, for packets of 8 or 16 */
+static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
+#define lane_valid(j) (lane_valid_all + (j))
+
 /* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths), double-buffered: packet
  * b + 1 is traced before packet b is shaded, so the triangle records of b's hits, prefetched
  * when b was traced, arrive while Embree works (they were the shading's main cost). */
@@ -92,14 +99,13 @@ static const float nibble_w[16][4] = {
                 rh->ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                       \
             }                                                                                                 \
         }                                                                                                     \
-        for (int q = 0; q < N; q++) {                                                                         \
-            rh->ray.tfar[q] = INFINITY;                                                                       \
-            rh->hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;                                                      \
-            rh->hit.instID[0][q] = RTC_INVALID_GEOMETRY_ID;                                                   \
-            valid[q] = q < k ? -1 : 0;                                                                        \
-        }                                                                                                     \
+        /* whole-vector copies: lane-by-lane stores here stalled (the lines are cold after shading) */       \
+        memcpy(rh->ray.tfar, lane_inf, sizeof(float) * N);                                                    \
+        memset(rh->hit.geomID, 0xff, sizeof(unsigned) * N); /* RTC_INVALID_GEOMETRY_ID */                    \
+        memset(rh->hit.instID[0], 0xff, sizeof(unsigned) * N);                                                \
+        memcpy(valid, lane_valid(16 - k), sizeof(int) * N);                                                      \
         rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
-        fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                      \
+        fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                                    \
     }                                                                                                         \
     /* Shades lanes 0 .. k-1 and writes them to level 0. */                                                 \
     static void finish_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,               \
