@@ -83,7 +83,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
      * pinhole by the ray kernel; a lens lane by lane. */                                                    \
     static void trace_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,             \
                           const fv_raygen_cam *rc, struct RTCIntersectContext *ictx, struct RTCRayHit##N *rh,  \
-                          int *valid, const uint8_t *px, int k, int x0, int y0)                               \
+                          int *valid, const fv_pyr_level *l0, const uint8_t *px, int k, int x0, int y0)       \
     {                                                                                                         \
         if (!cam->lens_on) {                                                                                  \
             dsp->ray.camera_rays(rc, px, x0, y0, rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z, N);             \
@@ -106,6 +106,9 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
         memcpy(valid, lane_valid(16 - k), sizeof(int) * N);                                                      \
         rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
         fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                                    \
+        /* and the image lines the packet will write: cold, and each store would wait for its line */        \
+        for (int q = 0; q < k; q++)                                                                           \
+            __builtin_prefetch(l0->rgbd + 4 * ((y0 + (px[q] >> 4)) * l0->stride + x0 + (px[q] & 15)), 1);     \
     }                                                                                                         \
     /* Shades lanes 0 .. k-1 and writes them to level 0. */                                                 \
     static void finish_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,               \
@@ -147,11 +150,11 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
                 rh[b].ray.mask[q] = ~0u, rh[b].ray.flags[q] = 0, rh[b].ray.id[q] = (unsigned)q;               \
             }                                                                                                 \
         const int np = (n + N - 1) / N;                                                                       \
-        trace_##N(scene, cam, dsp, &rc, &ictx, &rh[0], valid[0], px, n < N ? n : N, x0, y0);                 \
+        trace_##N(scene, cam, dsp, &rc, &ictx, &rh[0], valid[0], l0, px, n < N ? n : N, x0, y0);             \
         for (int b = 0; b < np; b++) {                                                                        \
             const int i = (b + 1) * N;                                                                        \
             if (b + 1 < np)                                                                                   \
-                trace_##N(scene, cam, dsp, &rc, &ictx, &rh[(b + 1) & 1], valid[(b + 1) & 1], px + i,           \
+                trace_##N(scene, cam, dsp, &rc, &ictx, &rh[(b + 1) & 1], valid[(b + 1) & 1], l0, px + i,       \
                           n - i < N ? n - i : N, x0, y0);                                                     \
             const int k = n - b * N < N ? n - b * N : N;                                                      \
             finish_##N(scene, cam, &dsp->shade, l0, &rh[b & 1], px + b * N, k, x0, y0);                       \
