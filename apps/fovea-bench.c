@@ -38,6 +38,9 @@ static void usage(FILE *f)
             "                     second at 90 Hz; default 0: a static head, as in Weier's table)\n"
             "  --trace-out FILE   write a Chrome trace-event JSON of every frame (Perfetto,\n"
             "                     chrome://tracing): worker, stage and ray-tile tracks\n"
+            "  --ceiling          after every frame, trace the same rays with bare Embree\n"
+            "                     (rtcIntersect16, no shading: core/ceiling.h) and report the\n"
+            "                     ray stage's time against it per mode (ceiling_ms in the JSON)\n"
             "  --counters on|off  hardware counters per stage through perf_event_open (default on;\n"
             "                     reported as unavailable where the kernel or VM has none)\n"
             "  --sweep P=VALUES   repeatable; runs every value of P after the base run, all in the\n"
@@ -84,7 +87,7 @@ int main(int argc, char **argv)
     int nsweeps = 0;
     char err[512];
     enum { OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_YAW, OPT_HELP, OPT_TRACE_OUT, OPT_COUNTERS,
-           OPT_SWEEP, OPT_KERNELS, OPT_KREPS, OPT_KERNEL, OPT_CALLS };
+           OPT_SWEEP, OPT_KERNELS, OPT_KREPS, OPT_KERNEL, OPT_CALLS, OPT_CEILING };
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, {"frames", required_argument, 0, OPT_FRAMES},
         {"warmup", required_argument, 0, OPT_WARMUP}, {"mode", required_argument, 0, OPT_MODE},
@@ -92,7 +95,7 @@ int main(int argc, char **argv)
         {"trace-out", required_argument, 0, OPT_TRACE_OUT}, {"counters", required_argument, 0, OPT_COUNTERS},
         {"sweep", required_argument, 0, OPT_SWEEP}, {"kernels", no_argument, 0, OPT_KERNELS},
         {"kernel-reps", required_argument, 0, OPT_KREPS}, {"kernel", required_argument, 0, OPT_KERNEL},
-        {"calls", required_argument, 0, OPT_CALLS},
+        {"calls", required_argument, 0, OPT_CALLS}, {"ceiling", no_argument, 0, OPT_CEILING},
         {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS,
         {0, 0, 0, 0}};
     opterr = 0;
@@ -118,6 +121,7 @@ int main(int argc, char **argv)
                 fv_usage_error(prog, "%s", err);
             break;
         case OPT_KERNELS: kernels = 1; break;
+        case OPT_CEILING: bo.ceiling = 1; break;
         case OPT_KREPS: kreps = (int)fv_arg_long(prog, "--kernel-reps", optarg, 1, 64); break;
         case OPT_KERNEL: kernel = optarg; break;
         case OPT_CALLS: calls = fv_arg_long(prog, "--calls", optarg, 0, 100000000); break;

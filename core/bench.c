@@ -31,6 +31,8 @@ int fv_bench_acc_init(fv_bench_acc *a, fv_bench_run *r, const char *mode, int fr
     memset(a, 0, sizeof *a);
     memset(r, 0, sizeof *r);
     r->mode = mode;
+    r->sampler = "weier";
+    r->ceiling_ms = r->ceiling_mrays = NAN;
     a->r = r;
     a->frames = frames;
     a->total = calloc((size_t)(frames > 0 ? frames : 1), sizeof *a->total);
@@ -54,8 +56,32 @@ void fv_bench_acc_finish(fv_bench_acc *a)
     fv_bench_run *r = a->r;
     r->total_median = fv_median(a->total, a->n);
     r->mrays = (double)r->samples / (r->stage_mean[FV_STAGE_TRACE] * 1e3);
+    if (a->ceil_n > 0) {
+        r->ceiling_ms = a->ceil_sum / a->ceil_n;
+        r->ceiling_mrays = (double)r->samples / (r->ceiling_ms * 1e3);
+    }
     free(a->total);
     a->total = NULL;
+}
+
+void fv_bench_acc_add_ceiling(fv_bench_acc *a, double ms)
+{
+    if (a->ceil_n >= a->frames)
+        return;
+    a->ceil_sum += ms;
+    a->ceil_n++;
+}
+
+double fv_bench_ceiling_ratio(const fv_bench_run *r)
+{
+    return r->ceiling_ms > 0.0 ? r->stage_mean[FV_STAGE_TRACE] / r->ceiling_ms : NAN;
+}
+
+double fv_bench_ray_cost(const fv_bench_run *fov, const fv_bench_run *full)
+{
+    if (!(full->ceiling_ms > 0.0) || fov->samples <= 0 || full->samples <= 0)
+        return NAN;
+    return (fov->stage_mean[FV_STAGE_TRACE] / (double)fov->samples) / (full->ceiling_ms / (double)full->samples);
 }
 
 void fv_frame_stats_sum(fv_frame_stats *sum, const fv_frame_stats *st, int first)

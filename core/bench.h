@@ -24,6 +24,9 @@ typedef struct fv_bench_run {
     double stage_mean[FV_STAGE_COUNT]; /* ms; NAN: the stage is not built */
     double total_mean, total_median;   /* ms */
     double mrays;                      /* samples over the mean ray-tracing time */
+    const char *sampler;               /* the sampling pattern: "weier" (Weier et al. 2018) */
+    double ceiling_ms;                 /* mean bare-Embree time of the same rays (core/ceiling.h); NAN: not run */
+    double ceiling_mrays;              /* samples over ceiling_ms */
     int counters;                      /* hardware counters were read */
     char counters_why[160];            /* else why not */
     double ctr[FV_PROF_STAGES][FV_BENCH_MAX_CTRS]; /* per frame, per profiled stage */
@@ -36,10 +39,19 @@ typedef struct fv_bench_acc {
     fv_bench_run *r;
     int frames, n;
     double *total; /* each frame's total_ms */
+    double ceil_sum;
+    int ceil_n;
 } fv_bench_acc;
 int fv_bench_acc_init(fv_bench_acc *a, fv_bench_run *r, const char *mode, int frames);
 void fv_bench_acc_add(fv_bench_acc *a, const fv_frame_stats *st);
 void fv_bench_acc_finish(fv_bench_acc *a);
+/* One timed frame's ceiling time (--ceiling): finish sets ceiling_ms to their mean. */
+void fv_bench_acc_add_ceiling(fv_bench_acc *a, double ms);
+/* The ray stage against its ceiling: trace / ceiling time of one run (NAN without a ceiling),
+ * and a foveated ray's cost in units of a full-frame bare-Embree ray (fov's trace time per ray
+ * over full's ceiling time per ray; NAN when either is missing). */
+double fv_bench_ceiling_ratio(const fv_bench_run *r);
+double fv_bench_ray_cost(const fv_bench_run *fov, const fv_bench_run *full);
 
 /* Sum of both eyes' stats (stage times, total, samples); first: st starts the sum. */
 void fv_frame_stats_sum(fv_frame_stats *sum, const fv_frame_stats *st, int first);

@@ -1,7 +1,8 @@
 /* fovea: run-time CPU detection for the hand-vectorised kernels (dav1d / libjpeg-turbo style).
  *
  * Every module with kernels has its own table and init (core/pullpush_dsp.h,
- * core/reproject_dsp.h, core/dof/dof_dsp.h, core/output_dsp.h, core/eyetrack/eyetrack_dsp.h):
+ * core/reproject_dsp.h, core/shade_dsp.h, core/raygen_dsp.h, core/dof/dof_dsp.h,
+ * core/output_dsp.h, core/eyetrack/eyetrack_dsp.h):
  *   <module>_ref.c         plain-C references + fv_<module>_dsp_init(ctx, isa_mask), which fills
  *                          the references, then lets every allowed ISA, lowest first, overwrite
  *                          the entries it implements

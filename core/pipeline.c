@@ -333,6 +333,11 @@ const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye)
 }
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye) { return &p->eyes[slot(eye)].cam; }
 const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p) { return p->smp_cur; }
+int fv_pipeline_last_phase(const fv_pipeline *p, fv_eye eye)
+{
+    const eye_state *es = &p->eyes[slot(eye)];
+    return p->taa && es->frame > 0 ? (int)((es->frame - 1) % p->smp_cur->phases) : 0;
+}
 
 int fv_pipeline_set_fovea_scale(fv_pipeline *p, float scale)
 {

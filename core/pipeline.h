@@ -53,6 +53,10 @@ const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye);
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye);
 /* The sampling pattern in force (it changes with fv_pipeline_set_fovea_scale). */
 const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p);
+/* The sampling phase the eye's last frame used (0 before its first frame, and without
+ * reprojection): with fv_pipeline_sampler and the camera, the exact pixel set that frame traced
+ * (the bench's ceiling retraces it). */
+int fv_pipeline_last_phase(const fv_pipeline *p, fv_eye eye);
 /* Widens the fovea for the following frames (both eyes) when the gaze is doubtful: r0 and r1
  * times `scale` (r1 capped at 90 deg), the scale rounded to a step of 0.25 in [1, 2] (below 1:
  * 1; NaN: 2), as fv_fovea_radius_scale (eyetrack/gazefilter.h) gives it for the gaze filter's

@@ -1,75 +1,192 @@
 #include "raycast.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <string.h>
+
+#include "render_dsp.h"
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
 
-/* Pixels of a tile in 4x2 blocks, so a full packet of 8 is a compact 4x2 footprint and a
- * sparse tile's packets still gather nearby pixels (coherent rays). */
-static const unsigned char *tile_order(void)
+int fv_raycast_packet_width(void)
 {
-    static const unsigned char order[FV_TILE * FV_TILE][2] = {
-#define B(bx, by) {bx*4+0,by*2+0},{bx*4+1,by*2+0},{bx*4+2,by*2+0},{bx*4+3,by*2+0}, \
-                  {bx*4+0,by*2+1},{bx*4+1,by*2+1},{bx*4+2,by*2+1},{bx*4+3,by*2+1}
-#define R(by) B(0,by),B(1,by),B(2,by),B(3,by)
-        R(0), R(1), R(2), R(3), R(4), R(5), R(6), R(7)
-#undef R
-#undef B
-    };
-    return &order[0][0];
+    static atomic_int width; /* 0: not asked yet; every device of one library answers the same */
+    int w = atomic_load_explicit(&width, memory_order_relaxed);
+    if (!w) {
+        RTCDevice d = rtcNewDevice(NULL);
+        w = d && rtcGetDeviceProperty(d, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
+        if (d)
+            rtcReleaseDevice(d);
+        atomic_store_explicit(&width, w, memory_order_relaxed);
+    }
+    return w;
 }
 
-long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_pyr_level *l0, int x0, int y0, int tw, int th,
-                     const uint32_t rows[FV_TILE])
+/* Block mask (bit i: pixel i & 3, i >> 2 of a 4x2 block) -> its set pixels' offsets (y << 4 | x)
+ * in bit order, 8 bytes (the unused ones 0), as one little-endian word. */
+static uint64_t block_lut[256];
+static uint8_t block_count[256]; /* popcount: a call into libgcc without -mpopcnt */
+static pthread_once_t block_lut_once = PTHREAD_ONCE_INIT;
+static void block_lut_init(void)
 {
-    const unsigned char *order = tile_order();
-    struct RTCIntersectContext ictx;
-    rtcInitIntersectContext(&ictx);
-    ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    struct RTCRayHit8 rh;
-    int valid[8];
-    int px[8], py[8];
-    long rays = 0;
-    int k = 0;
-    for (int i = 0; i <= FV_TILE * FV_TILE; i++) {
-        if (i < FV_TILE * FV_TILE) {
-            int lx = order[2 * i], ly = order[2 * i + 1];
-            if (lx >= tw || ly >= th || !((rows[ly] >> lx) & 1u))
-                continue;
-            px[k] = x0 + lx;
-            py[k] = y0 + ly;
-            float d[3];
-            fv_camera_ray(cam, (float)px[k] + 0.5f, (float)py[k] + 0.5f, d);
-            fv_ray8_set(&rh, k, cam->eye_pos, d);
-            valid[k] = -1;
-            if (++k < 8)
-                continue;
-        }
-        if (k == 0)
-            break;
-        for (int q = k; q < 8; q++)
-            valid[q] = 0;
-        rtcIntersect8(valid, fv_scene_rtc(scene), &ictx, &rh);
-        for (int q = 0; q < k; q++) {
-            float *dst = l0->rgbd + 4 * (py[q] * l0->stride + px[q]);
-            if (rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID) {
-                dst[0] = fv_background_rgb[0];
-                dst[1] = fv_background_rgb[1];
-                dst[2] = fv_background_rgb[2];
-                dst[3] = FV_DEPTH_MISS_M;
-            } else {
-                float org[3] = {rh.ray.org_x[q], rh.ray.org_y[q], rh.ray.org_z[q]};
-                float dir[3] = {rh.ray.dir_x[q], rh.ray.dir_y[q], rh.ray.dir_z[q]};
-                float len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-                float t = rh.ray.tfar[q];
-                fv_scene_shade(scene, rh.hit.geomID[q], rh.hit.primID[q], rh.hit.u[q], rh.hit.v[q], org, dir, t,
-                               cam->px_tan / len, cam->eye_pos, dst);
-                dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M; /* t is the view depth: dir.z_eye = -1 */
-            }
-            l0->wgt[py[q] * l0->stride + px[q]] = 1.0f;
-        }
-        rays += k;
-        k = 0;
+    for (unsigned m = 0; m < 256; m++) {
+        uint64_t v = 0;
+        int n = 0;
+        for (unsigned b = 0; b < 8; b++)
+            if (m >> b & 1u)
+                v |= (uint64_t)((b >> 2) << 4 | (b & 3)) << (8 * n++);
+        block_lut[m] = v;
+        block_count[m] = (uint8_t)n;
     }
-    return rays;
+}
+
+/* The sampled pixels of a tile as (y << 4 | x) in 4x2-block order, so a full packet of 8 is a
+ * compact 4x2 footprint (16: 8x2) and a sparse tile's packets still gather nearby pixels
+ * (coherent rays). Each block's 8-bit mask looks its offsets up; the block's corner is added to
+ * all 8 bytes at once (no carries: corner + offset < 256) and the word stored whole, n advancing
+ * by the mask's pixel count: no branch per pixel. px needs 8 bytes of slack. */
+static int compact(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_TILE * FV_TILE + 8])
+{
+    const uint32_t keep = tw >= 32 ? ~0u : (1u << tw) - 1u;
+    int n = 0;
+    for (int by = 0; by < FV_TILE / 2; by++) {
+        const uint32_t r0 = 2 * by < th ? rows[2 * by] & keep : 0, r1 = 2 * by + 1 < th ? rows[2 * by + 1] & keep : 0;
+        for (int bx = 0; bx < FV_TILE / 4; bx++) {
+            const unsigned m = (r0 >> (4 * bx) & 15u) | (r1 >> (4 * bx) & 15u) << 4;
+            const uint64_t v = block_lut[m] + (uint64_t)(2 * by << 4 | 4 * bx) * 0x0101010101010101ull;
+            memcpy(px + n, &v, 8);
+            n += block_count[m];
+        }
+    }
+    return n;
+}
+
+/* 4 weights from 4 bits */
+static const float nibble_w[16][4] = {
+    {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {1, 1, 0, 0}, {0, 0, 1, 0}, {1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, 1, 0},
+    {0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}, {1, 1, 0, 1}, {0, 0, 1, 1}, {1, 0, 1, 1}, {0, 1, 1, 1}, {1, 1, 1, 1}};
+
+_Static_assert(RTC_INVALID_GEOMETRY_ID == 0xffffffffu, "memset to all ones");
+static const float lane_inf[16] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY,
+                                   INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY};
+/* lane_valid(16 - k): a valid mask with the first k lanes on, for packets of 8 or 16 */
+static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
+#define lane_valid(j) (lane_valid_all + (j))
+
+/* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths), double-buffered: packet
+ * b + 1 is traced before packet b is shaded, so the triangle records of b's hits, prefetched
+ * when b was traced, arrive while Embree works (they were the shading's main cost). */
+#define DEF_PACKETS(N)                                                                                            \
+    /* Camera rays through the pixel centres px[0 .. N) (as fv_camera_ray computes them) straight into      \
+     * the SoA packet, lanes from k on invalid; px holds N copies of its last pixel past the end. The        \
+     * pinhole by the ray kernel; a lens lane by lane. */                                                    \
+    static void trace_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,             \
+                          const fv_raygen_cam *rc, struct RTCIntersectContext *ictx, struct RTCRayHit##N *rh,  \
+                          int *valid, const fv_pyr_level *l0, const uint8_t *px, int k, int x0, int y0)       \
+    {                                                                                                         \
+        if (!cam->lens_on) {                                                                                  \
+            dsp->ray.camera_rays(rc, px, x0, y0, rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z, N);             \
+        } else {                                                                                              \
+            for (int q = 0; q < N; q++) {                                                                     \
+                const int p = px[q];                                                                          \
+                float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;                     \
+                float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                      \
+                fv_lens_distort(cam->lens_k1, cam->lens_k2, cam->lens_scale, cam->lens_cx, cam->lens_cy, tx, ty, \
+                                &tx, &ty);                                                                    \
+                rh->ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                       \
+                rh->ray.dir_y[q] = tx * cam->right[1] + ty * cam->up[1] - cam->back[1];                       \
+                rh->ray.dir_z[q] = tx * cam->right[2] + ty * cam->up[2] - cam->back[2];                       \
+            }                                                                                                 \
+        }                                                                                                     \
+        /* whole-vector copies: lane-by-lane stores here stalled (the lines are cold after shading) */       \
+        memcpy(rh->ray.tfar, lane_inf, sizeof(float) * N);                                                    \
+        memset(rh->hit.geomID, 0xff, sizeof(unsigned) * N); /* RTC_INVALID_GEOMETRY_ID */                    \
+        memset(rh->hit.instID[0], 0xff, sizeof(unsigned) * N);                                                \
+        memcpy(valid, lane_valid(16 - k), sizeof(int) * N);                                                      \
+        rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
+        fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                                    \
+        /* and the image lines the packet will write: cold, and each store would wait for its line */        \
+        for (int q = 0; q < k; q++)                                                                           \
+            __builtin_prefetch(l0->rgbd + 4 * ((y0 + (px[q] >> 4)) * l0->stride + x0 + (px[q] & 15)), 1);     \
+    }                                                                                                         \
+    /* Shades lanes 0 .. k-1 and writes them to level 0. */                                                 \
+    static void finish_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,               \
+                           const fv_pyr_level *l0, const struct RTCRayHit##N *rh, const uint8_t *px, int k,    \
+                           int x0, int y0)                                                                    \
+    {                                                                                                         \
+        _Alignas(64) float rgb[3][16];                                                                        \
+        const fv_hit_packet hp = {rh->hit.geomID, rh->hit.primID, rh->hit.u, rh->hit.v, rh->ray.tfar,         \
+                                  {rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z}};                             \
+        fv_scene_shade_packet(scene, dsp, &hp, k, cam->px_tan, cam->eye_pos, rgb);                            \
+        for (int q = 0; q < k; q++) {                                                                         \
+            const int p = px[q];                                                                              \
+            float *dst = l0->rgbd + 4 * ((y0 + (p >> 4)) * l0->stride + x0 + (p & 15));                       \
+            if (rh->hit.geomID[q] == RTC_INVALID_GEOMETRY_ID) {                                               \
+                dst[0] = fv_background_rgb[0], dst[1] = fv_background_rgb[1], dst[2] = fv_background_rgb[2];  \
+                dst[3] = FV_DEPTH_MISS_M;                                                                     \
+            } else { /* t is the view depth: dir.z_eye = -1 */                                                \
+                const float t = rh->ray.tfar[q];                                                              \
+                dst[0] = rgb[0][q], dst[1] = rgb[1][q], dst[2] = rgb[2][q];                                   \
+                dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;                                           \
+            }                                                                                                 \
+        }                                                                                                     \
+    }                                                                                                         \
+    static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
+                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                  \
+    {                                                                                                         \
+        struct RTCIntersectContext ictx;                                                                      \
+        rtcInitIntersectContext(&ictx);                                                                       \
+        ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                                     \
+        _Alignas(64) struct RTCRayHit##N rh[2];                                                               \
+        _Alignas(64) int valid[2][N];                                                                         \
+        const fv_raygen_cam rc = {cam->tan_left, cam->tan_top, cam->px_tan, {cam->right[0], cam->right[1],    \
+                                  cam->right[2]}, {cam->up[0], cam->up[1], cam->up[2]},                       \
+                                  {cam->back[0], cam->back[1], cam->back[2]}};                                \
+        for (int b = 0; b < 2; b++)                                                                           \
+            for (int q = 0; q < N; q++) { /* what no lane changes */                                         \
+                rh[b].ray.org_x[q] = cam->eye_pos[0], rh[b].ray.org_y[q] = cam->eye_pos[1];                   \
+                rh[b].ray.org_z[q] = cam->eye_pos[2], rh[b].ray.tnear[q] = 0.0f, rh[b].ray.time[q] = 0.0f;    \
+                rh[b].ray.mask[q] = ~0u, rh[b].ray.flags[q] = 0, rh[b].ray.id[q] = (unsigned)q;               \
+            }                                                                                                 \
+        const int np = (n + N - 1) / N;                                                                       \
+        trace_##N(scene, cam, dsp, &rc, &ictx, &rh[0], valid[0], l0, px, n < N ? n : N, x0, y0);             \
+        for (int b = 0; b < np; b++) {                                                                        \
+            const int i = (b + 1) * N;                                                                        \
+            if (b + 1 < np)                                                                                   \
+                trace_##N(scene, cam, dsp, &rc, &ictx, &rh[(b + 1) & 1], valid[(b + 1) & 1], l0, px + i,       \
+                          n - i < N ? n - i : N, x0, y0);                                                     \
+            const int k = n - b * N < N ? n - b * N : N;                                                      \
+            finish_##N(scene, cam, &dsp->shade, l0, &rh[b & 1], px + b * N, k, x0, y0);                       \
+        }                                                                                                     \
+    }
+DEF_PACKETS(8)
+DEF_PACKETS(16)
+
+long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
+                     int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE])
+{
+    /* every pixel's weight, from the rows' bits (pull-push never reads the colour of a zero-weight
+     * pixel, so the others' colours are left alone) */
+    for (int y = 0; y < th; y++) {
+        float *w = l0->wgt + (ptrdiff_t)(y0 + y) * l0->stride + x0;
+        if (tw == FV_TILE)
+            for (int x = 0; x < FV_TILE; x += 4)
+                memcpy(w + x, nibble_w[rows[y] >> x & 15u], sizeof nibble_w[0]);
+        else
+            for (int x = 0; x < tw; x++)
+                w[x] = (float)(rows[y] >> x & 1u);
+    }
+    pthread_once(&block_lut_once, block_lut_init);
+    uint8_t px[FV_TILE * FV_TILE + 16];
+    const int n = compact(rows, tw, th, px);
+    if (n == 0)
+        return 0;
+    for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
+        px[q] = px[n - 1];
+    if (fv_raycast_packet_width() == 16)
+        packets_16(scene, cam, dsp, l0, x0, y0, px, n);
+    else
+        packets_8(scene, cam, dsp, l0, x0, y0, px, n);
+    return n;
 }

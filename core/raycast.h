@@ -37,10 +37,17 @@ static inline void fv_ray8_set(struct RTCRayHit8 *rh, int k, const float org[3],
     rh->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
 }
 
+struct fv_render_dsp;
+
+/* The packet width the ray stage traces with: 16 (rtcIntersect16) where this Embree has native
+ * 16-wide packets (its AVX-512 path), else 8. */
+int fv_raycast_packet_width(void);
+
 /* Casts a ray through the centre of every pixel of the tile [x0, x0+tw) x [y0, y0+th) whose bit
- * is set in rows[y - y0] (bit x - x0), shades the hits and writes r, g, b, depth_m with weight 1
- * into level 0 (l0's planes). Other pixels are not touched. Returns the number of rays cast. */
-long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_pyr_level *l0, int x0, int y0, int tw, int th,
-                     const uint32_t rows[FV_TILE]);
+ * is set in rows[y - y0] (bit x - x0), generates and shades them with dsp's kernels (ray, shade) and writes r, g, b,
+ * depth_m with weight 1 into level 0 (l0's planes); every other pixel of the tile gets weight 0
+ * and keeps its colour. Returns the number of rays cast. */
+long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const struct fv_render_dsp *dsp,
+                     const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE]);
 
 #endif

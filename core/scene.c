@@ -83,9 +83,8 @@ void fv_scene_free(fv_scene *s)
 {
     if (!s) return;
     for (size_t i = 0; i < s->mesh_count; i++) {
-        free(s->meshes[i].normals);
-        free(s->meshes[i].uvs);
-        free(s->meshes[i].texel_density);
+        free(s->meshes[i].attr);
+        free(s->meshes[i].face);
     }
     free(s->meshes);
     for (int i = 0; i < s->texture_count; i++) free(s->textures[i].data);

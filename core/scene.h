@@ -77,4 +77,21 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
                     const float org[3], const float dir[3], float t, float footprint_rad,
                     const float eye_pos[3], float rgb[3]);
 
+/* One Embree packet's hits for fv_scene_shade_packet, lane q in element q of each array (read
+ * straight from Embree's RTCRayHitN). A lane with geom RTC_INVALID_GEOMETRY_ID is a miss. */
+typedef struct fv_hit_packet {
+    const unsigned *geom, *prim;
+    const float *u, *v, *t;
+    const float *dir[3];
+} fv_hit_packet;
+/* Asks for the shading data of n hits (geometry and primitive IDs as Embree returns them) to
+ * be brought into the cache: call it as soon as a packet is traced, shade it later. */
+void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n);
+struct fv_shade_dsp;
+/* fv_scene_shade for lanes 0 .. n-1 of a packet of camera rays from eye_pos, each with
+ * footprint px_tan / |dir| (the camera's pixel angle), with the shading kernels of dsp: the same
+ * bits as fv_scene_shade lane by lane. Misses' rgb is unspecified. */
+void fv_scene_shade_packet(const fv_scene *s, const struct fv_shade_dsp *dsp, const fv_hit_packet *h, int n,
+                           float px_tan, const float eye_pos[3], float rgb[3][16]);
+
 #endif

@@ -1,11 +1,12 @@
 /* fovea: the scene's private parts, shared by the files that implement core/scene.h (scene.c:
  * lifecycle, lights, views; scene_mesh.c: Embree geometry; texture.c; shade.c). Not a public
  * API; gltf_import.c needs none of it (it uses the builder API). Mesh records (normals, uvs,
- * material, per-triangle texel density) stay here for shading, indexed by Embree geometry ID. */
+ * material, per-triangle texel density: fv_tri_attr) stay here for shading, indexed by Embree geometry ID. */
 #ifndef FOVEA_SCENE_IMPL_H
 #define FOVEA_SCENE_IMPL_H
 
 #include "scene.h"
+#include "shade_dsp.h" /* fv_light_rec: the lights as the shading kernels read them */
 
 #include <math.h>
 #include <pthread.h>
@@ -22,21 +23,29 @@ typedef struct fv_texture {
     float *data;
 } fv_texture;
 
+/* A triangle's shading inputs, one cache line: its corners' normals (world, unit or zero if
+ * degenerate) and uvs (0 without), mip-0 texels per metre (0 without texture). */
+typedef struct fv_tri_attr {
+    float n[9];  /* corner 0 x y z, corner 1, corner 2 */
+    float uv[6]; /* corner 0 u v, corner 1, corner 2 */
+    float texel_density;
+} fv_tri_attr;
+_Static_assert(sizeof(fv_tri_attr) == 64, "one cache line per triangle");
+
+/* A textured triangle's face normal, unnormalised (cross of its edges), and its length. */
+typedef struct fv_tri_face {
+    float ng[3], ng_len;
+} fv_tri_face;
+
 typedef struct fv_mesh_rec {
     const float *pos;      /* world positions, 3 per vertex: Embree's vertex buffer */
     const uint32_t *tri;   /* 3 per triangle: Embree's index buffer */
-    float *normals;        /* world, unit (or zero if degenerate), 3 per vertex */
-    float *uvs;            /* 2 per vertex, or NULL */
-    float *texel_density;  /* per triangle, mip-0 texels per metre; NULL without texture */
+    fv_tri_attr *attr;     /* per triangle, 64-byte aligned */
+    fv_tri_face *face;     /* per triangle of a textured mesh (the mip level), else NULL */
     size_t vertex_count, tri_count;
     float base_color[4];
     int texture;
 } fv_mesh_rec;
-
-typedef struct fv_light_rec {
-    fv_light l;
-    float cos_inner, cos_outer; /* spot only */
-} fv_light_rec;
 
 struct fv_scene {
     RTCDevice device;
@@ -65,6 +74,19 @@ int fv_scene_grow(void **p, size_t *cap, size_t n, size_t elem);
 int fv_scene_take_rtc_error(fv_scene *s, char *err, size_t err_len);
 /* Trilinear between the two mip levels around lod (lod 0 = full resolution), REPEAT addressing. */
 void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4]);
+/* fv_texture_sample in two steps, so a packet's texel fetches can be asked for before they are
+ * used: the taps (texel addresses and weights), then the blend; the same bits. */
+typedef struct fv_tex_tap {
+    const float *p[4]; /* texels 00, 10, 01, 11 */
+    float fx, fy;
+} fv_tex_tap;
+typedef struct fv_tex_taps {
+    fv_tex_tap tap[2]; /* the finer level, the coarser one when f > 0 */
+    float f;           /* weight of the coarser level */
+} fv_tex_taps;
+void fv_texture_taps(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp);
+void fv_texture_taps_prefetch(const fv_tex_taps *tp);
+void fv_texture_blend(const fv_tex_taps *tp, float out[4]);
 
 static inline void cross3(const float a[3], const float b[3], float o[3])
 {

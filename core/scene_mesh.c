@@ -78,11 +78,13 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     memcpy(r.base_color, m->base_color, sizeof r.base_color);
     float *pos = malloc(nv * 3 * sizeof(float));
     uint32_t *tri = malloc(nt * 3 * sizeof(uint32_t));
-    r.normals = calloc(nv * 3, sizeof(float));
-    r.uvs = m->uvs ? malloc(nv * 2 * sizeof(float)) : NULL;
-    r.texel_density = m->texture >= 0 ? malloc(nt * sizeof(float)) : NULL;
+    float *normals = calloc(nv * 3, sizeof(float));
+    float *uvs = m->uvs ? malloc(nv * 2 * sizeof(float)) : NULL;
+    float *density = m->texture >= 0 ? malloc(nt * sizeof(float)) : NULL;
+    r.attr = aligned_alloc(64, nt * sizeof *r.attr);
+    r.face = m->texture >= 0 ? malloc(nt * sizeof *r.face) : NULL;
     RTCGeometry g = NULL;
-    if (!pos || !tri || !r.normals || (m->uvs && !r.uvs) || (m->texture >= 0 && !r.texel_density)) {
+    if (!pos || !tri || !normals || !r.attr || (m->texture >= 0 && !r.face) || (m->uvs && !uvs) || (m->texture >= 0 && !density)) {
         fv_err(err, err_len, "out of memory");
         goto fail;
     }
@@ -111,7 +113,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         const float sgn = dot3(c0, k0) < 0.0f ? -1.0f : 1.0f;
         for (size_t i = 0; i < nv; i++) {
             const float *n = m->normals + 3 * i;
-            float *o = r.normals + 3 * i;
+            float *o = normals + 3 * i;
             for (int k = 0; k < 3; k++) o[k] = sgn * (k0[k] * n[0] + k1[k] * n[1] + k2[k] * n[2]);
             const float l = len3(o);
             if (!isfinite(l)) {
@@ -127,10 +129,10 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
             tri_edges(pos, tri + 3 * t, e1, e2);
             cross3(e1, e2, fn);
             for (int j = 0; j < 3; j++)
-                for (int k = 0; k < 3; k++) r.normals[3 * (size_t)tri[3 * t + (size_t)j] + (size_t)k] += fn[k];
+                for (int k = 0; k < 3; k++) normals[3 * (size_t)tri[3 * t + (size_t)j] + (size_t)k] += fn[k];
         }
         for (size_t i = 0; i < nv; i++) {
-            float *o = r.normals + 3 * i;
+            float *o = normals + 3 * i;
             const float l = len3(o);
             if (l > 0.0f && isfinite(l))
                 for (int k = 0; k < 3; k++) o[k] /= l;
@@ -144,9 +146,9 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
                 fv_err(err, err_len, "vertex %zu uv is not finite", i / 2);
                 goto fail;
             }
-        memcpy(r.uvs, m->uvs, nv * 2 * sizeof(float));
+        memcpy(uvs, m->uvs, nv * 2 * sizeof(float));
     }
-    if (r.texel_density) {
+    if (density) {
         const fv_texture *tx = &s->textures[m->texture];
         const double texels = (double)tx->w[0] * (double)tx->h[0];
         for (size_t t = 0; t < nt; t++) {
@@ -154,13 +156,30 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
             tri_edges(pos, tri + 3 * t, e1, e2);
             cross3(e1, e2, fn);
             const uint32_t *v = tri + 3 * t;
-            const float *u0 = r.uvs + 2 * (size_t)v[0], *u1 = r.uvs + 2 * (size_t)v[1], *u2 = r.uvs + 2 * (size_t)v[2];
+            const float *u0 = uvs + 2 * (size_t)v[0], *u1 = uvs + 2 * (size_t)v[1], *u2 = uvs + 2 * (size_t)v[2];
             const double uv_area2 = fabs((double)(u1[0] - u0[0]) * (u2[1] - u0[1]) - (double)(u1[1] - u0[1]) * (u2[0] - u0[0]));
             const double world_area2 = len3(fn);
             const double d = world_area2 > 0.0 ? sqrt(uv_area2 * texels / world_area2) : 0.0;
-            r.texel_density[t] = isfinite(d) && d < FLT_MAX ? (float)d : 0.0f;
+            density[t] = isfinite(d) && d < FLT_MAX ? (float)d : 0.0f;
+            for (int k = 0; k < 3; k++) r.face[t].ng[k] = fn[k];
+            r.face[t].ng_len = len3(fn);
         }
     }
+
+    /* shading reads one cache line per hit, not the index buffer and three vertices */
+    for (size_t t = 0; t < nt; t++) {
+        fv_tri_attr *a = &r.attr[t];
+        for (int c = 0; c < 3; c++) {
+            const size_t v = tri[3 * t + (size_t)c];
+            for (int k = 0; k < 3; k++) a->n[3 * c + k] = normals[3 * v + (size_t)k];
+            for (int k = 0; k < 2; k++) a->uv[2 * c + k] = uvs ? uvs[2 * v + (size_t)k] : 0.0f;
+        }
+        a->texel_density = density ? density[t] : 0.0f;
+    }
+    free(normals);
+    free(uvs);
+    free(density);
+    normals = uvs = density = NULL;
 
     g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     float *vb = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv) : NULL;
@@ -196,8 +215,10 @@ fail:
     if (g) rtcReleaseGeometry(g);
     free(pos);
     free(tri);
-    free(r.normals);
-    free(r.uvs);
-    free(r.texel_density);
+    free(normals);
+    free(uvs);
+    free(density);
+    free(r.attr);
+    free(r.face);
     return -1;
 }

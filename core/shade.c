@@ -4,11 +4,45 @@
 
 #include <math.h>
 
+_Static_assert(FV_SHADE_LANES == 16, "fv_hit_packet (scene.h) holds 16 lanes");
+
 static float smoothstepf(float e0, float e1, float x)
 {
     if (e1 <= e0) return x >= e1 ? 1.0f : 0.0f;
     const float t = fv_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
     return t * t * (3.0f - 2.0f * t);
+}
+
+/* A textured hit's texture coordinates and mip level (from the ray footprint: footprint_rad is
+ * the pixel's angle along the ray). */
+static void tex_coords(const fv_mesh_rec *m, unsigned prim, float u, float v, float w, const float dir[3], float t,
+                       float footprint_rad, float *tu, float *tv, float *lod)
+{
+    const fv_tri_attr *at = &m->attr[prim];
+    const float *a = at->uv, *b = at->uv + 2, *c = at->uv + 4;
+    *tu = w * a[0] + u * b[0] + v * c[0], *tv = w * a[1] + u * b[1] + v * c[1];
+    const float density = at->texel_density;
+    *lod = 0.0f;
+    if (footprint_rad > 0.0f && t > 0.0f && density > 0.0f) {
+        const fv_tri_face *f = &m->face[prim];
+        const float ng_len = f->ng_len, dir_len = len3(dir);
+        const float cos_theta = ng_len > 0.0f && dir_len > 0.0f ? fabsf(dot3(f->ng, dir)) / (ng_len * dir_len) : 1.0f;
+        const float width_m = t * dir_len * footprint_rad / fmaxf(cos_theta, 0.1f);
+        *lod = log2f(width_m * density);
+    }
+}
+
+/* The material's base colour at the hit, times its texture (trilinear). */
+static void base_colour(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
+                        const float dir[3], float t, float footprint_rad, float base[3])
+{
+    base[0] = m->base_color[0], base[1] = m->base_color[1], base[2] = m->base_color[2];
+    if (m->texture < 0)
+        return;
+    float tu, tv, lod, texel[4];
+    tex_coords(m, prim, u, v, w, dir, t, footprint_rad, &tu, &tv, &lod);
+    fv_texture_sample(&s->textures[m->texture], tu, tv, lod, texel);
+    for (int k = 0; k < 3; k++) base[k] *= texel[k];
 }
 
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
@@ -26,8 +60,8 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
      * unnormalised and the Lambert term divides by |n||L| once. Scalar sqrt/div chains were
      * most of the shading time. */
     float n[3];
-    const float *n0 = m->normals + 3 * (size_t)tri[0], *n1 = m->normals + 3 * (size_t)tri[1],
-                *n2 = m->normals + 3 * (size_t)tri[2];
+    const fv_tri_attr *at = &m->attr[prim_id];
+    const float *n0 = at->n, *n1 = at->n + 3, *n2 = at->n + 6;
     /* written out: a 3-iteration loop left n[] on the stack and the 8-byte reload of two
      * 4-byte stores stalled store forwarding on every call */
     n[0] = w * n0[0] + u * n1[0] + v * n2[0];
@@ -43,25 +77,8 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     if (dot3(n, dir) > 0.0f)
         for (int k = 0; k < 3; k++) n[k] = -n[k];
 
-    float base[3] = {m->base_color[0], m->base_color[1], m->base_color[2]};
-    if (m->texture >= 0) {
-        const float *a = m->uvs + 2 * (size_t)tri[0], *b = m->uvs + 2 * (size_t)tri[1], *c = m->uvs + 2 * (size_t)tri[2];
-        const float tu = w * a[0] + u * b[0] + v * c[0], tv = w * a[1] + u * b[1] + v * c[1];
-        const float density = m->texel_density[prim_id];
-        float lod = 0.0f;
-        if (footprint_rad > 0.0f && t > 0.0f && density > 0.0f) {
-            float e1[3], e2[3], ng[3];
-            tri_edges(m->pos, tri, e1, e2);
-            cross3(e1, e2, ng);
-            const float ng_len = len3(ng), dir_len = len3(dir);
-            const float cos_theta = ng_len > 0.0f && dir_len > 0.0f ? fabsf(dot3(ng, dir)) / (ng_len * dir_len) : 1.0f;
-            const float width_m = t * dir_len * footprint_rad / fmaxf(cos_theta, 0.1f);
-            lod = log2f(width_m * density);
-        }
-        float texel[4];
-        fv_texture_sample(&s->textures[m->texture], tu, tv, lod, texel);
-        for (int k = 0; k < 3; k++) base[k] *= texel[k];
-    }
+    float base[3];
+    base_colour(s, m, prim_id, u, v, w, dir, t, footprint_rad, base);
 
     const float p[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
     float light[3] = {FV_SCENE_AMBIENT, FV_SCENE_AMBIENT, FV_SCENE_AMBIENT};
@@ -97,4 +114,76 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         }
     }
     for (int k = 0; k < 3; k++) rgb[k] = base[k] * light[k];
+}
+
+void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
+{
+    for (int q = 0; q < n; q++)
+        if (geom[q] < s->mesh_count && prim[q] < s->meshes[geom[q]].tri_count) {
+            const fv_mesh_rec *m = &s->meshes[geom[q]];
+            __builtin_prefetch(&m->attr[prim[q]]);
+            if (m->face)
+                __builtin_prefetch(&m->face[prim[q]]);
+        }
+}
+
+void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_hit_packet *h, int n,
+                           float px_tan, const float eye_pos[3], float rgb[3][FV_SHADE_LANES])
+{
+    /* Per thread, zero at start: lanes of misses keep whatever an earlier packet left there
+     * (finite, initialised: their results are not used), so a miss costs no stores. */
+    static _Thread_local _Alignas(64) fv_shade_packet pk;
+    fv_tex_taps taps[FV_SHADE_LANES];
+    unsigned hits = 0, black = 0, textured = 0;
+    for (int q = 0; q < n; q++) {
+        const unsigned g = h->geom[q], prim = h->prim[q];
+        const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
+        if (!m || prim >= m->tri_count) { /* a miss, or no such triangle (black) */
+            if (g != RTC_INVALID_GEOMETRY_ID)
+                black |= 1u << q;
+            continue;
+        }
+        hits |= 1u << q;
+        const fv_tri_attr *at = &m->attr[prim];
+        for (int k = 0; k < 9; k++)
+            pk.nrm[k][q] = at->n[k];
+        const float u = h->u[q], v = h->v[q], t = h->t[q];
+        const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
+        pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
+        for (int k = 0; k < 3; k++) pk.dir[k][q] = dir[k];
+        const float fp = m->texture >= 0 ? px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]) : 0.0f;
+        for (int k = 0; k < 3; k++) pk.base[k][q] = m->base_color[k];
+        if (m->texture >= 0) { /* the texel fetches of all lanes are asked for before any is used */
+            float tu, tv, lod;
+            tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
+            fv_texture_taps(&s->textures[m->texture], tu, tv, lod, &taps[q]);
+            fv_texture_taps_prefetch(&taps[q]);
+            textured |= 1u << q;
+        }
+    }
+    for (unsigned r = textured; r; r &= r - 1) {
+        const int q = __builtin_ctz(r);
+        float texel[4];
+        fv_texture_blend(&taps[q], texel);
+        for (int k = 0; k < 3; k++) pk.base[k][q] *= texel[k];
+    }
+    if (!hits) { /* all misses: nothing to shade */
+        for (; black; black &= black - 1)
+            for (int k = 0; k < 3; k++) rgb[k][__builtin_ctz(black)] = 0.0f;
+        return;
+    }
+    const fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
+                              .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
+    unsigned rest = dsp->lambert(&pk, &env, rgb) & hits;
+    while (rest) { /* degenerate smooth normals: the scalar path's face normal */
+        const int q = __builtin_ctz(rest);
+        rest &= rest - 1;
+        const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
+        const float len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        float c[3];
+        fv_scene_shade(s, h->geom[q], h->prim[q], h->u[q], h->v[q], eye_pos, dir, h->t[q], px_tan / len, eye_pos, c);
+        for (int k = 0; k < 3; k++) rgb[k][q] = c[k];
+    }
+    for (; black; black &= black - 1)
+        for (int k = 0; k < 3; k++) rgb[k][__builtin_ctz(black)] = 0.0f;
 }

@@ -74,7 +74,8 @@ int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h)
 }
 
 /* Bilinear, REPEAT addressing; uv (0,0) is the first texel of the first row (glTF). */
-static void tex_bilinear(const fv_texture *t, int l, float u, float v, float out[4])
+/* A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. */
+static void tex_tap(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp)
 {
     const int w = t->w[l], h = t->h[l];
     const float *px = t->level[l];
@@ -82,35 +83,62 @@ static void tex_bilinear(const fv_texture *t, int l, float u, float v, float out
     v = isfinite(v) ? v - floorf(v) : 0.0f;
     const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
     const float xf = floorf(x), yf = floorf(y);
-    const float fx = x - xf, fy = y - yf;
+    tp->fx = x - xf, tp->fy = y - yf;
     int x0 = (int)xf, y0 = (int)yf, x1 = x0 + 1, y1 = y0 + 1; /* in [-1, side] */
     if (x0 < 0) x0 += w;
     if (y0 < 0) y0 += h;
     if (x1 >= w) x1 -= w;
     if (y1 >= h) y1 -= h;
-    const float *a = px + ((size_t)y0 * (size_t)w + (size_t)x0) * 4, *b = px + ((size_t)y0 * (size_t)w + (size_t)x1) * 4;
-    const float *c = px + ((size_t)y1 * (size_t)w + (size_t)x0) * 4, *d = px + ((size_t)y1 * (size_t)w + (size_t)x1) * 4;
+    tp->p[0] = px + ((size_t)y0 * (size_t)w + (size_t)x0) * 4, tp->p[1] = px + ((size_t)y0 * (size_t)w + (size_t)x1) * 4;
+    tp->p[2] = px + ((size_t)y1 * (size_t)w + (size_t)x0) * 4, tp->p[3] = px + ((size_t)y1 * (size_t)w + (size_t)x1) * 4;
+}
+
+static void tex_blend(const fv_tex_tap *tp, float out[4])
+{
+    const float *a = tp->p[0], *b = tp->p[1], *c = tp->p[2], *d = tp->p[3];
     for (int k = 0; k < 4; k++) {
-        const float top = a[k] + (b[k] - a[k]) * fx, bot = c[k] + (d[k] - c[k]) * fx;
-        out[k] = top + (bot - top) * fy;
+        const float top = a[k] + (b[k] - a[k]) * tp->fx, bot = c[k] + (d[k] - c[k]) * tp->fx;
+        out[k] = top + (bot - top) * tp->fy;
+    }
+}
+
+void fv_texture_taps(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp)
+{
+    if (!(lod > 0.0f)) lod = 0.0f; /* also NaN */
+    const float top = (float)(t->levels - 1);
+    tp->f = 0.0f;
+    if (lod >= top) {
+        tex_tap(t, t->levels - 1, u, v, &tp->tap[0]);
+        return;
+    }
+    const int l0 = (int)lod;
+    tp->f = lod - (float)l0;
+    tex_tap(t, l0, u, v, &tp->tap[0]);
+    if (tp->f > 0.0f)
+        tex_tap(t, l0 + 1, u, v, &tp->tap[1]);
+}
+
+void fv_texture_taps_prefetch(const fv_tex_taps *tp)
+{
+    for (int l = 0; l < (tp->f > 0.0f ? 2 : 1); l++)
+        for (int i = 0; i < 4; i++)
+            __builtin_prefetch(tp->tap[l].p[i]);
+}
+
+void fv_texture_blend(const fv_tex_taps *tp, float out[4])
+{
+    tex_blend(&tp->tap[0], out);
+    if (tp->f > 0.0f) {
+        float o1[4];
+        tex_blend(&tp->tap[1], o1);
+        for (int k = 0; k < 4; k++) out[k] += (o1[k] - out[k]) * tp->f;
     }
 }
 
 /* Trilinear between the two mip levels around lod (lod 0 = full resolution). */
 void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4])
 {
-    if (!(lod > 0.0f)) lod = 0.0f; /* also NaN */
-    const float top = (float)(t->levels - 1);
-    if (lod >= top) {
-        tex_bilinear(t, t->levels - 1, u, v, out);
-        return;
-    }
-    const int l0 = (int)lod;
-    const float f = lod - (float)l0;
-    tex_bilinear(t, l0, u, v, out);
-    if (f > 0.0f) {
-        float o1[4];
-        tex_bilinear(t, l0 + 1, u, v, o1);
-        for (int k = 0; k < 4; k++) out[k] += (o1[k] - out[k]) * f;
-    }
+    fv_tex_taps tp;
+    fv_texture_taps(t, u, v, lod, &tp);
+    fv_texture_blend(&tp, out);
 }

@@ -37,14 +37,11 @@ static void run_tile(void *ctx, int index, int thread_id)
     if (j->taa) /* early: the lines arrive while the rays are traced */
         fv_taa_prefetch(j->taa, FV_TILE_PULL_LEVELS, x0, y0, tw, th);
     uint32_t rows[FV_TILE];
-    for (int y = 0; y < th; y++) {
+    for (int y = 0; y < th; y++)
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
-        /* Pixels without a sample carry weight 0 into pull-push, which never reads the colour of
-         * a zero-weight pixel: clearing the weights is enough (a quarter of the bytes). */
-        memset(l0->wgt + (y0 + y) * l0->stride + x0, 0, sizeof(float) * (size_t)tw);
-    }
 
-    const long rays = fv_raycast_tile(j->scene, cam, l0, x0, y0, tw, th, rows);
+    /* writes every weight of the tile: pixels without a sample get 0 */
+    const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
         fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th);

@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/clock.h"
 #include "base/err.h"
+#include "ceiling.h"
 #include "cpu.h"
 #include "output.h"
 #include "perfctr.h"
@@ -68,6 +70,23 @@ int fv_bench_run_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, c
         }
         if (f >= warmup)
             fv_bench_acc_add(&acc, &st);
+        if (bo->ceiling) {
+            const fv_camera *cam = fv_pipeline_camera(pl, FV_EYE_CENTER);
+            const fv_ceiling_opts co = {.smp = full ? NULL : fv_pipeline_sampler(pl),
+                                        .gx = (int)floorf(0.5f * (float)cam->width),
+                                        .gy = (int)floorf(0.5f * (float)cam->height),
+                                        .phase = fv_pipeline_last_phase(pl, FV_EYE_CENTER)};
+            const int64_t c0 = fv_time_ns();
+            const long n = fv_ceiling_trace(scene, cam, fv_pipeline_pool(pl), &co, NULL);
+            const double ms = (double)(fv_time_ns() - c0) * 1e-6;
+            if (n != st.samples) { /* not the same rays: the ratio would mean nothing */
+                rc = fv_err(err, err_len, "%s frame %d: the ceiling traced %ld rays, the frame %ld", r->mode, f, n,
+                            st.samples);
+                break;
+            }
+            if (f >= warmup)
+                fv_bench_acc_add_ceiling(&acc, ms);
+        }
     }
     fv_pipeline_set_prof(pl, NULL);
     if (hook_prof)
@@ -191,6 +210,30 @@ static void print_counters(FILE *f, const fv_bench_run *r)
     }
 }
 
+void fv_bench_print_ceiling(FILE *f, const fv_bench_run *res, int nres)
+{
+    int any = 0;
+    for (int i = 0; i < nres; i++)
+        any |= !isnan(res[i].ceiling_ms);
+    if (!any)
+        return;
+    fprintf(f, "ray stage against bare Embree on the same rays (--ceiling, same run):\n");
+    fprintf(f, "  %-9s %-8s %10s %9s %11s %14s %8s %16s\n", "mode", "sampler", "samples", "trace ms", "ceiling ms",
+            "trace/ceiling", "Mrays/s", "ceiling Mrays/s");
+    for (int i = 0; i < nres; i++) {
+        const fv_bench_run *r = &res[i];
+        fprintf(f, "  %-9s %-8s %10ld", r->mode, r->sampler, r->samples);
+        cell(f, r->stage_mean[FV_STAGE_TRACE], 10, 2);
+        cell(f, r->ceiling_ms, 12, 2);
+        cell(f, fv_bench_ceiling_ratio(r), 15, 2);
+        cell(f, r->mrays, 9, 1);
+        cell(f, r->ceiling_mrays, 17, 1);
+        fprintf(f, "\n");
+    }
+    if (nres == 2 && !strcmp(res[0].mode, "foveated") && !strcmp(res[1].mode, "full"))
+        fprintf(f, "  a foveated ray costs %.2f full-frame bare-Embree rays\n", fv_bench_ray_cost(&res[0], &res[1]));
+}
+
 void fv_bench_print_results(FILE *f, const fv_bench_report *rep)
 {
     const fv_bench_run *res = rep->runs;
@@ -198,6 +241,7 @@ void fv_bench_print_results(FILE *f, const fv_bench_report *rep)
     if (rep->nruns == 2)
         fprintf(f, "samples foveated/full = %.3f   total foveated/full = %.3f\n",
                 (double)res[0].samples / res[1].samples, res[0].total_mean / res[1].total_mean);
+    fv_bench_print_ceiling(f, res, rep->nruns);
     print_roofline(f, res, rep->nruns, rep->width, rep->height, rep->copy_gbps);
     if (rep->nruns > 0)
         print_counters(f, &res[0]);
@@ -207,6 +251,7 @@ void fv_bench_print_sweep_point(FILE *f, const fv_sweep *sw, int k, int frames)
 {
     fprintf(f, "\nsweep %s = %s", fv_sweep_names[sw->param], sw->label[k]);
     fv_bench_print_table(f, sw->res[k], sw->nres[k], frames);
+    fv_bench_print_ceiling(f, sw->res[k], sw->nres[k]);
 }
 
 void fv_bench_print_scaling(FILE *f, const fv_sweep *sw)
@@ -241,6 +286,8 @@ static void json_run(FILE *f, const fv_bench_run *r, int w, int h, double gbps)
     }
     fprintf(f, "},\n   \"mrays_per_s\": ");
     json_num(f, r->mrays);
+    fprintf(f, ", \"sampler\": \"%s\", \"ceiling_ms\": ", r->sampler);
+    json_num(f, r->ceiling_ms);
     fprintf(f, ",\n   \"roofline\": {");
     for (int k = 0; k < FV_BENCH_NROOF; k++) {
         const int s = fv_bench_roof_stages[k];

@@ -23,10 +23,13 @@ typedef struct fv_bench_opts {
     int warmup, frames;
     int counters;   /* read hardware counters per stage */
     fv_prof *prof;  /* trace recorder or NULL */
+    int ceiling;    /* after every frame, time bare Embree on its rays (core/ceiling.h) */
 } fv_bench_opts;
 
 /* Renders warmup + frames frames of one eye (gaze at the centre) with cfg (full: full
- * sampling) into r. 0, or -1 with a reason in err (bad config, out of memory, or
+ * sampling) into r; with bo->ceiling, each frame is followed by fv_ceiling_trace on exactly its
+ * rays (every pixel in full mode, else the sampler's set for the frame's gaze and phase) on the
+ * pipeline's pool, so ray stage and ceiling share the run's load. 0, or -1 with a reason in err (bad config, out of memory, or
  * "FOVEATED|FULL frame N: rendering failed"). Counters that cannot be read are reported in r. */
 int fv_bench_run_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, const fv_pose *view,
                       const fv_bench_opts *bo, fv_bench_run *r, char *err, size_t err_len);
@@ -54,6 +57,9 @@ void fv_bench_print_setup(FILE *f, const char *prog, const fv_bench_report *rep)
 void fv_bench_print_table(FILE *f, const fv_bench_run *res, int nres, int frames);
 /* After the base runs: the table, the foveated/full ratios, the roofline and the first run's counters. */
 void fv_bench_print_results(FILE *f, const fv_bench_report *rep);
+/* With --ceiling: per run sampler, samples, trace ms, ceiling ms, their ratio, Mrays/s of both;
+ * with both modes, a foveated ray's cost in full-frame bare-Embree rays. */
+void fv_bench_print_ceiling(FILE *f, const fv_bench_run *res, int nres);
 /* A sweep point's heading and table; a thread sweep's scaling efficiency. */
 void fv_bench_print_sweep_point(FILE *f, const fv_sweep *sw, int k, int frames);
 void fv_bench_print_scaling(FILE *f, const fv_sweep *sw);

@@ -250,6 +250,19 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
     else
         bad "DoF bench failed: $(cat "$T/err")"
     fi
+    # without --ceiling: ceiling_ms null, the sampler named; with it (issue 15): a time per mode,
+    # the comparison block, a valid JSON (the ray counts of stage and ceiling agree, or it fails)
+    grep -q '"ceiling_ms": null' "$T/b.json" && grep -q '"sampler": "weier"' "$T/b.json" && ok ||
+        bad "bench JSON without --ceiling: $(cat "$T/b.json")"
+    if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --threads 2 --ceiling \
+        --json "$T/c.json" >"$T/out" 2>"$T/err"; then
+        [ "$(grep -c '"ceiling_ms": [0-9]' "$T/c.json")" = 2 ] && ok || bad "--ceiling JSON: $(cat "$T/c.json")"
+        grep -q 'trace/ceiling' "$T/out" && grep -q 'a foveated ray costs [0-9.]* full-frame bare-Embree rays' "$T/out" &&
+            ok || bad "--ceiling table: $(cat "$T/out")"
+        out=$(python3 tools/check_schema.py docs/bench.schema.json "$T/c.json") && ok || bad "--ceiling JSON schema: $out"
+    else
+        bad "--ceiling bench failed: $(cat "$T/err")"
+    fi
 else
     bad "bench failed: $(cat "$T/err")"
 fi

@@ -5,6 +5,7 @@
 #include "testutil.h"
 
 #include "scene.h"
+#include "shade_dsp.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -788,6 +789,90 @@ static void test_load_dof_glb_lights(void **state)
     fv_scene_free(s);
 }
 
+/* ---- packet shading ------------------------------------------------------------------ */
+
+/* fv_scene_shade_packet gives fv_scene_shade's bits lane by lane, with every ISA's kernel: for
+ * packets of 1..16 random hits and misses of a scene seen from its default view. */
+static void check_packets(const fv_scene *s, uint64_t seed)
+{
+    float lo[3], hi[3], p[3], q[4];
+    fv_scene_bounds(s, lo, hi);
+    fv_scene_default_view(s, 60, 1, p, q);
+    const float px_tan = 0.0015f;
+    static const unsigned isas[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_AVX2, FV_ISA_NEON};
+    int shaded = 0, degenerate_or_hit = 0;
+    for (int it = 0; it < 400; it++) {
+        const int n = 1 + (int)(fv_test_rand(&seed) % 16);
+        unsigned geom[16], prim[16];
+        float u[16], v[16], t[16], dir[3][16];
+        for (int l = 0; l < 16; l++) {
+            float d[3];
+            for (int k = 0; k < 3; k++)
+                d[k] = 0.5f * (lo[k] + hi[k]) - p[k] + (fv_test_randf(&seed) - 0.5f) * 1.5f * (hi[k] - lo[k]);
+            hit h;
+            if (!cast(s, p, d, &h))
+                h.geom = RTC_INVALID_GEOMETRY_ID;
+            geom[l] = h.geom, prim[l] = h.prim, u[l] = h.u, v[l] = h.v, t[l] = h.t;
+            for (int k = 0; k < 3; k++) dir[k][l] = d[k];
+        }
+        const fv_hit_packet hp = {geom, prim, u, v, t, {dir[0], dir[1], dir[2]}};
+        for (size_t i = 0; i < sizeof isas / sizeof isas[0]; i++) {
+            if (isas[i] && !(fv_cpu_isas() & isas[i]))
+                continue;
+            fv_shade_dsp dsp;
+            fv_shade_dsp_init(&dsp, isas[i] ? isas[i] : FV_ISA_C);
+            float rgb[3][16];
+            fv_scene_shade_packet(s, &dsp, &hp, n, px_tan, p, rgb);
+            for (int l = 0; l < n; l++) {
+                if (geom[l] == RTC_INVALID_GEOMETRY_ID)
+                    continue;
+                const float d[3] = {dir[0][l], dir[1][l], dir[2][l]};
+                const float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                float want[3];
+                fv_scene_shade(s, geom[l], prim[l], u[l], v[l], p, d, t[l], px_tan / len, p, want);
+                for (int k = 0; k < 3; k++)
+                    if (memcmp(&want[k], &rgb[k][l], sizeof(float))) {
+                        print_error("%s lane %d of %d channel %d: packet %.9g, scalar %.9g\n", fv_isa_name(isas[i]), l,
+                                    n, k, (double)rgb[k][l], (double)want[k]);
+                        fail();
+                    }
+                shaded++;
+                degenerate_or_hit += want[0] + want[1] + want[2] > 0.0f;
+            }
+        }
+    }
+    assert_true(shaded > 1000);
+    assert_true(degenerate_or_hit > 0);
+}
+
+static void test_packet_shading_matches_scalar(void **state)
+{
+    (void)state;
+    fv_scene *s = load_shared("FlightHelmet/FlightHelmet.gltf", 94722); /* textured, head light */
+    check_packets(s, 1);
+    fv_scene_free(s);
+    s = load_shared("DepthOfFieldExample/DepthOfFieldExample.glb", 10610); /* a KHR light */
+    check_packets(s, 2);
+    fv_scene_free(s);
+    /* zero vertex normals: every hit takes the scalar path's face normal; and a point and a
+     * spot light */
+    static const float pos[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    static const float nrm[] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    s = fv_scene_create();
+    fv_mesh_desc m = mesh(pos, 4, idx, 6);
+    m.normals = nrm;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    const fv_light l[2] = {{.type = FV_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 5, .pos = {0, 0, 2}, .range = 4},
+                           {.type = FV_LIGHT_SPOT, .color = {1, 0.5f, 0.5f}, .intensity = 9, .pos = {0.5f, 0, 3},
+                            .dir = {0, 0, -1}, .inner_cone = 0.3f, .outer_cone = 0.6f}};
+    for (int i = 0; i < 2; i++) fv_scene_add_light(s, &l[i]);
+    s = commit_or_fail(s);
+    check_packets(s, 3);
+    fv_scene_free(s);
+}
+
 /* ---- hostile files ------------------------------------------------------------------- */
 
 static void test_missing_and_garbage(void **state)
@@ -1034,6 +1119,7 @@ int main(void)
         cmocka_unit_test(test_builder_quad_hit_and_headlight),
         cmocka_unit_test(test_builder_transform_non_indexed),
         cmocka_unit_test(test_builder_computed_normals),
+        cmocka_unit_test(test_packet_shading_matches_scalar),
         cmocka_unit_test(test_builder_normals_inverse_transpose),
         cmocka_unit_test(test_texture_bilinear_wrap),
         cmocka_unit_test(test_texture_mips),

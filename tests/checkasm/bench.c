@@ -461,8 +461,82 @@ static void out_free(void *st)
     free(t->rgbd), free(t->rgb), free(t);
 }
 
+/* ---- shading: a full frame's packets of 16 hits, head light (range, FlightHelmet) and two
+ * KHR lights (DepthOfFieldExample has KHR lights) ---- */
+#define SH_PACKETS (W * H / FV_SHADE_LANES)
+#define SH_SET 64 /* distinct packets, cycled */
+typedef struct {
+    fv_shade_packet p[SH_SET];
+    fv_light_rec lights[2];
+    float rgb[3][FV_SHADE_LANES];
+} shade_st;
+static void *shade_setup(void)
+{
+    shade_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    uint32_t s = 7;
+    for (int i = 0; i < SH_SET; i++)
+        for (int q = 0; q < FV_SHADE_LANES; q++) {
+            fv_shade_packet *p = &t->p[i];
+            p->u[q] = frand(&s, 0.0f, 0.5f), p->v[q] = frand(&s, 0.0f, 0.5f), p->t[q] = frand(&s, 0.5f, 20.0f);
+            for (int k = 0; k < 9; k++) p->nrm[k][q] = frand(&s, -1.0f, 1.0f);
+            for (int k = 0; k < 3; k++)
+                p->dir[k][q] = k == 2 ? -1.0f : frand(&s, -1.0f, 1.0f), p->base[k][q] = frand(&s, 0.0f, 1.0f);
+        }
+    t->lights[0].l = (fv_light){.type = FV_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .dir = {0, -1, 0}};
+    t->lights[1].l = (fv_light){.type = FV_LIGHT_POINT, .color = {1, 0.8f, 0.6f}, .intensity = 50, .pos = {2, 5, 1},
+                                .range = 30};
+    return t;
+}
+static volatile float shade_sink;
+static void shade_run_n(void *st, const checkasm_dsp *d, int row0, int rows, int nlights)
+{
+    shade_st *t = st;
+    const fv_shade_env env = {.lights = t->lights, .nlights = nlights, .exposure = 1.0f, .eye = {0, 1.6f, 3}};
+    unsigned m = 0;
+    for (int k = 0; k < rows; k++)
+        m += d->shade.lambert(&t->p[(row0 + k) % SH_SET], &env, t->rgb);
+    shade_sink = t->rgb[0][0] + (float)m;
+}
+static void shade_head_run(void *st, const checkasm_dsp *d, int row0, int rows) { shade_run_n(st, d, row0, rows, 0); }
+static void shade_lights_run(void *st, const checkasm_dsp *d, int row0, int rows) { shade_run_n(st, d, row0, rows, 2); }
+
+/* ---- ray generation: every pixel of a 1280x1440 eye in packets of 16 (8x2 pixels) ---- */
+typedef struct {
+    uint8_t px[FV_TILE * FV_TILE];
+    float d[3][16];
+} ray_st;
+static void *ray_setup(void)
+{
+    ray_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    for (int i = 0; i < FV_TILE * FV_TILE; i++) /* 4x2 blocks, as core/raycast.c orders a full tile */
+        t->px[i] = (uint8_t)(((i >> 5) * 2 + (i >> 2 & 1)) << 4 | ((i >> 3 & 3) * 4 + (i & 3)));
+    return t;
+}
+static volatile float ray_sink;
+static void ray_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    ray_st *t = st;
+    const fv_raygen_cam c = {-1.19f, 1.19f, 0.00186f, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int k = 0; k < rows; k++) {
+        const int p = (row0 + k) % (W * H / 16), tile = p / 16;
+        d->ray.camera_rays(&c, t->px + 16 * (p % 16), tile % (W / 16) * 16, tile / (W / 16) * 16, t->d[0], t->d[1],
+                           t->d[2], 16);
+    }
+    ray_sink = t->d[0][0];
+}
+
 #define F(x) offsetof(checkasm_dsp, x)
 const checkasm_bench_kernel checkasm_bench_kernels[] = {
+    {"camera_rays", "1280x1440 rays, 115200 packets of 16", {F(ray.camera_rays), 0}, W * H / 16, ray_setup, NULL,
+     ray_run, free},
+    {"lambert", "1280x1440 hits, 115200 packets of 16, head light", {F(shade.lambert), 0}, SH_PACKETS, shade_setup,
+     NULL, shade_head_run, free},
+    {"lambert_lights", "1280x1440 hits, 115200 packets of 16, 2 KHR lights", {F(shade.lambert), 0}, SH_PACKETS,
+     shade_setup, NULL, shade_lights_run, free},
     {"pull_row", "1280x1440 -> 640x720, 720 rows", {F(pp.pull_row), 0}, H / 2, pull_setup, NULL, pull_run, pull_free},
     {"push_row", "1280x1440, 1440 rows", {F(pp.push_row), 0}, H, push_setup, NULL, push_run, push_free},
     {"taa_blend+taa_fill", "1280x1440, 7200 16x16 tiles, still head", {F(taa.taa_blend), F(taa.taa_fill)}, TX * TY, taa_setup,
@@ -522,6 +596,8 @@ void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask)
     fv_dof_dsp_init(&d->dof, isa_mask);
     fv_eyetrack_dsp_init(&d->et, isa_mask);
     fv_output_dsp_init(&d->out, isa_mask);
+    fv_shade_dsp_init(&d->shade, isa_mask);
+    fv_raygen_dsp_init(&d->ray, isa_mask);
 }
 
 static int cmp_double(const void *a, const void *b)

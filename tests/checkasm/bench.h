@@ -20,7 +20,9 @@
 #include "eyetrack/eyetrack_dsp.h"
 #include "output_dsp.h"
 #include "pullpush_dsp.h"
+#include "raygen_dsp.h"
 #include "reproject_dsp.h"
+#include "shade_dsp.h"
 
 /* Every module's table, for one ISA mask. */
 typedef struct checkasm_dsp {
@@ -30,6 +32,8 @@ typedef struct checkasm_dsp {
     fv_dof_dsp dof;
     fv_eyetrack_dsp et;
     fv_output_dsp out;
+    fv_shade_dsp shade;
+    fv_raygen_dsp ray;
 } checkasm_dsp;
 void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask);
 

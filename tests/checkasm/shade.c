@@ -1,0 +1,140 @@
+/* fovea checkasm: the packet shading kernel (shade_dsp.h), every ISA version against the C
+ * reference on random and edge-case packets, bit for bit (so -0 vs +0 counts): the head light
+ * and every kind of KHR light (directional, point and spot, with and without range, a spot with
+ * equal cones), hits at the eye (L = 0), normals facing away, opposite vertex normals
+ * (degenerate), zero and huge distances. Outputs are canaried (checkasm.h). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "checkasm.h"
+
+#include "shade_dsp.h"
+
+static float rnd(float lo, float hi) { return lo + (hi - lo) * checkasm_randf(); }
+
+enum { M_RANDOM, M_EDGE, M_COUNT };
+
+static void gen_packet(fv_shade_packet *p, int mode)
+{
+    static const float ext[] = {0.0f, -0.0f, 1e-30f, 1e-20f, 1.0f, -1.0f, 1e4f, 3e38f, 0.5f};
+    for (int q = 0; q < FV_SHADE_LANES; q++) {
+        float u = rnd(0.0f, 1.0f), v = rnd(0.0f, 1.0f - u);
+        float n0[3] = {rnd(-1, 1), rnd(-1, 1), rnd(-1, 1)};
+        for (int k = 0; k < 9; k++)
+            p->nrm[k][q] = k < 3 ? n0[k] : rnd(-1.0f, 1.0f);
+        float t = rnd(0.01f, 100.0f);
+        if (mode == M_EDGE) {
+            switch (checkasm_rand() % 8) {
+            case 0: /* opposite vertex normals at the midpoint: degenerate */
+                for (int k = 0; k < 3; k++) p->nrm[3 + k][q] = -n0[k], p->nrm[6 + k][q] = 0.0f;
+                u = 0.5f, v = 0.0f;
+                break;
+            case 1: t = 0.0f; break; /* the hit at the eye: L = 0 */
+            case 2: t = ext[checkasm_rand() % (sizeof ext / sizeof ext[0])]; break;
+            case 3: u = 1.0f, v = 0.0f; break;
+            case 4: for (int k = 0; k < 9; k++) p->nrm[k][q] = 0.0f; break; /* zero normals */
+            default: break;
+            }
+        }
+        p->u[q] = u, p->v[q] = v, p->t[q] = t;
+        for (int k = 0; k < 3; k++) {
+            p->dir[k][q] = k == 2 ? -1.0f : rnd(-1.5f, 1.5f);
+            p->base[k][q] = rnd(0.0f, 1.0f);
+        }
+    }
+}
+
+static int gen_lights(fv_light_rec *l, int max, int mode)
+{
+    const int n = (int)(checkasm_rand() % (unsigned)(max + 1));
+    for (int i = 0; i < n; i++) {
+        memset(&l[i], 0, sizeof l[i]);
+        l[i].l.type = (fv_light_type)(checkasm_rand() % 3);
+        for (int k = 0; k < 3; k++) {
+            l[i].l.color[k] = rnd(0.0f, 1.0f);
+            l[i].l.pos[k] = rnd(-20.0f, 20.0f);
+        }
+        const float d[3] = {rnd(-1, 1), rnd(-1, 1), rnd(-1, 1)};
+        const float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + 1e-6f;
+        for (int k = 0; k < 3; k++) l[i].l.dir[k] = d[k] / len;
+        l[i].l.intensity = mode == M_EDGE && checkasm_rand() % 4 == 0 ? 3e38f : rnd(0.0f, 100.0f);
+        l[i].l.range = checkasm_rand() % 2 ? rnd(1.0f, 40.0f) : 0.0f;
+        l[i].cos_outer = rnd(0.5f, 0.9f);
+        l[i].cos_inner = mode == M_EDGE && checkasm_rand() % 3 == 0 ? l[i].cos_outer : rnd(l[i].cos_outer, 1.0f);
+    }
+    return n;
+}
+
+static void test_tables(void **state)
+{
+    (void)state;
+    checkasm_rng = 0x5eed05adeull;
+    static const char *const names[] = {"lambert"};
+    fv_shade_dsp ref, own;
+    fv_shade_dsp_init(&ref, FV_ISA_C);
+    assert_true(ref.lambert == fv_shade_lambert_c);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        memset(&own, 0, sizeof own);
+        switch (isa) {
+#if defined(__x86_64__)
+        case FV_ISA_SSE41: fv_shade_dsp_init_sse41(&own); break;
+        case FV_ISA_AVX2: fv_shade_dsp_init_avx2(&own); break;
+#elif defined(__aarch64__)
+        case FV_ISA_NEON: fv_shade_dsp_init_neon(&own); break;
+#endif
+        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
+        }
+        checkasm_check_table("shade", isa, &own, &ref, sizeof own, names);
+    }
+}
+
+static void test_lambert(void **state)
+{
+    (void)state;
+    int tested = 0;
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "lambert"))
+            continue;
+        fv_shade_dsp d;
+        fv_shade_dsp_init(&d, isa);
+        if (!d.lambert || d.lambert == fv_shade_lambert_c)
+            fail_msg("lambert: %s has no version of its own", fv_isa_name(isa));
+        int runs = 0;
+        for (int r = 0; r < 2000; r++) {
+            const int mode = r % M_COUNT;
+            fv_shade_packet p;
+            fv_light_rec lights[6];
+            gen_packet(&p, mode);
+            const int nl = r < 200 ? 0 : gen_lights(lights, 6, mode);
+            const fv_shade_env env = {.lights = lights, .nlights = nl, .exposure = rnd(0.01f, 2.0f),
+                                      .eye = {rnd(-5, 5), rnd(-5, 5), rnd(-5, 5)}};
+            float ref[3][FV_SHADE_LANES];
+            buf got = checkasm_out_f32(3 * FV_SHADE_LANES, r & 3);
+            const unsigned dr = fv_shade_lambert_c(&p, &env, ref);
+            const unsigned dg = d.lambert(&p, &env, (float(*)[FV_SHADE_LANES])got.p);
+            checkasm_check_guards_f32(&got, 3 * FV_SHADE_LANES, fv_isa_name(isa), "lambert", r);
+            if (dr != dg)
+                fail_msg("%s lambert run %d: degenerate lanes %#x, c %#x", fv_isa_name(isa), r, dg, dr);
+            /* the degenerate lanes' rgb is unspecified: compare the others */
+            for (int q = 0; q < FV_SHADE_LANES; q++)
+                if (dr >> q & 1u)
+                    for (int c = 0; c < 3; c++) ref[c][q] = got.p[c * FV_SHADE_LANES + q] = 0.0f;
+            checkasm_compare(ref, got.p, 3 * FV_SHADE_LANES, CHECKASM_F32, 1, CHECKASM_EXACT,
+                             "%s lambert run %d lights %d mode %d", fv_isa_name(isa), r, nl, mode);
+            free(got.base);
+            runs++;
+        }
+        printf("[ checkasm ] lambert: %-7s == c on %d packets (bit-exact)\n", fv_isa_name(isa), runs);
+        tested++;
+    }
+    printf("[ checkasm ] lambert: %d ISA version(s) tested\n", tested);
+}
+
+const struct CMUnitTest checkasm_shade_tests[] = {
+    cmocka_unit_test(test_tables),
+    cmocka_unit_test(test_lambert),
+    {0},
+};
