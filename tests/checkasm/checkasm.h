@@ -11,6 +11,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "testutil.h"
 
@@ -67,6 +68,31 @@ void checkasm_compare(const void *ref, const void *got, size_t count, checkasm_t
  * not have: a failure (never a skip). own / ref are tables of n function pointers. */
 void checkasm_check_table(const char *module, unsigned isa, const void *own, const void *ref, size_t size,
                           const char *const *names);
+
+/* The loop of every module's table test: for each ISA of this build, a zeroed table of `type`
+ * (fv_<module>_dsp) filled by that ISA's init alone (type##_init_sse41 / _avx2 on x86,
+ * type##_init_neon on aarch64) goes through checkasm_check_table against ref (the C table). */
+#if defined(__x86_64__)
+#define CHECKASM_ISA_INIT_CASES(prefix, t)                                                         \
+    case FV_ISA_SSE41: prefix##_init_sse41(t); break;                                              \
+    case FV_ISA_AVX2: prefix##_init_avx2(t); break;
+#elif defined(__aarch64__)
+#define CHECKASM_ISA_INIT_CASES(prefix, t) case FV_ISA_NEON: prefix##_init_neon(t); break;
+#else
+#define CHECKASM_ISA_INIT_CASES(prefix, t)
+#endif
+#define CHECKASM_CHECK_ISA_TABLES(module, type, ref, names)                                        \
+    do {                                                                                           \
+        for (int k_ = 0; checkasm_isas[k_]; k_++) {                                                \
+            type own_;                                                                             \
+            memset(&own_, 0, sizeof own_);                                                         \
+            switch (checkasm_isas[k_]) {                                                           \
+                CHECKASM_ISA_INIT_CASES(type, &own_)                                               \
+            default: fail_msg("%s: no init for this build's ISA", fv_isa_name(checkasm_isas[k_])); \
+            }                                                                                      \
+            checkasm_check_table(module, checkasm_isas[k_], &own_, (ref), sizeof own_, names);     \
+        }                                                                                          \
+    } while (0)
 
 /* The modules' tests (each array ends with a zeroed entry). */
 extern const struct CMUnitTest checkasm_pullpush_tests[], checkasm_reproject_tests[], checkasm_dof_tests[],

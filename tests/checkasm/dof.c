@@ -80,7 +80,7 @@ static void test_tables(void **state)
     (void)state;
     checkasm_rng = 0xd0f5eed2026ull;
     fv_dof_gauss_tab_init(&tab);
-    fv_dof_dsp ref, own;
+    fv_dof_dsp ref;
     fv_dof_dsp_init(&ref, FV_ISA_C);
     assert_true(ref.dof_coc_row == fv_dof_coc_row_c);
     assert_true(ref.dof_hgauss_row == fv_dof_hgauss_row_c);
@@ -90,20 +90,7 @@ static void test_tables(void **state)
     assert_true(ref.dof_pyrblur_row == fv_dof_pyrblur_row_c);
     assert_true(ref.dof_nearblk_row == fv_dof_nearblk_row_c);
     assert_true(ref.dof_nearbox_row == fv_dof_nearbox_row_c);
-    for (int k = 0; checkasm_isas[k]; k++) {
-        const unsigned isa = checkasm_isas[k];
-        memset(&own, 0, sizeof own);
-        switch (isa) {
-#if defined(__x86_64__)
-        case FV_ISA_SSE41: fv_dof_dsp_init_sse41(&own); break;
-        case FV_ISA_AVX2: fv_dof_dsp_init_avx2(&own); break;
-#elif defined(__aarch64__)
-        case FV_ISA_NEON: fv_dof_dsp_init_neon(&own); break;
-#endif
-        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
-        }
-        checkasm_check_table("dof", isa, &own, &ref, sizeof own, names);
-    }
+    CHECKASM_CHECK_ISA_TABLES("dof", fv_dof_dsp, &ref, names);
 }
 
 /* ------------------------------------------------------------------ coc_row */

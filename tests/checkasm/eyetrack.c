@@ -46,27 +46,14 @@ static void test_tables(void **state)
 {
     (void)state;
     checkasm_rng = 0xe7e5eedull;
-    fv_eyetrack_dsp ref, own;
+    fv_eyetrack_dsp ref;
     fv_eyetrack_dsp_init(&ref, FV_ISA_C);
     assert_true(ref.et_down2_row == fv_et_down2_row_c);
     assert_true(ref.et_integral_row == fv_et_integral_row_c);
     assert_true(ref.et_thresh_row == fv_et_thresh_row_c);
     assert_true(ref.et_box_score_row == fv_et_box_score_row_c);
     assert_true(ref.et_box3_row == fv_et_box3_row_c);
-    for (int k = 0; checkasm_isas[k]; k++) {
-        const unsigned isa = checkasm_isas[k];
-        memset(&own, 0, sizeof own);
-        switch (isa) {
-#if defined(__x86_64__)
-        case FV_ISA_SSE41: fv_eyetrack_dsp_init_sse41(&own); break;
-        case FV_ISA_AVX2: fv_eyetrack_dsp_init_avx2(&own); break;
-#elif defined(__aarch64__)
-        case FV_ISA_NEON: fv_eyetrack_dsp_init_neon(&own); break;
-#endif
-        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
-        }
-        checkasm_check_table("eyetrack", isa, &own, &ref, sizeof own, names);
-    }
+    CHECKASM_CHECK_ISA_TABLES("eyetrack", fv_eyetrack_dsp, &ref, names);
 }
 
 typedef void (*runner)(const fv_eyetrack_dsp *d, const char *isa, int n, int off, int mode);

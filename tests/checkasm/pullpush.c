@@ -89,24 +89,11 @@ static void test_tables(void **state)
 {
     (void)state;
     checkasm_rng = 0x5eed0f0bea2018ull;
-    fv_pullpush_dsp ref, own;
+    fv_pullpush_dsp ref;
     fv_pullpush_dsp_init(&ref, FV_ISA_C);
     assert_true(ref.pull_row == fv_pull_row_c);
     assert_true(ref.push_row == fv_push_row_c);
-    for (int k = 0; checkasm_isas[k]; k++) {
-        const unsigned isa = checkasm_isas[k];
-        memset(&own, 0, sizeof own);
-        switch (isa) {
-#if defined(__x86_64__)
-        case FV_ISA_SSE41: fv_pullpush_dsp_init_sse41(&own); break;
-        case FV_ISA_AVX2: fv_pullpush_dsp_init_avx2(&own); break;
-#elif defined(__aarch64__)
-        case FV_ISA_NEON: fv_pullpush_dsp_init_neon(&own); break;
-#endif
-        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
-        }
-        checkasm_check_table("pullpush", isa, &own, &ref, sizeof own, names);
-    }
+    CHECKASM_CHECK_ISA_TABLES("pullpush", fv_pullpush_dsp, &ref, names);
 }
 
 /* ------------------------------------------------------------------ pull_row */

@@ -41,24 +41,11 @@ static void test_tables(void **state)
 {
     (void)state;
     checkasm_rng = 0x7aa2018ull;
-    fv_reproject_dsp ref, own;
+    fv_reproject_dsp ref;
     fv_reproject_dsp_init(&ref, FV_ISA_C);
     assert_true(ref.taa_blend == fv_taa_blend_c);
     assert_true(ref.taa_fill == fv_taa_fill_c);
-    for (int k = 0; checkasm_isas[k]; k++) {
-        const unsigned isa = checkasm_isas[k];
-        memset(&own, 0, sizeof own);
-        switch (isa) {
-#if defined(__x86_64__)
-        case FV_ISA_SSE41: fv_reproject_dsp_init_sse41(&own); break;
-        case FV_ISA_AVX2: fv_reproject_dsp_init_avx2(&own); break;
-#elif defined(__aarch64__)
-        case FV_ISA_NEON: fv_reproject_dsp_init_neon(&own); break;
-#endif
-        default: fail_msg("%s: no init for this build's ISA", fv_isa_name(isa));
-        }
-        checkasm_check_table("reproject", isa, &own, &ref, sizeof own, names);
-    }
+    CHECKASM_CHECK_ISA_TABLES("reproject", fv_reproject_dsp, &ref, names);
 }
 
 /* ------------------------------------------------------------------ reprojection */
