@@ -200,8 +200,9 @@ static float pyr_depth(void *ctx, float x, float y)
     return l0->rgbd[4 * ((ptrdiff_t)j * l0->stride + i) + 3];
 }
 
-/* Focus depth, CoC, filter, combine of one eye into es->out. */
-static void render_dof(fv_pipeline *p, eye_state *es, fv_eye eye, const fv_pyramid *pyr, float gaze_x,
+/* Focus depth, CoC, filter, combine of one eye into es->out. 1 when the model also wrote the
+ * display format (the output stage fused into its last pass), else 0. */
+static int render_dof(fv_pipeline *p, eye_state *es, fv_eye eye, const fv_pyramid *pyr, float gaze_x,
                        float gaze_y, fv_frame_stats *st)
 {
     const fv_pyr_level *l0 = &pyr->lv[0];
@@ -225,7 +226,7 @@ static void render_dof(fv_pipeline *p, eye_state *es, fv_eye eye, const fv_pyram
             memcpy(es->out + 4 * (ptrdiff_t)y * l0->stride, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride,
                    (size_t)l0->w * 4 * sizeof(float));
         st->stage_ms[FV_STAGE_COC] = focus_ms;
-        return;
+        return 0;
     }
     if (p->enh_fp && p->enh_for != p->smp_cur) {
         for (int i = 0; i < p->enh_n; i++) {
@@ -249,13 +250,19 @@ static void render_dof(fv_pipeline *p, eye_state *es, fv_eye eye, const fv_pyram
         .enh_step = 4.0f,
         .prof = p->prof,
         .prof_arg = (int)eye,
+        /* the lens's chromatic aberration reads other rows: then the output is a pass of its own */
+        .conv = es->lca && es->lca->on ? NULL : &p->conv,
+        .rgb8 = es->rgb8,
+        .rgb8_stride = (ptrdiff_t)l0->w * 3,
     };
     v.e_px_per_mm = fv_retina_px_per_mm(v.focal_px, FV_EYE_IMAGE_DIST_MM) * v.blur_scale;
-    fv_dof_times t = {NAN, NAN, NAN};
+    fv_dof_times t = {NAN, NAN, NAN, NAN};
     p->dof_fn(&v, &p->dof_work, es->out, l0->stride, p->pool, &p->dsp.dof, &t);
     st->stage_ms[FV_STAGE_COC] = (isnan(t.coc_ms) ? 0.0 : t.coc_ms) + focus_ms;
     st->stage_ms[FV_STAGE_DOF_FILTER] = t.filter_ms;
     st->stage_ms[FV_STAGE_COMBINE] = t.combine_ms;
+    st->stage_ms[FV_STAGE_OUTPUT] = t.output_ms;
+    return !isnan(t.output_ms);
 }
 
 void fv_pipeline_set_prof(fv_pipeline *p, fv_prof *prof)
@@ -297,15 +304,18 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     fv_pullpush_from(pyr, &p->dsp.pp, p->pool, fv_tile_pulled_levels(pyr));
     const int64_t t2 = fv_prof_stage_end(p->prof, FV_STAGE_RECONSTRUCT, tr0, (int)eye);
     st->focus_m = NAN;
-    if (p->dof)
-        render_dof(p, es, eye, pyr, gaze_x, gaze_y, st);
-    /* output: the display format, every frame (a headset pays for it each refresh) */
-    const int64_t to0 = fv_prof_stage_begin(p->prof, FV_STAGE_OUTPUT);
-    const fv_pyr_level *l0 = &pyr->lv[0];
-    const float *img = p->dof ? es->out : l0->rgbd;
-    fv_output_convert_pool(&p->conv, img, l0->stride, l0->w, l0->h, &es->cam, es->lca, es->rgb8,
-                           (ptrdiff_t)l0->w * 3, p->pool);
-    st->stage_ms[FV_STAGE_OUTPUT] = (double)(fv_prof_stage_end(p->prof, FV_STAGE_OUTPUT, to0, (int)eye) - to0) * 1e-6;
+    const int converted = p->dof && render_dof(p, es, eye, pyr, gaze_x, gaze_y, st);
+    /* output: the display format, every frame (a headset pays for it each refresh), unless the
+     * depth of field wrote it row by row in its last pass */
+    if (!converted) {
+        const int64_t to0 = fv_prof_stage_begin(p->prof, FV_STAGE_OUTPUT);
+        const fv_pyr_level *l0 = &pyr->lv[0];
+        const float *img = p->dof ? es->out : l0->rgbd;
+        fv_output_convert_pool(&p->conv, img, l0->stride, l0->w, l0->h, &es->cam, es->lca, es->rgb8,
+                               (ptrdiff_t)l0->w * 3, p->pool);
+        st->stage_ms[FV_STAGE_OUTPUT] =
+            (double)(fv_prof_stage_end(p->prof, FV_STAGE_OUTPUT, to0, (int)eye) - to0) * 1e-6;
+    }
     const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, (int)eye);
     es->cur = dst;
     es->prev_cam = es->cam;

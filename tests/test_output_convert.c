@@ -10,6 +10,8 @@
 #include <cmocka.h>
 
 #include "output_convert.h"
+#include "pipeline.h"
+#include "testscene.h"
 
 /* IEC 61966-2-1, rounded to 8 bits */
 static uint8_t srgb_ref(double v)
@@ -57,11 +59,53 @@ static void test_no_lca_without_lens(void **state)
     assert_null(fv_output_lca_create(&cam));
 }
 
+/* With the layered DoF the output stage runs fused into its last pass, row by row; every model
+ * (fused or not) must give the bytes of converting its final float image in one go, and report
+ * the output stage's time */
+static void test_fused_output_matches(void **state)
+{
+    (void)state;
+    fv_scene *scene = fv_scene_create();
+    assert_non_null(scene);
+    static const float a[3] = {0.8f, 0.3f, 0.2f}, b[3] = {0.1f, 0.5f, 0.9f};
+    fv_test_add_quad(scene, -3.0f, -3.0f, 3.0f, 3.0f, -6.0f, a, -1); /* far wall: blurred */
+    fv_test_add_quad(scene, -0.3f, -0.3f, 0.3f, 0.3f, -1.0f, b, -1); /* near card under the gaze */
+    char err[256];
+    assert_int_equal(fv_scene_commit(scene, err, sizeof err), 0);
+    enum { W = 96, H = 80 };
+    static uint8_t want[W * H * 3];
+    for (int model = 0; model < FV_DOF_MODEL_COUNT; model++) {
+        fv_pipeline_config cfg;
+        fv_pipeline_config_default(&cfg);
+        cfg.cam.width = W, cfg.cam.height = H, cfg.threads = 3;
+        cfg.dof.preset = FV_DOF_STRONG;
+        cfg.dof.model = (fv_dof_model)model;
+        fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
+        assert_non_null(pl);
+        static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
+        fv_frame_stats st;
+        for (int f = 0; f < 2; f++)
+            assert_int_equal(fv_pipeline_render(pl, FV_EYE_LEFT, &origin, 0.5f, 0.5f, &st), 0);
+        assert_false(isnan(st.stage_ms[FV_STAGE_OUTPUT]));
+        ptrdiff_t fstride, bstride;
+        const float *img = fv_pipeline_image(pl, FV_EYE_LEFT, &fstride);
+        fv_output_conv conv;
+        fv_output_conv_init(&conv, FV_ISA_C);
+        fv_output_convert(&conv, img, fstride, W, H, fv_pipeline_camera(pl, FV_EYE_LEFT), NULL, want, W * 3);
+        const uint8_t *got = fv_pipeline_rgb8(pl, FV_EYE_LEFT, &bstride);
+        assert_int_equal(bstride, W * 3);
+        assert_memory_equal(got, want, sizeof want);
+        fv_pipeline_destroy(pl);
+    }
+    fv_scene_free(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_srgb_values),
         cmocka_unit_test(test_no_lca_without_lens),
+        cmocka_unit_test(test_fused_output_matches),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -12,6 +12,7 @@
 #define FOVEA_DOF_DOF_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "dof_dsp.h"
 #include "../pool.h"
@@ -60,6 +61,13 @@ typedef struct fv_dof_view {
     int enh_n;
     float enh_step;
     struct fv_prof *prof;   /* trace recorder for the stage spans (core/prof.h), NULL = off */
+    /* The display format written row by row while each output row is hot (the output stage
+     * fused into the model's last pass): the converter (core/output_convert.h) and the 8-bit RGB
+     * image (rgb8_stride bytes a row). conv NULL: the pipeline converts afterwards. A model
+     * that fuses it reports fv_dof_times.output_ms; one that does not leaves it NAN. */
+    const struct fv_output_conv *conv;
+    uint8_t *rgb8;
+    ptrdiff_t rgb8_stride;
     int prof_arg;           /* the spans' argument (the eye) */
 } fv_dof_view;
 
@@ -93,6 +101,7 @@ void fv_dof_work_free(fv_dof_work *wk);
 /* Stage times of one run, ms (coc, filter, combine; NAN for a stage the model has not). */
 typedef struct fv_dof_times {
     double coc_ms, filter_ms, combine_ms;
+    double output_ms; /* the fused output stage (view conv set); NAN: not done here */
 } fv_dof_times;
 
 /* A model's whole DoF: out (4 floats a pixel, rows out_stride pixels) gets the blurred image. */

@@ -133,7 +133,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
     const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 2 * (size_t)th +
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 3 * (size_t)th +
                        4 * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
@@ -188,7 +188,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_hr = a, a += nl;
     x->l_hw = a, a += nl;
     x->l_v = a, a += 4 * nl;
-    x->band_ms = a, a += 2 * x->th;
+    x->band_ms = a, a += 3 * x->th;
     x->hw = half_w(x->w), x->hh = half_w(x->h);
     x->hblur = a, a += 4 * (ptrdiff_t)x->hw * x->hh;
     /* the centre rectangle: the transition disc plus the kernels' reach */
@@ -202,8 +202,9 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     fv_pool_run(pool, x->th, fvw_coc_band, x);
     fvw_dilate_tiles(x);
     const int64_t t1 = fv_dof_stage_end(v, FV_STAGE_COC, t0);
-    /* the combine runs fused into the vertical pass: one dof_filter span holds both, and the
-     * combine's share of the fused time is the workers' measured share */
+    /* the combine (and with v->conv the conversion to the display format) runs fused into the
+     * vertical pass: one dof_filter span holds them, and each one's share of the fused time is
+     * the workers' measured share */
     const int64_t tf = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     fv_pool_run(pool, x->th, fvw_hpass_band, x);
     fv_pool_run(pool, x->th, fvw_lvpass_band, x);
@@ -212,13 +213,14 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     fv_pool_run(pool, x->th, fvw_vcombine_band, x);
     const int64_t t3 = fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, tf);
     if (t) {
-        double f = 0.0, c = 0.0;
+        double f = 0.0, c = 0.0, o = 0.0;
         for (int b = 0; b < x->th; b++)
-            f += x->band_ms[2 * b], c += x->band_ms[2 * b + 1];
-        const double fused = (double)(t3 - t2) * 1e-6, share = f + c > 0.0 ? c / (f + c) : 0.0;
+            f += x->band_ms[3 * b], c += x->band_ms[3 * b + 1], o += x->band_ms[3 * b + 2];
+        const double fused = (double)(t3 - t2) * 1e-6, all = f + c + o;
         t->coc_ms = (double)(t1 - t0) * 1e-6;
-        t->filter_ms = (double)(t2 - tf) * 1e-6 + fused * (1.0 - share);
-        t->combine_ms = fused * share;
+        t->filter_ms = (double)(t2 - tf) * 1e-6 + (all > 0.0 ? fused * f / all : fused);
+        t->combine_ms = all > 0.0 ? fused * c / all : 0.0;
+        t->output_ms = v->conv ? (all > 0.0 ? fused * o / all : 0.0) : NAN;
     }
     return;
 fail:
@@ -227,6 +229,6 @@ fail:
         memcpy(out + 4 * (ptrdiff_t)y * out_stride, v->pyr->lv[0].rgbd + 4 * (ptrdiff_t)y * v->pyr->lv[0].stride,
                (size_t)v->pyr->lv[0].w * 4 * sizeof(float));
     if (t)
-        t->coc_ms = t->filter_ms = t->combine_ms = NAN;
+        t->coc_ms = t->filter_ms = t->combine_ms = t->output_ms = NAN; /* the pipeline converts */
 }
 

@@ -2,6 +2,7 @@
  * and near layers, the quarter-resolution near layer, the periphery's pyramid blur and the
  * fused vertical pass, which hands each finished row to the combine (combine.c). */
 #include "dof/weier_passes.h"
+#include "output_convert.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -274,7 +275,7 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
     float *far = fvw_slot(x, tid, 0), *near = fvw_slot(x, tid, 1), *trow = fvw_slot(x, tid, 8);
     float *enh = x->enh_on ? fvw_slot(x, tid, 10) : NULL;
     uint8_t sig[TILE * 8];
-    double filter_ns = 0.0, combine_ns = 0.0;
+    double filter_ns = 0.0, combine_ns = 0.0, output_ns = 0.0;
     /* t is 1 outside the disc of radius r1: the row holds 1 except across the disc's span, which
      * each row writes and puts back */
     for (int i = 0; i < x->w; i++)
@@ -357,12 +358,18 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         const int64_t tb = fv_time_ns();
         fvw_combine_row(x, y, sharp, coc, far, nfull, lup, trow, enh);
         const int64_t tc = fv_time_ns();
+        if (v->conv) /* the output stage on the row just written, while it is in cache */
+            fv_output_convert(v->conv, x->out + 4 * (ptrdiff_t)y * x->out_stride, x->out_stride, x->w, 1, NULL, NULL,
+                              v->rgb8 + (ptrdiff_t)y * v->rgb8_stride, v->rgb8_stride);
+        const int64_t td = v->conv ? fv_time_ns() : tc;
         for (int i = tx0; i < tx1; i++)
             trow[i] = 1.0f;
         filter_ns += (double)(tb - ta);
         combine_ns += (double)(tc - tb);
+        output_ns += (double)(td - tc);
     }
-    x->band_ms[2 * band] = (float)(filter_ns * 1e-6);
-    x->band_ms[2 * band + 1] = (float)(combine_ns * 1e-6);
+    x->band_ms[3 * band] = (float)(filter_ns * 1e-6);
+    x->band_ms[3 * band + 1] = (float)(combine_ns * 1e-6);
+    x->band_ms[3 * band + 2] = (float)(output_ns * 1e-6);
 }
 

@@ -57,7 +57,7 @@ typedef struct {
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
     const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
     int enh_on;                /* contrast enhancement runs */
-    float *band_ms;            /* per band: worker time (ms) in the filter and the combine (pairs) */
+    float *band_ms;            /* per band: worker time (ms) in the filter, the combine, the output (triples) */
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
     /* the periphery's far blur at half resolution (the level 1 grid), up-sampled once per row */
     int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
