@@ -4,6 +4,7 @@
 #include <stdatomic.h>
 #include <stdint.h>
 
+#include "raycast.h"
 #include "tile.h"
 
 typedef struct {
@@ -18,7 +19,7 @@ typedef struct {
 /* Packets of N lanes filled from one tile's pixel list; the lanes' layout is Embree's SoA
  * RTCRayHitN, so one routine serves both widths. */
 #define DEF_TILE_N(N)                                                                                   \
-    static long tile_##N(const ceil_job *j, RTCScene rs, const uint16_t *px, int n, int x0, int y0) \
+    static long tile_##N(const ceil_job *j, RTCScene rs, const uint8_t *px, int n, int x0, int y0) \
     {                                                                                                   \
         const fv_camera *cam = j->cam;                                                                  \
         struct RTCIntersectContext ictx;                                                                \
@@ -62,26 +63,12 @@ static void ceil_tile(void *ctx, int index, int thread_id)
     const int x0 = index % j->tiles_x * FV_TILE, y0 = index / j->tiles_x * FV_TILE;
     const int tw = cam->width - x0 < FV_TILE ? cam->width - x0 : FV_TILE;
     const int th = cam->height - y0 < FV_TILE ? cam->height - y0 : FV_TILE;
-    /* the tile's pixels as (y << 4 | x), in the real stage's 4x2 block order for a sparse set
-     * (coherent packets) and in rows for a full tile */
-    uint16_t px[FV_TILE * FV_TILE];
-    int n = 0;
-    if (!j->o.smp) {
-        for (int y = 0; y < th; y++)
-            for (int x = 0; x < tw; x++)
-                px[n++] = (uint16_t)(y << 4 | x);
-    } else {
-        uint32_t rows[FV_TILE];
-        for (int y = 0; y < th; y++)
-            rows[y] = (uint32_t)fv_sampler_row(j->o.smp, x0, y0 + y, tw, j->o.gx, j->o.gy, j->o.phase);
-        for (int by = 0; by < FV_TILE / 2; by++)
-            for (int bx = 0; bx < FV_TILE / 4; bx++)
-                for (int i = 0; i < 8; i++) {
-                    const int x = bx * 4 + (i & 3), y = by * 2 + (i >> 2);
-                    if (x < tw && y < th && (rows[y] >> x & 1u))
-                        px[n++] = (uint16_t)(y << 4 | x);
-                }
-    }
+    /* the tile's pixels in the real stage's order (fv_raycast_pixels): the same packets */
+    uint32_t rows[FV_TILE];
+    for (int y = 0; y < th; y++)
+        rows[y] = j->o.smp ? (uint32_t)fv_sampler_row(j->o.smp, x0, y0 + y, tw, j->o.gx, j->o.gy, j->o.phase) : ~0u;
+    uint8_t px[FV_TILE * FV_TILE + 8];
+    const int n = fv_raycast_pixels(rows, tw, th, px);
     if (n == 0)
         return;
     RTCScene rs = fv_scene_rtc(j->scene);

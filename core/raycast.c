@@ -41,13 +41,14 @@ static void block_lut_init(void)
     }
 }
 
-/* The sampled pixels of a tile as (y << 4 | x) in 4x2-block order, so a full packet of 8 is a
+/* (raycast.h) The sampled pixels of a tile as (y << 4 | x) in 4x2-block order, so a full packet of 8 is a
  * compact 4x2 footprint (16: 8x2) and a sparse tile's packets still gather nearby pixels
  * (coherent rays). Each block's 8-bit mask looks its offsets up; the block's corner is added to
  * all 8 bytes at once (no carries: corner + offset < 256) and the word stored whole, n advancing
  * by the mask's pixel count: no branch per pixel. px needs 8 bytes of slack. */
-static int compact(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_TILE * FV_TILE + 8])
+int fv_raycast_pixels(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_TILE * FV_TILE + 8])
 {
+    pthread_once(&block_lut_once, block_lut_init);
     const uint32_t keep = tw >= 32 ? ~0u : (1u << tw) - 1u;
     int n = 0;
     for (int by = 0; by < FV_TILE / 2; by++) {
@@ -177,9 +178,8 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_rende
             for (int x = 0; x < tw; x++)
                 w[x] = (float)(rows[y] >> x & 1u);
     }
-    pthread_once(&block_lut_once, block_lut_init);
     uint8_t px[FV_TILE * FV_TILE + 16];
-    const int n = compact(rows, tw, th, px);
+    const int n = fv_raycast_pixels(rows, tw, th, px);
     if (n == 0)
         return 0;
     for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */

@@ -42,6 +42,10 @@ struct fv_render_dsp;
 /* The packet width the ray stage traces with: 16 (rtcIntersect16) where this Embree has native
  * 16-wide packets (its AVX-512 path), else 8. */
 int fv_raycast_packet_width(void);
+/* The pixels of a tile whose bits are set in rows[y] (bit x; y < th, x < tw) as (y << 4 | x), in
+ * 4x2-block order (coherent packets); their count. px needs 8 bytes of slack past the count.
+ * The ray stage and the bare-Embree ceiling (core/ceiling.c) both cast in this order. */
+int fv_raycast_pixels(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[FV_TILE * FV_TILE + 8]);
 
 /* Casts a ray through the centre of every pixel of the tile [x0, x0+tw) x [y0, y0+th) whose bit
  * is set in rows[y - y0] (bit x - x0), generates and shades them with dsp's kernels (ray, shade) and writes r, g, b,
