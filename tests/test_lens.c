@@ -96,21 +96,13 @@ static void test_load_file(void **st)
 {
     (void)st;
     char path[] = "/tmp/fovea_lens_XXXXXX";
-    const int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    FILE *f = fdopen(fd, "w");
-    assert_non_null(f);
-    fputs("k1 0.1\nk2 0.02\nchroma 0.99 1 1.01\n", f);
-    fclose(f);
+    fv_test_temp_file(path, "k1 0.1\nk2 0.02\nchroma 0.99 1 1.01\n");
     fv_lens l;
     char err[512];
     assert_int_equal(fv_lens_load(&l, path, 2.0f, err, sizeof err), 0);
     assert_float_equal(l.k2, 0.02f, 0);
     assert_float_equal(l.scale[2], 1.01f, 0);
-    f = fopen(path, "w");
-    assert_non_null(f);
-    fputs("k1 0.1\nchroma 1\n", f);
-    fclose(f);
+    fv_test_write_file(path, "k1 0.1\nchroma 1\n");
     char want[256];
     snprintf(want, sizeof want, "%s:2: chroma wants 3 numbers", path);
     assert_int_equal(fv_lens_load(&l, path, 2.0f, err, sizeof err), -1);

@@ -137,20 +137,12 @@ static void test_load(void **st)
     assert_string_equal(err, "/tmp: read error");
 
     char path[] = "/tmp/fovea_trace_XXXXXX";
-    const int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    FILE *f = fdopen(fd, "w");
-    assert_non_null(f);
-    fputs("t_ms,gaze_x,gaze_y\n0,0.25,0.5\n10,0.75,0.5\n20,0.5\n", f);
-    fclose(f);
+    fv_test_temp_file(path, "t_ms,gaze_x,gaze_y\n0,0.25,0.5\n10,0.75,0.5\n20,0.5\n");
     char want[256];
     snprintf(want, sizeof want, "%s:4: 2 fields, expected 3 (truncated or malformed line)", path);
     assert_int_equal(fv_trace_load(&t, path, err, sizeof err), -1);
     assert_string_equal(err, want);
-    f = fopen(path, "w");
-    assert_non_null(f);
-    fputs("t_ms,gaze_x,gaze_y\n0,0.25,0.5\n10,0.75,0.5\n", f);
-    fclose(f);
+    fv_test_write_file(path, "t_ms,gaze_x,gaze_y\n0,0.25,0.5\n10,0.75,0.5\n");
     assert_int_equal(fv_trace_load(&t, path, err, sizeof err), 0);
     unlink(path);
     assert_int_equal(t.n, 2);

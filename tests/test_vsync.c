@@ -44,11 +44,7 @@ static void test_replay(void **st)
 {
     (void)st;
     char path[] = "/tmp/fovea_vsync_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    FILE *f = fdopen(fd, "w");
-    fprintf(f, "# recorded edges\n7000000000\n7003000000\n\n7006000000\n");
-    fclose(f);
+    fv_test_temp_file(path, "# recorded edges\n7000000000\n7003000000\n\n7006000000\n");
     fv_vsync *v;
     char err[256];
     char spec[64];
@@ -65,14 +61,10 @@ static void test_replay(void **st)
     assert_int_equal(fv_vsync_wait(v, 10000000, &t[0], err, sizeof err), 0);
     fv_vsync_close(v);
 
-    f = fopen(path, "w");
-    fprintf(f, "100\n50\n");
-    fclose(f);
+    fv_test_write_file(path, "100\n50\n");
     assert_int_equal(fv_vsync_open(&v, spec, err, sizeof err), -1);
     assert_non_null(strstr(err, ":2: times go backwards"));
-    f = fopen(path, "w");
-    fprintf(f, "100\n1.5e3\n");
-    fclose(f);
+    fv_test_write_file(path, "100\n1.5e3\n");
     assert_int_equal(fv_vsync_open(&v, spec, err, sizeof err), -1);
     assert_non_null(strstr(err, ":2: not an integer time in ns"));
     unlink(path);

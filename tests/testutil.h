@@ -3,6 +3,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <setjmp.h>
 #include <stdlib.h>
 #include <cmocka.h>
@@ -39,4 +40,24 @@ static inline buf buf_new(size_t count, int off)
     assert_non_null(b.base);
     b.p = b.base + off;
     return b;
+}
+
+/* A new temporary file holding text: path is a mkstemp template ("/tmp/fovea_x_XXXXXX"), filled
+ * in with the name. The caller removes it. */
+static inline void fv_test_temp_file(char *path, const char *text)
+{
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    FILE *f = fdopen(fd, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    assert_int_equal(fclose(f), 0);
+}
+/* Replaces the contents of the file at path with text. */
+static inline void fv_test_write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    assert_int_equal(fclose(f), 0);
 }
