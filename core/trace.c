@@ -96,6 +96,19 @@ int fv_trace_parse(fv_trace *tr, const char *text, size_t len, const char *name,
                 goto out;
             }
         }
+        /* Values are checked at the type and range they are used in, not only as finite doubles:
+         * t_ms becomes integer nanoseconds (int64 up to 9.2e18), the head position a float in metres
+         * that Embree asserts finite in every ray (1e30 m squared is infinite). */
+        if (fabs(v[0]) > FV_TRACE_MAX_T_MS) {
+            fv_err(err, err_len, "%s:%d: t_ms %g out of range (|t_ms| <= %g)", name, lineno, v[0], FV_TRACE_MAX_T_MS);
+            goto out;
+        }
+        for (int i = 3; i < 6 && i < nf; i++)
+            if (fabs(v[i]) > FV_TRACE_MAX_POS_M) {
+                fv_err(err, err_len, "%s:%d: head position %s = %g m out of range (|p| <= %g m)", name, lineno,
+                       head_cols[i - 3], v[i], FV_TRACE_MAX_POS_M);
+                goto out;
+            }
         if (tr->n && v[0] < tr->s[tr->n - 1].t_ms) {
             fv_err(err, err_len, "%s:%d: t_ms goes backwards (%g after %g)", name, lineno, v[0], tr->s[tr->n - 1].t_ms);
             goto out;

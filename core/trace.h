@@ -8,6 +8,12 @@
 #include <stddef.h>
 #include "camera.h"
 
+/* Input ranges (bad input beyond them): times up to about 31 years, head positions within 1000 km. */
+#define FV_TRACE_MAX_T_MS 1e12
+#define FV_TRACE_MAX_POS_M 1e6
+/* The largest trace file read (a 10-million-row trace is about 0.5 GiB). */
+#define FV_TRACE_MAX_FILE_BYTES ((size_t)1 << 30)
+
 typedef struct fv_trace_sample {
     double t_ms;
     float gaze_x, gaze_y;

@@ -2,6 +2,8 @@
 #include "base/clock.h"
 
 #include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -202,7 +204,7 @@ long fv_read_text_file(const char *path, char *buf, size_t cap, const char *kind
     return (long)n;
 }
 
-char *fv_read_file_alloc(const char *path, size_t *len_out, char *err, size_t err_len)
+char *fv_read_file_alloc(const char *path, size_t max_bytes, size_t *len_out, char *err, size_t err_len)
 {
     *len_out = 0;
     FILE *f = fopen(path, "rb");
@@ -210,7 +212,28 @@ char *fv_read_file_alloc(const char *path, size_t *len_out, char *err, size_t er
         fv_err(err, err_len, "%s: %s", path, strerror(errno));
         return NULL;
     }
-    size_t cap = 1 << 16, len = 0;
+    /* A regular file is judged by its size before anything is read or reserved; pipes and devices
+     * (no size) are read in growing steps that stop at the limit, or at the first NUL byte: a text
+     * format ends there, so /dev/zero costs one 64 KiB step, not a gigabyte. */
+    struct stat st;
+    if (fstat(fileno(f), &st)) {
+        fv_err(err, err_len, "%s: %s", path, strerror(errno));
+        fclose(f);
+        return NULL;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        fv_err(err, err_len, "%s: is a directory", path);
+        fclose(f);
+        return NULL;
+    }
+    if (S_ISREG(st.st_mode) && (uint64_t)st.st_size > max_bytes) {
+        fv_err(err, err_len, "%s: %lld bytes, larger than the %zu MiB limit", path, (long long)st.st_size,
+               max_bytes >> 20);
+        fclose(f);
+        return NULL;
+    }
+    size_t cap = S_ISREG(st.st_mode) ? (size_t)st.st_size + 1 : (size_t)1 << 16, len = 0;
+    cap = cap < max_bytes + 1 ? cap : max_bytes + 1;
     char *buf = malloc(cap);
     for (;;) {
         if (!buf) {
@@ -218,19 +241,28 @@ char *fv_read_file_alloc(const char *path, size_t *len_out, char *err, size_t er
             fv_err(err, err_len, "%s: out of memory", path);
             return NULL;
         }
-        len += fread(buf + len, 1, cap - len, f);
-        if (len < cap)
-            break;
-        if (cap > ((size_t)1 << 30)) {
+        const size_t got = fread(buf + len, 1, cap - len, f);
+        if (memchr(buf + len, '\0', got)) {
             free(buf);
             fclose(f);
-            fv_err(err, err_len, "%s: larger than 1 GiB", path);
+            fv_err(err, err_len, "%s: not a text file (NUL byte)", path);
             return NULL;
         }
-        char *nb = realloc(buf, cap *= 2);
+        len += got;
+        if (len < cap)
+            break;
+        if (len > max_bytes) {
+            free(buf);
+            fclose(f);
+            fv_err(err, err_len, "%s: larger than the %zu MiB limit", path, max_bytes >> 20);
+            return NULL;
+        }
+        const size_t ncap = cap > max_bytes / 2 ? max_bytes + 1 : 2 * cap;
+        char *nb = realloc(buf, ncap);
         if (!nb)
             free(buf);
         buf = nb;
+        cap = ncap;
     }
     int bad = ferror(f);
     fclose(f);

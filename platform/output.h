@@ -47,11 +47,12 @@ void fv_progress_end(fv_progress *p);
  * reason naming the file in err (cannot open, read error, over cap - 1 bytes: "too large for
  * <kind>", a NUL byte: "not a text file"). */
 long fv_read_text_file(const char *path, char *buf, size_t cap, const char *kind, char *err, size_t err_len);
-/* Reads a file of up to about 1 GiB whole into a malloc'd buffer (the caller frees it), for
- * inputs with no small size bound (traces): the buffer, with *len bytes, no terminator and any
- * NUL bytes left for the parser to judge; or NULL with a reason naming the file in err (cannot
- * open, "out of memory", "larger than 1 GiB", "read error"). */
-char *fv_read_file_alloc(const char *path, size_t *len, char *err, size_t err_len);
+/* Reads a text file of up to max_bytes whole into a malloc'd buffer (the caller frees it), for
+ * inputs with no small size bound (traces): the buffer, with *len bytes and no terminator; or
+ * NULL with a reason naming the file in err (cannot open, a directory, "larger than the N MiB
+ * limit" (a regular file's size is checked before reading), "not a text file (NUL byte)", "out of
+ * memory", "read error"). Never reserves more than max_bytes + 1. */
+char *fv_read_file_alloc(const char *path, size_t max_bytes, size_t *len, char *err, size_t err_len);
 
 /* mkdir -p; 0 on success. */
 int fv_mkdirs(const char *path, char *err, size_t err_len);

@@ -558,6 +558,13 @@ static void test_calib_file(void **state)
         { "fovea-calibration 1\ninput pupil\nnorm 1 2 3\nyaw_deg 1 2 3 4 5\n", "line 4: yaw_deg needs 6 numbers" },
         { "fovea-calibration 1\ninput pupil\nnorm 1 2 3\nyaw_deg 1 2 3 4 5 6\n", "missing pitch_deg" },
         { "fovea-calibration 1\nbogus 1\n", "line 2: unknown key 'bogus'" },
+        /* values checked at the type they are used in (an int, a float gaze), not only as finite doubles */
+        { "fovea-calibration 1\nsamples 1e300\n", "line 2: samples 1e+300 out of range" },
+        { "fovea-calibration 1\nsamples 2.5\n", "line 2: samples 2.5 out of range" },
+        { "fovea-calibration 1\nsamples -1\n", "line 2: samples -1 out of range" },
+        { "fovea-calibration 1\nrms_deg 1e40\n", "line 2: rms_deg 1e+40 out of range" },
+        { "fovea-calibration 1\ninput pupil\nnorm 1e300 2 3\n", "line 3: norm 1e+300 2 3 out of range" },
+        { "fovea-calibration 1\ninput pupil\nnorm 1 2 3\nyaw_deg 1 2 3 4 5 1e39\n", "line 4: yaw_deg coefficient 6" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         assert_int_equal(fv_calib_parse(&d, bad[i].text, err, sizeof err), -1);

@@ -2,9 +2,11 @@
  * (platform/tracefile.c). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "output.h"
 #include "testutil.h"
 #include "trace.h"
 #include "tracefile.h"
@@ -105,6 +107,10 @@ static void test_messages(void **st)
         {"t_ms,gaze_x,gaze_y\n0,40,0.5\n", "t.csv:2: gaze (40, 0.5) is far outside the normalised image [0,1]"},
         {"t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw\n0,0.5,0.5,0,0,0,0,0,0,0\n",
          "t.csv:2: head quaternion has length 0, expected about 1"},
+        /* finite as a double, infinite as the float it becomes (Embree aborted on such a ray origin) */
+        {"t_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw\n0,0.5,0.5,0,1e30,0,0,0,0,1\n",
+         "t.csv:2: head position head_py = 1e+30 m out of range (|p| <= 1e+06 m)"},
+        {"t_ms,gaze_x,gaze_y\n1e300,0.5,0.5\n", "t.csv:2: t_ms 1e+300 out of range (|t_ms| <= 1e+12)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
         fv_trace t;
@@ -134,7 +140,10 @@ static void test_load(void **st)
     assert_string_equal(err, "/nonexistent/trace.csv: No such file or directory");
     assert_null(t.s);
     assert_int_equal(fv_trace_load(&t, "/tmp", err, sizeof err), -1);
-    assert_string_equal(err, "/tmp: read error");
+    assert_string_equal(err, "/tmp: is a directory");
+    /* an endless device stops at its first NUL byte, after one 64 KiB step, not at the size limit */
+    assert_int_equal(fv_trace_load(&t, "/dev/zero", err, sizeof err), -1);
+    assert_string_equal(err, "/dev/zero: not a text file (NUL byte)");
 
     char path[] = "/tmp/fovea_trace_XXXXXX";
     fv_test_temp_file(path, "t_ms,gaze_x,gaze_y\n0,0.25,0.5\n10,0.75,0.5\n20,0.5\n");
@@ -150,6 +159,23 @@ static void test_load(void **st)
     fv_trace_at(&t, 5.0, &s);
     assert_float_equal(s.gaze_x, 0.5f, 1e-6);
     fv_trace_free(&t);
+
+    /* a regular file over the limit is refused by its size, before anything is read: a sparse
+     * 2 GiB file (no disk blocks) and, through the reader itself, a 64-byte file with a 63-byte limit */
+    char big[] = "/tmp/fovea_trace_big_XXXXXX";
+    fv_test_temp_file(big, "t_ms,gaze_x,gaze_y\n");
+    assert_int_equal(truncate(big, (off_t)2 << 30), 0);
+    assert_int_equal(fv_trace_load(&t, big, err, sizeof err), -1);
+    snprintf(want, sizeof want, "%s: 2147483648 bytes, larger than the 1024 MiB limit", big);
+    assert_string_equal(err, want);
+    fv_test_write_file(big, "0123456789012345678901234567890123456789012345678901234567890123");
+    size_t len;
+    assert_null(fv_read_file_alloc(big, 63, &len, err, sizeof err));
+    char *buf = fv_read_file_alloc(big, 64, &len, err, sizeof err);
+    assert_non_null(buf);
+    assert_int_equal(len, 64);
+    free(buf);
+    unlink(big);
 }
 
 /* a trace played in a loop: 100..400 ms is a 300 ms span */

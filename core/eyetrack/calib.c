@@ -262,16 +262,30 @@ int fv_calib_parse(fv_calib *c, const char *text, char *err, size_t err_len)
         } else if (!strcmp(key, "norm")) {
             if (numbers(rest, v, 3) || !(v[2] > 0))
                 return fv_err(err, err_len, "line %d: norm needs u0 v0 s (s > 0)", ln);
+            /* pupil positions are pixels of a camera image: beyond 1e6 is not a camera */
+            if (fabs(v[0]) > 1e6 || fabs(v[1]) > 1e6 || v[2] > 1e6 || v[2] < 1e-6)
+                return fv_err(err, err_len, "line %d: norm %g %g %g out of range (|u0|, |v0| <= 1e6, 1e-6 <= s <= 1e6)",
+                              ln, v[0], v[1], v[2]);
             c->u0 = v[0], c->v0 = v[1], c->s = v[2];
             have |= 4;
         } else if (!strcmp(key, "yaw_deg") || !strcmp(key, "pitch_deg")) {
             if (numbers(rest, v, 6))
                 return fv_err(err, err_len, "line %d: %s needs 6 numbers", ln, key);
+            for (int k = 0; k < 6; k++) /* degrees per normalised unit: a gaze in degrees stays a float */
+                if (fabs(v[k]) > 1e6)
+                    return fv_err(err, err_len, "line %d: %s coefficient %d (%g) out of range (|c| <= 1e6)", ln, key,
+                                  k + 1, v[k]);
             memcpy(key[0] == 'y' ? c->a : c->b, v, sizeof v);
             have |= key[0] == 'y' ? 8 : 16;
         } else if (!strcmp(key, "rms_deg") || !strcmp(key, "max_deg") || !strcmp(key, "samples")) {
             if (numbers(rest, v, 1))
                 return fv_err(err, err_len, "line %d: %s needs a number", ln, key);
+            /* checked at the type and range they are used in: a count is a whole number an int
+             * holds, an angular residual lies within a half turn */
+            if (key[0] == 's' ? !(v[0] >= 0 && v[0] <= FV_CALIB_MAX_SAMPLES && v[0] == floor(v[0]))
+                              : !(v[0] >= 0 && v[0] <= 180))
+                return fv_err(err, err_len, "line %d: %s %g out of range (%s)", ln, key, v[0],
+                              key[0] == 's' ? "a whole number 0..1000000" : "0..180 degrees");
             if (key[0] == 'r')
                 c->rms_deg = v[0];
             else if (key[0] == 'm')

@@ -13,6 +13,9 @@
 
 enum { FV_CALIB_PUPIL_GLINT = 0, FV_CALIB_PUPIL = 1 };
 
+/* The largest sample count a calibration file may state (far above any procedure's). */
+#define FV_CALIB_MAX_SAMPLES 1000000
+
 typedef struct fv_calib {
     int input;          /* FV_CALIB_PUPIL_GLINT or FV_CALIB_PUPIL */
     double u0, v0, s;   /* input normalisation */
