@@ -132,6 +132,10 @@ int main(int argc, char **argv)
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
     }
+    /* outputs first: an unwritable one is bad usage found now, not after the run */
+    if ((json_path && fv_output_probe(json_path, err, sizeof err)) ||
+        (trace_path && fv_output_probe(trace_path, err, sizeof err)))
+        fv_usage_error(prog, "%s", err);
     if (kernels) {
         if (optind < argc)
             fv_usage_error(prog, "unexpected argument '%s' (see --help)", argv[optind]);

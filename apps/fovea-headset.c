@@ -239,7 +239,9 @@ int main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     char err[1024];
-    /* every input is checked before anything opens hardware */
+    /* every input is checked before anything opens hardware; outputs too (bad usage now, not after the run) */
+    if ((csv_path && fv_output_probe(csv_path, err, sizeof err)) || (prof_path && fv_output_probe(prof_path, err, sizeof err)))
+        fv_usage_error(prog, "%s", err);
     fv_calib calib;
     if (calib_path && fv_calib_load(&calib, calib_path, err, sizeof err))
         fv_usage_error(prog, "--calibration %s", err);

@@ -202,18 +202,19 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: out of memory\n", prog);
         goto done;
     }
-    if (fv_mkdirs(out_dir, err, sizeof err)) {
-        fprintf(stderr, "%s: %s\n", prog, err);
-        goto done;
-    }
+    /* The outputs, opened once every input has been accepted and before any frame: one that cannot
+     * be written is bad usage (exit 2), found now rather than after the run. */
     snprintf(path, sizeof path, "%s/stats.csv", out_dir);
-    if (fv_afile_open(&csv, path, err, sizeof err)) {
+    if (fv_output_probe_dir(out_dir, err, sizeof err) || fv_afile_open(&csv, path, err, sizeof err) ||
+        (prof_path && fv_output_probe(prof_path, err, sizeof err))) {
         fprintf(stderr, "%s: %s\n", prog, err);
+        status = FV_EXIT_USAGE;
         goto done;
     }
     if (y4m_path) {
         if (fv_y4m_open(&y4m, y4m_path, outw, H, (int)lrintf(hz), err, sizeof err)) {
             fprintf(stderr, "%s: %s\n", prog, err);
+            status = FV_EXIT_USAGE;
             goto done;
         }
         y4m_open = 1;

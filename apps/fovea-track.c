@@ -133,6 +133,8 @@ int main(int argc, char **argv)
         fv_usage_error(prog, "--ctrl and --camera-size only apply to --device");
 
     char err[512];
+    if (out_path && fv_output_probe(out_path, err, sizeof err)) /* bad usage now, not after the run */
+        fv_usage_error(prog, "%s", err);
     fv_eyesrc *src = NULL;
     if (device) {
         cam_cfg.path = device;

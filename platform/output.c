@@ -26,6 +26,33 @@ int fv_afile_open(fv_afile *a, const char *path, char *err, size_t err_len)
     return 0;
 }
 
+int fv_output_probe(const char *path, char *err, size_t err_len)
+{
+    struct stat st;
+    if (!stat(path, &st) && S_ISDIR(st.st_mode))
+        return fv_err(err, err_len, "%s: is a directory", path);
+    fv_afile a;
+    if (fv_afile_open(&a, path, err, err_len))
+        return -1;
+    fv_afile_abort(&a);
+    return 0;
+}
+
+int fv_output_probe_dir(const char *dir, char *err, size_t err_len)
+{
+    if (fv_mkdirs(dir, err, err_len))
+        return -1;
+    char probe[4200];
+    if (snprintf(probe, sizeof probe, "%s/.fovea-probe-%ld", dir, (long)getpid()) >= (int)sizeof probe)
+        return fv_err(err, err_len, "%s: path too long", dir);
+    FILE *f = fopen(probe, "wb");
+    if (!f)
+        return fv_err(err, err_len, "%s: cannot write in it (%s)", dir, strerror(errno));
+    fclose(f);
+    unlink(probe);
+    return 0;
+}
+
 int fv_afile_commit(fv_afile *a, char *err, size_t err_len)
 {
     if (!a->f)

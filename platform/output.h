@@ -19,6 +19,12 @@ typedef struct fv_afile {
 int fv_afile_open(fv_afile *a, const char *path, char *err, size_t err_len);
 int fv_afile_commit(fv_afile *a, char *err, size_t err_len);
 void fv_afile_abort(fv_afile *a);
+/* Start-up check of an output path the run will write at its end (or as it goes): PATH.tmp can be
+ * created (and is removed again) and PATH is not a directory, so an unwritable output is bad usage
+ * found before any work, not after a long run. 0, or -1 with the reason naming the path. */
+int fv_output_probe(const char *path, char *err, size_t err_len);
+/* The same for an output folder: made if missing (mkdir -p) and a file can be created in it. */
+int fv_output_probe_dir(const char *dir, char *err, size_t err_len);
 
 /* YUV4MPEG2 4:2:0 (C420jpeg, full-range BT.601) from RGB frames. */
 typedef struct fv_y4m_writer {

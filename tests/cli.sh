@@ -71,6 +71,20 @@ expect_usage "replay bad focus" '--focus-m: 0 is out of range' $R --scene $SCENE
 expect_usage "replay bad pupil" '--pupil-mm: 25 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --pupil-mm 25
 expect_usage "replay reference vs-full" '--vs-full and --reference exclude each other' $R --scene $SCENE --out "$T/o2" --reference 4 --vs-full
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
+# values checked at the type they are used in: a head position finite as a double, infinite as a float
+# (it aborted Embree with exit 134 and left stats.csv.tmp behind)
+printf 't_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_qw\n0,0.5,0.5,0,1e30,0,0,0,0,1\n' >"$T/far.csv"
+expect_usage "replay head position 1e30" 'far.csv:2: head position head_py = 1e\+30 m out of range' $R --scene $SCENE --out "$T/o3" --trace "$T/far.csv"
+[ ! -e "$T/o3" ] && ok || bad "1e30 head position left output behind"
+expect_usage "replay trace from /dev/zero" '/dev/zero: not a text file' $R --scene $SCENE --out "$T/o3" --trace /dev/zero
+# unwritable outputs are bad usage found before the run (exit 2), not a failure after it
+expect_usage "replay unwritable out" '/proc/fovea-no' $R --scene $SCENE --size 64x72 --out /proc/fovea-no/o
+expect_usage "replay unwritable y4m" '/proc/fovea-no/v.y4m' $R --scene $SCENE --size 64x72 --out "$T/o4" --y4m /proc/fovea-no/v.y4m
+[ ! -e "$T/o4/stats.csv" ] && [ ! -e "$T/o4/stats.csv.tmp" ] && ok || bad "unwritable y4m left stats.csv behind"
+expect_usage "replay unwritable trace-out" '/proc/fovea-no/p.json' $R --scene $SCENE --size 64x72 --out "$T/o4" --trace-out /proc/fovea-no/p.json
+expect_usage "bench unwritable json" '/proc/fovea-no/b.json' $B/fovea-bench --scene $SCENE --size 64x72 --json /proc/fovea-no/b.json
+expect_usage "bench json is a directory" "$T: is a directory" $B/fovea-bench --scene $SCENE --size 64x72 --json "$T"
+expect_usage "track unwritable out" '/proc/fovea-no/t.csv' $B/fovea-track --video assets/eye_synth.y4m --out /proc/fovea-no/t.csv
 expect_usage "bench bad mode" '--mode: .fast. is not one of' $B/fovea-bench --scene $SCENE --mode fast
 expect_usage "bench bad yaw rate" '--yaw-rate: 1000 is out of range' $B/fovea-bench --scene $SCENE --yaw-rate 1000
 
@@ -434,6 +448,8 @@ expect_usage "headset kms cannot open" 'open\(/dev/dri/card99\)' $HS $HO --displ
 expect_usage "headset fbdev cannot open" "open\\($T/nofb\\)" $HS $HO --display fbdev:"$T/nofb"
 expect_usage "headset png dir cannot be made" '/proc/fovea-no' $HS $HO --display png:/proc/fovea-no/dir
 expect_usage "headset bad display" '--display tv: want kms' $HS $HO --display tv
+expect_usage "headset unwritable latency csv" '/proc/fovea-no/l.csv' $HS $HO --seconds 5 --latency-csv /proc/fovea-no/l.csv
+expect_usage "headset unwritable trace-out" '/proc/fovea-no/p.json' $HS $HO --seconds 5 --trace-out /proc/fovea-no/p.json
 expect_usage "headset calibration without camera" '--calibration only applies with --camera' $HS $HO --calibration x
 printf 'k1 0.1\nk9 1\n' >"$T/bad.lens"
 expect_usage "headset bad lens" 'bad.lens:2: unknown key' $HS $HO --lens "$T/bad.lens"
