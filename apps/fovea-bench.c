@@ -30,6 +30,7 @@ static void usage(FILE *f)
             "table of Weier et al. 2018 (Table 1) and writes JSON. Times are means over the frames\n"
             "after warm-up (medians are in the JSON too).\n"
             "  --scene FILE       glTF 2.0 scene (.gltf or .glb)\n"
+            FV_ASSET_ROOT_HELP
             "  --frames N         timed frames per mode (default 30)\n"
             "  --warmup N         untimed frames first (default 3)\n"
             "  --mode M           foveated, full or both (default both)\n"
@@ -79,6 +80,7 @@ int main(int argc, char **argv)
 {
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
+    const char *asset_root = NULL; /* --asset-root */
     const char *scene_path = NULL, *json_path = NULL, *mode = "both", *trace_path = NULL, *kernel = NULL;
     fv_bench_opts bo = {.yaw_rate = 0.0f, .warmup = 3, .frames = 30, .counters = 1, .prof = NULL};
     int kernels = 0, kreps = 7;
@@ -89,7 +91,7 @@ int main(int argc, char **argv)
     enum { OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_YAW, OPT_HELP, OPT_TRACE_OUT, OPT_COUNTERS,
            OPT_SWEEP, OPT_KERNELS, OPT_KREPS, OPT_KERNEL, OPT_CALLS, OPT_CEILING };
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, {"frames", required_argument, 0, OPT_FRAMES},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"frames", required_argument, 0, OPT_FRAMES},
         {"warmup", required_argument, 0, OPT_WARMUP}, {"mode", required_argument, 0, OPT_MODE},
         {"json", required_argument, 0, OPT_JSON}, {"yaw-rate", required_argument, 0, OPT_YAW},
         {"trace-out", required_argument, 0, OPT_TRACE_OUT}, {"counters", required_argument, 0, OPT_COUNTERS},
@@ -103,6 +105,7 @@ int main(int argc, char **argv)
     while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
+        case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
         case OPT_FRAMES: bo.frames = (int)fv_arg_long(prog, "--frames", optarg, 1, 100000); break;
         case OPT_WARMUP: bo.warmup = (int)fv_arg_long(prog, "--warmup", optarg, 0, 100000); break;
         case OPT_MODE:
@@ -151,7 +154,7 @@ int main(int argc, char **argv)
             fv_usage_error(prog, "%s", err);
 
     int64_t t0 = fv_time_ns();
-    fv_scene *scene = fv_scene_load(scene_path, err, sizeof err);
+    fv_scene *scene = fv_scene_load_in(scene_path, asset_root, err, sizeof err);
     if (!scene)
         fv_usage_error(prog, "%s", err);
     fv_bench_report rep = {.scene_path = scene_path, .triangles = fv_scene_triangle_count(scene),

@@ -36,6 +36,7 @@ static void usage(FILE *f)
             "                     [--calibration FILE] [--seconds S] [options]\n"
             "Renders both eyes locked to vsync with the newest gaze; prints a latency summary at exit.\n"
             "  --scene FILE        glTF 2.0 scene\n"
+            FV_ASSET_ROOT_HELP
             "  --camera SRC        eye camera (V4L2 device or a Y4M replayed at --camera-fps); default\n"
             "                      none: gaze from --trace, the mouse (--display window) or the centre\n"
             "  --vsync SRC         vsync source (default timer:90)\n"
@@ -186,6 +187,7 @@ int main(int argc, char **argv)
 {
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
+    const char *asset_root = NULL; /* --asset-root */
     const char *scene_path = NULL, *camera = "none", *vsync_spec = "timer:90", *display_spec = "none";
     const char *calib_path = NULL, *trace_path = NULL, *lens_path = NULL, *csv_path = NULL, *prof_path = NULL;
     double seconds = 0.0;
@@ -193,7 +195,7 @@ int main(int argc, char **argv)
     fv_prof *prof = NULL; /* --trace-out's recorder */
     int reproject_given = 0;
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, {"camera", required_argument, 0, OPT_CAMERA},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"camera", required_argument, 0, OPT_CAMERA},
         {"vsync", required_argument, 0, OPT_VSYNC}, {"display", required_argument, 0, OPT_DISPLAY},
         {"calibration", required_argument, 0, OPT_CALIB}, {"seconds", required_argument, 0, OPT_SECONDS},
         {"trace", required_argument, 0, OPT_TRACE}, {"lens", required_argument, 0, OPT_LENS},
@@ -206,6 +208,7 @@ int main(int argc, char **argv)
     while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
+        case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_VSYNC: vsync_spec = optarg; break;
         case OPT_DISPLAY: display_spec = optarg; break;
@@ -268,7 +271,7 @@ int main(int argc, char **argv)
         fv_vsync_close(a.vsync);
         fv_usage_error(prog, "%s", err);
     }
-    fv_scene *scene = fv_scene_load(scene_path, err, sizeof err);
+    fv_scene *scene = fv_scene_load_in(scene_path, asset_root, err, sizeof err);
     if (!scene) {
         fv_display_close(a.disp, NULL, 0);
         fv_vsync_close(a.vsync);

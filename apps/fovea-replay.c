@@ -31,6 +31,7 @@ static void usage(FILE *f)
             "Renders the scene along a gaze/head trace; writes DIR/frame_NNNNN.png (left eye, or\n"
             "both eyes side by side with --stereo) and DIR/stats.csv (per-stage ms and samples).\n"
             "  --scene FILE       glTF 2.0 scene (.gltf or .glb)\n"
+            FV_ASSET_ROOT_HELP
             "  --trace FILE       CSV t_ms,gaze_x,gaze_y[,head pose]; without it the gaze rests at the\n"
             "                     image centre and the head at the scene's default viewpoint\n"
             "  --frames N         frames to render (default: the trace's length at --hz, or 1)\n"
@@ -90,13 +91,14 @@ int main(int argc, char **argv)
 {
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
+    const char *asset_root = NULL; /* --asset-root */
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0, window = 0;
     fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
     float hz = 90.0f;
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, {"trace", required_argument, 0, OPT_TRACE},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"trace", required_argument, 0, OPT_TRACE},
         {"frames", required_argument, 0, OPT_FRAMES}, {"out", required_argument, 0, OPT_OUT},
         {"full", no_argument, 0, OPT_FULL}, {"stereo", no_argument, 0, OPT_STEREO},
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
@@ -109,6 +111,7 @@ int main(int argc, char **argv)
     while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
+        case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
         case OPT_TRACE: trace_path = optarg; break;
         case OPT_FRAMES: frames = fv_arg_long(prog, "--frames", optarg, 1, 10000000); break;
         case OPT_OUT: out_dir = optarg; break;
@@ -147,7 +150,7 @@ int main(int argc, char **argv)
     if (frames < 0)
         frames = trace_path ? 1 + (long)floor((tr.s[tr.n - 1].t_ms - tr.s[0].t_ms) * hz / 1000.0) : 1;
 
-    fv_scene *scene = fv_scene_load(scene_path, err, sizeof err);
+    fv_scene *scene = fv_scene_load_in(scene_path, asset_root, err, sizeof err);
     if (!scene) {
         fv_trace_free(&tr);
         fv_usage_error(prog, "%s", err);

@@ -120,12 +120,17 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
 
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len)
 {
-    char e[256] = "";
+    return fv_scene_load_in(path, NULL, err, err_len);
+}
+
+fv_scene *fv_scene_load_in(const char *path, const char *asset_root, char *err, size_t err_len)
+{
+    char e[1024] = "";
     if (!path) {
         fv_err(err, err_len, "no path");
         return NULL;
     }
-    fv_gltf_model *g = fv_gltf_load(path, e, sizeof e);
+    fv_gltf_model *g = fv_gltf_load(path, asset_root, e, sizeof e);
     if (!g) {
         fv_err(err, err_len, "%s: %s", path, e);
         return NULL;

@@ -8,6 +8,8 @@
 #include <tiny_gltf.h>
 
 #include <sys/stat.h>
+#include <climits>
+#include <cstdlib>
 
 #include <cerrno>
 #include <cfloat>
@@ -69,22 +71,67 @@ bool read_file(const std::string &path, std::vector<unsigned char> *out, std::st
     return true;
 }
 
-// tinygltf's filesystem hooks: regular files only, same size cap.
-bool fs_exists(const std::string &path, void *)
+// tinygltf's filesystem hooks: regular files only, same size cap, and only inside the scene's
+// folder tree (or --asset-root's). tinygltf has already percent-decoded the URI and joined it to
+// the scene's folder (and, failing that, to the current directory); realpath() then removes
+// every `..` and symbolic link, so the check is on the file that would really be opened. A
+// downloaded scene must not make the renderer read the user's other files.
+struct FsCtx {
+    std::string dir;       // the scene file's folder as tinygltf joins URIs to it
+    std::string root;      // canonical folder files must lie in ("" = no confinement)
+    std::string refusal;   // the first refused URI's message, reported instead of tinygltf's
+};
+
+bool inside_root(const FsCtx &c, const std::string &path)
 {
-    struct stat st;
-    return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+    if (c.root.empty()) return true;
+    char *real = realpath(path.c_str(), nullptr);
+    if (!real) return false;
+    const std::string r(real);
+    std::free(real);
+    return r.size() > c.root.size() && r.compare(0, c.root.size(), c.root) == 0 &&
+           (c.root.back() == '/' || r[c.root.size()] == '/');
 }
 
-bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+bool fs_exists(const std::string &path, void *u)
+{
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
+    FsCtx &c = *static_cast<FsCtx *>(u);
+    if (inside_root(c, path)) return true;
+    if (c.refusal.empty())
+        c.refusal = "'" + path + "' is outside the scene's folder " + c.root + " (--asset-root DIR allows another)";
+    return false;
+}
+
+bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *u)
 {
     std::string e;
-    if (read_file(path, out, &e)) return true;
+    if (!inside_root(*static_cast<FsCtx *>(u), path)) e = "outside the scene's folder";
+    else if (read_file(path, out, &e)) return true;
     if (err) *err += e;
     return false;
 }
 
-std::string fs_expand(const std::string &path, void *) { return path; }
+// Absolute paths and URI schemes other than data: (which tinygltf decodes itself and never
+// passes here) are refused outright, before any lookup.
+std::string fs_expand(const std::string &path, void *u)
+{
+    FsCtx &c = *static_cast<FsCtx *>(u);
+    // tinygltf joined the URI to the scene's folder or to "."; look at the URI part only
+    std::string uri = path;
+    for (const std::string &pre : {c.dir + "/", std::string("./")})
+        if (!c.dir.empty() && uri.compare(0, pre.size(), pre) == 0) {
+            uri = uri.substr(pre.size());
+            break;
+        }
+    if (uri.find("://") != std::string::npos || (!uri.empty() && uri[0] == '/')) {
+        if (c.refusal.empty())
+            c.refusal = "'" + path + "': absolute paths and URI schemes other than data: are not allowed";
+        return std::string();
+    }
+    return path;
+}
 
 bool fs_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
 {
@@ -649,10 +696,29 @@ void set_err(char *err, size_t err_len, const std::string &msg)
     std::snprintf(err, err_len, "%s", msg.c_str());
 }
 
-fv_gltf_model *load(const char *path)
+// A file that is neither GLB nor JSON is refused from its first bytes, before a multi-gigabyte
+// read (a zero-filled 2 GiB .gltf took 12 s to fail).
+void check_kind(const char *path)
+{
+    FILE *f = std::fopen(path, "rb");
+    if (!f) throw Fail(std::strerror(errno));
+    unsigned char head[256];
+    const size_t n = std::fread(head, 1, sizeof head, f);
+    std::fclose(f);
+    if (n >= 4 && std::memcmp(head, "glTF", 4) == 0) return;
+    size_t i = 0;
+    if (n >= 3 && head[0] == 0xef && head[1] == 0xbb && head[2] == 0xbf) i = 3; // UTF-8 byte order mark
+    while (i < n && (head[i] == ' ' || head[i] == '\t' || head[i] == '\r' || head[i] == '\n')) i++;
+    if (i < n && head[i] == '{') return;
+    throw Fail(i == n && n == sizeof head ? "not a glTF file (only white space in its first bytes)"
+                                          : "not a glTF file (neither a GLB header nor a JSON object)");
+}
+
+fv_gltf_model *load(const char *path, const char *asset_root)
 {
     std::vector<unsigned char> file;
     std::string e;
+    check_kind(path);
     if (!read_file(path, &file, &e)) throw Fail(e);
     const bool glb = file.size() >= 4 && std::memcmp(file.data(), "glTF", 4) == 0;
     if (glb) {
@@ -668,15 +734,25 @@ fv_gltf_model *load(const char *path)
     const size_t slash = dir.find_last_of('/');
     dir = slash == std::string::npos ? std::string() : dir.substr(0, slash);
 
+    FsCtx fsc;
+    {
+        const std::string root = asset_root ? std::string(asset_root) : (dir.empty() ? std::string(".") : dir);
+        char *real = realpath(root.c_str(), nullptr);
+        if (!real) throw Fail((asset_root ? "--asset-root " : "scene folder ") + root + ": " + std::strerror(errno));
+        fsc.root = real;
+        fsc.dir = dir;
+        std::free(real);
+    }
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
-    loader.SetFsCallbacks(tinygltf::FsCallbacks{&fs_exists, &fs_expand, &fs_read, &fs_write, nullptr});
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{&fs_exists, &fs_expand, &fs_read, &fs_write, &fsc});
     ImageHookCtx ictx{&model};
     loader.SetImageLoader(&keep_encoded_image, &ictx);
     std::string terr, twarn;
     const bool ok = glb ? loader.LoadBinaryFromMemory(&model, &terr, &twarn, file.data(), unsigned(file.size()), dir)
                         : loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(file.data()),
                                                      unsigned(file.size()), dir);
+    if (!ok && !fsc.refusal.empty()) throw Fail(fsc.refusal);
     if (!ok) throw Fail("tinygltf: " + (terr.empty() ? std::string("parse failed") : terr));
     file.clear();
     file.shrink_to_fit();
@@ -708,13 +784,13 @@ fv_gltf_model *load(const char *path)
 
 } // namespace
 
-extern "C" fv_gltf_model *fv_gltf_load(const char *path, char *err, size_t err_len)
+extern "C" fv_gltf_model *fv_gltf_load(const char *path, const char *asset_root, char *err, size_t err_len)
 {
     set_err(err, err_len, "");
     std::string msg;
     try {
         if (!path) throw Fail("no path");
-        return load(path);
+        return load(path, asset_root);
     } catch (const std::bad_alloc &) {
         msg = "out of memory";
     } catch (const std::exception &ex) {

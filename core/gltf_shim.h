@@ -61,9 +61,12 @@ typedef struct fv_gltf_model {
     void *impl; /* owner of the arrays above */
 } fv_gltf_model;
 
-/* Reads a .gltf or .glb (detected by content). Returns NULL with a one-line reason in err
- * on any failure; never throws. */
-fv_gltf_model *fv_gltf_load(const char *path, char *err, size_t err_len);
+/* Reads a .gltf or .glb (detected by content). External files (buffers, images) must lie inside
+ * asset_root's folder tree, or the scene file's own folder when asset_root is NULL (after `..`,
+ * percent-escapes and symbolic links are resolved; absolute paths and URI schemes other than
+ * data: are refused, the message naming the URI). Returns NULL with a one-line reason in err on
+ * any failure; never throws. */
+fv_gltf_model *fv_gltf_load(const char *path, const char *asset_root, char *err, size_t err_len);
 void fv_gltf_free(fv_gltf_model *m);
 
 #ifdef __cplusplus

@@ -21,6 +21,9 @@ typedef struct fv_scene fv_scene;
  * the base colour are ignored. The first perspective camera in depth-first node order
  * becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
+/* The same, with the folder the scene's external files must lie in (NULL: the scene file's own
+ * folder, which fv_scene_load uses): a URI leading elsewhere is refused, naming it. */
+fv_scene *fv_scene_load_in(const char *path, const char *asset_root, char *err, size_t err_len);
 
 /* Building a scene by hand (tests, generators): create, add meshes, commit. */
 typedef struct fv_mesh_desc {

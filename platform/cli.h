@@ -70,6 +70,13 @@ enum {
     "  --contrast-gain G  peripheral contrast enhancement (Patney 2016; default 0 = off)\n" \
     "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
+/* --asset-root DIR, in every program that loads a scene: the folder tree the scene's external
+ * files (buffers, textures) may come from; default the scene file's own folder (fv_scene_load_in). */
+#define FV_OPT_ASSET_ROOT 1100
+#define FV_ASSET_ROOT_LONGOPT {"asset-root", required_argument, 0, FV_OPT_ASSET_ROOT}
+#define FV_ASSET_ROOT_HELP                                                                         \
+    "  --asset-root DIR   folder tree the scene's buffers and textures may come from (default:\n" \
+    "                     the scene file's folder; a URI leading elsewhere is refused)\n"
 /* After getopt_long: no stray words, a scene was given, option combinations agree (r0 <= r1);
  * exits 2 with a reason otherwise. */
 void fv_common_validate(const char *prog, int argc, char **argv, const char *scene_path, const fv_pipeline_config *cfg);

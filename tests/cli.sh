@@ -77,6 +77,16 @@ printf 't_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_
 expect_usage "replay head position 1e30" 'far.csv:2: head position head_py = 1e\+30 m out of range' $R --scene $SCENE --out "$T/o3" --trace "$T/far.csv"
 [ ! -e "$T/o3" ] && ok || bad "1e30 head position left output behind"
 expect_usage "replay trace from /dev/zero" '/dev/zero: not a text file' $R --scene $SCENE --out "$T/o3" --trace /dev/zero
+# a scene's external files stay in its folder tree: a URI leading out is refused and named (exit 2);
+# --asset-root widens the tree
+mkdir -p "$T/esc/scene"
+printf '\0\0\0\0\0\0\0\0\0\0\0\0\0\0\200\77\0\0\0\0\0\0\0\0\0\0\0\0\0\0\200\77\0\0\0\0' >"$T/esc/tri.bin"
+printf '{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"%%2e%%2e/tri.bin"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}' >"$T/esc/scene/s.gltf"
+expect_usage "replay scene URI outside its folder" "esc/scene/\\.\\./tri.bin' is outside the scene's folder" $R --scene "$T/esc/scene/s.gltf" --out "$T/o5" --size 64x72
+expect_usage "bench scene URI outside its folder" "is outside the scene's folder" $B/fovea-bench --scene "$T/esc/scene/s.gltf" --size 64x72 --frames 1
+if $R --scene "$T/esc/scene/s.gltf" --asset-root "$T/esc" --out "$T/o5" --size 64x72 --quiet >/dev/null 2>"$T/err" && [ -s "$T/o5/frame_00000.png" ]; then ok
+else bad "replay --asset-root: $(head -c 300 "$T/err")"; fi
+expect_usage "replay bad asset root" "--asset-root $T/none: No such file" $R --scene "$T/esc/scene/s.gltf" --asset-root "$T/none" --out "$T/o6"
 # unwritable outputs are bad usage found before the run (exit 2), not a failure after it
 expect_usage "replay unwritable out" '/proc/fovea-no' $R --scene $SCENE --size 64x72 --out /proc/fovea-no/o
 expect_usage "replay unwritable y4m" '/proc/fovea-no/v.y4m' $R --scene $SCENE --size 64x72 --out "$T/o4" --y4m /proc/fovea-no/v.y4m

@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define SQ2 0.70710678f
@@ -883,6 +884,67 @@ static void test_packet_shading_matches_scalar(void **state)
 
 /* ---- hostile files ------------------------------------------------------------------- */
 
+/* A scene's external files stay inside its folder tree (or --asset-root's): `..`, percent-escaped
+ * `..`, a symbolic link out, an absolute path and a URI scheme are refused with a message naming
+ * the URI; the same file inside the folder loads, and so does the outside one under a wider root. */
+static void write_tri_scene(const char *path, const char *uri)
+{
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}",
+             uri);
+    write_all(path, json, strlen(json));
+}
+
+static void test_scene_folder_confinement(void **state)
+{
+    (void)state;
+    char *top = tmpdir_make(), sub[256], p[512], buf[512], q[600];
+    static const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    write_all(path_join(buf, sizeof buf, top, "secret.bin"), tri, sizeof tri);
+    path_join(sub, sizeof sub, top, "scene");
+    assert_int_equal(mkdir(sub, 0700), 0);
+    write_all(path_join(buf, sizeof buf, sub, "ok.bin"), tri, sizeof tri);
+    path_join(p, sizeof p, sub, "s.gltf");
+
+    write_tri_scene(p, "ok.bin");
+    char err[1024];
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    assert_non_null(s);
+    fv_scene_free(s);
+
+    write_tri_scene(p, "../secret.bin");
+    expect_load_fails(p, "is outside the scene's folder");
+    write_tri_scene(p, "%2e%2e/secret.bin");
+    expect_load_fails(p, "is outside the scene's folder");
+    assert_int_equal(symlink("../secret.bin", path_join(buf, sizeof buf, sub, "link.bin")), 0);
+    write_tri_scene(p, "link.bin");
+    expect_load_fails(p, "is outside the scene's folder");
+    snprintf(q, sizeof q, "%s/secret.bin", top);
+    write_tri_scene(p, q);
+    expect_load_fails(p, "absolute paths and URI schemes other than data: are not allowed");
+    write_tri_scene(p, "file:///etc/passwd");
+    expect_load_fails(p, "file:///etc/passwd");
+
+    /* --asset-root widens the tree: the file one level up now loads */
+    write_tri_scene(p, "../secret.bin");
+    s = fv_scene_load_in(p, top, err, sizeof err);
+    if (!s)
+        fail_msg("with the wider root: %s", err);
+    fv_scene_free(s);
+
+    unlink(path_join(buf, sizeof buf, sub, "link.bin"));
+    unlink(path_join(buf, sizeof buf, sub, "ok.bin"));
+    unlink(p);
+    rmdir(sub);
+    tmpdir_remove(top);
+}
+
 static void test_missing_and_garbage(void **state)
 {
     (void)state;
@@ -1145,6 +1207,7 @@ int main(void)
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),
         cmocka_unit_test(test_missing_and_garbage),
+        cmocka_unit_test(test_scene_folder_confinement),
         cmocka_unit_test(test_truncated),
         cmocka_unit_test(test_corrupted_flips),
         cmocka_unit_test(test_invalid_data),
