@@ -4,6 +4,7 @@
 // ranges, node graph shape, finiteness) is checked here, because the data it hands back is
 // untrusted. Any failure becomes a one-line message; no exception escapes.
 #include "gltf_shim.h"
+#include "base/pngcheck.h"
 
 #include <tiny_gltf.h>
 
@@ -515,6 +516,12 @@ void decode_images(const tinygltf::Model &m, Holder &h, const std::vector<char> 
         const tinygltf::Image &src = m.images[i];
         const std::string at = "image " + str(i) + (src.uri.empty() ? "" : " (" + src.uri + ")");
         if (src.image.empty()) throw Fail(at + ": could not be read");
+        if (fv_png_is_png(src.image.data(), src.image.size())) { // stb trusts the chunk lengths
+            char why[160];
+            if (fv_png_check(src.image.data(), src.image.size(), kMaxImageSide, kMaxImageTexels, nullptr, nullptr, why,
+                             sizeof why))
+                throw Fail(at + ": " + why);
+        }
         tinygltf::Image img;
         img.name = src.name;
         std::string e, w;

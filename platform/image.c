@@ -1,11 +1,21 @@
 #include "image.h"
 
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <sys/stat.h>
 #include <string.h>
 #include <stb/stb_image.h>
 
 #include "base/err.h"
+#include "base/pngcheck.h"
+
+/* The largest PNG file read, and the largest image decoded (eye-camera frames and textures are
+ * far smaller; the decoder is never asked for more). */
+#define FV_PNG_MAX_FILE_BYTES ((size_t)256 << 20)
+#define FV_PNG_MAX_SIDE 16384u
+#define FV_PNG_MAX_PIXELS ((uint64_t)1 << 26)
 
 uint8_t *fv_read_png(const char *path, int *w, int *h, char *err, size_t err_len)
 {
@@ -14,23 +24,42 @@ uint8_t *fv_read_png(const char *path, int *w, int *h, char *err, size_t err_len
         fv_err(err, err_len, "%s: %s", path, strerror(errno));
         return NULL;
     }
-    static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    uint8_t head[8];
-    const size_t got = fread(head, 1, sizeof head, f);
-    if (ferror(f)) { /* e.g. a directory */
-        fv_err(err, err_len, "%s: read error", path);
+    struct stat st;
+    if (fstat(fileno(f), &st) || !S_ISREG(st.st_mode)) {
+        fv_err(err, err_len, "%s: %s", path, S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
         fclose(f);
         return NULL;
     }
-    if (got < sizeof head || memcmp(head, sig, sizeof sig)) {
-        fv_err(err, err_len, "%s: not a PNG file", path);
+    if ((uint64_t)st.st_size > FV_PNG_MAX_FILE_BYTES) {
+        fv_err(err, err_len, "%s: %lld bytes, larger than the %zu MiB limit for a PNG", path, (long long)st.st_size,
+               FV_PNG_MAX_FILE_BYTES >> 20);
         fclose(f);
         return NULL;
     }
-    rewind(f);
-    int n;
-    uint8_t *px = stbi_load_from_file(f, w, h, &n, 3);
+    const size_t len = (size_t)st.st_size;
+    uint8_t *data = malloc(len ? len : 1);
+    const size_t got = data ? fread(data, 1, len, f) : 0;
     fclose(f);
+    if (!data || got != len) {
+        fv_err(err, err_len, "%s: %s", path, data ? "read error" : "out of memory");
+        free(data);
+        return NULL;
+    }
+    /* chunk lengths are checked against the file before stb sees them (stb reserves what they claim) */
+    char why[160];
+    if (!fv_png_is_png(data, len)) {
+        fv_err(err, err_len, "%s: not a PNG file", path);
+        free(data);
+        return NULL;
+    }
+    if (fv_png_check(data, len, FV_PNG_MAX_SIDE, FV_PNG_MAX_PIXELS, NULL, NULL, why, sizeof why)) {
+        fv_err(err, err_len, "%s: corrupt PNG (%s)", path, why);
+        free(data);
+        return NULL;
+    }
+    int n;
+    uint8_t *px = stbi_load_from_memory(data, (int)len, w, h, &n, 3);
+    free(data);
     if (!px)
         fv_err(err, err_len, "%s: corrupt PNG (%s)", path, stbi_failure_reason());
     return px;

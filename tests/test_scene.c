@@ -945,6 +945,37 @@ static void test_scene_folder_confinement(void **state)
     tmpdir_remove(top);
 }
 
+/* A texture PNG whose IDAT length lies is refused by the chunk check before stb_image reserves
+ * what it claims (2 GiB for 83 bytes); the message names the image. */
+static void test_texture_png_lying_length(void **state)
+{
+    (void)state;
+    static const unsigned char png[] = { /* 1x1 RGBA PNG; IDAT's length set to 0x7fffff00 */
+        0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0, 1, 0, 0, 0, 1, 8, 6,
+        0, 0, 0, 0x1f, 0x15, 0xc4, 0x89, 0x7f, 0xff, 0xff, 0x00, 'I', 'D', 'A', 'T', 0x78, 0x9c, 0x63, 0xf8, 0xcf,
+        0xc0, 0xf0, 0x1f, 0x00, 0x05, 0x00, 0x01, 0xff, 0x89, 0x99, 0x3d, 0x1d, 0, 0, 0, 0, 'I', 'E', 'N', 'D',
+        0xae, 0x42, 0x60, 0x82};
+    char *b64 = base64(png, sizeof png), *dir = tmpdir_make(), p[512];
+    static const float tri[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1};
+    char *members = malloc(strlen(b64) + 1024);
+    assert_non_null(members);
+    sprintf(members,
+            "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24}],"
+            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+            "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}],"
+            "\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],\"textures\":[{\"source\":0}],"
+            "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":0}]}],"
+            "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0",
+            b64);
+    write_gltf(path_join(p, sizeof p, dir, "lying.gltf"), tri, sizeof tri, members);
+    expect_load_fails(p, "image 0: PNG chunk IDAT claims 2147483392 bytes");
+    unlink(p);
+    free(members);
+    free(b64);
+    tmpdir_remove(dir);
+}
+
 static void test_missing_and_garbage(void **state)
 {
     (void)state;
@@ -1208,6 +1239,7 @@ int main(void)
         cmocka_unit_test(test_load_dof_glb_lights),
         cmocka_unit_test(test_missing_and_garbage),
         cmocka_unit_test(test_scene_folder_confinement),
+        cmocka_unit_test(test_texture_png_lying_length),
         cmocka_unit_test(test_truncated),
         cmocka_unit_test(test_corrupted_flips),
         cmocka_unit_test(test_invalid_data),
