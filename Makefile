@@ -28,6 +28,10 @@ SANFLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-r
 else ifeq ($(SAN),tsan)
 BUILD ?= build-tsan
 SANFLAGS := -fsanitize=thread
+else ifeq ($(SAN),fuzz)
+# make fuzz: clang, the libraries instrumented for libFuzzer's coverage, ASan + UBSan
+BUILD ?= build-fuzz
+SANFLAGS := -fsanitize=address,undefined,fuzzer-no-link -fno-omit-frame-pointer -fno-sanitize-recover=all
 else ifneq ($(CROSS),)
 BUILD ?= build-$(ARCH)
 else
@@ -40,7 +44,7 @@ LDFLAGS ?=
 WARN := -Wall -Wextra -Werror
 # ISO C: no silent FMA contraction, so the plain-C references give the same bits everywhere.
 BASE_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) $(WARN) -ffp-contract=off -fno-math-errno -pthread -Icore -Iplatform $(SANFLAGS)
-BASE_CXXFLAGS := -std=c++17 $(OPT) $(WARN) -Wno-unused-parameter -pthread -Icore $(SANFLAGS) $(if $(filter asan,$(SAN)),-fno-sanitize=vptr)
+BASE_CXXFLAGS := -std=c++17 $(OPT) $(WARN) -Wno-unused-parameter -pthread -Icore $(SANFLAGS) $(if $(filter asan fuzz,$(SAN)),-fno-sanitize=vptr)
 LIBS := -lembree3 -ltinygltf -lstb -ljpeg -lstdc++ -lm -lpthread
 TEST_LIBS := -lcmocka
 
@@ -105,7 +109,7 @@ TSAN_BUILD := build-tsan
 CROSS_BUILD := build-aarch64
 endif
 
-.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin test-hil
+.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin test-hil fuzz fuzz-bin
 all: $(LIB) $(PLIB) $(APPS) $(TOOLS)
 
 $(BUILD)/%.o: %.c
@@ -141,6 +145,14 @@ $(BUILD)/tools/%: tools/%.c $(PLIB) $(LIB)
 $(BUILD)/tests/%: tests/%.c tests/testutil.h tests/testscene.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Itests $< $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) $(TEST_LIBS) -o $@
+
+# Fuzz harnesses (tests/fuzz/, docs/robustness.md): linked into tests/test_fuzz (seeds plus
+# deterministic mutations, every make test) and, by make fuzz, into clang libFuzzer binaries.
+FUZZ_OBJ := $(BUILD)/tests/fuzz/targets.o
+$(FUZZ_OBJ): ALL_CFLAGS += -Itests $(HW_CFLAGS)
+$(BUILD)/tests/test_fuzz: tests/test_fuzz.c tests/testutil.h tests/fuzz/targets.h $(FUZZ_OBJ) $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests $< $(FUZZ_OBJ) $(PLIB) $(LIB) $(ALL_LDFLAGS) $(LIBS) $(HW_LIBS) $(TEST_LIBS) -o $@
 
 $(CHECKASM_OBJ): ALL_CFLAGS += -Itests
 $(CHECKASM): $(CHECKASM_OBJ) $(PLIB) $(LIB)
@@ -186,6 +198,30 @@ check-aarch64:
 	@tools/deps.sh --cross
 	@$(MAKE) --no-print-directory CROSS=aarch64-linux-gnu- test-bin
 	@BUILD=$(CROSS_BUILD) SHARED=$(SHARED) RUNNER=qemu-aarch64 tests/run.sh --core
+
+# Fuzzing (docs/robustness.md): each harness of tests/fuzz/ as a clang libFuzzer binary with ASan +
+# UBSan, run FUZZ_SECONDS (default 60) on a working corpus seeded from tests/fuzz/corpus/NAME;
+# FUZZ_TARGETS narrows the list. Not in CI (make test replays the seeds with mutations instead).
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?= gltf trace lens calib y4m imagelist pixfmt png
+FUZZ_BUILD := build-fuzz
+fuzz:
+	@tools/deps.sh --fuzz
+	@$(MAKE) --no-print-directory SAN=fuzz CC=clang CXX=clang++ BUILD=$(FUZZ_BUILD) fuzz-bin
+	@set -e; for t in $(FUZZ_TARGETS); do \
+	    mkdir -p $(FUZZ_BUILD)/corpus/$$t; \
+	    echo "== fuzz $$t: $(FUZZ_SECONDS) s"; \
+	    $(FUZZ_BUILD)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 -timeout=10 \
+	        -rss_limit_mb=3072 -artifact_prefix=$(FUZZ_BUILD)/crash-$$t- \
+	        $(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t 2>&1 | \
+	        grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|==[0-9]+==ERROR|SUMMARY)|Done|INFO: Seed' || true; \
+	    ls $(FUZZ_BUILD)/crash-$$t-* >/dev/null 2>&1 && { echo "fuzz $$t: crash, see $(FUZZ_BUILD)/crash-$$t-*"; exit 1; }; \
+	done; echo "fuzz: no crash in $(FUZZ_TARGETS)"
+fuzz-bin: $(LIB) $(PLIB) $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_TARGETS))
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/libfuzzer.c $(FUZZ_OBJ) $(PLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests -DFV_FUZZ_FN=fv_fuzz_$* -fsanitize=fuzzer $< $(FUZZ_OBJ) $(PLIB) $(LIB) \
+	    $(ALL_LDFLAGS) -fsanitize=fuzzer $(LIBS) $(HW_LIBS) -o $@
 
 check-asan:
 	@tools/deps.sh
@@ -234,6 +270,6 @@ install: all
 	sed -e 's|@PREFIX@|$(PREFIX)|g' tools/fovea.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/fovea.pc
 
 clean:
-	rm -rf build build-asan build-tsan build-aarch64 out $(RANGE) $(EYE_SYNTH) $(EYE_SYNTH_TRUTH)
+	rm -rf build build-asan build-tsan build-aarch64 build-fuzz out $(RANGE) $(EYE_SYNTH) $(EYE_SYNTH_TRUTH)
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

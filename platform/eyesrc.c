@@ -4,15 +4,21 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <sys/stat.h>
 #include <time.h>
 
 #include <stb/stb_image.h>
 
 #include "base/err.h"
+#include "base/pngcheck.h"
+
+/* The largest eye image read from a list (a camera frame is far smaller). */
+#define FV_EYE_IMAGE_MAX_BYTES ((uint64_t)64 << 20)
 
 typedef struct {
     char *path; /* as written */
@@ -265,15 +271,35 @@ static int next_list(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
     else
         snprintf(full, sizeof full, "%s/%s", s->dir, e->path);
     stbi_image_free(s->img);
+    s->img = NULL;
     int w, h, comp;
-    s->img = stbi_load(full, &w, &h, &comp, 1);
-    if (!s->img) {
-        FILE *t = fopen(full, "rb");
-        const char *why = t ? stbi_failure_reason() : strerror(errno);
-        if (t)
-            fclose(t);
-        return fv_err(err, err_len, "%s:%d: %s: %s", s->path, e->line, e->path, why ? why : "cannot read image");
-    }
+    /* read whole within a size limit, and a PNG's chunk lengths checked, before stb sees the bytes
+     * (stb reserves what an IDAT length claims) */
+    char why[200] = "";
+    FILE *t = fopen(full, "rb");
+    struct stat st;
+    uint8_t *bytes = NULL;
+    size_t len = 0;
+    if (!t)
+        snprintf(why, sizeof why, "%s", strerror(errno));
+    else if (fstat(fileno(t), &st) || !S_ISREG(st.st_mode))
+        snprintf(why, sizeof why, "not a regular file");
+    else if ((uint64_t)st.st_size > FV_EYE_IMAGE_MAX_BYTES)
+        snprintf(why, sizeof why, "%lld bytes, larger than the %d MiB limit", (long long)st.st_size,
+                 (int)(FV_EYE_IMAGE_MAX_BYTES >> 20));
+    else if (!(bytes = malloc((size_t)st.st_size + 1)) || fread(bytes, 1, (size_t)st.st_size, t) != (size_t)st.st_size)
+        snprintf(why, sizeof why, "%s", bytes ? "read error" : "out of memory");
+    else
+        len = (size_t)st.st_size;
+    if (t)
+        fclose(t);
+    if (!why[0] && fv_png_is_png(bytes, len))
+        (void)fv_png_check(bytes, len, 16384, (uint64_t)1 << 26, NULL, NULL, why, sizeof why); /* why set on failure */
+    if (!why[0] && !(s->img = stbi_load_from_memory(bytes, (int)len, &w, &h, &comp, 1)))
+        snprintf(why, sizeof why, "%s", stbi_failure_reason() ? stbi_failure_reason() : "cannot read image");
+    free(bytes);
+    if (!s->img)
+        return fv_err(err, err_len, "%s:%d: %s: %s", s->path, e->line, e->path, why);
     f->luma = s->img;
     f->w = w;
     f->h = h;

@@ -1,6 +1,7 @@
 #include "image.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,22 +46,29 @@ uint8_t *fv_read_png(const char *path, int *w, int *h, char *err, size_t err_len
         free(data);
         return NULL;
     }
-    /* chunk lengths are checked against the file before stb sees them (stb reserves what they claim) */
+    char why[300];
+    uint8_t *px = fv_decode_png(data, len, w, h, why, sizeof why);
+    free(data);
+    if (!px)
+        fv_err(err, err_len, "%s: %s", path, why);
+    return px;
+}
+
+uint8_t *fv_decode_png(const uint8_t *data, size_t len, int *w, int *h, char *err, size_t err_len)
+{
+    /* chunk lengths are checked against the bytes before stb sees them (stb reserves what they claim) */
     char why[160];
     if (!fv_png_is_png(data, len)) {
-        fv_err(err, err_len, "%s: not a PNG file", path);
-        free(data);
+        fv_err(err, err_len, "not a PNG file");
         return NULL;
     }
     if (fv_png_check(data, len, FV_PNG_MAX_SIDE, FV_PNG_MAX_PIXELS, NULL, NULL, why, sizeof why)) {
-        fv_err(err, err_len, "%s: corrupt PNG (%s)", path, why);
-        free(data);
+        fv_err(err, err_len, "corrupt PNG (%s)", why);
         return NULL;
     }
     int n;
-    uint8_t *px = stbi_load_from_memory(data, (int)len, w, h, &n, 3);
-    free(data);
+    uint8_t *px = len <= INT_MAX ? stbi_load_from_memory(data, (int)len, w, h, &n, 3) : NULL;
     if (!px)
-        fv_err(err, err_len, "%s: corrupt PNG (%s)", path, stbi_failure_reason());
+        fv_err(err, err_len, "corrupt PNG (%s)", stbi_failure_reason());
     return px;
 }

@@ -2,7 +2,7 @@
 # Installs the Debian (bookworm) packages fovea needs, only when missing. Idempotent; silent when
 # everything is present. --cross adds the aarch64 cross toolchain, qemu-user and arm64 libraries
 # (through dpkg multiarch) for the cross leg; --bench adds gnuplot for the charts of `make bench`
-# (not needed by `make test`).
+# (not needed by `make test`); --fuzz adds clang and its libFuzzer runtime for `make fuzz`.
 set -eu
 native="g++ make pkg-config libembree-dev libtinygltf-dev libstb-dev libcmocka-dev libjpeg62-turbo-dev
         libgpiod-dev libdrm-dev libsdl2-dev"
@@ -11,6 +11,7 @@ cross="gcc-aarch64-linux-gnu g++-aarch64-linux-gnu libc6-dev-arm64-cross qemu-us
 want=$native
 [ "${1:-}" = "--cross" ] && want="$native $cross"
 [ "${1:-}" = "--bench" ] && want="$native gnuplot-nox"
+[ "${1:-}" = "--fuzz" ] && want="$native clang libclang-rt-14-dev"
 
 arch=$(dpkg --print-architecture)
 missing=
