@@ -30,8 +30,8 @@ run isa-c        --scene $S --trace assets/gaze_sweep.csv --frames 3 --dof mediu
 run contrast     --scene $S --frames 2 --contrast-gain 0.5
 run reference    --scene $S --frames 1 --reference 4 --dof medium
 run refpin       --scene $S --frames 1 --reference 2 --dof none
-if [ -d "$SHARED/assets/scenes/FlightHelmet" ]; then
-    run helmet   --scene "$SHARED/assets/scenes/FlightHelmet/FlightHelmet.gltf" --frames 2 --dof strong
+if [ -d "assets/scenes/FlightHelmet" ]; then
+    run helmet   --scene "assets/scenes/FlightHelmet/FlightHelmet.gltf" --frames 2 --dof strong
 fi
 # tracker CSVs
 Tr="$B/bin/fovea-track"

@@ -3,14 +3,13 @@
 # focused near and far, every built model (full sampling, so only the DoF model differs) against
 # `fovea-replay --reference SPP` with the same pupil and focus; luma PSNR and SSIM from
 # fovea-compare. Then foveated vs full sampling with and without DoF in the periphery.
-#   tools/measure_dof.sh [OUT_DIR]     (env: BUILD=build SPP=64 SIZE=1280x1440 PUPIL=4.49 SHARED=../shared)
+#   tools/measure_dof.sh [OUT_DIR]     (env: BUILD=build SPP=64 SIZE=1280x1440 PUPIL=4.49)
 set -eu
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
 SPP=${SPP:-64}
 SIZE=${SIZE:-1280x1440}
 PUPIL=${PUPIL:-4.49}
-SHARED=${SHARED:-../shared}
 OUT=${1:-out/dof}
 MODELS=${MODELS:-"weier hussain mantiuk konrad liu"}
 R=$BUILD/bin/fovea-replay
@@ -18,7 +17,7 @@ C=$BUILD/bin/fovea-compare
 mkdir -p "$OUT"
 # scene name, file, near focus (m), far focus (m): the near object under the centre gaze
 cases="range assets/range.glb 1.2 40
-helmet $SHARED/assets/scenes/FlightHelmet/FlightHelmet.gltf 0.494 1000"
+helmet assets/scenes/FlightHelmet/FlightHelmet.gltf 0.494 1000"
 echo "| scene | focus | model | PSNR dB | SSIM |" > "$OUT/table.md"
 echo "|---|---|---|---|---|" >> "$OUT/table.md"
 echo "$cases" | while read -r name file fnear ffar; do

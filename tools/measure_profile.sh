@@ -3,12 +3,11 @@
 # FlightHelmet at 1280x1440, foveated and full, 1 and 2 threads (with DoF on, so that every
 # post-processing stage has a roofline figure), the kernel speed-ups, pmin / size / r0 sweeps, a
 # trace, then the charts. Each JSON carries the load average when it ran.
-#   tools/measure_profile.sh [OUT_DIR]     (default out/profile; BIN=build/bin, SHARED=../shared)
+#   tools/measure_profile.sh [OUT_DIR]     (default out/profile; BIN=build/bin,)
 set -eu
 OUT=${1:-out/profile}
 BIN=${BIN:-build/bin}
-SHARED=${SHARED:-../shared}
-HELMET=$SHARED/assets/scenes/FlightHelmet/FlightHelmet.gltf
+HELMET=assets/scenes/FlightHelmet/FlightHelmet.gltf
 FR=${FRAMES:-10}
 mkdir -p "$OUT"
 uptime | tee "$OUT/uptime-start.txt"
