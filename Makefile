@@ -109,7 +109,7 @@ TSAN_BUILD := build-tsan
 CROSS_BUILD := build-aarch64
 endif
 
-.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin test-hil fuzz fuzz-bin
+.PHONY: all deps test run bench check-asan check-tsan check-aarch64 install clean test-bin test-hil fuzz fuzz-bin soak
 all: $(LIB) $(PLIB) $(APPS) $(TOOLS)
 
 $(BUILD)/%.o: %.c
@@ -222,6 +222,12 @@ $(BUILD)/fuzz/fuzz_%: tests/fuzz/libfuzzer.c $(FUZZ_OBJ) $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Itests -DFV_FUZZ_FN=fv_fuzz_$* -fsanitize=fuzzer $< $(FUZZ_OBJ) $(PLIB) $(LIB) \
 	    $(ALL_LDFLAGS) -fsanitize=fuzzer $(LIBS) $(HW_LIBS) -o $@
+
+# Soak (docs/robustness.md; not in CI): 100,000 replayed frames and a 10-minute headset run, RSS
+# and open descriptors sampled, both must stay flat. SOAK_FRAMES / SOAK_SECONDS shorten it.
+soak: deps
+	@$(MAKE) --no-print-directory all $(RANGE) $(EYE_SYNTH)
+	@BUILD=$(BUILD) tools/soak.sh
 
 check-asan:
 	@tools/deps.sh

@@ -50,11 +50,12 @@ static void usage(FILE *f)
             "                     chrome://tracing): worker, stage and ray-tile tracks, frame markers\n"
             "  --window           also show each frame in a window (SDL2) as it is rendered; closing\n"
             "                     it (or Esc) ends the run early\n"
-            "  --quiet            no progress output\n" FV_COMMON_HELP "  --help             this text\n");
+            "  --quiet            no progress output\n"
+            "  --png on|off       write the frame PNGs (default on; off: stats.csv only, e.g. a soak)\n" FV_COMMON_HELP "  --help             this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_TRACE, OPT_FRAMES, OPT_OUT, OPT_FULL, OPT_STEREO, OPT_Y4M, OPT_REF, OPT_WINDOW, OPT_HZ,
-       OPT_QUIET, OPT_VS_FULL, OPT_TRACE_OUT, OPT_HELP };
+       OPT_QUIET, OPT_VS_FULL, OPT_TRACE_OUT, OPT_HELP, OPT_PNG };
 
 /* --reference: the thin-lens ground truth (core/reference.h) of one eye into rgb8. The focus is
  * fixed by the caller for both eyes (they accommodate together). Progress counts tiles. */
@@ -94,7 +95,7 @@ int main(int argc, char **argv)
     const char *asset_root = NULL; /* --asset-root */
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
-    int stereo = 0, quiet = 0, vs_full = 0, window = 0;
+    int stereo = 0, quiet = 0, vs_full = 0, window = 0, png = 1;
     fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
     float hz = 90.0f;
     static const struct option opts[] = {
@@ -103,7 +104,7 @@ int main(int argc, char **argv)
         {"full", no_argument, 0, OPT_FULL}, {"stereo", no_argument, 0, OPT_STEREO},
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
         {"window", no_argument, 0, OPT_WINDOW}, {"hz", required_argument, 0, OPT_HZ},
-        {"quiet", no_argument, 0, OPT_QUIET}, {"vs-full", no_argument, 0, OPT_VS_FULL},
+        {"quiet", no_argument, 0, OPT_QUIET}, {"png", required_argument, 0, OPT_PNG}, {"vs-full", no_argument, 0, OPT_VS_FULL},
         {"trace-out", required_argument, 0, OPT_TRACE_OUT},
         {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
@@ -120,6 +121,7 @@ int main(int argc, char **argv)
         case OPT_Y4M: y4m_path = optarg; break;
         case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
         case OPT_QUIET: quiet = 1; break;
+        case OPT_PNG: png = fv_arg_onoff(prog, "--png", optarg); break;
         case OPT_VS_FULL: vs_full = 1; break;
         case OPT_TRACE_OUT: prof_path = optarg; break;
         case OPT_REF: refp.spp = (int)fv_arg_long(prog, "--reference", optarg, 1, 65536); break;
@@ -287,7 +289,7 @@ int main(int argc, char **argv)
         fv_quality_row qr;
         fv_quality_frame(&q, rgb, (ptrdiff_t)outw * 3, full, gpx, gpy, sm->r0_px, sm->r1_px, &qr);
         snprintf(path, sizeof path, "%s/frame_%05ld.png", out_dir, f);
-        if (fv_write_png(path, rgb, outw, H, (ptrdiff_t)outw * 3, err, sizeof err) ||
+        if ((png && fv_write_png(path, rgb, outw, H, (ptrdiff_t)outw * 3, err, sizeof err)) ||
             (y4m_open && fv_y4m_write_rgb(&y4m, rgb, (ptrdiff_t)outw * 3, err, sizeof err))) {
             fprintf(stderr, "%s: %s\n", prog, err);
             goto done;
