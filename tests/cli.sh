@@ -166,6 +166,9 @@ head -c 100 "$P1" >"$T/trunc.png"
 expect_usage "compare missing file" 'nope.png: No such file' $C "$T/nope.png" "$P1"
 expect_usage "compare not png" 'bad.glb: not a PNG file' $C "$P1" "$T/bad.glb"
 expect_usage "compare corrupt png" 'trunc.png: corrupt PNG' $C "$T/trunc.png" "$P1"
+# an 83-byte PNG whose IDAT length lies (stb reserved the 2 GiB it claims): refused from its chunks
+printf '\211PNG\r\n\032\n\0\0\0\rIHDR\0\0\0\1\0\0\0\1\10\6\0\0\0\37\25\304\211\177\377\377\0IDATx\234c\370\317\300\360\37\0\5\0\1\377\211\231=\35\0\0\0\0IEND\256B`\202' >"$T/lying.png"
+expect_usage "compare lying png" 'lying.png: corrupt PNG \(PNG chunk IDAT claims 2147483392 bytes' $C "$T/lying.png" "$P1"
 expect_usage "compare size mismatch" 'is 64x72 but .* is 96x108: sizes must match' $C "$P1" "$T/run/frame_00000.png"
 expect_usage "compare malformed region" '--fovea: .1,2. is not CX,CY,R' $C "$P1" "$P2" --fovea 1,2
 expect_usage "compare region text" '--periphery: .a,b,c. is not CX,CY,R' $C "$P1" "$P2" --periphery a,b,c
@@ -461,6 +464,8 @@ expect_usage "headset bad display" '--display tv: want kms' $HS $HO --display tv
 expect_usage "headset unwritable latency csv" '/proc/fovea-no/l.csv' $HS $HO --seconds 5 --latency-csv /proc/fovea-no/l.csv
 expect_usage "headset unwritable trace-out" '/proc/fovea-no/p.json' $HS $HO --seconds 5 --trace-out /proc/fovea-no/p.json
 expect_usage "headset calibration without camera" '--calibration only applies with --camera' $HS $HO --calibration x
+printf 'fovea-calibration 1\ninput pupil\nnorm 320 240 100\nyaw_deg 0 20 0 0 0 0\npitch_deg 0 0 -15 0 0 0\nsamples 1e300\n' >"$T/huge.cal"
+expect_usage "headset calibration count out of range" 'huge.cal.*line 6: samples 1e\+300 out of range' $HS $HO --camera replay:assets/eye_synth.y4m --calibration "$T/huge.cal"
 printf 'k1 0.1\nk9 1\n' >"$T/bad.lens"
 expect_usage "headset bad lens" 'bad.lens:2: unknown key' $HS $HO --lens "$T/bad.lens"
 expect_usage "headset no scene" '--scene FILE is required' $HS --size 64x72
