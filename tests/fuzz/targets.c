@@ -134,7 +134,7 @@ static void drain(fv_eyesrc *s, int frames)
     fv_eye_frame f;
     char err[512];
     for (int i = 0; i < frames; i++) {
-        if (fv_eyesrc_next(s, &f, err, sizeof err) != 0)
+        if (fv_eyesrc_next(s, &f, err, sizeof err) != 1) /* 1: a frame; 0: the end; -1: an error */
             break;
         volatile uint8_t sink = f.luma[(size_t)(f.h - 1) * (size_t)f.stride + (size_t)f.w - 1];
         (void)sink;
