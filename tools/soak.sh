@@ -5,9 +5,10 @@
 #  2. fovea-headset: SOAK_SECONDS (default 600) with the bundled eye video replayed (tracker on),
 #     timer vsync at 90 Hz, no display, 128x144 per eye.
 # Every SOAK_EVERY seconds (default 5) the process's VmRSS and open descriptors are sampled into
-# OUT/<run>.csv. Flat means: the mean RSS of the last quarter of the samples exceeds that of the
-# second quarter (after warm-up) by at most 2 MiB and 2 %, and the descriptor count never changes
-# after the first quarter. Prints one line per run and exits 1 if either grew.
+# OUT/<run>.csv. Flat means: over the second half of the samples (after warm-up) RSS grows by at
+# most 4 MiB per hour (least-squares slope: a headset runs for hours, so a slow linear growth is a
+# leak even when the run's own change is small) and the descriptor count does not change. Prints
+# one line per run and exits 1 if either grew.
 #   tools/soak.sh [OUT_DIR]   (env: BUILD=build SOAK_FRAMES SOAK_SECONDS SOAK_EVERY)
 set -u
 cd "$(dirname "$0")/.."
@@ -35,18 +36,22 @@ sample() {
 
 judge() {
     name=$1 csv=$OUT/$1.csv rc=$2
-    verdict=$(awk -F, 'NR > 1 {r[n] = $2; f[n] = $3; n++}
+    verdict=$(awk -F, -v every="$EVERY" 'NR > 1 {t[n] = $1; r[n] = $2; f[n] = $3; n++}
         END {
             if (n < 8) {print "too few samples (" n ")"; exit}
-            q = int(n / 4); a = 0; b = 0
-            for (i = q; i < 2 * q; i++) a += r[i]
-            for (i = n - q; i < n; i++) b += r[i]
-            a /= q; b /= q; grow = b - a
+            # least-squares slope of RSS over the second half (after warm-up), projected to an hour:
+            # a headset runs for hours, so slow linear growth matters more than the end-to-end change
+            h = int(n / 2); st = 0; sr = 0; m = n - h
+            for (i = h; i < n; i++) {st += t[i]; sr += r[i]}
+            st /= m; sr /= m; num = 0; den = 0
+            for (i = h; i < n; i++) {num += (t[i] - st) * (r[i] - sr); den += (t[i] - st) ^ 2}
+            slope = den > 0 ? num / den : 0      # kB per second
+            per_hour = slope * 3600
             fd_changes = 0
-            for (i = q + 1; i < n; i++) if (f[i] != f[q]) fd_changes++
-            ok = grow <= 2048 && grow <= 0.02 * a && fd_changes == 0
-            printf "%s: %d samples, RSS %.1f -> %.1f MiB (%+.2f MiB), descriptors %d -> %d (%d changes)\n",
-                   ok ? "flat" : "GREW", n, a / 1024, b / 1024, grow / 1024, f[q], f[n - 1], fd_changes
+            for (i = h + 1; i < n; i++) if (f[i] != f[h]) fd_changes++
+            ok = per_hour <= 4096 && fd_changes == 0
+            printf "%s: %d samples, RSS %.1f -> %.1f MiB, %+.2f MiB per hour (second half), descriptors %d -> %d (%d changes)\n",
+                   ok ? "flat" : "GREW", n, r[h] / 1024, r[n - 1] / 1024, per_hour / 1024, f[h], f[n - 1], fd_changes
         }' "$csv")
     echo "soak $name: exit $rc, $verdict"
     case "$verdict" in flat*) [ "$rc" -eq 0 ] || status=1 ;; *) status=1 ;; esac
