@@ -157,6 +157,8 @@ int main(int argc, char **argv)
     fv_scene *scene = fv_scene_load_in(scene_path, asset_root, err, sizeof err);
     if (!scene)
         fv_usage_error(prog, "%s", err);
+    if (fv_scene_warning(scene)[0]) /* once, before any output */
+        fprintf(stderr, "%s: %s: warning: %s\n", prog, scene_path, fv_scene_warning(scene));
     fv_bench_report rep = {.scene_path = scene_path, .triangles = fv_scene_triangle_count(scene),
                            .load_ms = (double)(fv_time_ns() - t0) * 1e-6, .width = cfg.cam.width,
                            .height = cfg.cam.height, .warmup = bo.warmup, .frames = bo.frames,

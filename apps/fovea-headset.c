@@ -277,6 +277,8 @@ int main(int argc, char **argv)
         fv_vsync_close(a.vsync);
         fv_usage_error(prog, "%s", err);
     }
+    if (fv_scene_warning(scene)[0]) /* once, before any output */
+        fprintf(stderr, "%s: %s: warning: %s\n", prog, scene_path, fv_scene_warning(scene));
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)a.W / (float)a.H, a.view.pos, a.view.quat);
     a.pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
     fv_gaze_ring ring;

@@ -157,6 +157,8 @@ int main(int argc, char **argv)
         fv_trace_free(&tr);
         fv_usage_error(prog, "%s", err);
     }
+    if (fv_scene_warning(scene)[0]) /* once, before any output */
+        fprintf(stderr, "%s: %s: warning: %s\n", prog, scene_path, fv_scene_warning(scene));
     const int W = cfg.cam.width, H = cfg.cam.height, outw = stereo ? 2 * W : W;
     fv_pose view;
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)W / (float)H, view.pos, view.quat);

@@ -142,6 +142,7 @@ fv_scene *fv_scene_load_in(const char *path, const char *asset_root, char *err, 
         return NULL;
     }
     int rc = add_gltf(s, g, e, sizeof e);
+    fv_scene_set_warning(s, g->warning);
     fv_gltf_free(g);
     if (rc == 0 && fv_scene_triangle_count(s) == 0) { /* nothing to render: most likely not a real scene */
         fv_err(e, sizeof e, "no triangles reachable from the scene's root nodes");

@@ -351,7 +351,8 @@ std::vector<float> read_floats(const tinygltf::Model &m, int ai, int comps, cons
     return out;
 }
 
-std::vector<uint32_t> read_indices(const tinygltf::Model &m, int ai, size_t vertex_count, const std::string &what)
+std::vector<uint32_t> read_indices(const tinygltf::Model &m, int ai, size_t vertex_count, const std::string &what,
+                                   bool triangles = true)
 {
     if (ai < 0 || size_t(ai) >= m.accessors.size())
         throw Fail(what + ": index accessor " + str(ai) + " does not exist");
@@ -361,7 +362,7 @@ std::vector<uint32_t> read_indices(const tinygltf::Model &m, int ai, size_t vert
         ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
         throw Fail(what + ": index accessor " + str(ai) + ": componentType " + str(ct) +
                    " is not an unsigned byte/short/int");
-    if (a.count % 3 != 0)
+    if (triangles && a.count % 3 != 0)
         throw Fail(what + ": index accessor " + str(ai) + ": count " + str(a.count) + " is not a multiple of 3");
     std::vector<uint32_t> out;
     if (a.count <= kMaxCount) out.resize(a.count);
@@ -471,6 +472,8 @@ struct Holder {
     std::vector<fv_gltf_image> images;
     std::vector<fv_gltf_light> lights;
     std::vector<int> material_texcoord; // TEXCOORD_n set of each material's base colour texture
+    size_t skipped_prims = 0;           // points and lines
+    std::string warning;
 };
 
 const float *keep(Holder &h, std::vector<float> &&v)
@@ -555,7 +558,12 @@ void convert_meshes(const tinygltf::Model &m, Holder &h)
         const std::vector<tinygltf::Primitive> &prims = m.meshes[mi].primitives;
         for (size_t pi = 0; pi < prims.size(); pi++) {
             const tinygltf::Primitive &p = prims[pi];
-            if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES) continue; // points, lines, strips
+            const int mode = p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+            if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+                mode != TINYGLTF_MODE_TRIANGLE_FAN) { // points and lines: nothing a ray can hit
+                h.skipped_prims++;
+                continue;
+            }
             const std::string at = "mesh " + str(mi) + " primitive " + str(pi);
             if (p.material < -1 || (p.material >= 0 && size_t(p.material) >= m.materials.size()))
                 throw Fail(at + ": material " + str(p.material) + " does not exist");
@@ -581,7 +589,36 @@ void convert_meshes(const tinygltf::Model &m, Holder &h)
                                 ? h.material_texcoord[size_t(out.material)] : -1;
             out.uvs = set >= 0 ? attr("TEXCOORD_" + str(set), 2) : nullptr;
 
-            if (p.indices >= 0) {
+            if (mode != TINYGLTF_MODE_TRIANGLES) {
+                // strips and fans become an index list, in the specification's vertex order (3.7.2.1):
+                // strip triangle i = (v_i, v_{i+1+i%2}, v_{i+2-i%2}), fan triangle i = (v_{i+1}, v_{i+2}, v_0)
+                std::vector<uint32_t> seq;
+                if (p.indices >= 0) {
+                    seq = read_indices(m, p.indices, out.vertex_count, at, /*triangles=*/false);
+                } else {
+                    seq.resize(out.vertex_count);
+                    for (size_t k = 0; k < seq.size(); k++) seq[k] = uint32_t(k);
+                }
+                if (seq.size() > kMaxCount / 3) throw Fail(at + ": " + str(seq.size()) + " strip or fan vertices, too many");
+                if (seq.size() < 3) throw Fail(at + ": a triangle " + (mode == TINYGLTF_MODE_TRIANGLE_FAN ? "fan" : "strip") +
+                                                " needs at least 3 vertices, has " + str(seq.size()));
+                std::vector<uint32_t> tri;
+                tri.reserve(3 * (seq.size() - 2));
+                for (size_t k = 0; k + 2 < seq.size(); k++) {
+                    if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+                        tri.push_back(seq[k]);
+                        tri.push_back(seq[k + 1 + k % 2]);
+                        tri.push_back(seq[k + 2 - k % 2]);
+                    } else {
+                        tri.push_back(seq[k + 1]);
+                        tri.push_back(seq[k + 2]);
+                        tri.push_back(seq[0]);
+                    }
+                }
+                h.uints.push_back(std::move(tri));
+                out.indices = h.uints.back().data();
+                out.index_count = h.uints.back().size();
+            } else if (p.indices >= 0) {
                 h.uints.push_back(read_indices(m, p.indices, out.vertex_count, at));
                 out.indices = h.uints.back().data();
                 out.index_count = h.uints.back().size();
@@ -721,6 +758,131 @@ void check_kind(const char *path)
                                           : "not a glTF file (neither a GLB header nor a JSON object)");
 }
 
+// ---- what the file says it is, before tinygltf parses it -------------------------------
+// tinygltf reports a glTF 1.0 file as "asset object not found" and a Draco-compressed one as an
+// invalid bufferView; a user needs to hear the version or the extension. A small scan of the
+// top-level JSON members finds asset.version and extensionsRequired first.
+struct Scan {
+    const unsigned char *s;
+    size_t n, i;
+    void ws() { while (i < n && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r' || s[i] == '\n')) i++; }
+    bool str(std::string *out)
+    {
+        ws();
+        if (i >= n || s[i] != '"') return false;
+        for (i++; i < n && s[i] != '"'; i++) {
+            if (s[i] == '\\' && ++i >= n) return false;
+            if (out && out->size() < 256) out->push_back(char(s[i]));
+        }
+        return i++ < n;
+    }
+    bool skip() // one value of any kind
+    {
+        ws();
+        if (i < n && s[i] == '"') return str(nullptr);
+        int depth = 0;
+        for (; i < n; i++) {
+            const unsigned char c = s[i];
+            if (c == '"') {
+                if (!str(nullptr)) return false;
+                i--;
+            } else if (c == '{' || c == '[') {
+                depth++;
+            } else if (c == '}' || c == ']') {
+                if (depth-- == 0) return true; // the end of the enclosing container
+                if (depth == 0) { i++; return true; }
+            } else if (depth == 0 && c == ',') {
+                return true;
+            }
+        }
+        return depth == 0;
+    }
+};
+
+struct Declared {
+    bool has_asset = false;
+    std::string version;
+    std::vector<std::string> required;
+};
+
+Declared prescan(const unsigned char *s, size_t n)
+{
+    Declared d;
+    Scan sc{s, n, 0};
+    sc.ws();
+    if (sc.i >= n || s[sc.i] != '{') return d;
+    sc.i++;
+    for (;;) {
+        std::string key;
+        if (!sc.str(&key)) return d;
+        sc.ws();
+        if (sc.i >= n || s[sc.i++] != ':') return d;
+        sc.ws();
+        if (key == "asset" && sc.i < n && s[sc.i] == '{') {
+            d.has_asset = true;
+            sc.i++;
+            for (;;) {
+                std::string k;
+                if (!sc.str(&k)) return d;
+                sc.ws();
+                if (sc.i >= n || s[sc.i++] != ':') return d;
+                sc.ws();
+                if (k == "version" && sc.i < n && s[sc.i] == '"') sc.str(&d.version);
+                else if (!sc.skip()) return d;
+                sc.ws();
+                if (sc.i < n && s[sc.i] == ',') { sc.i++; continue; }
+                if (sc.i < n && s[sc.i] == '}') { sc.i++; break; }
+                return d;
+            }
+        } else if (key == "extensionsRequired" && sc.i < n && s[sc.i] == '[') {
+            sc.i++;
+            for (;;) {
+                sc.ws();
+                if (sc.i < n && s[sc.i] == ']') { sc.i++; break; }
+                std::string e;
+                if (!sc.str(&e)) return d;
+                if (d.required.size() < 64) d.required.push_back(e);
+                sc.ws();
+                if (sc.i < n && s[sc.i] == ',') sc.i++;
+            }
+        } else if (!sc.skip()) {
+            return d;
+        }
+        sc.ws();
+        if (sc.i < n && s[sc.i] == ',') { sc.i++; continue; }
+        return d;
+    }
+}
+
+// Extensions the file cannot be read without: ours, or ones that only refine materials beyond
+// this renderer's shading. Anything else (compression, other texture formats) would give
+// silently wrong geometry or textures.
+bool extension_supported(const std::string &ext)
+{
+    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" || ext.rfind("KHR_materials_", 0) == 0;
+}
+
+std::string extension_hint(const std::string &ext)
+{
+    if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression")
+        return " (compressed meshes: export the file without mesh compression)";
+    if (ext == "KHR_texture_basisu" || ext == "EXT_texture_webp" || ext == "MSFT_texture_dds")
+        return " (texture format: export PNG or JPEG textures)";
+    return "";
+}
+
+void check_declared(const unsigned char *json, size_t n)
+{
+    const Declared d = prescan(json, n);
+    if (!d.version.empty() && d.version[0] != '2')
+        throw Fail("glTF " + d.version + " is not supported, only glTF 2.0 (asset.version \"" + d.version +
+                   "\"): convert the file to glTF 2.0");
+    if (!d.has_asset)
+        throw Fail("no asset object: not a glTF 2.0 file (glTF 1.0 files may lack it: convert them to glTF 2.0)");
+    for (const std::string &ext : d.required)
+        if (!extension_supported(ext)) throw Fail("required extension " + ext + " is not supported" + extension_hint(ext));
+}
+
 fv_gltf_model *load(const char *path, const char *asset_root)
 {
     std::vector<unsigned char> file;
@@ -731,10 +893,13 @@ fv_gltf_model *load(const char *path, const char *asset_root)
     if (glb) {
         uint32_t json_len = 0;
         if (file.size() >= 20) std::memcpy(&json_len, file.data() + 12, 4);
-        if (file.size() >= 20 && json_len <= file.size() - 20 && !json_depth_ok(file.data() + 20, json_len))
-            throw Fail("JSON nested too deeply");
-    } else if (!json_depth_ok(file.data(), file.size())) {
-        throw Fail("JSON nested too deeply");
+        if (file.size() >= 20 && json_len <= file.size() - 20) {
+            if (!json_depth_ok(file.data() + 20, json_len)) throw Fail("JSON nested too deeply");
+            check_declared(file.data() + 20, json_len);
+        }
+    } else {
+        if (!json_depth_ok(file.data(), file.size())) throw Fail("JSON nested too deeply");
+        check_declared(file.data(), file.size());
     }
 
     std::string dir(path);
@@ -764,12 +929,8 @@ fv_gltf_model *load(const char *path, const char *asset_root)
     file.clear();
     file.shrink_to_fit();
 
-    // Extensions the file cannot be read without: ours, or ones that only refine materials
-    // beyond this renderer's shading. Anything else (compression, other texture formats)
-    // would give silently wrong geometry or textures.
-    for (const std::string &ext : model.extensionsRequired)
-        if (ext != "KHR_lights_punctual" && ext != "KHR_mesh_quantization" && ext.rfind("KHR_materials_", 0) != 0)
-            throw Fail("required extension " + ext + " is not supported");
+    for (const std::string &ext : model.extensionsRequired) // (the pre-scan saw them already)
+        if (!extension_supported(ext)) throw Fail("required extension " + ext + " is not supported" + extension_hint(ext));
 
     std::unique_ptr<Holder> h(new Holder);
     std::vector<char> image_used(model.images.size(), 0), light_ok(model.lights.size(), 0);
@@ -780,6 +941,10 @@ fv_gltf_model *load(const char *path, const char *asset_root)
     convert_nodes(model, *h, light_ok);
 
     fv_gltf_model &p = h->pub;
+    if (h->skipped_prims)
+        h->warning = "skipped " + str(h->skipped_prims) + " point or line primitive" + (h->skipped_prims > 1 ? "s" : "") +
+                     " (only triangles are rendered)";
+    p.warning = h->warning.c_str();
     p.meshes = h->meshes.data(), p.mesh_count = h->meshes.size();
     p.nodes = h->nodes.data(), p.node_count = h->nodes.size();
     p.materials = h->materials.data(), p.material_count = h->materials.size();

@@ -23,7 +23,7 @@ typedef struct fv_gltf_prim {
 } fv_gltf_prim;
 
 typedef struct fv_gltf_mesh {
-    const fv_gltf_prim *prims; /* TRIANGLES primitives only; other modes are skipped */
+    const fv_gltf_prim *prims; /* triangles (strips and fans converted to lists); points and lines skipped */
     size_t prim_count;
 } fv_gltf_mesh;
 
@@ -58,6 +58,7 @@ typedef struct fv_gltf_model {
     const fv_gltf_material *materials;  size_t material_count;
     const fv_gltf_image *images;        size_t image_count;
     const fv_gltf_light *lights;        size_t light_count;
+    const char *warning; /* one line for the user ("" when none): e.g. skipped point or line primitives */
     void *impl; /* owner of the arrays above */
 } fv_gltf_model;
 

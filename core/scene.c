@@ -218,3 +218,13 @@ int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, floa
     quat[0] = quat[1] = quat[2] = 0.0f, quat[3] = 1.0f;
     return 0;
 }
+
+void fv_scene_set_warning(fv_scene *s, const char *w)
+{
+    snprintf(s->warning, sizeof s->warning, "%s", w ? w : "");
+}
+
+const char *fv_scene_warning(const fv_scene *s)
+{
+    return s->warning;
+}

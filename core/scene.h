@@ -24,6 +24,11 @@ fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
 /* The same, with the folder the scene's external files must lie in (NULL: the scene file's own
  * folder, which fv_scene_load uses): a URI leading elsewhere is refused, naming it. */
 fv_scene *fv_scene_load_in(const char *path, const char *asset_root, char *err, size_t err_len);
+/* The loader's one-line warning for the user, "" when none (e.g. "skipped 2 point or line
+ * primitives (only triangles are rendered)"); the programs print it once. */
+const char *fv_scene_warning(const fv_scene *s);
+/* (loaders) Sets that line; NULL clears it. */
+void fv_scene_set_warning(fv_scene *s, const char *w);
 
 /* Building a scene by hand (tests, generators): create, add meshes, commit. */
 typedef struct fv_mesh_desc {

@@ -64,6 +64,7 @@ struct fv_scene {
     float view_pos[3], view_quat[4];
     pthread_mutex_t rtc_err_lock; /* Embree may report from its own threads */
     char rtc_err[192];
+    char warning[256]; /* the loader's one line for the user ("" when none) */
 };
 
 /* ---- shared helpers ------------------------------------------------------------------ */

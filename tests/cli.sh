@@ -87,7 +87,11 @@ expect_usage "bench scene URI outside its folder" "is outside the scene's folder
 if $R --scene "$T/esc/scene/s.gltf" --asset-root "$T/esc" --out "$T/o5" --size 64x72 --quiet >/dev/null 2>"$T/err" && [ -s "$T/o5/frame_00000.png" ]; then ok
 else bad "replay --asset-root: $(head -c 300 "$T/err")"; fi
 expect_usage "replay bad asset root" "--asset-root $T/none: No such file" $R --scene "$T/esc/scene/s.gltf" --asset-root "$T/none" --out "$T/o6"
-# unwritable outputs are bad usage found before the run (exit 2), not a failure after it
+# glTF 1.0 and unsupported required extensions: one line naming the version or the extension
+printf '{"asset":{"version":"1.0"},"meshes":{}}' >"$T/v1.gltf"
+expect_usage "replay glTF 1.0" 'v1.gltf: glTF 1.0 is not supported, only glTF 2.0' $R --scene "$T/v1.gltf" --out "$T/o7"
+printf '{"asset":{"version":"2.0"},"extensionsRequired":["KHR_draco_mesh_compression"],"accessors":[{"componentType":5126,"count":3,"type":"VEC3"}]}' >"$T/draco.gltf"
+expect_usage "replay draco" 'required extension KHR_draco_mesh_compression is not supported' $R --scene "$T/draco.gltf" --out "$T/o7"
 expect_usage "replay unwritable out" '/proc/fovea-no' $R --scene $SCENE --size 64x72 --out /proc/fovea-no/o
 expect_usage "replay unwritable y4m" '/proc/fovea-no/v.y4m' $R --scene $SCENE --size 64x72 --out "$T/o4" --y4m /proc/fovea-no/v.y4m
 [ ! -e "$T/o4/stats.csv" ] && [ ! -e "$T/o4/stats.csv.tmp" ] && ok || bad "unwritable y4m left stats.csv behind"

@@ -974,6 +974,120 @@ static void test_texture_png_lying_length(void **state)
     tmpdir_remove(dir);
 }
 
+/* Triangle strips and fans (glTF modes 5 and 6), indexed or not, against the equivalent triangle
+ * list written by hand from the specification's vertex order (3.7.2.1): strip triangle i is
+ * (v_i, v_{i+1+i%2}, v_{i+2-i%2}), fan triangle i is (v_{i+1}, v_{i+2}, v_0). Rays on a grid must
+ * hit the same triangle at the same distance with the same barycentrics (which fix the order). */
+static fv_scene *mode_scene(const char *dir, const char *name, int mode, const uint8_t *idx, int nidx)
+{
+    /* 5 vertices: a zigzag (strip) that is also a convex fan around vertex 0 */
+    static const float pos[15] = {0, 0, 0, 1, -1, 0, 1, 1, 0, -0.2f, 1.6f, 0, -1, 0.8f, 0};
+    unsigned char bin[60 + 16];
+    memcpy(bin, pos, sizeof pos);
+    memcpy(bin + 60, idx, (size_t)nidx);
+    char members[1024], p[512];
+    snprintf(members, sizeof members,
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":60}%s],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":5,\"type\":\"VEC3\","
+             "\"min\":[-1,-1,0],\"max\":[1,1.6,0]}%s],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":%d%s}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0",
+             nidx ? ",{\"buffer\":0,\"byteOffset\":60,\"byteLength\":16}" : "",
+             nidx ? ",{\"bufferView\":1,\"componentType\":5121,\"count\":0,\"type\":\"SCALAR\"}" : "", mode,
+             nidx ? ",\"indices\":1" : "");
+    if (nidx) { /* the index count */
+        char *c = strstr(members, "\"count\":0");
+        char num[8];
+        snprintf(num, sizeof num, "%d", nidx);
+        memmove(c + 8 + strlen(num), c + 9, strlen(c + 9) + 1);
+        memcpy(c + 8, num, strlen(num));
+    }
+    write_gltf(path_join(p, sizeof p, dir, name), bin, nidx ? 60 + 16 : 60, members);
+    char err[512];
+    fv_scene *sc = fv_scene_load(p, err, sizeof err);
+    if (!sc)
+        fail_msg("%s: %s", name, err);
+    return sc;
+}
+
+static void same_hits(const fv_scene *a, const fv_scene *b, const char *what)
+{
+    int hits = 0;
+    for (int y = 0; y < 24; y++)
+        for (int x = 0; x < 24; x++) {
+            const float o[3] = {-1.1f + 2.2f * (x + 0.5f) / 24, -1.1f + 2.8f * (y + 0.5f) / 24, 2}, d[3] = {0, 0, -1};
+            hit ha, hb;
+            const int ka = cast(a, o, d, &ha), kb = cast(b, o, d, &hb);
+            if (ka != kb || (ka && (ha.prim != hb.prim || fabsf(ha.t - hb.t) > 1e-6f || fabsf(ha.u - hb.u) > 1e-6f ||
+                                    fabsf(ha.v - hb.v) > 1e-6f)))
+                fail_msg("%s: ray %d,%d differs (hit %d/%d prim %u/%u u %g/%g v %g/%g)", what, x, y, ka, kb, ha.prim,
+                         hb.prim, ha.u, hb.u, ha.v, hb.v);
+            hits += ka;
+        }
+    assert_true(hits > 100); /* the shape really is under the grid */
+}
+
+static void test_strip_fan_modes(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make();
+    static const uint8_t seq[5] = {0, 1, 2, 3, 4};
+    static const uint8_t strip_list[9] = {0, 1, 2, 1, 3, 2, 2, 3, 4};
+    static const uint8_t fan_list[9] = {1, 2, 0, 2, 3, 0, 3, 4, 0};
+    fv_scene *ls = mode_scene(dir, "ls.gltf", 4, strip_list, 9), *lf = mode_scene(dir, "lf.gltf", 4, fan_list, 9);
+    fv_scene *si = mode_scene(dir, "si.gltf", 5, seq, 5), *sn = mode_scene(dir, "sn.gltf", 5, NULL, 0);
+    fv_scene *fi = mode_scene(dir, "fi.gltf", 6, seq, 5), *fn = mode_scene(dir, "fn.gltf", 6, NULL, 0);
+    assert_int_equal(fv_scene_triangle_count(si), 3);
+    assert_int_equal(fv_scene_triangle_count(fn), 3);
+    same_hits(ls, si, "indexed strip");
+    same_hits(ls, sn, "non-indexed strip");
+    same_hits(lf, fi, "indexed fan");
+    same_hits(lf, fn, "non-indexed fan");
+    assert_string_equal(fv_scene_warning(si), "");
+    fv_scene_free(ls), fv_scene_free(lf), fv_scene_free(si), fv_scene_free(sn), fv_scene_free(fi), fv_scene_free(fn);
+    tmpdir_remove(dir);
+}
+
+/* Points and lines are skipped with one warning; unsupported versions and required extensions
+ * fail with one line naming them (tinygltf said "asset object not found" and "accessor[0] invalid
+ * bufferView"). */
+static void test_modes_versions_extensions(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512];
+    static const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    write_gltf(path_join(p, sizeof p, dir, "mixed.gltf"), pos, sizeof pos,
+               "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+               "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+               "\"min\":[0,0,0],\"max\":[1,1,0]}],"
+               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":0},"
+               "{\"attributes\":{\"POSITION\":0},\"mode\":1},{\"attributes\":{\"POSITION\":0}}]}],"
+               "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0");
+    char err[512];
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    assert_non_null(s);
+    assert_int_equal(fv_scene_triangle_count(s), 1);
+    assert_string_equal(fv_scene_warning(s), "skipped 2 point or line primitives (only triangles are rendered)");
+    fv_scene_free(s);
+
+    static const char *const bad[][2] = {
+        {"{\"asset\":{\"version\":\"1.0\"},\"meshes\":{}}", "glTF 1.0 is not supported, only glTF 2.0"},
+        {"{\"meshes\":{\"m\":{}},\"accessors\":{}}", "no asset object: not a glTF 2.0 file"},
+        {"{\"asset\":{\"generator\":\"x\",\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],"
+         "\"extensionsRequired\":[\"KHR_draco_mesh_compression\"],\"accessors\":[{\"componentType\":5126,\"count\":3,"
+         "\"type\":\"VEC3\"}]}",
+         "required extension KHR_draco_mesh_compression is not supported (compressed meshes"},
+        {"{\"extensionsRequired\":[\"KHR_lights_punctual\", \"EXT_texture_webp\"],\"asset\":{\"version\":\"2.0\"}}",
+         "required extension EXT_texture_webp is not supported (texture format"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        write_all(path_join(p, sizeof p, dir, "bad.gltf"), bad[i][0], strlen(bad[i][0]));
+        expect_load_fails(p, bad[i][1]);
+    }
+    unlink(path_join(p, sizeof p, dir, "mixed.gltf"));
+    tmpdir_remove(dir);
+}
+
 static void test_missing_and_garbage(void **state)
 {
     (void)state;
@@ -1236,6 +1350,8 @@ int main(void)
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),
         cmocka_unit_test(test_missing_and_garbage),
+        cmocka_unit_test(test_strip_fan_modes),
+        cmocka_unit_test(test_modes_versions_extensions),
         cmocka_unit_test(test_scene_folder_confinement),
         cmocka_unit_test(test_texture_png_lying_length),
         cmocka_unit_test(test_truncated),
