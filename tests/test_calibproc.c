@@ -129,9 +129,9 @@ static void test_repeats_and_refusals(void **state)
     assert_int_equal(rep.n_grid_ok, 9);
 
     script_of(c, &sc, 1500.0f);
-    for (int b = 0; b < FV_SYNTH_SCRIPT_MAX; b++) /* blinks every 150 ms through the first 3 targets */
+    for (int b = 0; b < FV_SYNTH_SCRIPT_MAX; b++) /* blinks every 150 ms through the first 6 targets */
         sc.blink_ms[sc.n_blinks++] = 300.0f + 150.0f * b;
-    sc.wander_mask = ~0u << 3; /* and a wearer looking around at all the others */
+    sc.wander_mask = ~0u << 3; /* and a wearer looking around (from the 4th on) */
     assert_int_equal(run_truth(c, &p, &sc, 120, &cal, &rep, err, sizeof err), -1);
     printf("[ calib ] refused: %s\n", err);
     assert_non_null(strstr(err, "only 0 of the 9 grid points had a stable fixation (no fixation at points 1, 2, 3"));

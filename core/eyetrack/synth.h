@@ -65,7 +65,7 @@ void fv_synth_lid_set_frame(uint64_t *rng, int i, fv_synth_params *p, fv_synth_s
  * saccade_ms, then fixates with fixational drift and tremor of about jitter_deg (smooth,
  * deterministic from seed). Blinks (lids closing over 80 ms, reopening over 120 ms) start at
  * blink_ms[i]; in a "wander" slot the eye keeps drifting +-3 deg instead of fixating. */
-#define FV_SYNTH_SCRIPT_MAX 32
+#define FV_SYNTH_SCRIPT_MAX 64
 typedef struct fv_synth_script {
     int n;                                   /* targets */
     float yaw_deg[FV_SYNTH_SCRIPT_MAX], pitch_deg[FV_SYNTH_SCRIPT_MAX];
