@@ -16,6 +16,7 @@
 #include "eyetrack/gazefilter.h"
 #include "frameloop.h"
 #include "gazesrc.h"
+#include "calibrun.h"
 #include "lensfile.h"
 #include "output.h"
 #include "pipeline.h"
@@ -43,6 +44,10 @@ static void usage(FILE *f)
             "  --display DST       where frames go (default none)\n"
             "  --calibration FILE  gaze calibration (fovea-calibration text); without it the camera's\n"
             "                      pupil position maps linearly over the field of view (uncalibrated)\n"
+            "  --calibrate FILE    run the calibration procedure instead of rendering (needs --camera;\n"
+            "                      no scene): 9 grid targets and 4 validation targets on --display,\n"
+            "                      then FILE is written, or the points to repeat are named\n"
+            "  --calibrate-dwell-ms MS  each target's time on screen (default 1500)\n"
             "  --seconds S         run time (default: until SIGINT)\n"
             "  --trace FILE        gaze/head trace (CSV, looped); head pose from it with a camera too\n"
             "  --lens FILE         HMD lens profile: rays along the distorted directions (turns\n"
@@ -56,7 +61,7 @@ static void usage(FILE *f)
 }
 
 enum { OPT_SCENE = 1, OPT_CAMERA, OPT_VSYNC, OPT_DISPLAY, OPT_CALIB, OPT_SECONDS, OPT_TRACE, OPT_LENS, OPT_CSV,
-       OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_HELP };
+       OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_HELP, OPT_CALIBRATE, OPT_CALIB_DWELL };
 
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig)
@@ -194,6 +199,8 @@ int main(int argc, char **argv)
     float hz = 90.0f, cam_fps = 120.0f;
     fv_prof *prof = NULL; /* --trace-out's recorder */
     int reproject_given = 0;
+    const char *calibrate_path = NULL; /* --calibrate */
+    int calib_dwell_ms = 1500;
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"camera", required_argument, 0, OPT_CAMERA},
         {"vsync", required_argument, 0, OPT_VSYNC}, {"display", required_argument, 0, OPT_DISPLAY},
@@ -201,7 +208,8 @@ int main(int argc, char **argv)
         {"trace", required_argument, 0, OPT_TRACE}, {"lens", required_argument, 0, OPT_LENS},
         {"latency-csv", required_argument, 0, OPT_CSV}, {"hz", required_argument, 0, OPT_HZ},
         {"camera-fps", required_argument, 0, OPT_CAMFPS}, {"trace-out", required_argument, 0, OPT_TRACE_OUT},
-        {"help", no_argument, 0, OPT_HELP},
+        {"help", no_argument, 0, OPT_HELP}, {"calibrate", required_argument, 0, OPT_CALIBRATE},
+        {"calibrate-dwell-ms", required_argument, 0, OPT_CALIB_DWELL},
         FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -220,6 +228,8 @@ int main(int argc, char **argv)
         case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
         case OPT_CAMFPS: cam_fps = fv_arg_float(prog, "--camera-fps", optarg, 1.0f, 1000.0f); break;
         case OPT_TRACE_OUT: prof_path = optarg; break;
+        case OPT_CALIBRATE: calibrate_path = optarg; break;
+        case OPT_CALIB_DWELL: calib_dwell_ms = (int)fv_arg_long(prog, "--calibrate-dwell-ms", optarg, 300, 10000); break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
@@ -229,10 +239,15 @@ int main(int argc, char **argv)
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
     }
-    fv_common_validate(prog, argc, argv, scene_path, &cfg);
+    /* a calibration run renders no scene */
+    fv_common_validate(prog, argc, argv, calibrate_path && !scene_path ? "(none: --calibrate)" : scene_path, &cfg);
     const int have_camera = strcmp(camera, "none") != 0;
     if (calib_path && !have_camera)
         fv_usage_error(prog, "--calibration only applies with --camera");
+    if (calibrate_path && !have_camera)
+        fv_usage_error(prog, "--calibrate needs --camera (/dev/videoN or replay:FILE.y4m)");
+    if (calibrate_path && calib_path)
+        fv_usage_error(prog, "--calibrate and --calibration exclude each other");
 
     /* from here on SIGINT ends the run cleanly (start-up included: the loop stops at once) */
     struct sigaction sa;
@@ -243,8 +258,29 @@ int main(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
     char err[1024];
     /* every input is checked before anything opens hardware; outputs too (bad usage now, not after the run) */
-    if ((csv_path && fv_output_probe(csv_path, err, sizeof err)) || (prof_path && fv_output_probe(prof_path, err, sizeof err)))
+    if ((csv_path && fv_output_probe(csv_path, err, sizeof err)) || (prof_path && fv_output_probe(prof_path, err, sizeof err)) ||
+        (calibrate_path && fv_output_probe(calibrate_path, err, sizeof err)))
         fv_usage_error(prog, "%s", err);
+    if (calibrate_path) { /* the calibration procedure (platform/calibrun.h) instead of rendering */
+        fv_calibrate_opts co = {.out_path = calibrate_path, .camera = camera, .replay_fps = cam_fps, .cam = cfg.cam,
+                                .stop = &stop_requested, .out = stdout};
+        fv_calproc_default_params(&co.proc);
+        co.proc.dwell_ms = calib_dwell_ms;
+        co.proc.settle_ms = co.proc.settle_ms < calib_dwell_ms / 2 ? co.proc.settle_ms : calib_dwell_ms / 2;
+        co.proc.fix_ms = co.proc.fix_ms < calib_dwell_ms / 4 ? co.proc.fix_ms : calib_dwell_ms / 4;
+        co.realtime = !strncmp(display_spec, "window", 6) || !strncmp(display_spec, "kms", 3) ||
+                      !strncmp(display_spec, "fbdev", 5);
+        if (fv_display_open(&co.display, display_spec, 2 * cfg.cam.width, cfg.cam.height, (int)lrintf(hz), err,
+                            sizeof err))
+            fv_usage_error(prog, "%s", err);
+        const int rc = fv_calibrate_run(&co, err, sizeof err);
+        fv_display_close(co.display, NULL, 0);
+        if (rc == 2)
+            fv_usage_error(prog, "%s", err);
+        if (rc)
+            fv_fail(prog, FV_EXIT_FAIL, "%s", err);
+        return FV_EXIT_OK;
+    }
     fv_calib calib;
     if (calib_path && fv_calib_load(&calib, calib_path, err, sizeof err))
         fv_usage_error(prog, "--calibration %s", err);

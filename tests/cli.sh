@@ -470,6 +470,39 @@ expect_usage "headset unwritable trace-out" '/proc/fovea-no/p.json' $HS $HO --se
 expect_usage "headset calibration without camera" '--calibration only applies with --camera' $HS $HO --calibration x
 printf 'fovea-calibration 1\ninput pupil\nnorm 320 240 100\nyaw_deg 0 20 0 0 0 0\npitch_deg 0 0 -15 0 0 0\nsamples 1e300\n' >"$T/huge.cal"
 expect_usage "headset calibration count out of range" 'huge.cal.*line 6: samples 1e\+300 out of range' $HS $HO --camera replay:assets/eye_synth.y4m --calibration "$T/huge.cal"
+# the calibration procedure on a scripted wearer's eye video (tools/gen_eye --calibration): the
+# contract line, a file that --calibration then accepts; a wearer blinking through every target and
+# a camera that stops: a message naming why, exit 1, no file
+GE=$BT/gen_eye
+expect_usage "headset calibrate without camera" '--calibrate needs --camera' $HS --calibrate "$T/c.cal"
+if $GE --calibration 600 --fps 120 --supersample 1 --out "$T/cal.y4m" --truth "$T/cal.csv" 2>"$T/err" &&
+   $HS --calibrate "$T/c.cal" --calibrate-dwell-ms 600 --camera replay:"$T/cal.y4m" --display png:"$T/calpng" \
+       --size 160x180 >"$T/out" 2>"$T/err"; then
+    grep -Eq '^calibration: 9 points, validation mean 0\.[0-4][0-9] deg, max 0\.[0-9][0-9] deg$' "$T/out" && ok ||
+        bad "calibrate summary: $(tail -n 2 "$T/out")"
+    [ "$(ls "$T/calpng" | wc -l)" -eq 13 ] && ok || bad "calibrate showed $(ls "$T/calpng" | wc -l) targets, want 13"
+    if $HS $HO --seconds 0.5 --camera replay:"$T/cal.y4m" --calibration "$T/c.cal" >"$T/out" 2>"$T/err"; then ok
+    else bad "the written calibration was not accepted: $(cat "$T/err")"; fi
+else
+    bad "calibrate run failed: $(cat "$T/err")"
+fi
+blinks=
+for k in $(seq 0 21); do blinks="$blinks --blink-at $((k * 600 + 310)) --blink-at $((k * 600 + 450))"; done
+# shellcheck disable=SC2086
+$GE --calibration 600 --fps 120 --supersample 1 --frames 1700 $blinks --out "$T/blink.y4m" --truth "$T/blink.csv"
+if $HS --calibrate "$T/b.cal" --calibrate-dwell-ms 600 --camera replay:"$T/blink.y4m" >"$T/out" 2>"$T/err"; then
+    bad "calibration through blinks succeeded"
+else
+    [ "$(wc -l <"$T/err")" -eq 1 ] && grep -q 'calibration failed: only 0 of the 9 grid points had a stable fixation' "$T/err" &&
+        [ ! -e "$T/b.cal" ] && [ ! -e "$T/b.cal.tmp" ] && ok || bad "calibration through blinks: $(cat "$T/err")"
+fi
+head -c $((38 + 6 * 320 * 240 * 3)) "$T/cal.y4m" >"$T/cut.y4m" 2>/dev/null # (about 3 frames' worth)
+if $HS --calibrate "$T/s.cal" --calibrate-dwell-ms 600 --camera replay:"$T/cut.y4m" >"$T/out" 2>"$T/err"; then
+    bad "calibration on a video that stops succeeded"
+else
+    grep -q 'the eye camera stopped.*before the procedure ended' "$T/err" && [ ! -e "$T/s.cal" ] && ok ||
+        bad "calibration camera stop: $(cat "$T/err")"
+fi
 printf 'k1 0.1\nk9 1\n' >"$T/bad.lens"
 expect_usage "headset bad lens" 'bad.lens:2: unknown key' $HS $HO --lens "$T/bad.lens"
 expect_usage "headset no scene" '--scene FILE is required' $HS --size 64x72

@@ -10,6 +10,13 @@
  * t = t_first + i * 1000 / fps. The pupil radius oscillates between 1.6 and 3.0 mm (a slow
  * hippus); a blink (lids close and reopen over 9 frames) starts every --blink-every frames.
  *
+ * --calibration DWELL_MS: instead of a trace, a wearer going through fovea-headset --calibrate's
+ * schedule (core/eyetrack/calibproc.h: 9 grid targets then --valid N validation targets, each
+ * DWELL_MS long) with reaction time, saccades and fixational jitter (fv_synth_script); the video
+ * starts at the first target's onset and lasts the schedule plus one slot. --blink-at MS (repeatable)
+ * adds blinks at those times; --shift-mm X,Y slips the camera; --led-dist-mm D and --px-per-mm S
+ * change the eye-camera geometry.
+ *
  * Ground truth CSV (header line): frame,t_ms,yaw_deg,pitch_deg,open,blink,pupil_x,pupil_y,
  * pupil_r_px,pupil_visible,n_glints,g0_x,g0_y,...,g5_x,g5_y (pixels, corner origin: pixel (i,j)
  * has its centre at (i+0.5, j+0.5); an invisible glint's fields are empty).
@@ -22,6 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "eyetrack/calibproc.h"
 #include "eyetrack/synth.h"
 #include "tracefile.h"
 
@@ -51,13 +59,18 @@ int main(int argc, char **argv)
     int w = 320, h = 240, leds = 4, blink_every = 45, fps = 90, ss = 2;
     long frames = -1, seed = 1;
     double noise = 2.0;
+    int calib_dwell_ms = 0, n_valid = 4, n_blinks = 0;
+    float shift[2] = {0, 0}, led_dist = 0, px_per_mm = 0, blink_at[FV_SYNTH_SCRIPT_MAX];
     static const struct option opts[] = {
         {"trace", required_argument, 0, 't'}, {"out", required_argument, 0, 'o'},
         {"truth", required_argument, 0, 'g'}, {"size", required_argument, 0, 's'},
         {"frames", required_argument, 0, 'n'}, {"leds", required_argument, 0, 'l'},
         {"noise", required_argument, 0, 'z'}, {"seed", required_argument, 0, 'r'},
         {"blink-every", required_argument, 0, 'b'}, {"fps", required_argument, 0, 'f'},
-        {"supersample", required_argument, 0, 'a'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+        {"supersample", required_argument, 0, 'a'}, {"calibration", required_argument, 0, 'C'},
+        {"valid", required_argument, 0, 'V'}, {"blink-at", required_argument, 0, 'B'},
+        {"shift-mm", required_argument, 0, 'S'}, {"led-dist-mm", required_argument, 0, 'D'},
+        {"px-per-mm", required_argument, 0, 'P'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     opterr = 0;
     int o;
     while ((o = getopt_long(argc, argv, "", opts, NULL)) != -1) {
@@ -82,10 +95,24 @@ int main(int argc, char **argv)
         case 'b': blink_every = (int)num("--blink-every", optarg, 0, 100000); break;
         case 'f': fps = (int)num("--fps", optarg, 1, 1000); break;
         case 'a': ss = (int)num("--supersample", optarg, 1, 8); break;
+        case 'C': calib_dwell_ms = (int)num("--calibration", optarg, 300, 10000); break;
+        case 'V': n_valid = (int)num("--valid", optarg, 0, FV_CALPROC_MAX_VALID); break;
+        case 'B':
+            if (n_blinks == FV_SYNTH_SCRIPT_MAX)
+                die(2, "--blink-at: at most 64%s%s", "", "");
+            blink_at[n_blinks++] = (float)num("--blink-at", optarg, 0, 1000000);
+            break;
+        case 'S':
+            if (sscanf(optarg, "%f,%f", &shift[0], &shift[1]) != 2 || !(fabsf(shift[0]) <= 10) || !(fabsf(shift[1]) <= 10))
+                die(2, "--shift-mm: '%s' is not X,Y within +-10 mm%s", optarg, "");
+            break;
+        case 'D': led_dist = (float)num("--led-dist-mm", optarg, 15, 100); break;
+        case 'P': px_per_mm = (float)num("--px-per-mm", optarg, 2, 60); break;
         case 'h':
-            printf("usage: gen_eye --out FILE.y4m --truth FILE.csv [--trace FILE] [--frames N] [--size WxH]\n"
-                   "               [--leds 2..6] [--noise SIGMA] [--seed N] [--blink-every N] [--fps N]\n"
-                   "               [--supersample N]\n");
+            printf("usage: gen_eye --out FILE.y4m --truth FILE.csv [--trace FILE | --calibration DWELL_MS\n"
+                   "               [--valid N] [--blink-at MS]...] [--frames N] [--size WxH] [--leds 2..6]\n"
+                   "               [--noise SIGMA] [--seed N] [--blink-every N] [--fps N] [--supersample N]\n"
+                   "               [--shift-mm X,Y] [--led-dist-mm D] [--px-per-mm S]\n");
             return 0;
         default: die(2, "%s: unknown option or missing argument%s", argv[optind - 1], "");
         }
@@ -96,8 +123,32 @@ int main(int argc, char **argv)
     char err[512];
     if (trace_path && fv_trace_load(&tr, trace_path, err, sizeof err))
         die(2, "%s%s", err, "");
+    if (trace_path && calib_dwell_ms)
+        die(2, "--trace and --calibration exclude each other%s%s", "", "");
+    fv_synth_script sc;
+    if (calib_dwell_ms) { /* the procedure's own schedule, so a replay of the video follows it */
+        fv_calproc_params cp;
+        fv_calproc_default_params(&cp);
+        cp.dwell_ms = calib_dwell_ms;
+        cp.n_valid = n_valid;
+        cp.settle_ms = cp.settle_ms < calib_dwell_ms / 2 ? cp.settle_ms : calib_dwell_ms / 2;
+        cp.fix_ms = cp.fix_ms < calib_dwell_ms / 4 ? cp.fix_ms : calib_dwell_ms / 4;
+        fv_calproc *c = fv_calproc_create(&cp);
+        if (!c)
+            die(2, "--calibration: no schedule for these settings%s%s", "", "");
+        fv_synth_script_default(&sc, (float)calib_dwell_ms);
+        sc.n = fv_calproc_slots(c);
+        for (int k = 0; k < sc.n; k++)
+            fv_calproc_slot_target(c, k, &sc.yaw_deg[k], &sc.pitch_deg[k]);
+        fv_calproc_destroy(c);
+        sc.n_blinks = n_blinks;
+        memcpy(sc.blink_ms, blink_at, sizeof blink_at);
+        sc.seed = (uint64_t)seed;
+    }
     if (frames < 0)
-        frames = trace_path ? (long)floor((tr.s[tr.n - 1].t_ms - tr.s[0].t_ms) * fps / 1000.0) + 1 : 90;
+        frames = trace_path       ? (long)floor((tr.s[tr.n - 1].t_ms - tr.s[0].t_ms) * fps / 1000.0) + 1
+                 : calib_dwell_ms ? (long)((sc.n + 1) * (long)calib_dwell_ms * fps / 1000)
+                                  : 90;
 
     fv_synth_params p;
     fv_synth_default_params(&p, w, h);
@@ -105,6 +156,11 @@ int main(int argc, char **argv)
     p.noise_sigma = (float)noise;
     p.seed = (uint64_t)seed * 0x9e3779b97f4a7c15ull;
     p.supersample = ss;
+    p.cam_shift_mm[0] = shift[0], p.cam_shift_mm[1] = shift[1];
+    if (led_dist > 0)
+        p.led_dist_mm = led_dist;
+    if (px_per_mm > 0)
+        p.px_per_mm = px_per_mm;
     char tmp_v[4200], tmp_t[4200];
     snprintf(tmp_v, sizeof tmp_v, "%s.tmp", out);
     snprintf(tmp_t, sizeof tmp_t, "%s.tmp", truth_path);
@@ -123,7 +179,9 @@ int main(int argc, char **argv)
     for (long i = 0; i < frames; i++) {
         const double t = t0 + i * 1000.0 / fps;
         fv_synth_state s;
-        if (trace_path) {
+        if (calib_dwell_ms) {
+            fv_synth_script_state(&sc, t, &s);
+        } else if (trace_path) {
             fv_trace_sample smp;
             fv_trace_at(&tr, t, &smp);
             s.yaw_deg = (smp.gaze_x - 0.5f) * 50.0f;
@@ -133,9 +191,11 @@ int main(int argc, char **argv)
             s.yaw_deg = (float)(k % 3 - 1) * 15.0f;
             s.pitch_deg = (float)(1 - k / 3) * 10.0f;
         }
-        s.pupil_mm = (float)(2.3 + 0.7 * sin(t * 2.0 * 3.14159265358979 / 1300.0));
-        s.open = 1.0f;
-        if (blink_every > 0 && i % blink_every >= blink_every - 9) {
+        if (!calib_dwell_ms) {
+            s.pupil_mm = (float)(2.3 + 0.7 * sin(t * 2.0 * 3.14159265358979 / 1300.0));
+            s.open = 1.0f;
+        }
+        if (!calib_dwell_ms && blink_every > 0 && i % blink_every >= blink_every - 9) {
             const int b = (int)(i % blink_every) - (blink_every - 9); /* 0..8 */
             static const float prof[9] = { 0.7f, 0.35f, 0.05f, 0.0f, 0.0f, 0.15f, 0.4f, 0.65f, 0.85f };
             s.open = prof[b];

@@ -1,5 +1,6 @@
 /* fovea eye tracker: polynomial gaze calibration (see calib.h). */
 #include "eyetrack/calib.h"
+#include "eyetrack/eyetrack.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -32,6 +33,27 @@ void fv_calib_apply(const fv_calib *c, float in_x, float in_y, float *yaw_deg, f
         gx += c->a[k] * t[k], gy += c->b[k] * t[k];
     *yaw_deg = (float)gx;
     *pitch_deg = (float)gy;
+}
+
+double fv_calib_slip_gain(double d_led_mm)
+{
+    return 1.0 / (1.0 - 7.8 / (2.0 * d_led_mm));
+}
+
+int fv_calib_feature(const fv_calib *c, const fv_eye_result *r, float *fx, float *fy)
+{
+    if (r->status != FV_EYE_OK || !r->found)
+        return 0;
+    if (c->input == FV_CALIB_PUPIL) {
+        *fx = r->pupil_x, *fy = r->pupil_y;
+    } else {
+        if (!r->has_pg)
+            return 0;
+        const double k = c->slip_gain > 0 ? c->slip_gain : 1.0;
+        *fx = (float)(k * r->pg_x - (k - 1.0) * r->pupil_x);
+        *fy = (float)(k * r->pg_y - (k - 1.0) * r->pupil_y);
+    }
+    return isfinite(*fx) && isfinite(*fy);
 }
 
 double fv_gaze_angle_deg(double yaw1, double pitch1, double yaw2, double pitch2)
@@ -122,6 +144,7 @@ int fv_calib_fit(fv_calib *c, int input, const float *in_x, const float *in_y, c
 {
     memset(c, 0, sizeof *c);
     c->input = input;
+    c->slip_gain = 1.0; /* the caller sets the gain its features were made with */
     if (n < 6)
         return -1;
     double mx = 0, my = 0;
@@ -190,7 +213,8 @@ int fv_calib_format(const fv_calib *c, char *buf, size_t len)
     return snprintf(buf, len,
                     "# fovea eye calibration: yaw_deg / pitch_deg = coefficients . [1, u, v, u*v, u^2, v^2],\n"
                     "# u = (in_x - u0) / s, v = (in_y - v0) / s; in = pupil minus glint centroid (pupil_glint)\n"
-                    "# or the pupil centre (pupil), in pixels of the eye image\n"
+                    "# or the pupil centre (pupil), in pixels of the eye image; pupil_glint with slip_gain k:\n"
+                    "# in = k (pupil - glints) - (k - 1) pupil\n"
                     "fovea-calibration 1\n"
                     "input %s\n"
                     "norm %.17g %.17g %.17g\n"
@@ -198,10 +222,11 @@ int fv_calib_format(const fv_calib *c, char *buf, size_t len)
                     "pitch_deg %.17g %.17g %.17g %.17g %.17g %.17g\n"
                     "rms_deg %.6g\n"
                     "max_deg %.6g\n"
-                    "samples %d\n",
+                    "samples %d\n"
+                    "slip_gain %.17g\n",
                     c->input == FV_CALIB_PUPIL ? "pupil" : "pupil_glint", c->u0, c->v0, c->s, c->a[0], c->a[1],
                     c->a[2], c->a[3], c->a[4], c->a[5], c->b[0], c->b[1], c->b[2], c->b[3], c->b[4], c->b[5],
-                    c->rms_deg, c->max_deg, c->n_used);
+                    c->rms_deg, c->max_deg, c->n_used, c->slip_gain > 0 ? c->slip_gain : 1.0);
 }
 
 static int numbers(const char *s, double *v, int n)
@@ -221,6 +246,7 @@ static int numbers(const char *s, double *v, int n)
 int fv_calib_parse(fv_calib *c, const char *text, char *err, size_t err_len)
 {
     memset(c, 0, sizeof *c);
+    c->slip_gain = 1.0; /* files from before the key: the plain pupil-glint vector */
     int have = 0, ln = 0;
     const char *p = text;
     while (*p) {
@@ -292,6 +318,10 @@ int fv_calib_parse(fv_calib *c, const char *text, char *err, size_t err_len)
                 c->max_deg = v[0];
             else
                 c->n_used = (int)v[0];
+        } else if (!strcmp(key, "slip_gain")) {
+            if (numbers(rest, v, 1) || !(v[0] >= 1.0 && v[0] <= 2.0))
+                return fv_err(err, err_len, "line %d: slip_gain needs a number in [1, 2]", ln);
+            c->slip_gain = v[0];
         } else {
             return fv_err(err, err_len, "line %d: unknown key '%s'", ln, key);
         }

@@ -22,7 +22,15 @@ typedef struct fv_calib {
     double a[6], b[6];  /* yaw and pitch coefficients */
     double rms_deg, max_deg; /* angular residuals of the fit (the samples kept) */
     int n_used;         /* samples kept after outlier rejection */
+    /* pupil-glint input: the feature is k pg - (k - 1) pupil (k = slip_gain; 1: the plain
+     * pupil-glint vector). Under a camera slip s the glints move by (1 - 1/k) s less than the
+     * pupil (a corneal reflection of LEDs at distance d moves by R / (2 d) of the slip, R the
+     * corneal radius), so k = 1 / (1 - R / (2 d)) cancels the slip: fv_calib_slip_gain. */
+    double slip_gain;
 } fv_calib;
+
+/* k for LEDs d_led_mm from the cornea, corneal radius 7.8 mm (Le Grand's eye). */
+double fv_calib_slip_gain(double d_led_mm);
 
 /* The 3x3 calibration targets: yaw in {-span_x, 0, +span_x}, pitch in {+span_y, 0, -span_y},
  * row by row from the top left. */
@@ -35,6 +43,10 @@ void fv_calib_targets_3x3(float span_x_deg, float span_y_deg, float yaw_deg[9], 
 int fv_calib_fit(fv_calib *c, int input, const float *in_x, const float *in_y, const float *yaw_deg,
                  const float *pitch_deg, int n, float *resid_deg);
 void fv_calib_apply(const fv_calib *c, float in_x, float in_y, float *yaw_deg, float *pitch_deg);
+/* The input feature of a tracker result for c's input kind and slip gain: 1 with it, 0 when the
+ * frame has none (no pupil, a blink, no glint for a pupil-glint input). */
+struct fv_eye_result;
+int fv_calib_feature(const fv_calib *c, const struct fv_eye_result *r, float *fx, float *fy);
 
 /* Angle between two gaze directions, degrees. */
 double fv_gaze_angle_deg(double yaw1, double pitch1, double yaw2, double pitch2);

@@ -9,11 +9,13 @@ int fv_gaze_from_eye(const fv_eye_result *r, int w, int h, const fv_calib *calib
                      float *yaw_deg, float *pitch_deg)
 {
     *yaw_deg = *pitch_deg = 0.0f;
-    const int pg = calib && calib->input == FV_CALIB_PUPIL_GLINT;
-    if (r->status != FV_EYE_OK || !r->found || (pg && !r->has_pg))
+    if (r->status != FV_EYE_OK || !r->found)
         return 0;
     if (calib) {
-        fv_calib_apply(calib, pg ? r->pg_x : r->pupil_x, pg ? r->pg_y : r->pupil_y, yaw_deg, pitch_deg);
+        float fx, fy;
+        if (!fv_calib_feature(calib, r, &fx, &fy))
+            return 0;
+        fv_calib_apply(calib, fx, fy, yaw_deg, pitch_deg);
     } else {
         const float nx = r->pupil_x / (float)w, ny = r->pupil_y / (float)h;
         const float hx = atanf(cam->tan_right) * 57.29578f, hy = atanf(cam->tan_top) * 57.29578f;

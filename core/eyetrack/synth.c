@@ -95,7 +95,9 @@ static void setup(const fv_synth_params *p, const fv_synth_state *s, geom *g)
     const float cx = CORNEA_OFF * g->gx, cy = CORNEA_OFF * g->gy, cz = CORNEA_OFF * g->gz;
     for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
         const float a = (float)(2.0 * M_PI * (k + 0.5) / p->n_leds) + 0.3f;
-        const float lx = p->led_ring_mm * cosf(a), ly = p->led_ring_mm * sinf(a) * 0.6f, lz = p->led_dist_mm;
+        /* the LEDs sit on the camera's ring: they move with it when the headset slips */
+        const float lx = p->led_ring_mm * cosf(a) + p->cam_shift_mm[0], ly = p->led_ring_mm * sinf(a) * 0.6f + p->cam_shift_mm[1],
+                    lz = p->led_dist_mm;
         float dx = lx - cx, dy = ly - cy, dz = lz - cz;
         const float dl = sqrtf(dx * dx + dy * dy + dz * dz);
         float nx = dx / dl, ny = dy / dl, nz = dz / dl + 1.0f;
@@ -113,8 +115,9 @@ static void truth(const fv_synth_params *p, const fv_synth_state *s, const geom 
 {
     memset(t, 0, sizeof *t);
     const float sc = p->px_per_mm;
-    t->pupil_x = g->ix * sc + 0.5f * p->w;
-    t->pupil_y = -g->iy * sc + 0.5f * p->h;
+    const float sx = p->cam_shift_mm[0], sy = p->cam_shift_mm[1]; /* camera slip: the eye moves the other way */
+    t->pupil_x = (g->ix - sx) * sc + 0.5f * p->w;
+    t->pupil_y = -(g->iy - sy) * sc + 0.5f * p->h;
     t->pupil_r_px = s->pupil_mm * sc;
     int in = 0, tot = 0;
     for (int i = 0; i < 16; i++) /* visible fraction of the pupil disc, by sampling its image */
@@ -133,8 +136,8 @@ static void truth(const fv_synth_params *p, const fv_synth_state *s, const geom 
     t->pupil_visible = tot ? (float)in / tot : 0.0f;
     t->n_glints = p->n_leds;
     for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
-        t->glint_x[k] = g->gl_x[k] * sc + 0.5f * p->w;
-        t->glint_y[k] = -g->gl_y[k] * sc + 0.5f * p->h;
+        t->glint_x[k] = (g->gl_x[k] - sx) * sc + 0.5f * p->w;
+        t->glint_y[k] = -(g->gl_y[k] - sy) * sc + 0.5f * p->h;
         t->glint_visible[k] = g->gl_vis[k];
     }
 }
@@ -241,7 +244,8 @@ void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t
             for (int a = 0; a < ss; a++)
                 for (int b = 0; b < ss; b++) {
                     const float px = i + (b + 0.5f) / ss, py = j + (a + 0.5f) / ss;
-                    acc += shade(p, s, &g, (px - 0.5f * p->w) * inv, -(py - 0.5f * p->h) * inv);
+                    acc += shade(p, s, &g, (px - 0.5f * p->w) * inv + p->cam_shift_mm[0],
+                                 -(py - 0.5f * p->h) * inv + p->cam_shift_mm[1]);
                 }
             float v = acc / (float)(ss * ss);
             for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
@@ -255,5 +259,60 @@ void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t
             v += p->noise_sigma * gauss(&st);
             row[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : lrintf(v));
         }
+    }
+}
+
+void fv_synth_script_default(fv_synth_script *sc, float dwell_ms)
+{
+    memset(sc, 0, sizeof *sc);
+    sc->dwell_ms = dwell_ms;
+    sc->reaction_ms = 220.0f;
+    sc->saccade_ms = 45.0f;
+    sc->jitter_deg = 0.05f;
+    sc->seed = 0xca11b;
+}
+
+/* smooth deterministic jitter: a few incommensurate sines with seeded phases, amplitude ~1 */
+static float jitter(uint64_t seed, int axis, double t_s)
+{
+    uint64_t st = mix(seed * 2 + (uint64_t)axis);
+    double v = 0;
+    static const double hz[3] = {0.7, 1.9, 5.3}, amp[3] = {0.6, 0.3, 0.1};
+    for (int i = 0; i < 3; i++) {
+        st = mix(st + 0x9e3779b97f4a7c15ull);
+        v += amp[i] * sin(2.0 * M_PI * hz[i] * t_s + (double)(st >> 11) * (2.0 * M_PI / 9007199254740992.0));
+    }
+    return (float)v;
+}
+
+void fv_synth_script_state(const fv_synth_script *sc, double t_ms, fv_synth_state *s)
+{
+    const int n = sc->n < 1 ? 1 : sc->n > FV_SYNTH_SCRIPT_MAX ? FV_SYNTH_SCRIPT_MAX : sc->n;
+    const double tt = t_ms < 0 ? 0 : t_ms;
+    int k = (int)(tt / sc->dwell_ms);
+    k = k >= n ? n - 1 : k;
+    const double in = tt - k * (double)sc->dwell_ms;
+    const int prev = k > 0 ? k - 1 : 0;
+    float yaw = sc->yaw_deg[k], pitch = sc->pitch_deg[k];
+    if (k > 0 && in < sc->reaction_ms + sc->saccade_ms) { /* still on the last target, or on the way */
+        const double a = in <= sc->reaction_ms ? 0.0 : (in - sc->reaction_ms) / sc->saccade_ms;
+        const double e = a * a * (3 - 2 * a); /* a smooth saccade profile */
+        yaw = (float)(sc->yaw_deg[prev] + e * (sc->yaw_deg[k] - sc->yaw_deg[prev]));
+        pitch = (float)(sc->pitch_deg[prev] + e * (sc->pitch_deg[k] - sc->pitch_deg[prev]));
+    }
+    const double ts = tt * 1e-3;
+    float amp = sc->jitter_deg;
+    if (k < 32 && (sc->wander_mask >> k & 1u))
+        amp = 3.0f; /* looking around instead of at the target */
+    s->yaw_deg = yaw + amp * jitter(sc->seed, 0, amp > 1.0f ? ts * 2.5 : ts);
+    s->pitch_deg = pitch + amp * jitter(sc->seed, 1, amp > 1.0f ? ts * 2.5 : ts);
+    s->pupil_mm = 2.2f + 0.3f * (float)sin(2.0 * M_PI * 0.15 * ts);
+    s->open = 1.0f;
+    for (int b = 0; b < sc->n_blinks && b < FV_SYNTH_SCRIPT_MAX; b++) {
+        const double d = tt - sc->blink_ms[b];
+        if (d >= 0 && d < 80)
+            s->open = fminf(s->open, (float)(1.0 - d / 80.0));
+        else if (d >= 80 && d < 200)
+            s->open = fminf(s->open, (float)((d - 80.0) / 120.0));
     }
 }

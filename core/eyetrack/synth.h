@@ -27,6 +27,8 @@ typedef struct fv_synth_params {
     float brightness;    /* skin / sclera level scale (1 = nominal) */
     int supersample;     /* n x n samples per pixel */
     uint64_t seed;       /* iris texture and lash pattern (the subject) */
+    float cam_shift_mm[2]; /* the camera and its LED ring displaced from the nominal place (x right, y up):
+                              a headset slipping on the face; default 0 */
 } fv_synth_params;
 
 typedef struct fv_synth_state {
@@ -57,5 +59,27 @@ void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t
  * into a lid opened 0.35-0.65, even i pitch +-10 deg with the lids open. Sets p's noise_sigma,
  * brightness and n_leds, and *s. */
 void fv_synth_lid_set_frame(uint64_t *rng, int i, fv_synth_params *p, fv_synth_state *s);
+
+/* A scripted wearer following a schedule of targets (a calibration run): target k is shown from
+ * k * dwell_ms on; the eye stays on the previous one for reaction_ms, makes a saccade of
+ * saccade_ms, then fixates with fixational drift and tremor of about jitter_deg (smooth,
+ * deterministic from seed). Blinks (lids closing over 80 ms, reopening over 120 ms) start at
+ * blink_ms[i]; in a "wander" slot the eye keeps drifting +-3 deg instead of fixating. */
+#define FV_SYNTH_SCRIPT_MAX 64
+typedef struct fv_synth_script {
+    int n;                                   /* targets */
+    float yaw_deg[FV_SYNTH_SCRIPT_MAX], pitch_deg[FV_SYNTH_SCRIPT_MAX];
+    float dwell_ms, reaction_ms, saccade_ms, jitter_deg;
+    int n_blinks;
+    float blink_ms[FV_SYNTH_SCRIPT_MAX];     /* onsets, from the first target's onset */
+    uint32_t wander_mask;                    /* bit k: no fixation in slot k */
+    uint64_t seed;
+} fv_synth_script;
+
+/* Defaults: reaction 220 ms, saccade 45 ms, jitter 0.05 deg, no blinks, no wandering. */
+void fv_synth_script_default(fv_synth_script *sc, float dwell_ms);
+/* The eye at t_ms from the first onset (before it: looking at the first target). The pupil
+ * radius follows a slow hippus around 2.2 mm. */
+void fv_synth_script_state(const fv_synth_script *sc, double t_ms, fv_synth_state *s);
 
 #endif
