@@ -13,6 +13,7 @@
 #include "benchio.h"
 #include "cli.h"
 #include "checkasm/bench.h" /* --kernels: tests/checkasm/bench.c */
+#include "lens.h"
 #include "output.h"
 #include "pipeline.h"
 #include "prof.h"
@@ -30,7 +31,7 @@ static void usage(FILE *f)
             "table of Weier et al. 2018 (Table 1) and writes JSON. Times are means over the frames\n"
             "after warm-up (medians are in the JSON too).\n"
             "  --scene FILE       glTF 2.0 scene (.gltf or .glb)\n"
-            FV_ASSET_ROOT_HELP
+            FV_ASSET_ROOT_HELP FV_LENS_HELP
             "  --frames N         timed frames per mode (default 30)\n"
             "  --warmup N         untimed frames first (default 3)\n"
             "  --mode M           foveated, full or both (default both)\n"
@@ -81,6 +82,8 @@ int main(int argc, char **argv)
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
     const char *asset_root = NULL; /* --asset-root */
+    const char *lens_path = NULL;  /* --lens */
+    int reproject_given = 0;
     const char *scene_path = NULL, *json_path = NULL, *mode = "both", *trace_path = NULL, *kernel = NULL;
     fv_bench_opts bo = {.yaw_rate = 0.0f, .warmup = 3, .frames = 30, .counters = 1, .prof = NULL};
     int kernels = 0, kreps = 7;
@@ -88,10 +91,10 @@ int main(int argc, char **argv)
     static fv_sweep sweeps[FV_BENCH_MAX_SWEEPS];
     int nsweeps = 0;
     char err[512];
-    enum { OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_YAW, OPT_HELP, OPT_TRACE_OUT, OPT_COUNTERS,
+    enum { OPT_LENS = 500, OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_YAW, OPT_HELP, OPT_TRACE_OUT, OPT_COUNTERS,
            OPT_SWEEP, OPT_KERNELS, OPT_KREPS, OPT_KERNEL, OPT_CALLS, OPT_CEILING };
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"frames", required_argument, 0, OPT_FRAMES},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"lens", required_argument, 0, OPT_LENS}, {"frames", required_argument, 0, OPT_FRAMES},
         {"warmup", required_argument, 0, OPT_WARMUP}, {"mode", required_argument, 0, OPT_MODE},
         {"json", required_argument, 0, OPT_JSON}, {"yaw-rate", required_argument, 0, OPT_YAW},
         {"trace-out", required_argument, 0, OPT_TRACE_OUT}, {"counters", required_argument, 0, OPT_COUNTERS},
@@ -106,6 +109,7 @@ int main(int argc, char **argv)
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
         case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
+        case OPT_LENS: lens_path = optarg; break;
         case OPT_FRAMES: bo.frames = (int)fv_arg_long(prog, "--frames", optarg, 1, 100000); break;
         case OPT_WARMUP: bo.warmup = (int)fv_arg_long(prog, "--warmup", optarg, 0, 100000); break;
         case OPT_MODE:
@@ -131,6 +135,7 @@ int main(int argc, char **argv)
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
+            reproject_given |= o == FV_OPT_REPROJECT;
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
@@ -149,6 +154,9 @@ int main(int argc, char **argv)
     if (kernel || calls)
         fv_usage_error(prog, "--kernel and --calls need --kernels");
     fv_common_validate(prog, argc, argv, scene_path, &cfg);
+    fv_lens lens; /* --lens: outlives the pipeline (its cameras point at it) */
+    if (lens_path)
+        fv_cli_lens(prog, lens_path, &lens, &cfg, reproject_given);
     for (int i = 0; i < nsweeps; i++)
         if (fv_sweep_check(&sweeps[i], &cfg, err, sizeof err))
             fv_usage_error(prog, "%s", err);

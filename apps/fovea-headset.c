@@ -50,8 +50,9 @@ static void usage(FILE *f)
             "  --calibrate-dwell-ms MS  each target's time on screen (default 1500)\n"
             "  --seconds S         run time (default: until SIGINT)\n"
             "  --trace FILE        gaze/head trace (CSV, looped); head pose from it with a camera too\n"
-            "  --lens FILE         HMD lens profile: rays along the distorted directions (turns\n"
-            "                      reprojection off: it does not model the lens yet)\n"
+            "  --lens FILE         HMD lens profile: rays along the distorted directions, each eye's\n"
+            "                      axis through its lens centre (turns reprojection off: it does\n"
+            "                      not model the lens yet)\n"
             "  --latency-csv FILE  per-frame gaze/ray/done/photon times\n"
             "  --hz HZ             nominal refresh for gpio/replay vsync (default 90)\n"
             "  --camera-fps F      frame rate of a replayed eye video (default 120)\n"
@@ -288,15 +289,8 @@ int main(int argc, char **argv)
     if (trace_path && fv_trace_load(&tr, trace_path, err, sizeof err))
         fv_usage_error(prog, "%s", err);
     fv_lens lens;
-    if (lens_path) {
-        const float r_max = 3.0f * tanf(cfg.cam.fov_y_deg * 3.14159265f / 360.0f); /* beyond any corner */
-        if (fv_lens_load(&lens, lens_path, r_max, err, sizeof err))
-            fv_usage_error(prog, "--lens %s", err);
-        cfg.cam.lens = &lens;
-        if (reproject_given && cfg.taa.enabled)
-            fv_usage_error(prog, "--lens: reprojection does not model the lens yet; drop --reproject on");
-        cfg.taa.enabled = 0;
-    }
+    if (lens_path)
+        fv_cli_lens(prog, lens_path, &lens, &cfg, reproject_given);
     app a = {0};
     a.trace = trace_path ? &tr : NULL;
     a.W = cfg.cam.width;

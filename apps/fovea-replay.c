@@ -11,6 +11,7 @@
 #include "benchio.h"
 #include "cli.h"
 #include "display.h"
+#include "lens.h"
 #include "output.h"
 #include "pipeline.h"
 #include "prof.h"
@@ -31,7 +32,7 @@ static void usage(FILE *f)
             "Renders the scene along a gaze/head trace; writes DIR/frame_NNNNN.png (left eye, or\n"
             "both eyes side by side with --stereo) and DIR/stats.csv (per-stage ms and samples).\n"
             "  --scene FILE       glTF 2.0 scene (.gltf or .glb)\n"
-            FV_ASSET_ROOT_HELP
+            FV_ASSET_ROOT_HELP FV_LENS_HELP
             "  --trace FILE       CSV t_ms,gaze_x,gaze_y[,head pose]; without it the gaze rests at the\n"
             "                     image centre and the head at the scene's default viewpoint\n"
             "  --frames N         frames to render (default: the trace's length at --hz, or 1)\n"
@@ -54,7 +55,7 @@ static void usage(FILE *f)
             "  --png on|off       write the frame PNGs (default on; off: stats.csv only, e.g. a soak)\n" FV_COMMON_HELP "  --help             this text\n");
 }
 
-enum { OPT_SCENE = 1, OPT_TRACE, OPT_FRAMES, OPT_OUT, OPT_FULL, OPT_STEREO, OPT_Y4M, OPT_REF, OPT_WINDOW, OPT_HZ,
+enum { OPT_LENS = 500, OPT_SCENE = 1, OPT_TRACE, OPT_FRAMES, OPT_OUT, OPT_FULL, OPT_STEREO, OPT_Y4M, OPT_REF, OPT_WINDOW, OPT_HZ,
        OPT_QUIET, OPT_VS_FULL, OPT_TRACE_OUT, OPT_HELP, OPT_PNG };
 
 /* --reference: the thin-lens ground truth (core/reference.h) of one eye into rgb8. The focus is
@@ -93,13 +94,15 @@ int main(int argc, char **argv)
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
     const char *asset_root = NULL; /* --asset-root */
+    const char *lens_path = NULL;  /* --lens */
+    int reproject_given = 0;
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0, window = 0, png = 1;
     fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
     float hz = 90.0f;
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"trace", required_argument, 0, OPT_TRACE},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"lens", required_argument, 0, OPT_LENS}, {"trace", required_argument, 0, OPT_TRACE},
         {"frames", required_argument, 0, OPT_FRAMES}, {"out", required_argument, 0, OPT_OUT},
         {"full", no_argument, 0, OPT_FULL}, {"stereo", no_argument, 0, OPT_STEREO},
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
@@ -113,6 +116,7 @@ int main(int argc, char **argv)
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
         case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
+        case OPT_LENS: lens_path = optarg; break;
         case OPT_TRACE: trace_path = optarg; break;
         case OPT_FRAMES: frames = fv_arg_long(prog, "--frames", optarg, 1, 10000000); break;
         case OPT_OUT: out_dir = optarg; break;
@@ -129,11 +133,15 @@ int main(int argc, char **argv)
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
+            reproject_given |= o == FV_OPT_REPROJECT;
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
     }
     fv_common_validate(prog, argc, argv, scene_path, &cfg);
+    fv_lens lens; /* --lens: outlives the pipeline (its cameras point at it) */
+    if (lens_path)
+        fv_cli_lens(prog, lens_path, &lens, &cfg, reproject_given);
     if (!out_dir)
         fv_usage_error(prog, "--out DIR is required (see --help)");
     /* the reference's lens is the pipeline's eye: same pupil, same fixed focus if one is given */

@@ -84,13 +84,22 @@ int fv_camera_setup(fv_camera *c, const fv_camera_desc *d, const fv_pose *head)
     float tx = ty * (float)d->width / (float)d->height;
     /* The left eye's optical axis sits toward the nose (+x): its frustum extends further
      * to the left. Mirror for the right eye. */
-    float shift = d->axis_shift * tx;
+    float shift = d->axis_shift * tx, vshift = 0.0f;
     if (d->eye == FV_EYE_RIGHT)
         shift = -shift;
+    if (d->lens) {
+        /* With a lens the eye looks straight ahead through the lens centre: the frustum is the
+         * asymmetric one that puts the optical axis (tangent 0) on this eye's lens centre, from
+         * the profile (axis_shift is not used). A centre left of the panel's middle widens the
+         * frustum to the right, and so on. */
+        const float *ctr = d->lens->center[d->eye == FV_EYE_RIGHT ? 1 : 0];
+        shift = (2.0f * ctr[0] - 1.0f) * tx;
+        vshift = (2.0f * ctr[1] - 1.0f) * ty;
+    }
     c->tan_left = -tx - shift;
     c->tan_right = tx - shift;
-    c->tan_bottom = -ty;
-    c->tan_top = ty;
+    c->tan_bottom = -ty + vshift;
+    c->tan_top = ty + vshift;
     c->px_tan = 2.0f * ty / (float)d->height;
     c->focal_px = 1.0f / c->px_tan;
     /* every field set, lens or not: reprojection compares whole cameras (memcmp) */
@@ -105,7 +114,7 @@ int fv_camera_setup(fv_camera *c, const fv_camera_desc *d, const fv_pose *head)
         c->lens_k1 = d->lens->k1;
         c->lens_k2 = d->lens->k2;
         c->lens_scale = d->lens->scale[FV_LENS_G];
-        c->lens_cx = c->tan_left + ctr[0] * (float)d->width * c->px_tan;
+        c->lens_cx = c->tan_left + ctr[0] * (float)d->width * c->px_tan; /* ~0: on the axis, above */
         c->lens_cy = c->tan_top - ctr[1] * (float)d->height * c->px_tan;
     }
 

@@ -36,8 +36,9 @@ typedef struct fv_camera_desc {
     /* Horizontal offset of the optical axis as a fraction of the half-width, signed toward
      * the nose for the left eye; 0 = symmetric. Negated for the right eye (mirror image). */
     float axis_shift;
-    /* HMD lens (core/lens.h), NULL = none (the default): each eye uses its own lens centre.
-     * Must outlive the cameras set up from this description. */
+    /* HMD lens (core/lens.h), NULL = none (the default): each eye uses its own lens centre,
+     * which also places that eye's optical axis (an asymmetric frustum; axis_shift is then not
+     * used). Must outlive the cameras set up from this description. */
     const fv_lens *lens;
 } fv_camera_desc;
 

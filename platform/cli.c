@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "base/parse.h"
+#include "lensfile.h"
 
 static _Noreturn void vexit(const char *prog, int status, const char *fmt, va_list ap)
 {
@@ -166,4 +167,16 @@ void fv_common_validate(const char *prog, int argc, char **argv, const char *sce
         fv_usage_error(prog, "--scene FILE is required (see --help)");
     if (cfg->samp.r0_deg > cfg->samp.r1_deg)
         fv_usage_error(prog, "--r0 %g must not exceed --r1 %g", (double)cfg->samp.r0_deg, (double)cfg->samp.r1_deg);
+}
+
+void fv_cli_lens(const char *prog, const char *path, struct fv_lens *lens, fv_pipeline_config *cfg, int reproject_given)
+{
+    char err[512];
+    const float r_max = 3.0f * tanf(cfg->cam.fov_y_deg * 3.14159265f / 360.0f); /* beyond any corner */
+    if (fv_lens_load(lens, path, r_max, err, sizeof err))
+        fv_usage_error(prog, "--lens %s", err);
+    cfg->cam.lens = lens;
+    if (reproject_given && cfg->taa.enabled)
+        fv_usage_error(prog, "--lens: reprojection does not model the lens yet; drop --reproject on");
+    cfg->taa.enabled = 0;
 }

@@ -505,6 +505,19 @@ else
 fi
 printf 'k1 0.1\nk9 1\n' >"$T/bad.lens"
 expect_usage "headset bad lens" 'bad.lens:2: unknown key' $HS $HO --lens "$T/bad.lens"
+# --lens in replay and bench too (issue 16 item 3): a bad profile and --reproject on are refused; a good one
+# renders, the same bytes for 1 and 2 threads, and differs from the lensless frame
+expect_usage "replay bad lens" 'bad.lens:2: unknown key' $R --scene $SCENE --out "$T/ol" --lens "$T/bad.lens"
+expect_usage "bench bad lens" 'bad.lens:2: unknown key' $B/fovea-bench --scene $SCENE --lens "$T/bad.lens"
+expect_usage "replay lens with reproject" '--lens: reprojection does not model the lens yet' $R --scene $SCENE --out "$T/ol" --lens assets/hmd_example.lens --reproject on
+for th in 1 2; do
+    $R --scene $SCENE --size 64x72 --frames 2 --stereo --lens assets/hmd_example.lens --threads $th --quiet --out "$T/lens$th" >/dev/null 2>&1 || bad "replay --lens run ($th threads)"
+done
+$R --scene $SCENE --size 64x72 --frames 2 --stereo --reproject off --threads 2 --quiet --out "$T/nolens" >/dev/null 2>&1
+if cmp -s "$T/lens1/frame_00001.png" "$T/lens2/frame_00001.png" && ! cmp -s "$T/lens2/frame_00001.png" "$T/nolens/frame_00001.png"; then ok
+else bad "replay --lens: frames differ between thread counts, or equal the lensless frame"; fi
+$B/fovea-bench --scene $SCENE --size 64x72 --frames 1 --warmup 0 --lens assets/hmd_example.lens --counters off >"$T/out" 2>&1 &&
+    grep -q '^foveated' "$T/out" && ok || bad "bench --lens: $(tail -n 3 "$T/out")"
 expect_usage "headset no scene" '--scene FILE is required' $HS --size 64x72
 
 # good runs: a summary, a latency CSV with one row per frame

@@ -173,13 +173,25 @@ static void test_camera(void **st)
     for (int i = 0; i < 3; i++)
         assert_true(dir[i] == tx * plain.right[i] + ty * plain.up[i] - plain.back[i]);
 
-    /* the lens centre pixel looks along the same direction either way */
-    float a[3], b[3];
+    /* the frustum is the asymmetric one of the lens centre: the centre pixel (0.45, 0.55 of the
+     * panel) looks straight ahead, along -back; the extents are the plain ones shifted by
+     * (2 c - 1) tan (hand formula), the total field unchanged */
+    float b[3];
     const float px0 = 0.45f * 320, py0 = 0.55f * 360;
-    fv_camera_ray(&plain, px0, py0, a);
     fv_camera_ray(&lensed, px0, py0, b);
     for (int i = 0; i < 3; i++)
-        assert_float_equal(a[i], b[i], 1e-6);
+        assert_float_equal(b[i], -lensed.back[i], 2e-6);
+    assert_float_equal(lensed.tan_left, plain.tan_left - (2 * 0.45f - 1) * plain.tan_right, 1e-6);
+    assert_float_equal(lensed.tan_right, plain.tan_right - (2 * 0.45f - 1) * plain.tan_right, 1e-6);
+    assert_float_equal(lensed.tan_top, plain.tan_top + (2 * 0.55f - 1) * plain.tan_top, 1e-6);
+    assert_float_equal(lensed.tan_bottom, plain.tan_bottom + (2 * 0.55f - 1) * plain.tan_top, 1e-6);
+    assert_float_equal(lensed.lens_cx, 0.0f, 1e-6);
+    assert_float_equal(lensed.lens_cy, 0.0f, 1e-6);
+    /* the left eye takes its own centre (the default 0.5, 0.5: symmetric) */
+    d.eye = FV_EYE_LEFT;
+    fv_camera left;
+    assert_int_equal(fv_camera_setup(&left, &d, &head), 0);
+    assert_float_equal(left.tan_left, -left.tan_right, 1e-6);
 
     /* elsewhere: along the distorted tangent; projecting the point seen returns the pixel */
     for (int y = 10; y < 360; y += 50)
