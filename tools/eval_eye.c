@@ -38,6 +38,8 @@ static void usage(FILE *f)
                "  --frames N   frames drawn before the visibility split (default 400; 1..100000)\n"
                "  --seed N     random set (default 1)\n"
                "  --history    track each frame after 4 open-eye frames of the same eye\n"
+               "  --specs      the same poses through spectacles (fv_synth_specs_set_frame: lens\n"
+               "               reflections, tint, a rim); also reports the pupil-glint vector's error\n"
                "  --mode M     tracker mode: headset (default), crop or auto\n",
             prog);
 }
@@ -68,12 +70,12 @@ int main(int argc, char **argv)
 {
     int w = 320, h = 240, frames = 400;
     long seed = 1;
-    int history = 0;
+    int history = 0, specs = 0;
     fv_eye_mode mode = FV_EYE_MODE_HEADSET;
     static const struct option opts[] = { { "size", required_argument, 0, 's' },
                                           { "frames", required_argument, 0, 'n' },
                                           { "seed", required_argument, 0, 'r' },
-                                          { "history", no_argument, 0, 'H' },
+                                          { "history", no_argument, 0, 'H' }, { "specs", no_argument, 0, 'S' },
                                           { "mode", required_argument, 0, 'm' },
                                           { "help", no_argument, 0, 'h' },
                                           { 0, 0, 0, 0 } };
@@ -90,6 +92,7 @@ int main(int argc, char **argv)
         case 'n': frames = (int)num("bad --frames (1..100000)", optarg, 1, 100000); break;
         case 'r': seed = num("bad --seed", optarg, 0, 0x7fffffffL); break;
         case 'H': history = 1; break;
+        case 'S': specs = 1; break;
         case 'm':
             if (fv_eye_mode_parse(optarg, &mode))
                 bad("bad --mode (auto, headset, crop)", optarg);
@@ -114,12 +117,15 @@ int main(int argc, char **argv)
     }
     uint64_t rng = (uint64_t)seed;
     const int progress = isatty(2);
-    int n[3] = { 0, 0, 0 };
+    int n[3] = { 0, 0, 0 }, pg_n = 0, pg_ok = 0, w5 = 0, all = 0;
     double track_s = 0;
     int tracked = 0;
     for (int i = 0; i < frames; i++) {
         fv_synth_state s;
-        fv_synth_lid_set_frame(&rng, i, &p, &s);
+        if (specs)
+            fv_synth_specs_set_frame(&rng, i, &p, &s);
+        else
+            fv_synth_lid_set_frame(&rng, i, &p, &s);
         fv_synth_truth gt;
         fv_synth_render(&p, &s, 1000u + (uint64_t)i, img, w, &gt);
         if (gt.pupil_visible < 0.5f)
@@ -141,13 +147,25 @@ int main(int argc, char **argv)
         const float e = r.found && r.status == FV_EYE_OK ? hypotf(r.pupil_x - gt.pupil_x, r.pupil_y - gt.pupil_y) : INFINITY;
         const int b = gt.pupil_visible >= 0.99f ? 0 : gt.pupil_visible >= 0.7f ? 1 : 2;
         err[b][n[b]++] = e;
+        /* the pupil-glint vector against the truth's (pupil minus the visible glints' mean) */
+        float gx = 0, gy = 0;
+        int ng = 0;
+        for (int k = 0; k < gt.n_glints; k++)
+            if (gt.glint_visible[k])
+                gx += gt.glint_x[k], gy += gt.glint_y[k], ng++;
+        if (ng) {
+            pg_n++;
+            if (e <= 3.0f && r.has_pg)
+                pg_ok += hypotf(r.pg_x - (gt.pupil_x - gx / ng), r.pg_y - (gt.pupil_y - gy / ng)) <= 1.0f;
+        }
+        w5 += e <= 5.0f, all++;
         if (progress && i % 50 == 49)
             fprintf(stderr, "\r%s: %d / %d frames", prog, i + 1, frames);
     }
     if (progress)
         fprintf(stderr, "\r%*s\r", 40, "");
-    printf("%s: %dx%d, %d frames drawn, seed %ld%s%s%s\n", prog, w, h, frames, seed,
-           history ? ", after 4 open-eye frames" : "", mode == FV_EYE_MODE_HEADSET ? "" : ", mode ",
+    printf("%s: %dx%d, %d frames drawn, seed %ld%s%s%s%s\n", prog, w, h, frames, seed,
+           specs ? ", through spectacles" : "", history ? ", after 4 open-eye frames" : "", mode == FV_EYE_MODE_HEADSET ? "" : ", mode ",
            mode == FV_EYE_MODE_HEADSET ? "" : fv_eye_mode_name(mode));
     static const char *names[3] = { "full view", "70-99% in view", "50-70% in view" };
     for (int b = 0; b < 3; b++) {
@@ -163,6 +181,9 @@ int main(int argc, char **argv)
                names[b], n[b], (double)err[b][n[b] / 2], (double)err[b][n[b] * 9 / 10], (double)err[b][n[b] - 1],
                100.0 * k1 / n[b], 100.0 * k3 / n[b]);
     }
+    if (all)
+        printf("  all %d frames: pupil within 5 px %.1f%%; pupil-glint vector within 1 px of the truth's %.1f%% "
+               "(of %d frames with a visible glint)\n", all, 100.0 * w5 / all, pg_n ? 100.0 * pg_ok / pg_n : 0.0, pg_n);
     if (tracked)
         printf("  time per frame (tracking only, one thread): %.3f ms\n", 1e3 * track_s / tracked);
     fv_eye_destroy(t);

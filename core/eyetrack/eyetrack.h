@@ -36,6 +36,9 @@ typedef enum fv_eye_mode {
 /* What a mode does; fv_eye_headset_settings and fv_eye_crop_settings are the two. */
 typedef struct fv_eye_mode_settings {
     fv_eye_mode mode;
+    /* search */
+    int search_sides;           /* the pupil box must contrast with its ring on 3 of 4 sides (a
+                                   spectacle frame's rim, a dark band, does not): headset frames */
     /* refinement */
     int refine_on_search_image; /* refine on the (inpainted) search image, not the frame */
     int refine_max_side;        /* else on the frame halved while its min side exceeds this

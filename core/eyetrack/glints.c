@@ -183,9 +183,14 @@ int fv_et_find_glints(const fv_eyetrack_dsp *d, const uint8_t *luma, int w, int 
     if (ww < 1 || wh < 1)
         return 0;
     const int thr = fv_maxi((int)pp->ring + 40, (int)(pp->ring + 0.5f * (255.0f - pp->ring)));
-    const float max_area = fmaxf(4.0f, 0.8f * pp->r * pp->r);
+    /* a corneal glint is the LED's tiny virtual image in a 7.8 mm convex mirror (~0.4 mm across,
+     * under a tenth of the pupil's area); a reflection on spectacles (a nearly flat mirror) shows
+     * the LED at full size and is several times larger: refused by area */
+    const float max_area = fmaxf(12.0f, 0.2f * pp->r * pp->r);
     /* lab: 255 bright and not yet in a blob, 1 in one, 0 dark (thr above 255: none bright) */
-    int n = 0;
+    int n = 0, nc = 0;
+    enum { MAX_CAND = 32 };
+    fv_eye_glint cand[MAX_CAND];
     for (int y = 0; y < wh; y++)
         d->et_thresh_row(lab + y * ww, luma + (y + y0) * stride + x0, ww, fv_mini(thr, 256));
     for (int y = 0; y < wh; y++)
@@ -238,19 +243,32 @@ int fv_et_find_glints(const fv_eyetrack_dsp *d, const uint8_t *luma, int w, int 
             if (peak - bg / 8 < 50)
                 continue;
             const float dd = hypotf(gl.x - pp->x, gl.y - pp->y);
-            if (dd > rad)
+            if (dd > rad || nc == MAX_CAND)
                 continue;
-            /* insertion by distance to the pupil centre */
-            int j = n < FV_EYE_MAX_GLINTS ? n++ : n - 1;
-            if (j == FV_EYE_MAX_GLINTS - 1 && n == FV_EYE_MAX_GLINTS &&
-                hypotf(g[j].x - pp->x, g[j].y - pp->y) <= dd && j > 0)
-                continue; /* full, and farther than all kept */
-            while (j > 0 && hypotf(g[j - 1].x - pp->x, g[j - 1].y - pp->y) > dd) {
-                g[j] = g[j - 1];
-                j--;
-            }
-            g[j] = gl;
+            cand[nc++] = gl;
         }
+    /* corneal glints are images of the same LEDs in the same mirror: about equally small. A
+     * reflection on spectacles is a larger image of an LED: refused when more than 3x the area of
+     * the smallest candidate (itself most likely corneal) */
+    float amin = INFINITY;
+    for (int i = 0; i < nc; i++)
+        amin = fminf(amin, cand[i].area_px);
+    for (int i = 0; i < nc; i++) {
+        const fv_eye_glint gl = cand[i];
+        if (gl.area_px > fmaxf(3.0f * amin, 12.0f))
+            continue;
+        const float dd = hypotf(gl.x - pp->x, gl.y - pp->y);
+        /* insertion by distance to the pupil centre */
+        int j = n < FV_EYE_MAX_GLINTS ? n++ : n - 1;
+        if (j == FV_EYE_MAX_GLINTS - 1 && n == FV_EYE_MAX_GLINTS && hypotf(g[j].x - pp->x, g[j].y - pp->y) <= dd &&
+            j > 0)
+            continue; /* full, and farther than all kept */
+        while (j > 0 && hypotf(g[j - 1].x - pp->x, g[j - 1].y - pp->y) > dd) {
+            g[j] = g[j - 1];
+            j--;
+        }
+        g[j] = gl;
+    }
     return fv_mini(n, max_glints);
 }
 

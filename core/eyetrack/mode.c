@@ -6,6 +6,7 @@
 
 const fv_eye_mode_settings fv_eye_headset_settings = {
     .mode = FV_EYE_MODE_HEADSET,
+    .search_sides = 1,
     .refine_on_search_image = 0,
     .refine_max_side = 320, /* the edge points keep sub-pixel precision, noise halves, work quarters */
     .window_side_div = 4,   /* the search box can be only the darkest part of a big pupil */

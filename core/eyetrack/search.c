@@ -7,6 +7,7 @@
  * (box_search); the best is refined in position and size on F. Contrast, not darkness alone,
  * rejects brows, lashes and shadows (as dark around as inside). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "base/util.h"
@@ -48,7 +49,10 @@ typedef struct {
     const uint32_t *ii;
     int iw, sw, sh;
     float dark, prior, cxm, cym;
+    int sides; /* only boxes that pass sides_ok */
 } box_ctx;
+
+static int sides_ok(const uint32_t *ii, int sw, int sh, int x, int y, int k, float inner, float ring);
 
 static inline void box_offer(const box_ctx *b, box_hit *best, float score, float mi, float mo, int x, int y, int k)
 {
@@ -58,7 +62,7 @@ static inline void box_offer(const box_ctx *b, box_hit *best, float score, float
         const float ddx = (float)x - b->cxm, ddy = (float)y - b->cym;
         score -= b->prior * sqrtf(ddx * ddx + ddy * ddy);
     }
-    if (score > best->score)
+    if (score > best->score && (!b->sides || sides_ok(b->ii, b->sw, b->sh, x, y, k, mi, mo)))
         *best = (box_hit){ score, mi, mo, x, y, k };
 }
 
@@ -85,10 +89,10 @@ static void box_clipped(const box_ctx *b, box_hit *best, int k, int ko, int y, i
 }
 
 static void box_search(const fv_eyetrack_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
-                       int x1, int y0, int y1, float dark, float mu, box_hit *best)
+                       int x1, int y0, int y1, float dark, float mu, int sides, box_hit *best)
 {
     const float rf = 1.5f;
-    const box_ctx b = { ii, sw + 1, sw, sh, dark, mu / (float)(sw < sh ? sw : sh), 0.5f * (sw - 1), 0.5f * (sh - 1) };
+    const box_ctx b = { ii, sw + 1, sw, sh, dark, mu / (float)(sw < sh ? sw : sh), 0.5f * (sw - 1), 0.5f * (sh - 1), sides };
     const int iw = sw + 1, xs = fv_maxi(0, x0), xe = fv_mini(sw, x1);
     enum { CHUNK = 256 };
     float sc[CHUNK];
@@ -126,11 +130,33 @@ static void box_search(const fv_eyetrack_dsp *d, const uint32_t *ii, int sw, int
     }
 }
 
+/* A pupil is surrounded by brighter iris on every side; a band (a spectacle frame's rim, a lid
+ * margin) is as dark as the box along itself. Each of the ring's four side strips must be
+ * brighter than the box by half the ring's contrast (and 10 grey levels), but one side may fail (a pupil under
+ * the lashes of a lowered lid). */
+static int sides_ok(const uint32_t *ii, int sw, int sh, int x, int y, int k, float inner, float ring)
+{
+    const int iw = sw + 1, ko = (int)lrintf(1.5f * k);
+    const int ox0 = fv_maxi(0, x - ko), ox1 = fv_mini(sw, x + ko + 1), oy0 = fv_maxi(0, y - ko), oy1 = fv_mini(sh, y + ko + 1);
+    const int bx0 = x - k, bx1 = x + k + 1, by0 = y - k, by1 = y + k + 1;
+    const int side[4][4] = {{ox0, oy0, ox1, by0}, {ox0, by1, ox1, oy1}, {ox0, by0, bx0, by1}, {bx1, by0, ox1, by1}};
+    const float need = fmaxf((ring - inner) * 0.5f, 10.0f); /* grey levels: a box inside a uniform band has no contrast at all */
+    int fails = 0;
+    for (int i = 0; i < 4; i++) {
+        const int a = (side[i][2] - side[i][0]) * (side[i][3] - side[i][1]);
+        if (a <= 0)
+            continue; /* clipped away by the image edge: no evidence either way */
+        const float m = (float)box_sum(ii, iw, side[i][0], side[i][1], side[i][2], side[i][3]) / (float)a;
+        fails += m - inner < need;
+    }
+    return fails <= 1;
+}
+
 /* Two levels: F (halved until min side <= SEARCH_MAX_SIDE; reflections inpainted there) and C
  * (F halved again until min side <= SEARCH_C_SIDE). The exhaustive search runs on C;
  * F only refines position and size around C's answer, which costs ~25x less than searching F. */
 fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
-                             ptrdiff_t stride, const fv_et_scratch *s)
+                             ptrdiff_t stride, const fv_et_scratch *s, int sides_test)
 {
     fv_et_candidate c = { 0 };
     uint8_t *work = s->work, *mask = s->mask, *small = s->lowres;
@@ -172,14 +198,22 @@ fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, c
     /* centres no nearer the border than border_frac of the side: vignetted corners and image
      * edges are dark, and a pupil there is cut anyway */
     const int mx = (int)lrintf(p->border_frac * side);
-    box_search(d, ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, p->centre_prior, &b);
+    /* the best box whose four sides all (but one) contrast with it (a band-shaped box is
+     * refused); only if there is none, the best box */
+    for (int sides = sides_test; sides >= 0; sides--) {
+        b = (box_hit){ -1e30f, 0, 0, 0, 0, 0 };
+        box_search(d, ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, p->centre_prior, sides, &b);
+        if (b.score > -1e30f)
+            break;
+    }
     if (b.score <= -1e30f)
         return c;
     if (f > 1) { /* refine on F around C's answer */
         const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
         box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
         integral(d, work, sw, sh, ii);
-        box_search(d, ii, sw, sh, fv_maxi(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f, &bf); /* no prior: it would bias the position */
+        box_search(d, ii, sw, sh, fv_maxi(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f,
+                   0, &bf); /* no prior: it would bias the position */
         if (bf.score > -1e30f)
             b = bf;
         else

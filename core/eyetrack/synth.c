@@ -227,6 +227,62 @@ static float gauss(uint64_t *st)
     return sqrtf(-2.0f * logf(u1)) * cosf((float)(2.0 * M_PI) * u2);
 }
 
+void fv_synth_specs_default(fv_synth_specs *sp)
+{
+    memset(sp, 0, sizeof *sp);
+    sp->on = 1;
+    sp->transmit = 0.85f;
+    sp->refl_scale = 0.45f;
+    sp->refl_r_mm = 0.9f;
+    sp->refl_level = 250.0f;
+    sp->rim_y_mm = -8.0f;
+    sp->rim_curve = 0.01f;
+    sp->rim_half_mm = 1.2f;
+    sp->rim_grey = 40.0f;
+}
+
+static void refl_centre(const fv_synth_params *p, int k, float *cx, float *cy) /* camera-plane mm */
+{
+    const fv_synth_specs *sp = &p->specs;
+    const float a = (float)(2.0 * M_PI * (k + 0.5) / p->n_leds) + 0.3f;
+    *cx = sp->refl_scale * p->led_ring_mm * cosf(a) + sp->refl_dx_mm;
+    *cy = sp->refl_scale * p->led_ring_mm * sinf(a) * 0.6f + sp->refl_dy_mm;
+}
+
+void fv_synth_specs_reflection(const fv_synth_params *p, int k, float *x, float *y, float *r_px)
+{
+    float cx, cy;
+    refl_centre(p, k, &cx, &cy);
+    *x = cx * p->px_per_mm + 0.5f * p->w;
+    *y = -cy * p->px_per_mm + 0.5f * p->h;
+    *r_px = p->specs.refl_r_mm * p->px_per_mm;
+}
+
+/* pass 0: the lens's tint and the rim over the eye's radiance v at camera-plane point (x, y) mm;
+ * pass 1: the LED reflections on the lens (after the corneal glints: the lens is in front) */
+static float specs_over(const fv_synth_params *p, float v, float x, float y, int pass)
+{
+    const fv_synth_specs *sp = &p->specs;
+    const float rim = sp->rim_y_mm + sp->rim_curve * x * x;
+    const int above = sp->rim_y_mm < 0; /* a rim below the eye: the lens is above it, and vice versa */
+    const int in_lens = above ? y > rim + sp->rim_half_mm : y < rim - sp->rim_half_mm;
+    if (pass == 0) {
+        if (fabsf(y - rim) <= sp->rim_half_mm)
+            return sp->rim_grey * p->brightness;
+        return in_lens ? v * sp->transmit : v;
+    }
+    if (!in_lens)
+        return v;
+    for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
+        float cx, cy;
+        refl_centre(p, k, &cx, &cy);
+        const float d = hypotf(x - cx, (y - cy) * 1.3f) / sp->refl_r_mm; /* slightly elongated */
+        if (d < 1.4f) /* a flat-topped disc with a soft edge: a flat mirror's image of the LED */
+            v = fmaxf(v, sp->refl_level * (d < 1.0f ? 1.0f : 1.0f - (d - 1.0f) / 0.4f));
+    }
+    return v;
+}
+
 void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t noise_seed, uint8_t *img,
                      ptrdiff_t stride, fv_synth_truth *t)
 {
@@ -248,6 +304,8 @@ void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t
                                  -(py - 0.5f * p->h) * inv + p->cam_shift_mm[1]);
                 }
             float v = acc / (float)(ss * ss);
+            if (p->specs.on) /* spectacles, fixed to the camera: camera image-plane mm */
+                v = specs_over(p, v, (i + 0.5f - 0.5f * p->w) * inv, -(j + 0.5f - 0.5f * p->h) * inv, 0);
             for (int k = 0; k < p->n_leds && k < FV_SYNTH_MAX_LEDS; k++) {
                 if (!t->glint_visible[k])
                     continue;
@@ -256,6 +314,8 @@ void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t
                 if (d2 < 25.0f * gsig * gsig)
                     v += 400.0f * expf(-d2 / (2.0f * gsig * gsig));
             }
+            if (p->specs.on) /* the lens's own reflections, over everything behind it */
+                v = specs_over(p, v, (i + 0.5f - 0.5f * p->w) * inv, -(j + 0.5f - 0.5f * p->h) * inv, 1);
             v += p->noise_sigma * gauss(&st);
             row[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : lrintf(v));
         }
@@ -315,4 +375,21 @@ void fv_synth_script_state(const fv_synth_script *sc, double t_ms, fv_synth_stat
         else if (d >= 80 && d < 200)
             s->open = fminf(s->open, (float)((d - 80.0) / 120.0));
     }
+}
+
+void fv_synth_specs_set_frame(uint64_t *rng, int i, fv_synth_params *p, fv_synth_state *s)
+{
+    fv_synth_lid_set_frame(rng, i, p, s);
+    fv_synth_specs_default(&p->specs);
+    fv_synth_specs *sp = &p->specs;
+    sp->transmit = 0.7f + 0.25f * uniform(rng);
+    sp->refl_scale = 0.3f + 0.4f * uniform(rng);
+    sp->refl_dx_mm = -7.0f + 14.0f * uniform(rng);
+    sp->refl_dy_mm = -5.0f + 10.0f * uniform(rng);
+    sp->refl_r_mm = 0.6f + 0.8f * uniform(rng);
+    const float depth = 3.0f + 6.0f * uniform(rng);
+    sp->rim_y_mm = i % 3 == 2 ? depth + 4.0f : -depth;
+    sp->rim_curve = (uniform(rng) - 0.3f) * 0.03f;
+    sp->rim_half_mm = 0.8f + 1.2f * uniform(rng);
+    sp->rim_grey = 25.0f + 40.0f * uniform(rng);
 }

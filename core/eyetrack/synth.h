@@ -17,6 +17,19 @@
 
 #define FV_SYNTH_MAX_LEDS 6
 
+/* Spectacles between the eye and the camera (they move with the headset, i.e. the camera):
+ * the lens dims the eye (transmit), each LED leaves a large reflection on the lens surface at a
+ * place fixed in the camera image (LED ring x refl_scale + offset, radius refl_r_mm, level
+ * refl_level; they do not move with the eye, unlike corneal glints), and the frame's rim crosses
+ * the image as a dark curved band y = rim_y_mm + rim_curve x^2 (mm, camera image plane, y up),
+ * rim_half_mm thick either side, grey rim_grey; the lens is above the rim (outside it, no tint). */
+typedef struct fv_synth_specs {
+    int on;
+    float transmit;
+    float refl_scale, refl_dx_mm, refl_dy_mm, refl_r_mm, refl_level;
+    float rim_y_mm, rim_curve, rim_half_mm, rim_grey;
+} fv_synth_specs;
+
 typedef struct fv_synth_params {
     int w, h;
     float px_per_mm;     /* image scale */
@@ -29,7 +42,16 @@ typedef struct fv_synth_params {
     uint64_t seed;       /* iris texture and lash pattern (the subject) */
     float cam_shift_mm[2]; /* the camera and its LED ring displaced from the nominal place (x right, y up):
                               a headset slipping on the face; default 0 */
+    fv_synth_specs specs;  /* off by default */
 } fv_synth_params;
+
+/* Plausible spectacles (on): transmit 0.85, reflections 0.9 mm at 0.45 x the LED ring, rim 8 mm
+ * below the eye's centre, 1.2 mm either side, grey 40. */
+void fv_synth_specs_default(fv_synth_specs *sp);
+/* Where LED k's reflection on the spectacle lens is centred in the image (pixels, corner origin),
+ * and its radius in pixels. */
+void fv_synth_specs_reflection(const fv_synth_params *p, int k, float *x, float *y, float *r_px);
+
 
 typedef struct fv_synth_state {
     float yaw_deg, pitch_deg; /* gaze: + yaw = towards +x of the image, + pitch = up */
@@ -59,6 +81,11 @@ void fv_synth_render(const fv_synth_params *p, const fv_synth_state *s, uint64_t
  * into a lid opened 0.35-0.65, even i pitch +-10 deg with the lids open. Sets p's noise_sigma,
  * brightness and n_leds, and *s. */
 void fv_synth_lid_set_frame(uint64_t *rng, int i, fv_synth_params *p, fv_synth_state *s);
+/* Frame i of the "spectacle set" (measured by tools/eval_eye --specs): the lid set's poses
+ * (fv_synth_lid_set_frame) seen through spectacles whose reflections sit anywhere within 7 mm
+ * of the camera axis (often on or beside the pupil), whose rim runs 3-9 mm below or above the
+ * eye's centre (every third frame above), tilted and curved at random, transmitting 0.7-0.95. */
+void fv_synth_specs_set_frame(uint64_t *rng, int i, fv_synth_params *p, fv_synth_state *s);
 
 /* A scripted wearer following a schedule of targets (a calibration run): target k is shown from
  * k * dwell_ms on; the eye stays on the previous one for reaction_ms, makes a saccade of

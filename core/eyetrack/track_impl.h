@@ -51,7 +51,7 @@ typedef struct fv_et_candidate {
 } fv_et_candidate;
 
 fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
-                             ptrdiff_t stride, const fv_et_scratch *s);
+                             ptrdiff_t stride, const fv_et_scratch *s, int sides);
 
 /* ---- glints.c */
 
