@@ -154,6 +154,10 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
     case FV_OPT_CHROMA:
         cfg->dof.chroma = fv_arg_onoff(prog, "--chroma", arg);
         return 1;
+    case FV_OPT_SAMPLING: /* issue 15 item 3: Liu's polar sampler */
+        if (fv_sampler_kind_parse(arg, &cfg->samp.kind))
+            fv_usage_error(prog, "--sampling: '%s' is not one of weier, liu", arg);
+        return 1;
     }
     return 0;
 }
