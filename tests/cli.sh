@@ -54,6 +54,7 @@ for p in fovea-replay fovea-bench; do
     expect_usage "$p bad taa-fill" '--taa-fill: .yes. is not one of on, off' $B/$p --scene $SCENE $O --taa-fill yes
     expect_usage "$p bad pattern" '--pattern: .spiral. is not one of rotate, static' $B/$p --scene $SCENE $O --pattern spiral
     expect_usage "$p bad sampling" '--sampling: .polar. is not one of weier, liu' $B/$p --scene $SCENE $O --sampling polar
+    expect_usage "$p bad liu density" '--liu-density 0.5: must be 0' $B/$p --scene $SCENE $O --sampling liu --liu-density 0.5
     if $B/$p --help >"$T/help" 2>&1 && grep -q -- --scene "$T/help"; then ok; else bad "$p --help"; fi
 done
 [ ! -e "$T/o1" ] && ok || bad "bad input left output directory $T/o1 behind"
