@@ -161,7 +161,7 @@ static double match_count(double ppd, int w, int h, long target)
 {
     const int cx = w / 2, cy = h / 2;
     const double q = 4.0; /* histogram bins per pixel of radius */
-    const int nb = (int)(q * sqrt((double)cx * cx + (double)cy * cy + (double)w * w + (double)h * h)) + 2;
+    const int nb = (int)(q * sqrt((double)cx * cx + (double)cy * cy)) + 2; /* cx >= w - 1 - cx */
     long *hist = calloc((size_t)nb, sizeof *hist);
     double *rel = malloc((size_t)nb * sizeof *rel);
     uint64_t *bits = malloc((size_t)h * ((w + 63) / 64) * sizeof *bits);
