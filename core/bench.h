@@ -24,7 +24,7 @@ typedef struct fv_bench_run {
     double stage_mean[FV_STAGE_COUNT]; /* ms; NAN: the stage is not built */
     double total_mean, total_median;   /* ms */
     double mrays;                      /* samples over the mean ray-tracing time */
-    const char *sampler;               /* the sampling pattern: "weier" (Weier et al. 2018) */
+    const char *sampler;               /* the sampling pattern, fv_sampler_names: "weier" | "liu" */
     double ceiling_ms;                 /* mean bare-Embree time of the same rays (core/ceiling.h); NAN: not run */
     double ceiling_mrays;              /* samples over ceiling_ms */
     int counters;                      /* hardware counters were read */

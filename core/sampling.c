@@ -1,10 +1,23 @@
 #include "sampling.h"
+#include "sampling_liu.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define PI_D 3.14159265358979323846
+
+const char *const fv_sampler_names[FV_SAMPLER_KIND_COUNT] = {"weier", "liu"};
+
+int fv_sampler_kind_parse(const char *name, int *kind)
+{
+    for (int k = 0; k < FV_SAMPLER_KIND_COUNT; k++)
+        if (!strcmp(name, fv_sampler_names[k])) {
+            *kind = k;
+            return 0;
+        }
+    return -1;
+}
 
 void fv_sampling_params_default(fv_sampling_params *p)
 {
@@ -13,6 +26,8 @@ void fv_sampling_params_default(fv_sampling_params *p)
     p->p_min = 0.2f;
     p->full = 0;
     p->rotate = 0;
+    p->kind = FV_SAMPLER_WEIER;
+    p->liu_density = 0.0f;
 }
 
 float fv_sampling_radius(const fv_sampling_params *p, float u)
@@ -53,7 +68,8 @@ int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const 
     memset(s, 0, sizeof *s);
     if (width < 1 || height < 1 || !(focal_px > 0.0f))
         return -1;
-    if (!(p->r0_deg > 0.0f && p->r0_deg <= p->r1_deg && p->r1_deg <= 90.0f && p->p_min > 0.0f && p->p_min <= 1.0f))
+    if (!(p->r0_deg > 0.0f && p->r0_deg <= p->r1_deg && p->r1_deg <= 90.0f && p->p_min > 0.0f && p->p_min <= 1.0f) ||
+        (unsigned)p->kind >= FV_SAMPLER_KIND_COUNT)
         return -1;
     s->prm = *p;
     s->width = width;
@@ -70,6 +86,13 @@ int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const 
         K = K < 1 ? 1 : K > FV_SAMPLER_MAX_PHASES ? FV_SAMPLER_MAX_PHASES : K;
     }
     s->phases = K;
+    if (p->kind == FV_SAMPLER_LIU) {
+        if (fv_sampler_liu_init(s, focal_px)) {
+            fv_sampler_free(s);
+            return -1;
+        }
+        return 0;
+    }
     int side = 2 * s->rin + 1;
     s->in_stride = (side + 63) / 64;
     s->out_stride = (width + 63) / 64;
@@ -131,6 +154,8 @@ float fv_sampler_probability(const fv_sampler *s, float dx_px, float dy_px)
 {
     if (s->prm.full)
         return 1.0f;
+    if (s->prm.kind == FV_SAMPLER_LIU)
+        return fv_sampler_liu_probability(s, dx_px, dy_px);
     float r_px = sqrtf(dx_px * dx_px + dy_px * dy_px);
     if (r_px < s->r0_px)
         return 1.0f;
@@ -163,6 +188,12 @@ uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int g
     if (s->prm.full)
         return all;
     const int k = (phase % s->phases + s->phases) % s->phases;
+    if (s->prm.kind == FV_SAMPLER_LIU) { /* one table around the gaze (sampling_liu.c) */
+        const int cx = gx < 0 ? 0 : gx >= s->width ? s->width - 1 : gx;
+        const int cy = gy < 0 ? 0 : gy >= s->height ? s->height - 1 : gy;
+        const uint64_t *row = s->s_in + ((size_t)k * (2 * s->height - 1) + (size_t)(y - cy + s->height - 1)) * s->in_stride;
+        return get_bits(row, s->in_stride, x0 - cx + s->width - 1, n);
+    }
     uint64_t out = get_bits(s->s_out + ((size_t)k * s->height + y) * s->out_stride, s->out_stride, x0, n);
     int dy = y - gy;
     if (dy < -s->rin || dy > s->rin)

@@ -1,4 +1,5 @@
-/* fovea: acuity-driven sampling pattern (Weier et al. 2018, section 3.1).
+/* fovea: acuity-driven sampling pattern (Weier et al. 2018, section 3.1; or Liu et al.'s polar
+ * pattern, core/sampling_liu.c, selected by fv_sampling_params.kind).
  * Two precomputed bit tables: S_in, centred on the point of regard and moved with it (probability
  * 1 inside r0, importance-sampled with eq. (1)-(2) from a Halton sequence in r0..r1), and S_out,
  * a static uniform pattern of probability p_min for the periphery (static so it does not flicker).
@@ -9,6 +10,16 @@
 
 #include <stdint.h>
 
+/* Which pattern: the values index fv_sampler_names (the --sampling flag, the bench's "sampler"). */
+typedef enum fv_sampler_kind {
+    FV_SAMPLER_WEIER = 0, /* S_in / S_out, Weier et al. 2018 */
+    FV_SAMPLER_LIU,       /* polar-space acuity sampling, Liu et al. eq. 1-3 (sampling_liu.h) */
+    FV_SAMPLER_KIND_COUNT
+} fv_sampler_kind;
+extern const char *const fv_sampler_names[FV_SAMPLER_KIND_COUNT];
+/* "weier" or "liu" -> *kind; 0 on success, -1 for any other name. */
+int fv_sampler_kind_parse(const char *name, int *kind);
+
 typedef struct fv_sampling_params {
     float r0_deg;  /* fully sampled fovea radius, default 10 */
     float r1_deg;  /* end of the transition region, default 20 */
@@ -18,6 +29,12 @@ typedef struct fv_sampling_params {
      * reprojection accumulates them: static content converges to every pixel sampled);
      * 0: one static pattern, as in Weier et al. (nothing new to accumulate). */
     int rotate;
+    int kind;      /* fv_sampler_kind, default FV_SAMPLER_WEIER */
+    /* Liu only: samples per pixel of the polar grid where eq. 1 is flat (lambda_0 in
+     * sampling_liu.h), 1..1e4; 0 (default): chosen so the pattern casts as many rays as Weier's
+     * pattern with the same r0, r1, p_min for the gaze at the image centre (equal ray counts;
+     * at least 1, a fully sampled fovea). */
+    float liu_density;
 } fv_sampling_params;
 
 typedef struct fv_sampler {
@@ -35,6 +52,14 @@ typedef struct fv_sampler {
      * S_out phase k is the lattice shifted by k/K (so K >= 1/p_min phases cover every pixel),
      * S_in phase k takes the k-th block of transition_points Halton points. */
     int phases;
+    /* Liu (kind FV_SAMPLER_LIU): s_in holds phases tables of (2 width - 1) x (2 height - 1)
+     * bits, offsets -(width-1)..width-1 around the gaze, in_stride words a row; s_out is unused.
+     * r0_px, r1_px are still the parameters' (they mark the fovea for DoF and the metrics). */
+    double liu_l0;        /* lambda_0 in force (given or matched to Weier's ray count) */
+    int liu_nphi;         /* polar grid: samples per ring */
+    double liu_drho;      /* polar grid: ring spacing in eq. 2's units (deg^2) */
+    double liu_sat_px;    /* every pixel closer than this is sampled (lambda >= 1) */
+    long liu_target;      /* Weier's ray count it was matched to (0: liu_density was given) */
 } fv_sampler;
 
 #define FV_SAMPLER_MAX_PHASES 16
@@ -53,12 +78,13 @@ float fv_sampling_transition_density(const fv_sampling_params *p, float r_deg);
 
 /* Sampling bits of the n <= 64 pixels x0..x0+n-1 of row y (bit i = pixel x0+i) for the point of
  * regard at pixel (gx, gy) (integer pixel the pattern is centred on), in pattern phase
- * `phase` (taken modulo s->phases; 0 for a static pattern). */
+ * `phase` (taken modulo s->phases; 0 for a static pattern). Liu: a gaze outside the image is
+ * clamped to its nearest pixel (the table reaches every pixel from any pixel). */
 uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy, int phase);
 
 /* The acuity model's sampling probability per frame at pixel offset (dx, dy) from the point of
  * regard: 1 inside r0, eq. (1)'s density lambda(r) (clamped to [p_min, 1]) in r0..r1, p_min
- * outside; 1 everywhere with full. */
+ * outside; 1 everywhere with full. Liu: min(1, lambda(eccentricity)) of sampling_liu.h. */
 float fv_sampler_probability(const fv_sampler *s, float dx_px, float dy_px);
 
 #endif

@@ -38,6 +38,7 @@ int fv_bench_run_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, c
         fv_pipeline_destroy(pl);
         return fv_err(err, err_len, "out of memory");
     }
+    r->sampler = fv_sampler_names[cfg.samp.kind]; /* full mode: the pattern its foveated twin uses */
     /* counters: opened after the pool started, so every worker thread is counted */
     fv_perfctr *pc = NULL;
     fv_bench_ctrs cs;

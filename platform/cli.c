@@ -155,6 +155,15 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
     case FV_OPT_CHROMA:
         cfg->dof.chroma = fv_arg_onoff(prog, "--chroma", arg);
         return 1;
+    case FV_OPT_SAMPLING: /* issue 15 item 3: Liu's polar sampler */
+        if (fv_sampler_kind_parse(arg, &cfg->samp.kind))
+            fv_usage_error(prog, "--sampling: '%s' is not one of weier, liu", arg);
+        return 1;
+    case FV_OPT_LIU_DENSITY:
+        cfg->samp.liu_density = fv_arg_float(prog, "--liu-density", arg, 0.0f, 1e4f);
+        if (cfg->samp.liu_density > 0.0f && cfg->samp.liu_density < 1.0f)
+            fv_usage_error(prog, "--liu-density %s: must be 0 (Weier's ray count) or at least 1 (a full fovea)", arg);
+        return 1;
     }
     return 0;
 }

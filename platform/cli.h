@@ -29,6 +29,7 @@ enum {
     FV_OPT_DOF, FV_OPT_DOF_MODEL, FV_OPT_REPROJECT, FV_OPT_TAA_ALPHA, FV_OPT_TAA_TOL, FV_OPT_TAA_FILL,
     FV_OPT_PATTERN, FV_OPT_FOCUS_M, FV_OPT_PUPIL_MM, FV_OPT_GAZE_ERR, FV_OPT_DOF_TOL, FV_OPT_ACCOMMODATION,
     FV_OPT_CONTRAST, FV_OPT_CHROMA,
+    FV_OPT_SAMPLING, FV_OPT_LIU_DENSITY,
 };
 #define FV_COMMON_LONGOPTS                                                                     \
     {"size", required_argument, 0, FV_OPT_SIZE}, {"threads", required_argument, 0, FV_OPT_THREADS}, \
@@ -42,7 +43,8 @@ enum {
     {"pupil-mm", required_argument, 0, FV_OPT_PUPIL_MM}, {"gaze-error-deg", required_argument, 0, FV_OPT_GAZE_ERR}, \
     {"dof-tolerance-m", required_argument, 0, FV_OPT_DOF_TOL},                                   \
     {"accommodation-ms", required_argument, 0, FV_OPT_ACCOMMODATION},                            \
-    {"contrast-gain", required_argument, 0, FV_OPT_CONTRAST}, {"chroma", required_argument, 0, FV_OPT_CHROMA}
+    {"contrast-gain", required_argument, 0, FV_OPT_CONTRAST}, {"chroma", required_argument, 0, FV_OPT_CHROMA}, \
+    {"sampling", required_argument, 0, FV_OPT_SAMPLING}, {"liu-density", required_argument, 0, FV_OPT_LIU_DENSITY}
 #define FV_COMMON_HELP                                                                             \
     "  --size WxH         eye image size in pixels (default 1280x1440)\n"                          \
     "  --fov DEG          vertical field of view (default 100)\n"                                  \
@@ -55,6 +57,10 @@ enum {
     "  --taa-alpha A      minimum weight of a new sample per frame of history (default 0.3)\n"  \
     "  --taa-depth-tol F  relative depth difference that rejects history (default 0.03)\n"     \
     "  --taa-fill on|off  fill pixels without a sample from valid history (default on)\n"      \
+    "  --sampling weier|liu  sampling pattern: Weier's S_in/S_out (default) or Liu's polar\n"  \
+    "                     acuity grid (eq. 1-3), at Weier's ray count for r0, r1, pmin\n"     \
+    "  --liu-density L    liu: samples per pixel where eq. 1 is flat (>= 1; default 0 =\n"      \
+    "                     Weier's ray count for the gaze at the centre)\n"                      \
     "  --pattern rotate|static   sampling pattern over frames (default rotate with\n"          \
     "                     reprojection; static always without it)\n"                           \
     "  --threads N        worker threads (default: online CPUs)\n"                                 \

@@ -53,6 +53,8 @@ for p in fovea-replay fovea-bench; do
     expect_usage "$p bad taa-alpha" '--taa-alpha: 0 is out of range' $B/$p --scene $SCENE $O --taa-alpha 0
     expect_usage "$p bad taa-fill" '--taa-fill: .yes. is not one of on, off' $B/$p --scene $SCENE $O --taa-fill yes
     expect_usage "$p bad pattern" '--pattern: .spiral. is not one of rotate, static' $B/$p --scene $SCENE $O --pattern spiral
+    expect_usage "$p bad sampling" '--sampling: .polar. is not one of weier, liu' $B/$p --scene $SCENE $O --sampling polar
+    expect_usage "$p bad liu density" '--liu-density 0.5: must be 0' $B/$p --scene $SCENE $O --sampling liu --liu-density 0.5
     if $B/$p --help >"$T/help" 2>&1 && grep -q -- --scene "$T/help"; then ok; else bad "$p --help"; fi
 done
 [ ! -e "$T/o1" ] && ok || bad "bad input left output directory $T/o1 behind"
@@ -144,6 +146,22 @@ for f in frame_00000.png frame_00001.png frame_00002.png; do
         if cmp -s "$T/d1/$f" "$T/$d/$f"; then ok; else bad "$f differs between d1 and $d"; fi
     done
 done
+# Liu's polar sampler (issue 15 item 3): the same bytes for 1 and 5 threads, not Weier's frames,
+# and the bench names it and its rays agree with the ceiling's
+for th in 1 5; do
+    $R --scene $SCENE --trace assets/gaze_sweep.csv --frames 3 --size 160x180 --threads $th --sampling liu \
+        --out "$T/l$th" --quiet 2>"$T/err" || bad "replay --sampling liu --threads $th failed: $(cat "$T/err")"
+done
+for f in frame_00000.png frame_00002.png; do
+    cmp -s "$T/l1/$f" "$T/l5/$f" && ok || bad "--sampling liu: $f differs between 1 and 5 threads"
+    cmp -s "$T/l1/$f" "$T/d1/$f" && bad "--sampling liu: $f is Weier's" || ok
+done
+if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --threads 2 --ceiling --sampling liu \
+    --json "$T/l.json" >/dev/null 2>"$T/err"; then
+    [ "$(grep -c '"sampler": "liu"' "$T/l.json")" = 2 ] && ok || bad "--sampling liu bench JSON: $(cat "$T/l.json")"
+else
+    bad "--sampling liu bench failed: $(cat "$T/err")"
+fi
 # --reference: same files and header; the stage columns are empty, total_ms is the render time,
 # samples = (SPP + 1 depth ray) per pixel; a zero pupil at SPP 1 is the full pinhole render;
 # same bytes for 1 and 2 threads
