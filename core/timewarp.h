@@ -30,3 +30,29 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
 #define FV_TW_INVD_PAD 4
 
 #endif
+
+/* ---- a rendered stereo frame kept for the warp (one mailbox slot of the headset) ---- */
+struct fv_pipeline;
+typedef struct fv_tw_frame {
+    int w, h;               /* per eye */
+    uint8_t *rgb[2];        /* left, right: display bytes, w * 3 a row, FV_TW_RGB_PAD past the end */
+    uint16_t *invd[2];      /* w a row, FV_TW_INVD_PAD bytes past the end */
+    fv_camera cam[2];       /* the cameras they were rendered from */
+} fv_tw_frame;
+
+int fv_tw_frame_alloc(fv_tw_frame *f, int w, int h); /* 0, or -1 out of memory */
+void fv_tw_frame_free(fv_tw_frame *f);
+/* After fv_pipeline_render of eye e (0 left, 1 right): keep its display bytes, inverse depth and
+ * camera. */
+void fv_tw_frame_capture(fv_tw_frame *f, const struct fv_pipeline *pl, int e);
+/* Warps eye e of f to camera `display` (same size, no lens) into dst (rows of dst_stride bytes).
+ * Returns the disoccluded pixels. */
+long fv_tw_frame_warp(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, const fv_camera *display, uint8_t *dst,
+                      ptrdiff_t dst_stride, float tol);
+
+/* The warp's image quality: luma PSNR (dB) of `warped` against `ref` (a frame rendered directly
+ * at the display camera), both w x h 8-bit RGB rows of w * 3 bytes, over the pixels the warp
+ * (map m, source src) did not fill as disocclusions; *disocc_frac gets the disoccluded fraction.
+ * INFINITY when identical, NAN when every pixel is disoccluded or out of memory. */
+double fv_tw_psnr_outside_holes(const uint8_t *warped, const uint8_t *ref, const fv_tw_map *m, const fv_tw_src *src,
+                                double *disocc_frac);
