@@ -26,8 +26,8 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
                      const fv_tw_src *src);
 
 /* Bytes a plane must have past its last pixel / element for the kernels' word reads. */
-#define FV_TW_RGB_PAD 4
-#define FV_TW_INVD_PAD 4
+#define FV_TW_RGB_PAD 16
+#define FV_TW_INVD_PAD 32
 
 #endif
 

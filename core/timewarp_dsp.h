@@ -16,9 +16,10 @@
  *   background beside the hole, not the foreground that hid it). Colour: bilinear tap of the
  *   source's 8-bit RGB with 7-bit weights, integer arithmetic (fv_tw_pixel has the formula).
  *   Coordinates outside the source clamp to its edge. Returns the number of disoccluded pixels.
- *   Reads: src->rgb rows as 32-bit words (3 bytes + 1 past each pixel: the plane must be
- *   readable 1 byte past its last pixel), src->invd as 32-bit words (readable 2 bytes past its
- *   last element); h * stride must stay below 2^31 (bytes for rgb, elements for invd).
+ *   Reads: src->rgb up to 16 bytes past a pixel (the plane must be readable 16 bytes past its
+ *   last pixel, FV_TW_RGB_PAD), src->invd up to 15 elements past one (readable 32 bytes past its
+ *   last element, FV_TW_INVD_PAD); h * stride must stay below 2^31 (bytes for rgb, elements for
+ *   invd).
  *   Every ISA version gives the reference's bytes and count (the float steps are the same IEEE
  *   operations in the same order, true division, no FMA; the colour is integer). */
 #ifndef FOVEA_TIMEWARP_DSP_H
