@@ -91,10 +91,11 @@ typedef struct app {
     long display_failures;
     long frame;        /* frames rendered (the frame loop's numbering) */
     int render_failed; /* a render failed: the run ends with status 1 */
-    /* head pose: the trace read as a 1 kHz pose source, predicted to the photon time */
-    fv_posepred pp;
-    pthread_mutex_t pp_mu;
-    int64_t pp_fed_ns;
+    /* head pose: the trace read as a 1 kHz pose source, predicted to the photon time; one
+     * predictor per thread (0: the display's or the serial loop's, 1: the renderer's), so the
+     * display never waits on a lock the renderer holds (it runs above it) */
+    fv_posepred pp[2];
+    int64_t pp_fed_ns[2];
     int64_t head_t_ns;  /* the pose sample of the frame being rendered (timewarp off) */
     fv_pose head_pred;  /* its prediction */
     /* --timewarp on */
@@ -152,26 +153,25 @@ static void head_true(const app *a, int64_t t_ns, fv_pose *out)
     fv_trace_at(a->trace, trace_t_ms(a, t_ns), &ts);
     *out = ts.head;
 }
-/* Feeds the pose source's 1 kHz samples up to now and predicts the pose at photon_ns; returns
- * the newest sample's time (the start of motion-to-photon). Both threads call it. */
-static int64_t head_latch(app *a, int64_t now, int64_t photon_ns, fv_pose *out)
+/* Feeds thread `th`'s predictor the pose source's 1 kHz samples up to now and predicts the pose
+ * at photon_ns; returns the newest sample's time (the start of motion-to-photon). */
+static int64_t head_latch(app *a, int th, int64_t now, int64_t photon_ns, fv_pose *out)
 {
     if (!has_head(a)) {
         *out = a->view;
         return now; /* a fixed head, sampled now */
     }
-    pthread_mutex_lock(&a->pp_mu);
-    int64_t t = a->pp_fed_ns && a->pp_fed_ns > now - 20000000 ? a->pp_fed_ns + 1000000 : now - 20000000;
+    const int64_t fed = a->pp_fed_ns[th];
+    int64_t t = fed && fed > now - 20000000 ? fed + 1000000 : now - 20000000;
     for (; t <= now; t += 1000000) {
         fv_pose p;
         head_true(a, t, &p);
-        fv_posepred_push(&a->pp, t, &p);
-        a->pp_fed_ns = t;
+        fv_posepred_push(&a->pp[th], t, &p);
+        a->pp_fed_ns[th] = t;
     }
     int64_t ts = now;
-    if (!fv_posepred_predict(&a->pp, photon_ns, out, &ts))
+    if (!fv_posepred_predict(&a->pp[th], photon_ns, out, &ts))
         *out = a->view;
-    pthread_mutex_unlock(&a->pp_mu);
     return ts;
 }
 static void a_sample_gaze(void *c, int64_t now)
@@ -201,7 +201,7 @@ static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
     if (stop_requested || fv_time_ns() >= a->end_ns || (a->disp && fv_display_quit_requested(a->disp)))
         return -1;
     fv_pose head; /* sampled now, predicted to the photon time */
-    a->head_t_ns = head_latch(a, fv_time_ns(), t_ns, &head);
+    a->head_t_ns = head_latch(a, 0, fv_time_ns(), t_ns, &head);
     a->head_pred = head;
     const float gx = g ? g->x : 0.5f, gy = g ? g->y : 0.5f;
     /* the focus filter accommodates in photon time; a doubtful gaze widens the fovea */
@@ -271,7 +271,7 @@ static void *render_main(void *arg)
          * corrects the rest) */
         const int64_t aim = start + last_ns + period;
         fv_pose head;
-        head_latch(a, start, aim, &head);
+        head_latch(a, 1, start, aim, &head);
         fv_pipeline_set_time_ns(a->pl, aim);
         if (fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(hg ? g.confidence : 0.0f)) && !a->reported_scale) {
             fprintf(stderr, "%s: no memory to widen the fovea for a doubtful gaze; keeping its size\n", prog);
@@ -318,7 +318,7 @@ static int a_compose(void *c, int64_t vsync_ns, fv_refresh_record *rec)
     if (s < 0)
         return 0; /* nothing rendered yet: the panel keeps what it shows */
     rec->frame = seq;
-    rec->head_t_ns = head_latch(a, now, vsync_ns, &a->head_pred);
+    rec->head_t_ns = head_latch(a, 0, now, vsync_ns, &a->head_pred);
     rec->has_gaze = a->meta[s].has_gaze;
     rec->gaze_t_ns = a->meta[s].g.t_ns;
     rec->gaze_x = a->meta[s].g.x;
@@ -435,8 +435,8 @@ int main(int argc, char **argv)
     }
     app a = {0};
     a.trace = trace_path ? &tr : NULL;
-    fv_posepred_init(&a.pp, 8000000, 50000000);
-    pthread_mutex_init(&a.pp_mu, NULL);
+    for (int k = 0; k < 2; k++)
+        fv_posepred_init(&a.pp[k], 8000000, 50000000);
     a.W = cfg.cam.width;
     a.H = cfg.cam.height;
     if (fv_vsync_open(&a.vsync, vsync_spec, err, sizeof err))
@@ -647,7 +647,7 @@ int main(int argc, char **argv)
     } else {
         const long skip = nrr > 40 ? 20 : 0;
         fv_display_summary s;
-        fv_display_summarise(rr + skip, nrr - skip, 2.0 * a.W * a.H, &s);
+        fv_display_summarise(rr + skip, nrr - skip, 2.0 * a.W * a.H, period, &s);
         /* rendered frames completed within the summarised photon span */
         long rendered = 0;
         double rhz = NAN, rp50 = NAN, rp99 = NAN;
@@ -669,8 +669,9 @@ int main(int argc, char **argv)
                 free(v);
             }
         }
+        /* late: vsyncs without a newly composed image (composed after its vsync, or skipped) */
         printf("fovea-headset: displayed %ld frames (%.2f Hz), rendered %ld frames (%.2f Hz), late %ld\n", s.displayed,
-               s.displayed_hz, rendered, rhz, s.late);
+               s.displayed_hz, rendered, rhz, s.missed);
         printf("  %ld refreshes in %.2f s (%ld frames rendered in all), %dx%d per eye, vsync %s (%.2f Hz nominal), "
                "display %s, timewarp on, display thread %s\n",
                nrr, run_s, a.ndone, a.W, a.H, vsync_spec, run_hz, disp_kind, prio);
@@ -679,6 +680,9 @@ int main(int argc, char **argv)
         printf("; ");
         summary_line("gaze-to-photon", s.g2p_p50_ms, s.g2p_p99_ms);
         printf("\n");
+        printf("  late: %ld refreshes composed after their vsync, %ld vsyncs skipped (a composition longer than a "
+               "period)\n",
+               s.late, s.skipped);
         printf("  reused %ld refreshes (an old frame warped again); render p50 %.2f ms, p99 %.2f ms; warp+present "
                "p50 %.2f ms, p99 %.2f ms; frame age at the photons p50 %.2f ms; disoccluded %.3f %% of pixels\n",
                s.reused, rp50, rp99, s.compose_p50_ms, s.compose_p99_ms, s.age_p50_ms, 100.0 * s.disoccluded_frac);
@@ -732,6 +736,5 @@ done:
         fv_tw_frame_free(&a.slot[k]);
     free(a.done_ns);
     free(a.render_ms);
-    pthread_mutex_destroy(&a.pp_mu);
     return status;
 }

@@ -9,7 +9,15 @@ int fv_mailbox_init(fv_frame_mailbox *m)
     memset(m->seq, 0, sizeof m->seq);
     m->newest = m->reading = m->writing = -1;
     m->published = 0;
-    return pthread_mutex_init(&m->mu, NULL) ? -1 : 0;
+    /* priority inheritance: the display thread runs above the renderer, which must not hold it
+     * up while preempted inside the lock */
+    pthread_mutexattr_t at;
+    if (pthread_mutexattr_init(&at))
+        return -1;
+    pthread_mutexattr_setprotocol(&at, PTHREAD_PRIO_INHERIT); /* best effort */
+    const int rc = pthread_mutex_init(&m->mu, &at);
+    pthread_mutexattr_destroy(&at);
+    return rc ? -1 : 0;
 }
 
 void fv_mailbox_destroy(fv_frame_mailbox *m) { pthread_mutex_destroy(&m->mu); }
@@ -190,7 +198,8 @@ double fv_percentile(double *v, long n, double p)
     return v[i];
 }
 
-void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refresh, fv_display_summary *s)
+void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refresh, int64_t period_ns,
+                          fv_display_summary *s)
 {
     memset(s, 0, sizeof *s);
     s->displayed_hz = s->mtp_p50_ms = s->mtp_p99_ms = s->g2p_p50_ms = s->g2p_p99_ms = NAN;
@@ -217,6 +226,11 @@ void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refr
             holes += (double)r[i].disoccluded;
         }
     }
+    for (long i = 1; i < n && period_ns > 0; i++) {
+        const long gap = lround((double)(r[i].photon_ns - r[i - 1].photon_ns) / (double)period_ns);
+        s->skipped += gap > 1 ? gap - 1 : 0;
+    }
+    s->missed = s->late + s->skipped;
     if (n > 1 && r[n - 1].photon_ns > r[0].photon_ns)
         s->displayed_hz = (double)(s->displayed - 1) * 1e9 / (double)(r[n - 1].photon_ns - r[0].photon_ns);
     m = 0;

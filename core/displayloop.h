@@ -112,6 +112,8 @@ int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec);
 /* ---- accounting ---- */
 typedef struct fv_display_summary {
     long refreshes, displayed, late, reused, frames_shown; /* frames_shown: distinct rendered frames */
+    long skipped;            /* vsyncs between two refreshes' photons that got no new image */
+    long missed;             /* late + skipped: vsyncs without a newly composed image */
     double displayed_hz;                                   /* on-time refreshes per second of photon time */
     double mtp_p50_ms, mtp_p99_ms;                         /* head pose sample -> photon */
     double g2p_p50_ms, g2p_p99_ms;                         /* gaze sample -> photon */
@@ -120,8 +122,10 @@ typedef struct fv_display_summary {
     double pose_err_p50_deg, pose_err_p99_deg;
     double disoccluded_frac;                               /* of the pixels warped */
 } fv_display_summary;
-/* px_per_refresh: pixels warped per refresh (both eyes), for disoccluded_frac. */
-void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refresh, fv_display_summary *s);
+/* px_per_refresh: pixels warped per refresh (both eyes), for disoccluded_frac; period_ns: the
+ * refresh period, for the vsyncs skipped between refreshes (a composition longer than a period). */
+void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refresh, int64_t period_ns,
+                          fv_display_summary *s);
 /* p (0..1) of v[0..n) by nearest rank, sorting v; NAN when n == 0. */
 double fv_percentile(double *v, long n, double p);
 

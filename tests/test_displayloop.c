@@ -139,7 +139,9 @@ static void test_every_refresh_newest_untorn(void **state)
     assert_true(started);
     assert_int_equal(f->bad_torn, 0);
     fv_display_summary s;
-    fv_display_summarise(r + 10, N - 10, 0, &s);
+    fv_display_summarise(r + 10, N - 10, 0, P, &s);
+    assert_int_equal(s.skipped, 0);
+    assert_int_equal(s.missed, 0);
     assert_true(fabs(s.displayed_hz - 90.0) < 0.01);
     /* one new frame every 2.5 refreshes: the rest reuse (are warped again) */
     const double frames = (double)(N - 10) * P / (double)f->render_ns;
@@ -238,13 +240,17 @@ static void test_summary(void **state)
         r[i].pose_err_deg = NAN;
     }
     r[3].late = 1;
+    /* the late one came 2 vsyncs after its predecessor's next: 2 skipped (its latencies unchanged) */
+    r[3].photon_ns += 2 * P, r[3].head_t_ns += 2 * P, r[3].gaze_t_ns += 2 * P;
     fv_display_summary s;
-    fv_display_summarise(r, 4, 1000, &s);
+    fv_display_summarise(r, 4, 1000, P, &s);
+    assert_int_equal(s.skipped, 2);
+    assert_int_equal(s.missed, 3);
     assert_int_equal(s.displayed, 3);
     assert_int_equal(s.late, 1);
     assert_int_equal(s.reused, 2);
     assert_int_equal(s.frames_shown, 2);
-    assert_true(fabs(s.displayed_hz - 2.0 / (3.0 * P * 1e-9)) < 1e-6);
+    assert_true(fabs(s.displayed_hz - 2.0 / (5.0 * P * 1e-9)) < 1e-6);
     assert_true(fabs(s.mtp_p50_ms - 2.0) < 1e-9 && fabs(s.mtp_p99_ms - 4.0) < 1e-9);
     assert_true(fabs(s.g2p_p50_ms - 20.0) < 1e-9);
     assert_true(fabs(s.disoccluded_frac - 0.01) < 1e-12);
