@@ -243,9 +243,11 @@ void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refr
         if (r[i].has_gaze && r[i].frame >= 0)
             v[m++] = (double)(r[i].photon_ns - r[i].gaze_t_ns) * 1e-6;
     s->g2p_p50_ms = fv_percentile(v, m, 0.5), s->g2p_p99_ms = fv_percentile(v, m, 0.99);
-    for (long i = 0; i < n; i++)
-        v[i] = (double)(r[i].done_ns - r[i].wake_ns) * 1e-6;
-    s->compose_p50_ms = fv_percentile(v, n, 0.5), s->compose_p99_ms = fv_percentile(v, n, 0.99);
+    m = 0;
+    for (long i = 0; i < n; i++) /* refreshes that warped a frame (before the first there is nothing to do) */
+        if (r[i].frame >= 0)
+            v[m++] = (double)(r[i].done_ns - r[i].wake_ns) * 1e-6;
+    s->compose_p50_ms = fv_percentile(v, m, 0.5), s->compose_p99_ms = fv_percentile(v, m, 0.99);
     m = 0;
     for (long i = 0; i < n; i++)
         if (r[i].frame >= 0)

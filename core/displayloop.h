@@ -117,7 +117,7 @@ typedef struct fv_display_summary {
     double displayed_hz;                                   /* on-time refreshes per second of photon time */
     double mtp_p50_ms, mtp_p99_ms;                         /* head pose sample -> photon */
     double g2p_p50_ms, g2p_p99_ms;                         /* gaze sample -> photon */
-    double compose_p50_ms, compose_p99_ms;
+    double compose_p50_ms, compose_p99_ms;                 /* of the refreshes that warped a frame */
     double age_p50_ms;                                     /* rendered frame's completion -> photon */
     double pose_err_p50_deg, pose_err_p99_deg;
     double disoccluded_frac;                               /* of the pixels warped */
