@@ -104,24 +104,38 @@ static int tw_row_neon(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_
     const float32x4_t ax0 = vdupq_n_f32(m->ax[0]), ax1 = vdupq_n_f32(m->ax[1]), ax2 = vdupq_n_f32(m->ax[2]);
     static const int32_t lanes[4] = {0, 1, 2, 3};
     int holes = 0, i = 0;
-    for (; i + 4 <= n; i += 4) {
-        const int32x4_t xi = vaddq_s32(vdupq_n_s32(x0 + i), vld1q_s32(lanes));
-        const float32x4_t px = vaddq_f32(vcvtq_f32_s32(xi), c.half);
-        const float32x4_t A0 = vaddq_f32(r0, vmulq_f32(px, ax0)), A1 = vaddq_f32(r1, vmulq_f32(px, ax1));
-        const float32x4_t A2 = vaddq_f32(r2, vmulq_f32(px, ax2));
-        float32x4_t u0, v0, u1, v1, u2, v2;
-        proj4(&c, A0, A1, A2, vdupq_n_f32(0.0f), &u0, &v0);
-        const float32x4_t w1 = fetch_w4(&c, A2, u0, v0);
-        proj4(&c, A0, A1, A2, w1, &u1, &v1);
-        const float32x4_t w2 = fetch_w4(&c, A2, u1, v1);
-        proj4(&c, A0, A1, A2, w2, &u2, &v2);
-        const float32x4_t w3 = fetch_w4(&c, A2, u2, v2);
-        const float32x4_t d = vabsq_f32(vsubq_f32(w3, w2)), mx = gt_sel(w3, w2);
-        const uint32x4_t dis = vcgtq_f32(d, vmulq_f32(c.tol, mx));
-        const uint32x4_t first = vandq_u32(dis, vcltq_f32(w2, w3));
-        tap4(&c, dst + 3 * i, vbslq_f32(first, u1, u2), vbslq_f32(first, v1, v2));
-        holes += (int)vaddvq_u32(vshrq_n_u32(dis, 31));
+    /* TW_G groups of 4 a step, each stage for all before the next (see the AVX2 version) */
+#define TW_G 8
+    for (int g; i + 4 <= n; i += 4 * g) {
+        g = (n - i) / 4 < TW_G ? (n - i) / 4 : TW_G;
+        float32x4_t A0[TW_G], A1[TW_G], A2[TW_G], u0[TW_G], v0[TW_G], u1[TW_G], v1[TW_G], u2[TW_G], v2[TW_G];
+        float32x4_t w1[TW_G], w2[TW_G], w3[TW_G];
+        for (int k = 0; k < g; k++) {
+            const int32x4_t xi = vaddq_s32(vdupq_n_s32(x0 + i + 4 * k), vld1q_s32(lanes));
+            const float32x4_t px = vaddq_f32(vcvtq_f32_s32(xi), c.half);
+            A0[k] = vaddq_f32(r0, vmulq_f32(px, ax0)), A1[k] = vaddq_f32(r1, vmulq_f32(px, ax1));
+            A2[k] = vaddq_f32(r2, vmulq_f32(px, ax2));
+            proj4(&c, A0[k], A1[k], A2[k], vdupq_n_f32(0.0f), &u0[k], &v0[k]);
+        }
+        for (int k = 0; k < g; k++)
+            w1[k] = fetch_w4(&c, A2[k], u0[k], v0[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w1[k], &u1[k], &v1[k]);
+        for (int k = 0; k < g; k++)
+            w2[k] = fetch_w4(&c, A2[k], u1[k], v1[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w2[k], &u2[k], &v2[k]);
+        for (int k = 0; k < g; k++)
+            w3[k] = fetch_w4(&c, A2[k], u2[k], v2[k]);
+        for (int k = 0; k < g; k++) {
+            const float32x4_t d = vabsq_f32(vsubq_f32(w3[k], w2[k])), mx = gt_sel(w3[k], w2[k]);
+            const uint32x4_t dis = vcgtq_f32(d, vmulq_f32(c.tol, mx));
+            const uint32x4_t first = vandq_u32(dis, vcltq_f32(w2[k], w3[k]));
+            tap4(&c, dst + 3 * (i + 4 * k), vbslq_f32(first, u1[k], u2[k]), vbslq_f32(first, v1[k], v2[k]));
+            holes += (int)vaddvq_u32(vshrq_n_u32(dis, 31));
+        }
     }
+#undef TW_G
     for (; i < n; i++) {
         const float px = (float)(x0 + i) + 0.5f;
         const float A[3] = {r[0] + px * m->ax[0], r[1] + px * m->ax[1], r[2] + px * m->ax[2]};

@@ -99,24 +99,38 @@ static int tw_row_sse41(uint8_t *restrict dst, int x0, int y, int n, const fv_tw
     const __m128 ax0 = _mm_set1_ps(m->ax[0]), ax1 = _mm_set1_ps(m->ax[1]), ax2 = _mm_set1_ps(m->ax[2]);
     const __m128 sign = _mm_set1_ps(-0.0f);
     int holes = 0, i = 0;
-    for (; i + 4 <= n; i += 4) {
-        const __m128i xi = _mm_add_epi32(_mm_set1_epi32(x0 + i), _mm_setr_epi32(0, 1, 2, 3));
-        const __m128 px = _mm_add_ps(_mm_cvtepi32_ps(xi), c.half);
-        const __m128 A0 = _mm_add_ps(r0, _mm_mul_ps(px, ax0)), A1 = _mm_add_ps(r1, _mm_mul_ps(px, ax1));
-        const __m128 A2 = _mm_add_ps(r2, _mm_mul_ps(px, ax2));
-        __m128 u0, v0, u1, v1, u2, v2;
-        proj4(&c, A0, A1, A2, _mm_setzero_ps(), &u0, &v0);
-        const __m128 w1 = fetch_w4(&c, A2, u0, v0);
-        proj4(&c, A0, A1, A2, w1, &u1, &v1);
-        const __m128 w2 = fetch_w4(&c, A2, u1, v1);
-        proj4(&c, A0, A1, A2, w2, &u2, &v2);
-        const __m128 w3 = fetch_w4(&c, A2, u2, v2);
-        const __m128 d = _mm_andnot_ps(sign, _mm_sub_ps(w3, w2)), mx = _mm_max_ps(w3, w2);
-        const __m128 dis = _mm_cmpgt_ps(d, _mm_mul_ps(c.tol, mx));
-        const __m128 first = _mm_and_ps(dis, _mm_cmplt_ps(w2, w3));
-        tap4(&c, dst + 3 * i, _mm_blendv_ps(u2, u1, first), _mm_blendv_ps(v2, v1, first));
-        holes += __builtin_popcount((unsigned)_mm_movemask_ps(dis));
+    /* TW_G groups of 4 a step, each stage for all before the next (see the AVX2 version) */
+#define TW_G 8
+    for (int g; i + 4 <= n; i += 4 * g) {
+        g = (n - i) / 4 < TW_G ? (n - i) / 4 : TW_G;
+        __m128 A0[TW_G], A1[TW_G], A2[TW_G], u0[TW_G], v0[TW_G], u1[TW_G], v1[TW_G], u2[TW_G], v2[TW_G];
+        __m128 w1[TW_G], w2[TW_G], w3[TW_G];
+        for (int k = 0; k < g; k++) {
+            const __m128i xi = _mm_add_epi32(_mm_set1_epi32(x0 + i + 4 * k), _mm_setr_epi32(0, 1, 2, 3));
+            const __m128 px = _mm_add_ps(_mm_cvtepi32_ps(xi), c.half);
+            A0[k] = _mm_add_ps(r0, _mm_mul_ps(px, ax0)), A1[k] = _mm_add_ps(r1, _mm_mul_ps(px, ax1));
+            A2[k] = _mm_add_ps(r2, _mm_mul_ps(px, ax2));
+            proj4(&c, A0[k], A1[k], A2[k], _mm_setzero_ps(), &u0[k], &v0[k]);
+        }
+        for (int k = 0; k < g; k++)
+            w1[k] = fetch_w4(&c, A2[k], u0[k], v0[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w1[k], &u1[k], &v1[k]);
+        for (int k = 0; k < g; k++)
+            w2[k] = fetch_w4(&c, A2[k], u1[k], v1[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w2[k], &u2[k], &v2[k]);
+        for (int k = 0; k < g; k++)
+            w3[k] = fetch_w4(&c, A2[k], u2[k], v2[k]);
+        for (int k = 0; k < g; k++) {
+            const __m128 d = _mm_andnot_ps(sign, _mm_sub_ps(w3[k], w2[k])), mx = _mm_max_ps(w3[k], w2[k]);
+            const __m128 dis = _mm_cmpgt_ps(d, _mm_mul_ps(c.tol, mx));
+            const __m128 first = _mm_and_ps(dis, _mm_cmplt_ps(w2[k], w3[k]));
+            tap4(&c, dst + 3 * (i + 4 * k), _mm_blendv_ps(u2[k], u1[k], first), _mm_blendv_ps(v2[k], v1[k], first));
+            holes += __builtin_popcount((unsigned)_mm_movemask_ps(dis));
+        }
     }
+#undef TW_G
     for (; i < n; i++) {
         const float px = (float)(x0 + i) + 0.5f;
         const float A[3] = {r[0] + px * m->ax[0], r[1] + px * m->ax[1], r[2] + px * m->ax[2]};
