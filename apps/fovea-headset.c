@@ -109,6 +109,7 @@ typedef struct app {
     } meta[FV_MAILBOX_SLOTS];
     fv_timewarp_dsp twd;
     int mouse;          /* the gaze is the mouse over a window (read on the display's thread only) */
+    int64_t period_ns;  /* the nominal refresh period */
     int stop;           /* the render thread ends (atomic) */
     int64_t *done_ns;   /* completion time of every rendered frame (render thread; read after join) */
     double *render_ms;
@@ -251,7 +252,7 @@ static int stopping(app *a) { return __atomic_load_n(&a->stop, __ATOMIC_ACQUIRE)
 static void *render_main(void *arg)
 {
     app *a = arg;
-    const int64_t period = 11111111;
+    const int64_t period = a->period_ns;
     int64_t last_ns = 3 * period;
     while (!stopping(a)) {
         const int64_t start = fv_time_ns();
@@ -294,6 +295,15 @@ static void *render_main(void *arg)
             a->meta[s].g = g;
         a->meta[s].start_ns = start;
         a->meta[s].done_ns = done;
+        if (a->ndone == a->capdone) { /* the summary's record (only this thread touches it until the join) */
+            const long cap = a->capdone ? 2 * a->capdone : 1024;
+            int64_t *d = realloc(a->done_ns, (size_t)cap * sizeof *d);
+            if (d)
+                a->done_ns = d;
+            double *r = d ? realloc(a->render_ms, (size_t)cap * sizeof *r) : NULL;
+            if (r)
+                a->render_ms = r, a->capdone = cap;
+        }
         if (a->ndone < a->capdone) {
             a->done_ns[a->ndone] = done;
             a->render_ms[a->ndone] = (double)(done - start) * 1e-6;
@@ -338,8 +348,9 @@ static int a_compose(void *c, int64_t vsync_ns, fv_refresh_record *rec)
     return 0;
 }
 
-/* The display thread above the renderer's: SCHED_FIFO where allowed (root, CAP_SYS_NICE),
- * else the renderer is niced. Returns what was done, for the summary. */
+/* The display thread above the renderer's: SCHED_FIFO where allowed (root, CAP_SYS_NICE); else
+ * both run at normal priority (the summary says which). Set after the render thread and the pool
+ * exist, so they do not inherit it. */
 static const char *display_priority(void)
 {
     struct sched_param sp = {.sched_priority = 10};
@@ -552,12 +563,10 @@ int main(int argc, char **argv)
     } else {
         /* the renderer on its own thread, the display loop on this one, above it */
         a.cd = cfg.cam;
+        a.period_ns = period;
         a.mouse = a.disp && !strcmp(fv_display_kind(a.disp), "window");
         fv_timewarp_dsp_init(&a.twd, cfg.isa_mask);
-        a.capdone = (long)((seconds > 0 ? seconds : 3600.0) * 400.0) + 64;
-        a.done_ns = malloc((size_t)a.capdone * sizeof *a.done_ns);
-        a.render_ms = malloc((size_t)a.capdone * sizeof *a.render_ms);
-        int slots_ok = a.done_ns && a.render_ms;
+        int slots_ok = 1;
         for (int k = 0; k < FV_MAILBOX_SLOTS; k++)
             slots_ok = slots_ok && !fv_tw_frame_alloc(&a.slot[k], a.W, a.H);
         if (!slots_ok || fv_mailbox_init(&a.mb)) {
