@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "base/parse.h"
 #include "displayloop.h"
 #include "benchio.h"
 #include "calibfile.h"
@@ -61,12 +62,14 @@ static void usage(FILE *f)
             "                      at every vsync the newest complete frame is warped to the head\n"
             "                      pose predicted for that refresh (per-pixel depth) and shown.\n"
             "                      off: one frame rendered per shown frame, aimed at a vsync.\n"
-            "                      Off with --lens (the warp does not model the lens yet)\n" FV_COMMON_HELP
+            "                      Off with --lens (the warp does not model the lens yet)\n"
+            "  --warp-threads N    1 (default) or 2: with 2 the right eye is warped on a second\n"
+            "                      display-priority thread (shorter refreshes, less CPU for rendering)\n" FV_COMMON_HELP
             "  --help              this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_CAMERA, OPT_VSYNC, OPT_DISPLAY, OPT_CALIB, OPT_SECONDS, OPT_TRACE, OPT_LENS, OPT_CSV,
-       OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_TIMEWARP, OPT_HELP };
+       OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_TIMEWARP, OPT_WARP_THREADS, OPT_HELP };
 
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig)
@@ -110,6 +113,14 @@ typedef struct app {
     fv_timewarp_dsp twd;
     int mouse;          /* the gaze is the mouse over a window (read on the display's thread only) */
     int64_t period_ns;  /* the nominal refresh period */
+    /* the right eye's warp on a second display-priority thread (--warp-threads 2) */
+    int helper_on, helper_job, helper_quit;
+    pthread_mutex_t helper_mu;
+    pthread_cond_t helper_cv;
+    const fv_tw_frame *helper_f;
+    fv_camera helper_cam;
+    uint8_t *helper_dst;
+    long helper_holes;
     int stop;           /* the render thread ends (atomic) */
     int64_t *done_ns;   /* completion time of every rendered frame (render thread; read after join) */
     double *render_ms;
@@ -336,16 +347,55 @@ static int a_compose(void *c, int64_t vsync_ns, fv_refresh_record *rec)
     rec->frame_start_ns = a->meta[s].start_ns;
     rec->frame_done_ns = a->meta[s].done_ns;
     uint8_t *dst = a->img[a->back];
+    fv_camera cam[2];
     for (int e = 0; e < 2; e++) {
         fv_camera_desc cd = a->cd;
         cd.eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
-        fv_camera cam;
-        fv_camera_setup(&cam, &cd, &a->head_pred);
-        rec->disoccluded += fv_tw_frame_warp(&a->twd, &a->slot[s], e, &cam, dst + (size_t)e * a->W * 3,
+        fv_camera_setup(&cam[e], &cd, &a->head_pred);
+    }
+    if (a->helper_on) { /* the right eye on the helper meanwhile */
+        pthread_mutex_lock(&a->helper_mu);
+        a->helper_f = &a->slot[s], a->helper_cam = cam[1], a->helper_dst = dst + (size_t)a->W * 3;
+        a->helper_job = 1;
+        pthread_cond_broadcast(&a->helper_cv);
+        pthread_mutex_unlock(&a->helper_mu);
+    }
+    for (int e = 0; e < (a->helper_on ? 1 : 2); e++)
+        rec->disoccluded += fv_tw_frame_warp(&a->twd, &a->slot[s], e, &cam[e], dst + (size_t)e * a->W * 3,
                                              (ptrdiff_t)a->W * 6, 0.05f);
+    if (a->helper_on) {
+        pthread_mutex_lock(&a->helper_mu);
+        while (a->helper_job)
+            pthread_cond_wait(&a->helper_cv, &a->helper_mu);
+        rec->disoccluded += a->helper_holes;
+        pthread_mutex_unlock(&a->helper_mu);
     }
     a_present(a, FV_PRESENT_NEW, vsync_ns);
     return 0;
+}
+
+/* --warp-threads 2: warps the right eye while the display thread warps the left */
+static void *warp_helper_main(void *arg)
+{
+    app *a = arg;
+    pthread_mutex_lock(&a->helper_mu);
+    for (;;) {
+        while (!a->helper_job && !a->helper_quit)
+            pthread_cond_wait(&a->helper_cv, &a->helper_mu);
+        if (a->helper_quit)
+            break;
+        const fv_tw_frame *f = a->helper_f;
+        const fv_camera cam = a->helper_cam;
+        uint8_t *dst = a->helper_dst;
+        pthread_mutex_unlock(&a->helper_mu);
+        const long h = fv_tw_frame_warp(&a->twd, f, 1, &cam, dst, (ptrdiff_t)a->W * 6, 0.05f);
+        pthread_mutex_lock(&a->helper_mu);
+        a->helper_holes = h;
+        a->helper_job = 0;
+        pthread_cond_broadcast(&a->helper_cv);
+    }
+    pthread_mutex_unlock(&a->helper_mu);
+    return NULL;
 }
 
 /* The display thread above the renderer's: SCHED_FIFO where allowed (root, CAP_SYS_NICE); else
@@ -372,7 +422,7 @@ int main(int argc, char **argv)
     double seconds = 0.0;
     float hz = 90.0f, cam_fps = 120.0f;
     fv_prof *prof = NULL; /* --trace-out's recorder */
-    int reproject_given = 0, timewarp = 1, timewarp_given = 0;
+    int reproject_given = 0, timewarp = 1, timewarp_given = 0, warp_threads = 1;
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, {"camera", required_argument, 0, OPT_CAMERA},
         {"vsync", required_argument, 0, OPT_VSYNC}, {"display", required_argument, 0, OPT_DISPLAY},
@@ -380,7 +430,8 @@ int main(int argc, char **argv)
         {"trace", required_argument, 0, OPT_TRACE}, {"lens", required_argument, 0, OPT_LENS},
         {"latency-csv", required_argument, 0, OPT_CSV}, {"hz", required_argument, 0, OPT_HZ},
         {"camera-fps", required_argument, 0, OPT_CAMFPS}, {"trace-out", required_argument, 0, OPT_TRACE_OUT},
-        {"timewarp", required_argument, 0, OPT_TIMEWARP}, {"help", no_argument, 0, OPT_HELP},
+        {"timewarp", required_argument, 0, OPT_TIMEWARP}, {"warp-threads", required_argument, 0, OPT_WARP_THREADS},
+        {"help", no_argument, 0, OPT_HELP},
         FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -398,6 +449,14 @@ int main(int argc, char **argv)
         case OPT_HZ: hz = fv_arg_float(prog, "--hz", optarg, 1.0f, 1000.0f); break;
         case OPT_CAMFPS: cam_fps = fv_arg_float(prog, "--camera-fps", optarg, 1.0f, 1000.0f); break;
         case OPT_TRACE_OUT: prof_path = optarg; break;
+        case OPT_WARP_THREADS: {
+            long v;
+            char e[256];
+            if (fv_parse_long("--warp-threads", optarg, 1, 2, &v, e, sizeof e))
+                fv_usage_error(prog, "%s", e);
+            warp_threads = (int)v;
+            break;
+        }
         case OPT_TIMEWARP:
             timewarp = fv_arg_onoff(prog, "--timewarp", optarg);
             timewarp_given = 1;
@@ -579,6 +638,17 @@ int main(int argc, char **argv)
             goto done;
         }
         prio = display_priority();
+        pthread_t helper;
+        if (warp_threads > 1) { /* created by the display thread: inherits its priority */
+            pthread_mutexattr_t at;
+            pthread_mutexattr_init(&at);
+            pthread_mutexattr_setprotocol(&at, PTHREAD_PRIO_INHERIT);
+            a.helper_on = !pthread_mutex_init(&a.helper_mu, &at) && !pthread_cond_init(&a.helper_cv, NULL) &&
+                          !pthread_create(&helper, NULL, warp_helper_main, &a);
+            pthread_mutexattr_destroy(&at);
+            if (!a.helper_on)
+                fprintf(stderr, "%s: cannot start the second warp thread; warping both eyes on one\n", prog);
+        }
         fv_displayloop_params dp;
         fv_displayloop_default_params(&dp, period);
         fv_displayloop_ops dops = {&a, a_now, a_sleep, a_wait_edge, a_compose};
@@ -603,6 +673,14 @@ int main(int argc, char **argv)
                 q->pose_err_mm = fv_pose_dist_m(&a.head_pred, &truth) * 1e3;
             }
             nrr++;
+        }
+        if (a.helper_on) {
+            pthread_mutex_lock(&a.helper_mu);
+            a.helper_quit = 1;
+            pthread_cond_broadcast(&a.helper_cv);
+            pthread_mutex_unlock(&a.helper_mu);
+            pthread_join(helper, NULL);
+            a.helper_on = 0;
         }
         __atomic_store_n(&a.stop, 1, __ATOMIC_RELEASE);
         pthread_join(render_thread, NULL);

@@ -469,6 +469,12 @@ if $HS $HO --seconds 1 --trace assets/gaze_sweep.csv --timewarp off --latency-cs
 else
     bad "headset --timewarp off run failed: $(cat "$T/err")"
 fi
+if $HS $HO --seconds 1 --warp-threads 2 >"$T/out" 2>"$T/err"; then
+    head -n 1 "$T/out" | grep -Eq "$L1" && grep -Eq "$L2" "$T/out" && ok || bad "headset --warp-threads 2: $(cat "$T/out")"
+else
+    bad "headset --warp-threads 2 run failed: $(cat "$T/err")"
+fi
+expect_usage "headset bad warp threads" '--warp-threads: 3 is out of range' $HS $HO --warp-threads 3
 expect_usage "headset bad timewarp" "--timewarp: 'sideways'" $HS $HO --timewarp sideways
 expect_usage "headset timewarp with lens" '--lens: the timewarp does not model the lens' $HS $HO --lens assets/hmd_example.lens --timewarp on
 # --trace-out: valid trace, one track per worker, the stage tracks and the loop's markers
