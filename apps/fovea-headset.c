@@ -1,14 +1,19 @@
 /* fovea-headset: the live headset runtime. Wires a vsync source, the gaze (eye camera, trace
  * or mouse), the stereo pipeline and a display to the vsync-locked frame loop
  * (core/frameloop.h), and accounts gaze-to-photon latency. */
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <pthread.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/clock.h"
+#include "base/parse.h"
+#include "displayloop.h"
 #include "benchio.h"
 #include "calibfile.h"
 #include "cli.h"
@@ -20,9 +25,11 @@
 #include "lensfile.h"
 #include "output.h"
 #include "pipeline.h"
+#include "posepred.h"
 #include "prof.h"
 #include "proftrace.h"
 #include "scene.h"
+#include "timewarp.h"
 #include "tracefile.h"
 #include "vsync.h"
 
@@ -57,12 +64,19 @@ static void usage(FILE *f)
             "  --hz HZ             nominal refresh for gpio/replay vsync (default 90)\n"
             "  --camera-fps F      frame rate of a replayed eye video (default 120)\n"
             "  --trace-out FILE    write a Chrome trace-event JSON of the run (Perfetto): worker\n"
-            "                      and stage tracks, gaze-latch / vsync / late markers\n" FV_COMMON_HELP
+            "                      and stage tracks, gaze-latch / vsync / late markers\n"
+            "  --timewarp on|off   on (default): rendering runs on its own thread at its own rate;\n"
+            "                      at every vsync the newest complete frame is warped to the head\n"
+            "                      pose predicted for that refresh (per-pixel depth) and shown.\n"
+            "                      off: one frame rendered per shown frame, aimed at a vsync.\n"
+            "                      Off with --lens (the warp does not model the lens yet)\n"
+            "  --warp-threads N    1 (default) or 2: with 2 the right eye is warped on a second\n"
+            "                      display-priority thread (shorter refreshes, less CPU for rendering)\n" FV_COMMON_HELP
             "  --help              this text\n");
 }
 
 enum { OPT_SCENE = 1, OPT_CAMERA, OPT_VSYNC, OPT_DISPLAY, OPT_CALIB, OPT_SECONDS, OPT_TRACE, OPT_LENS, OPT_CSV,
-       OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_HELP, OPT_CALIBRATE, OPT_CALIB_DWELL };
+       OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_TIMEWARP, OPT_WARP_THREADS, OPT_HELP, OPT_CALIBRATE, OPT_CALIB_DWELL };
 
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig)
@@ -87,6 +101,37 @@ typedef struct app {
     long display_failures;
     long frame;        /* frames rendered (the frame loop's numbering) */
     int render_failed; /* a render failed: the run ends with status 1 */
+    /* head pose: the trace read as a 1 kHz pose source, predicted to the photon time; one
+     * predictor per thread (0: the display's or the serial loop's, 1: the renderer's), so the
+     * display never waits on a lock the renderer holds (it runs above it) */
+    fv_posepred pp[2];
+    int64_t pp_fed_ns[2];
+    int64_t head_t_ns;  /* the pose sample of the frame being rendered (timewarp off) */
+    fv_pose head_pred;  /* its prediction */
+    /* --timewarp on */
+    fv_camera_desc cd;
+    fv_frame_mailbox mb;
+    fv_tw_frame slot[FV_MAILBOX_SLOTS];
+    struct {
+        int has_gaze;
+        fv_gaze_sample g;
+        int64_t start_ns, done_ns;
+    } meta[FV_MAILBOX_SLOTS];
+    fv_timewarp_dsp twd;
+    int mouse;          /* the gaze is the mouse over a window (read on the display's thread only) */
+    int64_t period_ns;  /* the nominal refresh period */
+    /* the right eye's warp on a second display-priority thread (--warp-threads 2) */
+    int helper_on, helper_job, helper_quit;
+    pthread_mutex_t helper_mu;
+    pthread_cond_t helper_cv;
+    const fv_tw_frame *helper_f;
+    fv_camera helper_cam;
+    uint8_t *helper_dst;
+    long helper_holes;
+    int stop;           /* the render thread ends (atomic) */
+    int64_t *done_ns;   /* completion time of every rendered frame (render thread; read after join) */
+    double *render_ms;
+    long ndone, capdone;
 } app;
 
 static int64_t a_now(void *c)
@@ -115,6 +160,39 @@ static double trace_t_ms(const app *a, int64_t t_ns)
 {
     return fv_trace_loop_ms(a->trace, (double)(t_ns - a->t_start_ns) * 1e-6);
 }
+static int has_head(const app *a) { return a->trace && a->trace->has_head; }
+/* the true head pose at t_ns (the trace; without one the default view) */
+static void head_true(const app *a, int64_t t_ns, fv_pose *out)
+{
+    if (!has_head(a)) {
+        *out = a->view;
+        return;
+    }
+    fv_trace_sample ts;
+    fv_trace_at(a->trace, trace_t_ms(a, t_ns), &ts);
+    *out = ts.head;
+}
+/* Feeds thread `th`'s predictor the pose source's 1 kHz samples up to now and predicts the pose
+ * at photon_ns; returns the newest sample's time (the start of motion-to-photon). */
+static int64_t head_latch(app *a, int th, int64_t now, int64_t photon_ns, fv_pose *out)
+{
+    if (!has_head(a)) {
+        *out = a->view;
+        return now; /* a fixed head, sampled now */
+    }
+    const int64_t fed = a->pp_fed_ns[th];
+    int64_t t = fed && fed > now - 20000000 ? fed + 1000000 : now - 20000000;
+    for (; t <= now; t += 1000000) {
+        fv_pose p;
+        head_true(a, t, &p);
+        fv_posepred_push(&a->pp[th], t, &p);
+        a->pp_fed_ns[th] = t;
+    }
+    int64_t ts = now;
+    if (!fv_posepred_predict(&a->pp[th], photon_ns, out, &ts))
+        *out = a->view;
+    return ts;
+}
 static void a_sample_gaze(void *c, int64_t now)
 {
     app *a = c;
@@ -141,12 +219,9 @@ static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
     app *a = c;
     if (stop_requested || fv_time_ns() >= a->end_ns || (a->disp && fv_display_quit_requested(a->disp)))
         return -1;
-    fv_pose head = a->view;
-    if (a->trace && a->trace->has_head) {
-        fv_trace_sample ts;
-        fv_trace_at(a->trace, trace_t_ms(a, t_ns), &ts); /* the head where it will be at the photon time */
-        head = ts.head;
-    }
+    fv_pose head; /* sampled now, predicted to the photon time */
+    a->head_t_ns = head_latch(a, 0, fv_time_ns(), t_ns, &head);
+    a->head_pred = head;
     const float gx = g ? g->x : 0.5f, gy = g ? g->y : 0.5f;
     /* the focus filter accommodates in photon time; a doubtful gaze widens the fovea */
     fv_pipeline_set_time_ns(a->pl, t_ns);
@@ -189,6 +264,162 @@ static int a_present(void *c, int which, int64_t vsync_ns)
     return 0;
 }
 
+/* ---- --timewarp on: the render thread and the display's composition ---- */
+static int stopping(app *a) { return __atomic_load_n(&a->stop, __ATOMIC_ACQUIRE); }
+
+static void *render_main(void *arg)
+{
+    app *a = arg;
+    const int64_t period = a->period_ns;
+    int64_t last_ns = 3 * period;
+    while (!stopping(a)) {
+        const int64_t start = fv_time_ns();
+        if (!a->cam && !a->mouse) { /* trace (or centre) gaze, sampled just before the rays */
+            fv_gaze_sample ts = {.t_ns = start, .x = 0.5f, .y = 0.5f, .confidence = 1.0f};
+            if (a->trace) {
+                fv_trace_sample t;
+                fv_trace_at(a->trace, trace_t_ms(a, start), &t);
+                ts.x = t.gaze_x;
+                ts.y = t.gaze_y;
+            }
+            fv_gaze_ring_push(a->ring, &ts);
+        }
+        fv_gaze_sample g;
+        const int hg = fv_gaze_ring_latest(a->ring, start, &g);
+        /* aimed at about when it will be shown: a render time and a refresh ahead (the warp
+         * corrects the rest) */
+        const int64_t aim = start + last_ns + period;
+        fv_pose head;
+        head_latch(a, 1, start, aim, &head);
+        fv_pipeline_set_time_ns(a->pl, aim);
+        if (fv_pipeline_set_fovea_scale(a->pl, fv_fovea_radius_scale(hg ? g.confidence : 0.0f)) && !a->reported_scale) {
+            fprintf(stderr, "%s: no memory to widen the fovea for a doubtful gaze; keeping its size\n", prog);
+            a->reported_scale = 1;
+        }
+        const int s = fv_mailbox_begin_write(&a->mb);
+        for (int e = 0; e < 2; e++) {
+            fv_frame_stats st;
+            if (fv_pipeline_render(a->pl, e ? FV_EYE_RIGHT : FV_EYE_LEFT, &head, hg ? g.x : 0.5f, hg ? g.y : 0.5f, &st)) {
+                fprintf(stderr, "%s: frame %ld (%s eye): rendering failed\n", prog, a->ndone, e ? "right" : "left");
+                __atomic_store_n(&a->render_failed, 1, __ATOMIC_RELEASE);
+                __atomic_store_n(&a->stop, 1, __ATOMIC_RELEASE);
+                return NULL;
+            }
+            fv_tw_frame_capture(&a->slot[s], a->pl, e);
+        }
+        const int64_t done = fv_time_ns();
+        a->meta[s].has_gaze = hg;
+        if (hg)
+            a->meta[s].g = g;
+        a->meta[s].start_ns = start;
+        a->meta[s].done_ns = done;
+        if (a->ndone == a->capdone) { /* the summary's record (only this thread touches it until the join) */
+            const long cap = a->capdone ? 2 * a->capdone : 1024;
+            int64_t *d = realloc(a->done_ns, (size_t)cap * sizeof *d);
+            if (d)
+                a->done_ns = d;
+            double *r = d ? realloc(a->render_ms, (size_t)cap * sizeof *r) : NULL;
+            if (r)
+                a->render_ms = r, a->capdone = cap;
+        }
+        if (a->ndone < a->capdone) {
+            a->done_ns[a->ndone] = done;
+            a->render_ms[a->ndone] = (double)(done - start) * 1e-6;
+        }
+        fv_mailbox_publish(&a->mb, s, a->ndone);
+        a->ndone++;
+        last_ns = done - start;
+    }
+    return NULL;
+}
+
+static int a_compose(void *c, int64_t vsync_ns, fv_refresh_record *rec)
+{
+    app *a = c;
+    const int64_t now = fv_time_ns();
+    if (stop_requested || now >= a->end_ns || stopping(a) || (a->disp && fv_display_quit_requested(a->disp)))
+        return -1;
+    if (a->cam || a->mouse)
+        a_sample_gaze(a, now); /* the camera's health, or the mouse (SDL wants its own thread) */
+    long seq;
+    const int s = fv_mailbox_acquire(&a->mb, &seq);
+    if (s < 0)
+        return 0; /* nothing rendered yet: the panel keeps what it shows */
+    rec->frame = seq;
+    rec->head_t_ns = head_latch(a, 0, now, vsync_ns, &a->head_pred);
+    rec->has_gaze = a->meta[s].has_gaze;
+    rec->gaze_t_ns = a->meta[s].g.t_ns;
+    rec->gaze_x = a->meta[s].g.x;
+    rec->gaze_y = a->meta[s].g.y;
+    rec->frame_start_ns = a->meta[s].start_ns;
+    rec->frame_done_ns = a->meta[s].done_ns;
+    uint8_t *dst = a->img[a->back];
+    fv_camera cam[2];
+    for (int e = 0; e < 2; e++) {
+        fv_camera_desc cd = a->cd;
+        cd.eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
+        fv_camera_setup(&cam[e], &cd, &a->head_pred);
+    }
+    if (a->helper_on) { /* the right eye on the helper meanwhile */
+        pthread_mutex_lock(&a->helper_mu);
+        a->helper_f = &a->slot[s], a->helper_cam = cam[1], a->helper_dst = dst + (size_t)a->W * 3;
+        a->helper_job = 1;
+        pthread_cond_broadcast(&a->helper_cv);
+        pthread_mutex_unlock(&a->helper_mu);
+    }
+    for (int e = 0; e < (a->helper_on ? 1 : 2); e++)
+        rec->disoccluded += fv_tw_frame_warp(&a->twd, &a->slot[s], e, &cam[e], dst + (size_t)e * a->W * 3,
+                                             (ptrdiff_t)a->W * 6, 0.05f);
+    if (a->helper_on) {
+        pthread_mutex_lock(&a->helper_mu);
+        while (a->helper_job)
+            pthread_cond_wait(&a->helper_cv, &a->helper_mu);
+        rec->disoccluded += a->helper_holes;
+        pthread_mutex_unlock(&a->helper_mu);
+    }
+    a_present(a, FV_PRESENT_NEW, vsync_ns);
+    return 0;
+}
+
+/* --warp-threads 2: warps the right eye while the display thread warps the left */
+static void *warp_helper_main(void *arg)
+{
+    app *a = arg;
+    pthread_mutex_lock(&a->helper_mu);
+    for (;;) {
+        while (!a->helper_job && !a->helper_quit)
+            pthread_cond_wait(&a->helper_cv, &a->helper_mu);
+        if (a->helper_quit)
+            break;
+        const fv_tw_frame *f = a->helper_f;
+        const fv_camera cam = a->helper_cam;
+        uint8_t *dst = a->helper_dst;
+        pthread_mutex_unlock(&a->helper_mu);
+        const long h = fv_tw_frame_warp(&a->twd, f, 1, &cam, dst, (ptrdiff_t)a->W * 6, 0.05f);
+        pthread_mutex_lock(&a->helper_mu);
+        a->helper_holes = h;
+        a->helper_job = 0;
+        pthread_cond_broadcast(&a->helper_cv);
+    }
+    pthread_mutex_unlock(&a->helper_mu);
+    return NULL;
+}
+
+/* The display thread above the renderer's: SCHED_FIFO where allowed (root, CAP_SYS_NICE); else
+ * both run at normal priority (the summary says which). Set after the render thread and the pool
+ * exist, so they do not inherit it. */
+static const char *display_priority(void)
+{
+    struct sched_param sp = {.sched_priority = 10};
+    const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+    return rc ? "normal (SCHED_FIFO refused)" : "SCHED_FIFO 10";
+}
+
+static void summary_line(const char *what, double p50, double p99)
+{
+    printf("%s p50 %.2f ms p99 %.2f ms", what, p50, p99);
+}
+
 int main(int argc, char **argv)
 {
     fv_pipeline_config cfg;
@@ -199,7 +430,7 @@ int main(int argc, char **argv)
     double seconds = 0.0;
     float hz = 90.0f, cam_fps = 120.0f;
     fv_prof *prof = NULL; /* --trace-out's recorder */
-    int reproject_given = 0;
+    int reproject_given = 0, timewarp = 1, timewarp_given = 0, warp_threads = 1;
     const char *calibrate_path = NULL; /* --calibrate */
     int calib_dwell_ms = 1500;
     static const struct option opts[] = {
@@ -209,6 +440,7 @@ int main(int argc, char **argv)
         {"trace", required_argument, 0, OPT_TRACE}, {"lens", required_argument, 0, OPT_LENS},
         {"latency-csv", required_argument, 0, OPT_CSV}, {"hz", required_argument, 0, OPT_HZ},
         {"camera-fps", required_argument, 0, OPT_CAMFPS}, {"trace-out", required_argument, 0, OPT_TRACE_OUT},
+        {"timewarp", required_argument, 0, OPT_TIMEWARP}, {"warp-threads", required_argument, 0, OPT_WARP_THREADS},
         {"help", no_argument, 0, OPT_HELP}, {"calibrate", required_argument, 0, OPT_CALIBRATE},
         {"calibrate-dwell-ms", required_argument, 0, OPT_CALIB_DWELL},
         FV_COMMON_LONGOPTS, {0, 0, 0, 0}};
@@ -231,6 +463,18 @@ int main(int argc, char **argv)
         case OPT_TRACE_OUT: prof_path = optarg; break;
         case OPT_CALIBRATE: calibrate_path = optarg; break;
         case OPT_CALIB_DWELL: calib_dwell_ms = (int)fv_arg_long(prog, "--calibrate-dwell-ms", optarg, 300, 10000); break;
+        case OPT_WARP_THREADS: {
+            long v;
+            char e[256];
+            if (fv_parse_long("--warp-threads", optarg, 1, 2, &v, e, sizeof e))
+                fv_usage_error(prog, "%s", e);
+            warp_threads = (int)v;
+            break;
+        }
+        case OPT_TIMEWARP:
+            timewarp = fv_arg_onoff(prog, "--timewarp", optarg);
+            timewarp_given = 1;
+            break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
@@ -289,10 +533,16 @@ int main(int argc, char **argv)
     if (trace_path && fv_trace_load(&tr, trace_path, err, sizeof err))
         fv_usage_error(prog, "%s", err);
     fv_lens lens;
-    if (lens_path)
+    if (lens_path) {
         fv_cli_lens(prog, lens_path, &lens, &cfg, reproject_given);
+        if (timewarp_given && timewarp)
+            fv_usage_error(prog, "--lens: the timewarp does not model the lens yet; drop --timewarp on");
+        timewarp = 0;
+    }
     app a = {0};
     a.trace = trace_path ? &tr : NULL;
+    for (int k = 0; k < 2; k++)
+        fv_posepred_init(&a.pp[k], 8000000, 50000000);
     a.W = cfg.cam.width;
     a.H = cfg.cam.height;
     if (fv_vsync_open(&a.vsync, vsync_spec, err, sizeof err))
@@ -346,6 +596,8 @@ int main(int argc, char **argv)
     int status = FV_EXIT_FAIL;
     fv_frame_record *rec = NULL;
     long nrec = 0, caprec = 0;
+    fv_refresh_record *rr = NULL; /* --timewarp on: one per refresh */
+    long nrr = 0, caprr = 0;
     a.img[0] = calloc((size_t)a.W * 2 * a.H, 3);
     a.img[1] = calloc((size_t)a.W * 2 * a.H, 3);
     if (!a.img[0] || !a.img[1]) {
@@ -370,48 +622,211 @@ int main(int argc, char **argv)
         }
         fv_pipeline_set_prof(a.pl, prof);
     }
+    const double run_hz = 1e9 / (double)period;
+    fv_vsync_pred *pred = NULL;
+    int source_dead = 0;
     fv_frameloop loop;
-    fv_frameloop_init(&loop, &lp, &ops, &ring);
-    for (;;) {
-        if (nrec == caprec) {
-            caprec = caprec ? 2 * caprec : 1024;
-            fv_frame_record *n = realloc(rec, (size_t)caprec * sizeof *n);
-            if (!n) {
-                fprintf(stderr, "%s: out of memory for frame records\n", prog);
-                goto done;
+    fv_displayloop dl;
+    pthread_t render_thread;
+    const char *prio = "-";
+    if (!timewarp) {
+        fv_frameloop_init(&loop, &lp, &ops, &ring);
+        for (;;) {
+            if (nrec == caprec) {
+                caprec = caprec ? 2 * caprec : 1024;
+                fv_frame_record *n = realloc(rec, (size_t)caprec * sizeof *n);
+                if (!n) {
+                    fprintf(stderr, "%s: out of memory for frame records\n", prog);
+                    goto done;
+                }
+                rec = n;
             }
-            rec = n;
+            if (fv_frameloop_frame(&loop, &rec[nrec]))
+                break;
+            fv_frame_record *q = &rec[nrec];
+            q->head_t_ns = a.head_t_ns;
+            q->pose_err_deg = NAN;
+            if (has_head(&a)) {
+                fv_pose truth;
+                head_true(&a, q->photon_ns, &truth);
+                q->pose_err_deg = fv_pose_angle_deg(&a.head_pred, &truth);
+            }
+            if (prof) /* gaze latch, vsync (photon) and late markers of this frame */
+                fv_prof_frame_markers(prof, q->frame, q->ray_start_ns, q->photon_ns, q->late);
+            nrec++;
         }
-        if (fv_frameloop_frame(&loop, &rec[nrec]))
-            break;
-        if (prof) /* gaze latch, vsync (photon) and late markers of this frame */
-            fv_prof_frame_markers(prof, rec[nrec].frame, rec[nrec].ray_start_ns, rec[nrec].photon_ns, rec[nrec].late);
-        nrec++;
+        pred = &loop.pred;
+        source_dead = loop.source_dead;
+    } else {
+        /* the renderer on its own thread, the display loop on this one, above it */
+        a.cd = cfg.cam;
+        a.period_ns = period;
+        a.mouse = a.disp && !strcmp(fv_display_kind(a.disp), "window");
+        fv_timewarp_dsp_init(&a.twd, cfg.isa_mask);
+        int slots_ok = 1;
+        for (int k = 0; k < FV_MAILBOX_SLOTS; k++)
+            slots_ok = slots_ok && !fv_tw_frame_alloc(&a.slot[k], a.W, a.H);
+        if (!slots_ok || fv_mailbox_init(&a.mb)) {
+            fprintf(stderr, "%s: out of memory for the timewarp's frames\n", prog);
+            goto done;
+        }
+        if (pthread_create(&render_thread, NULL, render_main, &a)) {
+            fprintf(stderr, "%s: cannot start the render thread\n", prog);
+            fv_mailbox_destroy(&a.mb);
+            goto done;
+        }
+        prio = display_priority();
+        pthread_t helper;
+        if (warp_threads > 1) { /* created by the display thread: inherits its priority */
+            pthread_mutexattr_t at;
+            pthread_mutexattr_init(&at);
+            pthread_mutexattr_setprotocol(&at, PTHREAD_PRIO_INHERIT);
+            a.helper_on = !pthread_mutex_init(&a.helper_mu, &at) && !pthread_cond_init(&a.helper_cv, NULL) &&
+                          !pthread_create(&helper, NULL, warp_helper_main, &a);
+            pthread_mutexattr_destroy(&at);
+            if (!a.helper_on)
+                fprintf(stderr, "%s: cannot start the second warp thread; warping both eyes on one\n", prog);
+        }
+        fv_displayloop_params dp;
+        fv_displayloop_default_params(&dp, period);
+        fv_displayloop_ops dops = {&a, a_now, a_sleep, a_wait_edge, a_compose};
+        fv_displayloop_init(&dl, &dp, &dops);
+        for (;;) {
+            if (nrr == caprr) {
+                caprr = caprr ? 2 * caprr : 4096;
+                fv_refresh_record *n = realloc(rr, (size_t)caprr * sizeof *n);
+                if (!n) {
+                    fprintf(stderr, "%s: out of memory for refresh records\n", prog);
+                    break;
+                }
+                rr = n;
+            }
+            if (fv_displayloop_refresh(&dl, &rr[nrr]))
+                break;
+            fv_refresh_record *q = &rr[nrr];
+            if (q->frame >= 0 && has_head(&a)) { /* the prediction against the trace's true pose */
+                fv_pose truth;
+                head_true(&a, q->photon_ns, &truth);
+                q->pose_err_deg = fv_pose_angle_deg(&a.head_pred, &truth);
+                q->pose_err_mm = fv_pose_dist_m(&a.head_pred, &truth) * 1e3;
+            }
+            nrr++;
+        }
+        if (a.helper_on) {
+            pthread_mutex_lock(&a.helper_mu);
+            a.helper_quit = 1;
+            pthread_cond_broadcast(&a.helper_cv);
+            pthread_mutex_unlock(&a.helper_mu);
+            pthread_join(helper, NULL);
+            a.helper_on = 0;
+        }
+        __atomic_store_n(&a.stop, 1, __ATOMIC_RELEASE);
+        pthread_join(render_thread, NULL);
+        fv_mailbox_destroy(&a.mb);
+        a.render_failed = __atomic_load_n(&a.render_failed, __ATOMIC_ACQUIRE);
+        pred = &dl.pred;
+        source_dead = dl.source_dead;
+        if (prof) /* markers after the run: the recorder's slot 0 is a worker's while rendering */
+            for (long k = 0; k < nrr; k++)
+                if (rr[k].frame >= 0)
+                    fv_prof_frame_markers(prof, rr[k].refresh, rr[k].frame_start_ns, rr[k].photon_ns, rr[k].late);
     }
     status = a.render_failed ? FV_EXIT_FAIL : FV_EXIT_OK; /* the summary of the frames shown, either way */
-    /* the summary: the first frames (acquiring the line, the first renders' cold caches still in
-     * the 16-frame budget) left out */
-    const long skip = nrec > 40 ? 20 : 0;
-    fv_latency_summary s;
-    fv_latency_summarise(rec + skip, nrec - skip, &s);
+    /* the summary leaves out the first frames (acquiring the line, the first renders' cold caches
+     * still in the budget / margin) */
     const double run_s = (double)(fv_time_ns() - a.t_start_ns) * 1e-9;
-    printf("fovea-headset: %ld frames in %.2f s, %dx%d per eye, vsync %s (%.2f Hz nominal), display %s\n", nrec,
-           run_s, a.W, a.H, vsync_spec, 1e9 / (double)period, a.disp ? fv_display_kind(a.disp) : "none");
-    printf("  frame rate %.2f fps; late %ld of %ld (%.1f %%)\n", s.fps, s.late, s.frames,
-           s.frames ? 100.0 * (double)s.late / (double)s.frames : 0.0);
-    printf("  gaze-to-photon p50 %.2f ms, p99 %.2f ms, max %.2f ms; render p50 %.2f ms, p99 %.2f ms\n", s.p50_ms,
-           s.p99_ms, s.max_ms, s.render_p50_ms, s.render_p99_ms);
+    const char *disp_kind = a.disp ? fv_display_kind(a.disp) : "none";
+    if (!timewarp) {
+        const long skip = nrec > 40 ? 20 : 0;
+        fv_latency_summary s;
+        fv_latency_summarise(rec + skip, nrec - skip, &s);
+        double *v = malloc((size_t)(nrec + 1) * sizeof *v);
+        double mtp50 = NAN, mtp99 = NAN, pe50 = NAN, pe99 = NAN;
+        if (v) {
+            long m = 0;
+            for (long k = skip; k < nrec; k++)
+                v[m++] = (double)(rec[k].photon_ns - rec[k].head_t_ns) * 1e-6;
+            mtp50 = fv_percentile(v, m, 0.5), mtp99 = fv_percentile(v, m, 0.99);
+            m = 0;
+            for (long k = skip; k < nrec; k++)
+                if (!isnan(rec[k].pose_err_deg))
+                    v[m++] = rec[k].pose_err_deg;
+            pe50 = fv_percentile(v, m, 0.5), pe99 = fv_percentile(v, m, 0.99);
+            free(v);
+        }
+        /* every frame rendered is shown: displayed = rendered */
+        printf("fovea-headset: displayed %ld frames (%.2f Hz), rendered %ld frames (%.2f Hz), late %ld\n", s.frames,
+               s.fps, s.frames, s.fps, s.late);
+        printf("  %ld frames in %.2f s, %dx%d per eye, vsync %s (%.2f Hz nominal), display %s, timewarp off\n", nrec,
+               run_s, a.W, a.H, vsync_spec, run_hz, disp_kind);
+        printf("  ");
+        summary_line("motion-to-photon", mtp50, mtp99);
+        printf("; ");
+        summary_line("gaze-to-photon", s.p50_ms, s.p99_ms);
+        printf("\n");
+        printf("  late %ld of %ld (%.1f %%); gaze-to-photon max %.2f ms; render p50 %.2f ms, p99 %.2f ms\n", s.late,
+               s.frames, s.frames ? 100.0 * (double)s.late / (double)s.frames : 0.0, s.max_ms, s.render_p50_ms,
+               s.render_p99_ms);
+        if (has_head(&a))
+            printf("  head pose prediction error at the photon time p50 %.3f deg, p99 %.3f deg\n", pe50, pe99);
+    } else {
+        const long skip = nrr > 40 ? 20 : 0;
+        fv_display_summary s;
+        fv_display_summarise(rr + skip, nrr - skip, 2.0 * a.W * a.H, period, &s);
+        /* rendered frames completed within the summarised photon span */
+        long rendered = 0;
+        double rhz = NAN, rp50 = NAN, rp99 = NAN;
+        const long nd = a.ndone < a.capdone ? a.ndone : a.capdone;
+        if (nrr - skip > 1) {
+            const int64_t t0 = rr[skip].photon_ns, t1 = rr[nrr - 1].photon_ns;
+            double *v = malloc((size_t)(nd + 1) * sizeof *v);
+            long m = 0;
+            for (long k = 0; k < nd; k++)
+                if (a.done_ns[k] >= t0 && a.done_ns[k] <= t1) {
+                    rendered++;
+                    if (v)
+                        v[m++] = a.render_ms[k];
+                }
+            if (t1 > t0)
+                rhz = (double)rendered * 1e9 / (double)(t1 - t0);
+            if (v) {
+                rp50 = fv_percentile(v, m, 0.5), rp99 = fv_percentile(v, m, 0.99);
+                free(v);
+            }
+        }
+        /* late: vsyncs without a newly composed image (composed after its vsync, or skipped) */
+        printf("fovea-headset: displayed %ld frames (%.2f Hz), rendered %ld frames (%.2f Hz), late %ld\n", s.displayed,
+               s.displayed_hz, rendered, rhz, s.missed);
+        printf("  %ld refreshes in %.2f s (%ld frames rendered in all), %dx%d per eye, vsync %s (%.2f Hz nominal), "
+               "display %s, timewarp on, display thread %s\n",
+               nrr, run_s, a.ndone, a.W, a.H, vsync_spec, run_hz, disp_kind, prio);
+        printf("  ");
+        summary_line("motion-to-photon", s.mtp_p50_ms, s.mtp_p99_ms);
+        printf("; ");
+        summary_line("gaze-to-photon", s.g2p_p50_ms, s.g2p_p99_ms);
+        printf("\n");
+        printf("  late: %ld refreshes composed after their vsync, %ld vsyncs skipped (a composition longer than a "
+               "period)\n",
+               s.late, s.skipped);
+        printf("  reused %ld refreshes (an old frame warped again); render p50 %.2f ms, p99 %.2f ms; warp+present "
+               "p50 %.2f ms, p99 %.2f ms; frame age at the photons p50 %.2f ms; disoccluded %.3f %% of pixels\n",
+               s.reused, rp50, rp99, s.compose_p50_ms, s.compose_p99_ms, s.age_p50_ms, 100.0 * s.disoccluded_frac);
+        if (has_head(&a))
+            printf("  head pose prediction error at the photon time p50 %.3f deg, p99 %.3f deg\n", s.pose_err_p50_deg,
+                   s.pose_err_p99_deg);
+    }
     printf("  vsync: %ld edges, missed %ld, spurious %ld, doubled %ld, relocks %ld, jitter %.1f us, period %.1f us, "
            "state %s%s\n",
-           loop.pred.edges, loop.pred.missed, loop.pred.spurious, loop.pred.doubled, loop.pred.relocks,
-           fv_vsync_pred_jitter_ns(&loop.pred) * 1e-3, fv_vsync_pred_period_ns(&loop.pred) * 1e-3,
-           fv_vsync_state_name(fv_vsync_pred_state(&loop.pred, fv_time_ns())),
-           loop.source_dead ? " (source failed)" : "");
+           pred->edges, pred->missed, pred->spurious, pred->doubled, pred->relocks,
+           fv_vsync_pred_jitter_ns(pred) * 1e-3, fv_vsync_pred_period_ns(pred) * 1e-3,
+           fv_vsync_state_name(fv_vsync_pred_state(pred, fv_time_ns())), source_dead ? " (source failed)" : "");
     if (a.cam)
         printf("  camera: %ld frames tracked%s\n", fv_gazesrc_frames(a.cam),
                fv_gazesrc_failed(a.cam) ? " (failed mid-run)" : "");
     if (csv_path) {
-        if (fv_latency_csv_write(csv_path, rec, nrec, a.t_start_ns, err, sizeof err)) {
+        const int rc = timewarp ? fv_refresh_csv_write(csv_path, rr, nrr, a.t_start_ns, err, sizeof err)
+                                : fv_latency_csv_write(csv_path, rec, nrec, a.t_start_ns, err, sizeof err);
+        if (rc) {
             fprintf(stderr, "%s: %s\n", prog, err);
             status = FV_EXIT_FAIL;
         }
@@ -441,5 +856,10 @@ done:
     free(a.img[0]);
     free(a.img[1]);
     free(rec);
+    free(rr);
+    for (int k = 0; k < FV_MAILBOX_SLOTS; k++)
+        fv_tw_frame_free(&a.slot[k]);
+    free(a.done_ns);
+    free(a.render_ms);
     return status;
 }

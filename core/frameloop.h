@@ -88,6 +88,10 @@ typedef struct fv_frame_record {
     int photon_edge;      /* photon_ns is a measured edge (1) or a prediction (0) */
     int vsync_state;      /* FV_VSYNC_* when presented */
     int64_t budget_ns;
+    /* filled by the caller (the frame loop leaves them 0 / NAN): the head pose sample the frame
+     * was rendered from, and its prediction's error against the true pose at photon_ns */
+    int64_t head_t_ns;
+    double pose_err_deg;
 } fv_frame_record;
 
 #define FV_FRAMELOOP_MAX_BUDGET_FRAMES 64

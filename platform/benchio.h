@@ -9,6 +9,7 @@
 #include <stdio.h>
 
 #include "bench.h"
+#include "displayloop.h"
 #include "frameloop.h"
 #include "prof.h"
 #include "quality.h"
@@ -76,5 +77,10 @@ void fv_stats_csv_row(FILE *f, long frame, double t_ms, float gaze_x, float gaze
  * atomically. 0, or -1 with a reason. */
 int fv_latency_csv_write(const char *path, const fv_frame_record *r, long n, int64_t t0_ns, char *err,
                          size_t err_len);
+/* --timewarp on: one row per refresh (displayloop.h): refresh,frame,reused,late,head_t_ms,
+ * gaze_t_ms,frame_start_ms,frame_done_ms,compose_start_ms,compose_done_ms,target_ms,photon_ms,
+ * motion_to_photon_ms,gaze_to_photon_ms,photon_edge,vsync_state,margin_ms,disoccluded,
+ * pose_err_deg,gaze_x,gaze_y (ms since t0; empty where unknown). 0, or -1 with err. */
+int fv_refresh_csv_write(const char *path, const fv_refresh_record *r, long n, int64_t t0, char *err, size_t err_len);
 
 #endif

@@ -538,17 +538,44 @@ $B/fovea-bench --scene $SCENE --size 64x72 --frames 1 --warmup 0 --lens assets/h
     grep -q '^foveated' "$T/out" && ok || bad "bench --lens: $(tail -n 3 "$T/out")"
 expect_usage "headset no scene" '--scene FILE is required' $HS --size 64x72
 
-# good runs: a summary, a latency CSV with one row per frame
+# good runs: the summary's contract lines (DESIGN.md), a latency CSV with one row per refresh
+# (--timewarp on, the default) or per frame (--timewarp off)
+L1='^fovea-headset: displayed [0-9]+ frames \([0-9.]+ Hz\), rendered [0-9]+ frames \([0-9.]+ Hz\), late [0-9]+$'
+L2='motion-to-photon p50 [0-9.]+ ms p99 [0-9.]+ ms; gaze-to-photon p50 [0-9.]+ ms p99 [0-9.]+ ms$'
 if $HS $HO --seconds 1 --trace assets/gaze_sweep.csv --latency-csv "$T/lat.csv" >"$T/out" 2>"$T/err"; then
-    grep -q 'gaze-to-photon p50' "$T/out" && ok || bad "headset summary: $(cat "$T/out")"
-    n=$(sed -n 's/^fovea-headset: \([0-9]*\) frames.*/\1/p' "$T/out")
-    [ -n "$n" ] && [ "$n" -gt 5 ] && [ "$(($(wc -l <"$T/lat.csv") - 1))" -eq "$n" ] && ok \
-        || bad "headset latency csv: $n frames, $(wc -l <"$T/lat.csv") lines"
-    head -n 1 "$T/lat.csv" | grep -q '^frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms' && ok \
+    head -n 1 "$T/out" | grep -Eq "$L1" && ok || bad "headset summary first line: $(head -n 1 "$T/out")"
+    grep -Eq "$L2" "$T/out" && ok || bad "headset summary latency line: $(cat "$T/out")"
+    grep -q 'timewarp on' "$T/out" && ok || bad "headset timewarp not on by default: $(cat "$T/out")"
+    n=$(sed -n 's/^  \([0-9]*\) refreshes in.*/\1/p' "$T/out")
+    [ -n "$n" ] && [ "$n" -gt 50 ] && [ "$(($(wc -l <"$T/lat.csv") - 1))" -eq "$n" ] && ok \
+        || bad "headset latency csv: $n refreshes, $(wc -l <"$T/lat.csv") lines"
+    head -n 1 "$T/lat.csv" | grep -q '^refresh,frame,reused,late,head_t_ms,gaze_t_ms' && ok \
         || bad "headset csv header: $(head -n 1 "$T/lat.csv")"
+    # every refresh after the first frame showed one, frame numbers never go back
+    awk -F, 'NR > 1 { if ($2 < 0) { if (seen) bad++; next } if (seen && $2 < last) bad++; seen = 1; last = $2 }
+             END { exit bad > 0 }' "$T/lat.csv" && ok || bad "headset refreshes without a frame or going back"
 else
     bad "headset good run failed: $(cat "$T/err")"
 fi
+if $HS $HO --seconds 1 --trace assets/gaze_sweep.csv --timewarp off --latency-csv "$T/lat0.csv" >"$T/out" 2>"$T/err"; then
+    head -n 1 "$T/out" | grep -Eq "$L1" && ok || bad "headset --timewarp off first line: $(head -n 1 "$T/out")"
+    grep -Eq "$L2" "$T/out" && ok || bad "headset --timewarp off latency line: $(cat "$T/out")"
+    n=$(sed -n 's/^  \([0-9]*\) frames in.*/\1/p' "$T/out")
+    [ -n "$n" ] && [ "$n" -gt 5 ] && [ "$(($(wc -l <"$T/lat0.csv") - 1))" -eq "$n" ] && ok \
+        || bad "headset --timewarp off latency csv: $n frames, $(wc -l <"$T/lat0.csv") lines"
+    head -n 1 "$T/lat0.csv" | grep -q '^frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms' && ok \
+        || bad "headset --timewarp off csv header: $(head -n 1 "$T/lat0.csv")"
+else
+    bad "headset --timewarp off run failed: $(cat "$T/err")"
+fi
+if $HS $HO --seconds 1 --warp-threads 2 >"$T/out" 2>"$T/err"; then
+    head -n 1 "$T/out" | grep -Eq "$L1" && grep -Eq "$L2" "$T/out" && ok || bad "headset --warp-threads 2: $(cat "$T/out")"
+else
+    bad "headset --warp-threads 2 run failed: $(cat "$T/err")"
+fi
+expect_usage "headset bad warp threads" '--warp-threads: 3 is out of range' $HS $HO --warp-threads 3
+expect_usage "headset bad timewarp" "--timewarp: 'sideways'" $HS $HO --timewarp sideways
+expect_usage "headset timewarp with lens" '--lens: the timewarp does not model the lens' $HS $HO --lens assets/hmd_example.lens --timewarp on
 # --trace-out: valid trace, one track per worker, the stage tracks and the loop's markers
 if $HS $HO --seconds 2 --trace-out "$T/hs.json" >"$T/out" 2>"$T/err"; then
     out=$(python3 tools/check_trace.py "$T/hs.json" 2 --stages) && ok || bad "headset trace: $out"
@@ -599,7 +626,7 @@ rc=$?
 [ "$rc" -eq 0 ] && ok || bad "headset SIGINT: exit $rc: $(cat "$T/err")"
 grep -q 'display png failed (.*); continuing without a display' "$T/err" && ok || bad "headset display fault: $(cat "$T/err")"
 grep -q 'display none' "$T/out" && grep -q 'gaze-to-photon p50' "$T/out" && ok || bad "headset summary after SIGINT: $(cat "$T/out")"
-n=$(sed -n 's/^fovea-headset: \([0-9]*\) frames.*/\1/p' "$T/out")
+n=$(sed -n 's/^fovea-headset: displayed \([0-9]*\) frames.*/\1/p' "$T/out")
 [ -n "$n" ] && [ "$n" -gt 2 ] && ok || bad "headset frames after the display fault: $n"
 
 echo "cli: $pass passed, $fail failed"

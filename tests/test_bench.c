@@ -356,28 +356,72 @@ static void test_latency_csv(void **state)
     r[0].frame = 0, r[0].has_gaze = 1, r[0].gaze_t_ns = t0 + 1000000, r[0].ray_start_ns = t0 + 2000000;
     r[0].done_ns = t0 + 9500000, r[0].target_ns = t0 + 11111111, r[0].photon_ns = t0 + 11111111;
     r[0].late = 0, r[0].photon_edge = 1, r[0].budget_ns = 8000000, r[0].gaze_x = 0.25f, r[0].gaze_y = 0.5f;
+    r[0].head_t_ns = t0 + 2000000, r[0].pose_err_deg = 0.125; /* motion-to-photon 9.111 ms */
     r[1] = r[0];
-    r[1].frame = 1, r[1].has_gaze = 0, r[1].late = 1;
+    r[1].frame = 1, r[1].has_gaze = 0, r[1].late = 1, r[1].head_t_ns = 0; /* no head sample: empty */
     char err[256];
     assert_int_equal(fv_latency_csv_write(path, r, 2, t0, err, sizeof err), 0);
     FILE *f = fopen(path, "r");
     assert_non_null(f);
     assert_non_null(fgets(line[0], sizeof line[0], f));
     assert_string_equal(line[0], "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,"
-                                 "render_ms,late,photon_edge,vsync_state,budget_ms,gaze_x,gaze_y\n");
+                                 "render_ms,late,photon_edge,vsync_state,budget_ms,gaze_x,gaze_y,head_t_ms,"
+                                 "motion_to_photon_ms,pose_err_deg\n");
     assert_non_null(fgets(line[0], sizeof line[0], f));
     assert_non_null(fgets(line[1], sizeof line[1], f));
     fclose(f);
     char want[2][256];
-    snprintf(want[0], sizeof want[0], "0,1.000,2.000,9.500,11.111,11.111,10.111,7.500,0,1,%s,8.000,0.2500,0.5000\n",
+    snprintf(want[0], sizeof want[0], "0,1.000,2.000,9.500,11.111,11.111,10.111,7.500,0,1,%s,8.000,0.2500,0.5000,2.000,9.111,0.1250\n",
              fv_vsync_state_name(0));
-    snprintf(want[1], sizeof want[1], "1,,2.000,9.500,11.111,11.111,,7.500,1,1,%s,8.000,,\n", fv_vsync_state_name(0));
+    snprintf(want[1], sizeof want[1], "1,,2.000,9.500,11.111,11.111,,7.500,1,1,%s,8.000,,,,,\n", fv_vsync_state_name(0));
     assert_string_equal(line[0], want[0]);
     assert_string_equal(line[1], want[1]);
     remove(path);
     snprintf(path, sizeof path, "%s/no/such/dir/lat.csv", dir);
     assert_int_equal(fv_latency_csv_write(path, r, 2, t0, err, sizeof err), -1);
     assert_non_null(strstr(err, "lat.csv"));
+    rmdir(dir);
+}
+
+/* --timewarp on's --latency-csv: one row per refresh; fields of a refresh without a frame empty */
+static void test_refresh_csv(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/fv_rfsXXXXXX", path[64], line[3][320];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/r.csv", dir);
+    const int64_t t0 = 1000000000;
+    fv_refresh_record r[2];
+    memset(r, 0, sizeof r);
+    r[0].refresh = 0, r[0].frame = -1, r[0].pose_err_deg = NAN;
+    r[0].wake_ns = t0 + 1000000, r[0].done_ns = t0 + 1500000, r[0].target_ns = r[0].photon_ns = t0 + 11111111;
+    r[0].margin_ns = 3000000;
+    r[1] = r[0];
+    r[1].refresh = 1, r[1].frame = 7, r[1].reused = 1, r[1].head_t_ns = t0 + 12000000, r[1].has_gaze = 1;
+    r[1].gaze_t_ns = t0 + 2000000, r[1].frame_start_ns = t0 + 3000000, r[1].frame_done_ns = t0 + 9000000;
+    r[1].wake_ns = t0 + 12500000, r[1].done_ns = t0 + 15000000, r[1].target_ns = r[1].photon_ns = t0 + 22222222;
+    r[1].photon_edge = 1, r[1].disoccluded = 42, r[1].pose_err_deg = 0.25, r[1].gaze_x = 0.5f, r[1].gaze_y = 0.75f;
+    char err[256];
+    assert_int_equal(fv_refresh_csv_write(path, r, 2, t0, err, sizeof err), 0);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    for (int i = 0; i < 3; i++)
+        assert_non_null(fgets(line[i], sizeof line[i], f));
+    fclose(f);
+    assert_string_equal(line[0], "refresh,frame,reused,late,head_t_ms,gaze_t_ms,frame_start_ms,frame_done_ms,"
+                                 "compose_start_ms,compose_done_ms,target_ms,photon_ms,motion_to_photon_ms,"
+                                 "gaze_to_photon_ms,photon_edge,vsync_state,margin_ms,disoccluded,pose_err_deg,"
+                                 "gaze_x,gaze_y\n");
+    char want[2][320];
+    snprintf(want[0], sizeof want[0], "0,-1,0,0,,,,,1.000,1.500,11.111,11.111,,,0,%s,3.000,0,,,\n",
+             fv_vsync_state_name(0));
+    snprintf(want[1], sizeof want[1],
+             "1,7,1,0,12.000,2.000,3.000,9.000,12.500,15.000,22.222,22.222,10.222,20.222,1,%s,3.000,42,0.2500,"
+             "0.5000,0.7500\n",
+             fv_vsync_state_name(0));
+    assert_string_equal(line[1], want[0]);
+    assert_string_equal(line[2], want[1]);
+    remove(path);
     rmdir(dir);
 }
 
@@ -388,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_counter_hook), cmocka_unit_test(test_roofline),    cmocka_unit_test(test_sweep_parse),
         cmocka_unit_test(test_head_at),      cmocka_unit_test(test_copy_gbps),   cmocka_unit_test(test_mean_acc),
         cmocka_unit_test(test_quality),      cmocka_unit_test(test_report_lines), cmocka_unit_test(test_latency_csv),
+        cmocka_unit_test(test_refresh_csv),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,6 +11,7 @@
 #include "base/clock.h"
 #include "cli.h"
 #include "output.h"
+#include "timewarp.h"
 
 #include "camera.h"
 #include "dof/weier_impl.h"
@@ -461,6 +462,57 @@ static void out_free(void *st)
     free(t->rgbd), free(t->rgb), free(t);
 }
 
+/* ---- timewarp: one eye's frame warped by a refresh of head turn (30 deg/s, 11.1 ms, plus
+ * 2 mm of the eye's swing) over a source with depth edges ---- */
+typedef struct {
+    uint8_t *rgb, *dst;
+    uint16_t *invd;
+    fv_tw_map m;
+    fv_tw_src s;
+} tw_st;
+static void *tw_setup(void)
+{
+    tw_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    t->rgb = malloc((size_t)W * H * 3 + FV_TW_RGB_PAD), t->dst = malloc((size_t)W * H * 3);
+    t->invd = malloc(((size_t)W * H + FV_TW_INVD_PAD / 2) * sizeof *t->invd);
+    if (!t->rgb || !t->dst || !t->invd)
+        return free(t->rgb), free(t->dst), free(t->invd), free(t), NULL;
+    uint32_t s = 11;
+    for (size_t i = 0; i < (size_t)W * H * 3 + FV_TW_RGB_PAD; i++)
+        t->rgb[i] = (uint8_t)((s = s * 1664525u + 1013904223u) >> 24);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            t->invd[(size_t)y * W + x] = (uint16_t)(FV_TW_INVD_PER_M / (1.0f + (float)(((x >> 6) + (y >> 6)) & 7)));
+    fv_camera_desc cd;
+    fv_camera_desc_default(&cd);
+    const float a = 30.0f / 90.0f * 3.14159265f / 360.0f;
+    fv_pose p0 = {{0, 0, 0}, {0, 0, 0, 1}}, p1 = {{0.002f, 0, 0}, {0, sinf(a), 0, cosf(a)}};
+    fv_camera c0, c1;
+    fv_camera_setup(&c0, &cd, &p0);
+    fv_camera_setup(&c1, &cd, &p1);
+    fv_tw_setup(&t->m, &c1, &c0, 0.05f);
+    t->s = (fv_tw_src){t->rgb, (ptrdiff_t)W * 3, t->invd, W, W, H};
+    return t;
+}
+static int tw_sink;
+static void tw_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    tw_st *t = st;
+    int h = 0;
+    for (int k = 0; k < rows; k++) {
+        const int y = (row0 + k) % H;
+        h += d->tw.tw_row(t->dst + (size_t)y * W * 3, 0, y, W, &t->m, &t->s);
+    }
+    tw_sink = h;
+}
+static void tw_free(void *st)
+{
+    tw_st *t = st;
+    free(t->rgb), free(t->dst), free(t->invd), free(t);
+}
+
 /* ---- shading: a full frame's packets of 16 hits, head light (range, FlightHelmet) and two
  * KHR lights (DepthOfFieldExample has KHR lights) ---- */
 #define SH_PACKETS (W * H / FV_SHADE_LANES)
@@ -563,6 +615,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
      box_setup, NULL, box_run, et_free},
     {"et_box3_row", "640x480, 478 rows", {F(et.et_box3_row), 0}, EH - 2, et_setup, NULL, box3_run, et_free},
     {"rgb8_row", "1280x1440, 1440 rows", {F(out.rgb8_row), 0}, H, out_setup, NULL, out_run, out_free},
+    {"tw_row", "1280x1440, 1440 rows, 1 refresh of a 30 deg/s turn", {F(tw.tw_row), 0}, H, tw_setup, NULL, tw_run,
+     tw_free},
 };
 const int checkasm_bench_count = (int)(sizeof checkasm_bench_kernels / sizeof checkasm_bench_kernels[0]);
 
@@ -598,6 +652,7 @@ void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask)
     fv_output_dsp_init(&d->out, isa_mask);
     fv_shade_dsp_init(&d->shade, isa_mask);
     fv_raygen_dsp_init(&d->ray, isa_mask);
+    fv_timewarp_dsp_init(&d->tw, isa_mask);
 }
 
 static int cmp_double(const void *a, const void *b)

@@ -23,6 +23,7 @@
 #include "raygen_dsp.h"
 #include "reproject_dsp.h"
 #include "shade_dsp.h"
+#include "timewarp_dsp.h"
 
 /* Every module's table, for one ISA mask. */
 typedef struct checkasm_dsp {
@@ -34,6 +35,7 @@ typedef struct checkasm_dsp {
     fv_output_dsp out;
     fv_shade_dsp shade;
     fv_raygen_dsp ray;
+    fv_timewarp_dsp tw;
 } checkasm_dsp;
 void checkasm_dsp_init(checkasm_dsp *d, unsigned isa_mask);
 

@@ -199,7 +199,7 @@ int main(int argc, char **argv)
     }
     const struct CMUnitTest *mods[] = {checkasm_pullpush_tests, checkasm_reproject_tests, checkasm_dof_tests,
                                        checkasm_eyetrack_tests, checkasm_shade_tests, checkasm_raygen_tests,
-                                       checkasm_output_tests, checkasm_bench_tests};
+                                       checkasm_output_tests, checkasm_timewarp_tests, checkasm_bench_tests};
     size_t n = 0;
     for (size_t m = 0; m < sizeof mods / sizeof mods[0]; m++)
         n += count_tests(mods[m]);

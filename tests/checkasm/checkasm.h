@@ -1,6 +1,6 @@
 /* fovea checkasm (dav1d's tests/checkasm idea): every ISA version of every kernel against its
  * plain-C reference, one file per module (pullpush.c, reproject.c, dof.c, eyetrack.c, shade.c, raygen.c,
- * output.c), and with
+ * output.c, timewarp.c), and with
  * --bench their speed at production sizes (bench.c). Shared here: the seeded RNG, canaried
  * output buffers, the compare helper and the ISA bookkeeping.
  *
@@ -97,6 +97,6 @@ void checkasm_check_table(const char *module, unsigned isa, const void *own, con
 /* The modules' tests (each array ends with a zeroed entry). */
 extern const struct CMUnitTest checkasm_pullpush_tests[], checkasm_reproject_tests[], checkasm_dof_tests[],
     checkasm_eyetrack_tests[], checkasm_shade_tests[], checkasm_raygen_tests[], checkasm_output_tests[],
-    checkasm_bench_tests[];
+    checkasm_timewarp_tests[], checkasm_bench_tests[];
 
 #endif

@@ -1,0 +1,147 @@
+/* fovea: the timewarp kernel, NEON: 4 display pixels a step, the float steps in vector code,
+ * the source reads per lane (NEON has no gather), the bilinear tap in 32-bit integer lanes.
+ * Same IEEE steps as the reference, in its order; max / min are written as the reference's
+ * compares (vmaxq_f32 would propagate NaN where the reference does not). */
+#include <arm_neon.h>
+#include <string.h>
+
+#include "timewarp_dsp.h"
+
+typedef struct {
+    float32x4_t t0, t1, t2, zmin, one, denmin, wscale, tol, wm1, hm1, half, k128;
+    int32x4_t wm1i, hm1i, istride, rstride;
+    const uint16_t *invd;
+    const uint8_t *rgb;
+} tw4;
+
+static inline float32x4_t gt_sel(float32x4_t a, float32x4_t b) { return vbslq_f32(vcgtq_f32(a, b), a, b); }
+static inline float32x4_t lt_sel(float32x4_t a, float32x4_t b) { return vbslq_f32(vcltq_f32(a, b), a, b); }
+static inline float32x4_t clamp4(float32x4_t v, float32x4_t hi) { return lt_sel(gt_sel(v, vdupq_n_f32(0.0f)), hi); }
+
+static inline void proj4(const tw4 *c, float32x4_t A0, float32x4_t A1, float32x4_t A2, float32x4_t w, float32x4_t *u,
+                         float32x4_t *v)
+{
+    const float32x4_t nz = gt_sel(vaddq_f32(A2, vmulq_f32(c->t2, w)), c->zmin);
+    const float32x4_t inv = vdivq_f32(c->one, nz);
+    *u = vmulq_f32(vaddq_f32(A0, vmulq_f32(c->t0, w)), inv);
+    *v = vmulq_f32(vaddq_f32(A1, vmulq_f32(c->t1, w)), inv);
+}
+
+static inline int32x4_t gather_u16(const uint16_t *p, int32x4_t i)
+{
+    const int32_t v[4] = {p[vgetq_lane_s32(i, 0)], p[vgetq_lane_s32(i, 1)], p[vgetq_lane_s32(i, 2)],
+                          p[vgetq_lane_s32(i, 3)]};
+    return vld1q_s32(v);
+}
+static inline int32x4_t gather_w32(const uint8_t *p, int32x4_t o)
+{
+    int32_t v[4];
+    memcpy(&v[0], p + vgetq_lane_s32(o, 0), 4);
+    memcpy(&v[1], p + vgetq_lane_s32(o, 1), 4);
+    memcpy(&v[2], p + vgetq_lane_s32(o, 2), 4);
+    memcpy(&v[3], p + vgetq_lane_s32(o, 3), 4);
+    return vld1q_s32(v);
+}
+
+static inline float32x4_t fetch_w4(const tw4 *c, float32x4_t A2, float32x4_t u, float32x4_t v)
+{
+    const int32x4_t ix = vcvtq_s32_f32(clamp4(u, c->wm1)), iy = vcvtq_s32_f32(clamp4(v, c->hm1));
+    const int32x4_t g = gather_u16(c->invd, vaddq_s32(vmulq_s32(iy, c->istride), ix));
+    const float32x4_t ws = vmulq_f32(vcvtq_f32_s32(g), c->wscale);
+    const float32x4_t den = gt_sel(vsubq_f32(c->one, vmulq_f32(c->t2, ws)), c->denmin);
+    return vdivq_f32(vmulq_f32(A2, ws), den);
+}
+
+static inline int32x4_t chan(int32x4_t g, int sh)
+{
+    return vandq_s32(vreinterpretq_s32_u32(vshlq_u32(vreinterpretq_u32_s32(g), vdupq_n_s32(-sh))), vdupq_n_s32(255));
+}
+
+static inline int32x4_t lerp_chan(int32x4_t g00, int32x4_t g10, int32x4_t g01, int32x4_t g11, int sh, int32x4_t fx,
+                                  int32x4_t fy)
+{
+    const int32x4_t c00 = chan(g00, sh), c10 = chan(g10, sh), c01 = chan(g01, sh), c11 = chan(g11, sh);
+    const int32x4_t top = vaddq_s32(vshlq_n_s32(c00, 7), vmulq_s32(vsubq_s32(c10, c00), fx));
+    const int32x4_t bot = vaddq_s32(vshlq_n_s32(c01, 7), vmulq_s32(vsubq_s32(c11, c01), fx));
+    const int32x4_t s = vaddq_s32(vshlq_n_s32(top, 7), vmulq_s32(vsubq_s32(bot, top), fy));
+    return vshrq_n_s32(vaddq_s32(s, vdupq_n_s32(8192)), 14);
+}
+
+static inline void tap4(const tw4 *c, uint8_t *dst, float32x4_t u, float32x4_t v)
+{
+    const float32x4_t bu = clamp4(vsubq_f32(u, c->half), c->wm1), bv = clamp4(vsubq_f32(v, c->half), c->hm1);
+    const int32x4_t x0 = vcvtq_s32_f32(bu), y0 = vcvtq_s32_f32(bv);
+    const int32x4_t fx = vcvtq_s32_f32(vmulq_f32(vsubq_f32(bu, vcvtq_f32_s32(x0)), c->k128));
+    const int32x4_t fy = vcvtq_s32_f32(vmulq_f32(vsubq_f32(bv, vcvtq_f32_s32(y0)), c->k128));
+    const int32x4_t x1 = vsubq_s32(x0, vreinterpretq_s32_u32(vcgtq_s32(c->wm1i, x0))); /* + 1 inside */
+    const int32x4_t y1 = vsubq_s32(y0, vreinterpretq_s32_u32(vcgtq_s32(c->hm1i, y0)));
+    const int32x4_t r0 = vmulq_s32(y0, c->rstride), r1 = vmulq_s32(y1, c->rstride);
+    const int32x4_t b0 = vmulq_n_s32(x0, 3), b1 = vmulq_n_s32(x1, 3);
+    const int32x4_t g00 = gather_w32(c->rgb, vaddq_s32(r0, b0)), g10 = gather_w32(c->rgb, vaddq_s32(r0, b1));
+    const int32x4_t g01 = gather_w32(c->rgb, vaddq_s32(r1, b0)), g11 = gather_w32(c->rgb, vaddq_s32(r1, b1));
+    int32_t ch[3][4];
+    for (int k = 0; k < 3; k++)
+        vst1q_s32(ch[k], lerp_chan(g00, g10, g01, g11, 8 * k, fx, fy));
+    for (int p = 0; p < 4; p++)
+        for (int k = 0; k < 3; k++)
+            dst[3 * p + k] = (uint8_t)ch[k][p];
+}
+
+static int tw_row_neon(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s)
+{
+    const float py = (float)y + 0.5f;
+    const float r[3] = {m->a0[0] + py * m->ay[0], m->a0[1] + py * m->ay[1], m->a0[2] + py * m->ay[2]};
+    tw4 c;
+    c.t0 = vdupq_n_f32(m->t[0]), c.t1 = vdupq_n_f32(m->t[1]), c.t2 = vdupq_n_f32(m->t[2]);
+    c.zmin = vdupq_n_f32(FV_TW_ZMIN), c.one = vdupq_n_f32(1.0f), c.denmin = vdupq_n_f32(FV_TW_DEN_MIN);
+    c.wscale = vdupq_n_f32(m->w_scale), c.tol = vdupq_n_f32(m->tol);
+    c.wm1 = vdupq_n_f32((float)(s->w - 1)), c.hm1 = vdupq_n_f32((float)(s->h - 1));
+    c.half = vdupq_n_f32(0.5f), c.k128 = vdupq_n_f32(128.0f);
+    c.wm1i = vdupq_n_s32(s->w - 1), c.hm1i = vdupq_n_s32(s->h - 1);
+    c.istride = vdupq_n_s32((int32_t)s->invd_stride), c.rstride = vdupq_n_s32((int32_t)s->rgb_stride);
+    c.invd = s->invd, c.rgb = s->rgb;
+    const float32x4_t r0 = vdupq_n_f32(r[0]), r1 = vdupq_n_f32(r[1]), r2 = vdupq_n_f32(r[2]);
+    const float32x4_t ax0 = vdupq_n_f32(m->ax[0]), ax1 = vdupq_n_f32(m->ax[1]), ax2 = vdupq_n_f32(m->ax[2]);
+    static const int32_t lanes[4] = {0, 1, 2, 3};
+    int holes = 0, i = 0;
+    /* TW_G groups of 4 a step, each stage for all before the next (see the AVX2 version) */
+#define TW_G 8
+    for (int g; i + 4 <= n; i += 4 * g) {
+        g = (n - i) / 4 < TW_G ? (n - i) / 4 : TW_G;
+        float32x4_t A0[TW_G], A1[TW_G], A2[TW_G], u0[TW_G], v0[TW_G], u1[TW_G], v1[TW_G], u2[TW_G], v2[TW_G];
+        float32x4_t w1[TW_G], w2[TW_G], w3[TW_G];
+        for (int k = 0; k < g; k++) {
+            const int32x4_t xi = vaddq_s32(vdupq_n_s32(x0 + i + 4 * k), vld1q_s32(lanes));
+            const float32x4_t px = vaddq_f32(vcvtq_f32_s32(xi), c.half);
+            A0[k] = vaddq_f32(r0, vmulq_f32(px, ax0)), A1[k] = vaddq_f32(r1, vmulq_f32(px, ax1));
+            A2[k] = vaddq_f32(r2, vmulq_f32(px, ax2));
+            proj4(&c, A0[k], A1[k], A2[k], vdupq_n_f32(0.0f), &u0[k], &v0[k]);
+        }
+        for (int k = 0; k < g; k++)
+            w1[k] = fetch_w4(&c, A2[k], u0[k], v0[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w1[k], &u1[k], &v1[k]);
+        for (int k = 0; k < g; k++)
+            w2[k] = fetch_w4(&c, A2[k], u1[k], v1[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w2[k], &u2[k], &v2[k]);
+        for (int k = 0; k < g; k++)
+            w3[k] = fetch_w4(&c, A2[k], u2[k], v2[k]);
+        for (int k = 0; k < g; k++) {
+            const float32x4_t d = vabsq_f32(vsubq_f32(w3[k], w2[k])), mx = gt_sel(w3[k], w2[k]);
+            const uint32x4_t dis = vcgtq_f32(d, vmulq_f32(c.tol, mx));
+            const uint32x4_t first = vandq_u32(dis, vcltq_f32(w2[k], w3[k]));
+            tap4(&c, dst + 3 * (i + 4 * k), vbslq_f32(first, u1[k], u2[k]), vbslq_f32(first, v1[k], v2[k]));
+            holes += (int)vaddvq_u32(vshrq_n_u32(dis, 31));
+        }
+    }
+#undef TW_G
+    for (; i < n; i++) {
+        const float px = (float)(x0 + i) + 0.5f;
+        const float A[3] = {r[0] + px * m->ax[0], r[1] + px * m->ax[1], r[2] + px * m->ax[2]};
+        holes += fv_tw_pixel(dst + 3 * i, m, s, A);
+    }
+    return holes;
+}
+
+void fv_timewarp_dsp_init_neon(fv_timewarp_dsp *d) { d->tw_row = tw_row_neon; }

@@ -1,0 +1,31 @@
+/* fovea: the timewarp kernel's C reference (contract: timewarp_dsp.h). */
+#include "timewarp_dsp.h"
+
+int fv_tw_row_c(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s)
+{
+    const float py = (float)y + 0.5f;
+    const float r[3] = {m->a0[0] + py * m->ay[0], m->a0[1] + py * m->ay[1], m->a0[2] + py * m->ay[2]};
+    int holes = 0;
+    for (int i = 0; i < n; i++) {
+        const float px = (float)(x0 + i) + 0.5f;
+        const float A[3] = {r[0] + px * m->ax[0], r[1] + px * m->ax[1], r[2] + px * m->ax[2]};
+        holes += fv_tw_pixel(dst + 3 * i, m, s, A);
+    }
+    return holes;
+}
+
+void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask)
+{
+    d->tw_row = fv_tw_row_c;
+    const unsigned avail = isa_mask & fv_cpu_isas();
+    (void)avail;
+#if defined(__x86_64__)
+    if (avail & FV_ISA_SSE41)
+        fv_timewarp_dsp_init_sse41(d);
+    if (avail & FV_ISA_AVX2)
+        fv_timewarp_dsp_init_avx2(d);
+#elif defined(__aarch64__)
+    if (avail & FV_ISA_NEON)
+        fv_timewarp_dsp_init_neon(d);
+#endif
+}

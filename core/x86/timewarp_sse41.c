@@ -1,0 +1,142 @@
+/* fovea: the timewarp kernel, SSE4.1: 4 display pixels a step, the float steps in vector code,
+ * the source reads per lane (SSE4.1 has no gather), the bilinear tap in 32-bit integer lanes.
+ * Same IEEE steps as the reference, in its order. */
+#include <smmintrin.h>
+#include <string.h>
+
+#include "timewarp_dsp.h"
+
+typedef struct {
+    __m128 t0, t1, t2, zmin, one, denmin, wscale, tol, wm1, hm1, half, k128;
+    __m128i wm1i, hm1i, istride, rstride;
+    const uint16_t *invd;
+    const uint8_t *rgb;
+} tw4;
+
+static inline __m128 clamp4(__m128 v, __m128 hi) { return _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), hi); }
+
+static inline void proj4(const tw4 *c, __m128 A0, __m128 A1, __m128 A2, __m128 w, __m128 *u, __m128 *v)
+{
+    const __m128 nz = _mm_max_ps(_mm_add_ps(A2, _mm_mul_ps(c->t2, w)), c->zmin);
+    const __m128 inv = _mm_div_ps(c->one, nz);
+    *u = _mm_mul_ps(_mm_add_ps(A0, _mm_mul_ps(c->t0, w)), inv);
+    *v = _mm_mul_ps(_mm_add_ps(A1, _mm_mul_ps(c->t1, w)), inv);
+}
+
+static inline __m128i gather_u16(const uint16_t *p, __m128i i)
+{
+    return _mm_setr_epi32(p[_mm_cvtsi128_si32(i)], p[_mm_extract_epi32(i, 1)], p[_mm_extract_epi32(i, 2)],
+                          p[_mm_extract_epi32(i, 3)]);
+}
+static inline int32_t word_at(const uint8_t *p)
+{
+    int32_t v;
+    memcpy(&v, p, 4);
+    return v;
+}
+static inline __m128i gather_w32(const uint8_t *p, __m128i o)
+{
+    return _mm_setr_epi32(word_at(p + _mm_cvtsi128_si32(o)), word_at(p + _mm_extract_epi32(o, 1)),
+                          word_at(p + _mm_extract_epi32(o, 2)), word_at(p + _mm_extract_epi32(o, 3)));
+}
+
+static inline __m128 fetch_w4(const tw4 *c, __m128 A2, __m128 u, __m128 v)
+{
+    const __m128i ix = _mm_cvttps_epi32(clamp4(u, c->wm1)), iy = _mm_cvttps_epi32(clamp4(v, c->hm1));
+    const __m128i g = gather_u16(c->invd, _mm_add_epi32(_mm_mullo_epi32(iy, c->istride), ix));
+    const __m128 ws = _mm_mul_ps(_mm_cvtepi32_ps(g), c->wscale);
+    const __m128 den = _mm_max_ps(_mm_sub_ps(c->one, _mm_mul_ps(c->t2, ws)), c->denmin);
+    return _mm_div_ps(_mm_mul_ps(A2, ws), den);
+}
+
+static inline __m128i chan(__m128i g, int sh) { return _mm_and_si128(_mm_srli_epi32(g, sh), _mm_set1_epi32(255)); }
+
+static inline __m128i lerp_chan(__m128i g00, __m128i g10, __m128i g01, __m128i g11, int sh, __m128i fx, __m128i fy)
+{
+    const __m128i c00 = chan(g00, sh), c10 = chan(g10, sh), c01 = chan(g01, sh), c11 = chan(g11, sh);
+    const __m128i top = _mm_add_epi32(_mm_slli_epi32(c00, 7), _mm_mullo_epi32(_mm_sub_epi32(c10, c00), fx));
+    const __m128i bot = _mm_add_epi32(_mm_slli_epi32(c01, 7), _mm_mullo_epi32(_mm_sub_epi32(c11, c01), fx));
+    const __m128i s = _mm_add_epi32(_mm_slli_epi32(top, 7), _mm_mullo_epi32(_mm_sub_epi32(bot, top), fy));
+    return _mm_srli_epi32(_mm_add_epi32(s, _mm_set1_epi32(8192)), 14);
+}
+
+static inline void tap4(const tw4 *c, uint8_t *dst, __m128 u, __m128 v)
+{
+    const __m128 bu = clamp4(_mm_sub_ps(u, c->half), c->wm1), bv = clamp4(_mm_sub_ps(v, c->half), c->hm1);
+    const __m128i x0 = _mm_cvttps_epi32(bu), y0 = _mm_cvttps_epi32(bv);
+    const __m128i fx = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(bu, _mm_cvtepi32_ps(x0)), c->k128));
+    const __m128i fy = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(bv, _mm_cvtepi32_ps(y0)), c->k128));
+    const __m128i x1 = _mm_sub_epi32(x0, _mm_cmpgt_epi32(c->wm1i, x0)); /* + 1 inside */
+    const __m128i y1 = _mm_sub_epi32(y0, _mm_cmpgt_epi32(c->hm1i, y0));
+    const __m128i r0 = _mm_mullo_epi32(y0, c->rstride), r1 = _mm_mullo_epi32(y1, c->rstride);
+    const __m128i b0 = _mm_add_epi32(x0, _mm_add_epi32(x0, x0)), b1 = _mm_add_epi32(x1, _mm_add_epi32(x1, x1));
+    const __m128i g00 = gather_w32(c->rgb, _mm_add_epi32(r0, b0)), g10 = gather_w32(c->rgb, _mm_add_epi32(r0, b1));
+    const __m128i g01 = gather_w32(c->rgb, _mm_add_epi32(r1, b0)), g11 = gather_w32(c->rgb, _mm_add_epi32(r1, b1));
+    const __m128i px = _mm_or_si128(_mm_or_si128(lerp_chan(g00, g10, g01, g11, 0, fx, fy),
+                                                 _mm_slli_epi32(lerp_chan(g00, g10, g01, g11, 8, fx, fy), 8)),
+                                    _mm_slli_epi32(lerp_chan(g00, g10, g01, g11, 16, fx, fy), 16));
+    const __m128i keep = _mm_setr_epi8(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1);
+    const __m128i b = _mm_shuffle_epi8(px, keep);
+    const int32_t t = _mm_extract_epi32(b, 2);
+    _mm_storel_epi64((__m128i *)(void *)dst, b);
+    memcpy(dst + 8, &t, 4);
+}
+
+static int tw_row_sse41(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s)
+{
+    const float py = (float)y + 0.5f;
+    const float r[3] = {m->a0[0] + py * m->ay[0], m->a0[1] + py * m->ay[1], m->a0[2] + py * m->ay[2]};
+    tw4 c;
+    c.t0 = _mm_set1_ps(m->t[0]), c.t1 = _mm_set1_ps(m->t[1]), c.t2 = _mm_set1_ps(m->t[2]);
+    c.zmin = _mm_set1_ps(FV_TW_ZMIN), c.one = _mm_set1_ps(1.0f), c.denmin = _mm_set1_ps(FV_TW_DEN_MIN);
+    c.wscale = _mm_set1_ps(m->w_scale), c.tol = _mm_set1_ps(m->tol);
+    c.wm1 = _mm_set1_ps((float)(s->w - 1)), c.hm1 = _mm_set1_ps((float)(s->h - 1));
+    c.half = _mm_set1_ps(0.5f), c.k128 = _mm_set1_ps(128.0f);
+    c.wm1i = _mm_set1_epi32(s->w - 1), c.hm1i = _mm_set1_epi32(s->h - 1);
+    c.istride = _mm_set1_epi32((int)s->invd_stride), c.rstride = _mm_set1_epi32((int)s->rgb_stride);
+    c.invd = s->invd, c.rgb = s->rgb;
+    const __m128 r0 = _mm_set1_ps(r[0]), r1 = _mm_set1_ps(r[1]), r2 = _mm_set1_ps(r[2]);
+    const __m128 ax0 = _mm_set1_ps(m->ax[0]), ax1 = _mm_set1_ps(m->ax[1]), ax2 = _mm_set1_ps(m->ax[2]);
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    int holes = 0, i = 0;
+    /* TW_G groups of 4 a step, each stage for all before the next (see the AVX2 version) */
+#define TW_G 8
+    for (int g; i + 4 <= n; i += 4 * g) {
+        g = (n - i) / 4 < TW_G ? (n - i) / 4 : TW_G;
+        __m128 A0[TW_G], A1[TW_G], A2[TW_G], u0[TW_G], v0[TW_G], u1[TW_G], v1[TW_G], u2[TW_G], v2[TW_G];
+        __m128 w1[TW_G], w2[TW_G], w3[TW_G];
+        for (int k = 0; k < g; k++) {
+            const __m128i xi = _mm_add_epi32(_mm_set1_epi32(x0 + i + 4 * k), _mm_setr_epi32(0, 1, 2, 3));
+            const __m128 px = _mm_add_ps(_mm_cvtepi32_ps(xi), c.half);
+            A0[k] = _mm_add_ps(r0, _mm_mul_ps(px, ax0)), A1[k] = _mm_add_ps(r1, _mm_mul_ps(px, ax1));
+            A2[k] = _mm_add_ps(r2, _mm_mul_ps(px, ax2));
+            proj4(&c, A0[k], A1[k], A2[k], _mm_setzero_ps(), &u0[k], &v0[k]);
+        }
+        for (int k = 0; k < g; k++)
+            w1[k] = fetch_w4(&c, A2[k], u0[k], v0[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w1[k], &u1[k], &v1[k]);
+        for (int k = 0; k < g; k++)
+            w2[k] = fetch_w4(&c, A2[k], u1[k], v1[k]);
+        for (int k = 0; k < g; k++)
+            proj4(&c, A0[k], A1[k], A2[k], w2[k], &u2[k], &v2[k]);
+        for (int k = 0; k < g; k++)
+            w3[k] = fetch_w4(&c, A2[k], u2[k], v2[k]);
+        for (int k = 0; k < g; k++) {
+            const __m128 d = _mm_andnot_ps(sign, _mm_sub_ps(w3[k], w2[k])), mx = _mm_max_ps(w3[k], w2[k]);
+            const __m128 dis = _mm_cmpgt_ps(d, _mm_mul_ps(c.tol, mx));
+            const __m128 first = _mm_and_ps(dis, _mm_cmplt_ps(w2[k], w3[k]));
+            tap4(&c, dst + 3 * (i + 4 * k), _mm_blendv_ps(u2[k], u1[k], first), _mm_blendv_ps(v2[k], v1[k], first));
+            holes += __builtin_popcount((unsigned)_mm_movemask_ps(dis));
+        }
+    }
+#undef TW_G
+    for (; i < n; i++) {
+        const float px = (float)(x0 + i) + 0.5f;
+        const float A[3] = {r[0] + px * m->ax[0], r[1] + px * m->ax[1], r[2] + px * m->ax[2]};
+        holes += fv_tw_pixel(dst + 3 * i, m, s, A);
+    }
+    return holes;
+}
+
+void fv_timewarp_dsp_init_sse41(fv_timewarp_dsp *d) { d->tw_row = tw_row_sse41; }
