@@ -244,7 +244,7 @@ static void test_partial_occlusion(void **state)
 /* The same poses through spectacles (fv_synth_specs_set_frame: LED reflections on the lens that
  * do not move with the eye, tint, a dark rim crossing the image): the rim is not taken for the
  * pupil (the sides test of the search; before it 57.7 % of the eval_eye set was within 5 px, the
- * rim winning most misses) and a lens reflection is not taken for a corneal glint (area). Set of
+ * rim winning most misses) and a lens reflection is rarely taken for a corneal glint (area). Set of
  * build/tools/eval_eye --specs --frames 160. */
 static void test_spectacles(void **state)
 {

@@ -248,14 +248,19 @@ int fv_et_find_glints(const fv_eyetrack_dsp *d, const uint8_t *luma, int w, int 
             cand[nc++] = gl;
         }
     /* corneal glints are images of the same LEDs in the same mirror: about equally small. A
-     * reflection on spectacles is a larger image of an LED: refused when more than 3x the area of
-     * the smallest candidate (itself most likely corneal) */
-    float amin = INFINITY;
-    for (int i = 0; i < nc; i++)
-        amin = fminf(amin, cand[i].area_px);
+     * reflection on spectacles is a larger image of an LED: refused when more than 3x the median
+     * candidate's area (the corneal glints are the majority near the pupil) */
+    float area[MAX_CAND];
+    for (int i = 0; i < nc; i++) { /* insertion sort of the areas */
+        int j = i;
+        for (; j > 0 && area[j - 1] > cand[i].area_px; j--)
+            area[j] = area[j - 1];
+        area[j] = cand[i].area_px;
+    }
+    const float amed = nc ? area[nc / 2] : 0.0f;
     for (int i = 0; i < nc; i++) {
         const fv_eye_glint gl = cand[i];
-        if (gl.area_px > fmaxf(3.0f * amin, 12.0f))
+        if (nc >= 3 && gl.area_px > fmaxf(3.0f * amed, 12.0f))
             continue;
         const float dd = hypotf(gl.x - pp->x, gl.y - pp->y);
         /* insertion by distance to the pupil centre */
