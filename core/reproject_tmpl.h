@@ -88,6 +88,9 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
                               struct fv_taa_flow *flow)
 {
     float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
+    /* a new sample's weight of 1 (the fovea, where every pixel is traced every frame): only the
+     * flow sums are wanted, for the tile's fill; h + 1 (px - h) would only round px */
+    const int keep_sample = t->alpha >= 1.0f;
     /* Samples are projected (and their flow summed) in row-major order; their taps run
      * TAA_PREFETCH_DIST samples later. A blend changes only its own sample's colour, never a
      * depth another projection reads, so the result is the one-pass loop's, bit for bit. */
@@ -126,6 +129,8 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
             fdx = fdx + (u - pxc);
             fdy = fdy + (v - py);
             fn = fn + 1.0f;
+            if (keep_sample)
+                continue; /* history has no weight here: the sample stays exactly as traced */
             const float fp = (d * rz) * t->widen;
             const int l = taa_level(fp, f->max_level);
             const float ts = taa_pow2[l], inv_ts = taa_inv_pow2[l];
