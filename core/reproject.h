@@ -57,7 +57,7 @@ typedef struct fv_taa_frame {
 /* Per-tile constants. */
 typedef struct fv_taa_tile {
     float widen;          /* footprint scale 1/sqrt(history density), >= 1 */
-    float alpha;          /* minimum weight of a new sample in this tile */
+    float alpha;          /* minimum weight of a new sample in this tile (>= 1: samples kept as traced) */
     int flow_x, flow_y;   /* fill: the history texel of pixel (x, y) is (x + flow_x, y + flow_y) */
 } fv_taa_tile;
 

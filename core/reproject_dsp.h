@@ -11,9 +11,9 @@
 /* Temporal reprojection (core/reproject.h has the model), on a block of level 0: pixels
  * x0 .. x0+w-1 (w <= 64) of rows y0 .. y0+h-1; rgbd / wgt point at pixel (x0, y0), rows are
  * stride pixels apart. One call per tile, so the per-call set-up is paid once.
- * taa_blend: every pixel with weight 1 (a sample) is blended with its reprojected history; the
- *   sums of its flow to the previous frame are added to *flow in row-major pixel order. Other
- *   pixels untouched.
+ * taa_blend: every pixel with weight 1 (a sample) is blended with its reprojected history (none
+ *   is when the tile's alpha >= 1: the samples come back bit for bit); the sums of its flow to
+ *   the previous frame are added to *flow in row-major pixel order. Other pixels untouched.
  * taa_fill: every pixel with weight 0 (a hole) takes valid history, if any: colour, depth in
  *   this frame's view, weight = the history's confidence in (0, 1]. Others untouched.
  * Both read the history pyramid only at texels [-1, w] x [-1, h] of a level (its border).

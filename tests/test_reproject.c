@@ -169,6 +169,84 @@ static void test_mapping(void **st)
     fv_pyramid_free(&hist);
 }
 
+/* Where the tile's alpha is 1 (the fovea: every pixel traced every frame), the history has no
+ * weight: the samples must come back bit for bit, for every ISA, while the flow sums the fill
+ * needs are still taken. The history here is far brighter than the samples on the same surface,
+ * so blending with a weight of 1 and rounding (h + 1 (px - h)) would show: 1000.3 + (0.1 - 1000.3)
+ * is 0.1000366 in float, not 0.1. */
+static void test_fovea_samples_untouched(void **st)
+{
+    (void)st;
+    enum { W = 40, H = 24 };
+    fv_camera_desc d;
+    fv_camera_desc_default(&d);
+    d.width = W;
+    d.height = H;
+    static const fv_pose o = {{0, 0, 0}, {0, 0, 0, 1}};
+    fv_camera cam;
+    assert_int_equal(fv_camera_setup(&cam, &d, &o), 0);
+    fv_pyramid hist, cur;
+    assert_int_equal(fv_pyramid_init(&hist, W, H), 0);
+    assert_int_equal(fv_pyramid_init(&cur, W, H), 0);
+    for (int l = 0; l < hist.levels; l++) {
+        fv_pyr_level *L = &hist.lv[l];
+        for (int y = -1; y <= L->h; y++)
+            for (int x = -1; x <= L->w; x++) {
+                float *c = L->rgbd + 4 * ((ptrdiff_t)y * L->stride + x);
+                c[0] = 1000.3f, c[1] = 700.7f, c[2] = 333.3f, c[3] = 2.0f;
+                L->wgt[(ptrdiff_t)y * L->stride + x] = 1.0f;
+            }
+    }
+    fv_taa_frame f;
+    fv_taa_frame_setup(&f, &cam, &cam, &hist, 0.03f);
+    fv_pyr_level *c0 = &cur.lv[0];
+    for (int motion = 0; motion < 2; motion++) {
+        if (motion) { /* a small turn: the samples land between history texels */
+            fv_pose p = o;
+            p.quat[1] = 0.0087f, p.quat[3] = 0.99996f;
+            fv_camera prev;
+            assert_int_equal(fv_camera_setup(&prev, &d, &p), 0);
+            fv_taa_frame_setup(&f, &cam, &prev, &hist, 0.03f);
+            assert_false(f.identity);
+        }
+        for (unsigned isa = 0; isa <= FV_ISA_NEON; isa = isa ? isa << 1 : 1) {
+            if (isa && !(fv_cpu_isas() & isa))
+                continue;
+            fv_reproject_dsp dsp;
+            fv_reproject_dsp_init(&dsp, isa);
+            int n = 0;
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++) {
+                    float *c = c0->rgbd + 4 * ((ptrdiff_t)y * c0->stride + x);
+                    c[0] = 0.1f, c[1] = 0.2f + 0.001f * (float)x, c[2] = 0.3f, c[3] = 2.0f;
+                    c0->wgt[(ptrdiff_t)y * c0->stride + x] = (x + y) % 3 ? 1.0f : 0.0f;
+                    float u, v; /* the flow counts the samples that land in the previous image */
+                    const float z = fv_taa_project(&f, (float)x + 0.5f, (float)y + 0.5f, 2.0f, &u, &v);
+                    n += (x + y) % 3 != 0 && z > 0.0f && u >= 0.0f && u < (float)W && v >= 0.0f && v < (float)H;
+                }
+            assert_true(n > W * H / 2);
+            fv_taa_tile t = {1.0f, 1.0f, 0, 0};
+            fv_taa_flow fl = {0.0f, 0.0f, 0.0f};
+            dsp.taa_blend(&f, &t, c0->rgbd, c0->wgt, c0->stride, 0, 0, W, H, &fl);
+            assert_float_equal(fl.n, (float)n, 0.0);
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++) {
+                    const float *c = c0->rgbd + 4 * ((ptrdiff_t)y * c0->stride + x);
+                    const float want[4] = {0.1f, 0.2f + 0.001f * (float)x, 0.3f, 2.0f};
+                    if (memcmp(c, want, sizeof want))
+                        fail_msg("%s motion %d: sample (%d, %d) changed to %.9g %.9g %.9g", fv_isa_name(isa),
+                                 motion, x, y, (double)c[0], (double)c[1], (double)c[2]);
+                }
+            /* the same samples at alpha 0.5 do take history: the case is not vacuous */
+            t.alpha = 0.5f;
+            dsp.taa_blend(&f, &t, c0->rgbd, c0->wgt, c0->stride, 0, 0, W, H, &fl);
+            assert_true(c0->rgbd[4 * (5 * c0->stride + 5)] > 100.0f);
+        }
+    }
+    fv_pyramid_free(&hist);
+    fv_pyramid_free(&cur);
+}
+
 /* A textured plane at 2 m and a sideways head translation of exactly 3 pixels at that depth:
  * after the static view has converged, every pixel whose history is in view must come out as the
  * full render of the new pose (samples fresh, holes from history at the exact shift), although
@@ -375,6 +453,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quat_mul),
         cmocka_unit_test(test_mapping),
+        cmocka_unit_test(test_fovea_samples_untouched),
         cmocka_unit_test(test_exact_plane_shift),
         cmocka_unit_test(test_static_convergence),
         cmocka_unit_test(test_no_ghost_on_disocclusion),
