@@ -178,7 +178,7 @@ $(HIL_GUEST): tests/hil/guest.c tests/hil/pattern.h $(PLIB) $(LIB)
 
 test-hil:
 	@tools/deps.sh
-	@$(MAKE) --no-print-directory $(HIL_GUEST) $(EYE_SYNTH)
+	@$(MAKE) --no-print-directory $(HIL_GUEST) $(EYE_SYNTH) $(RANGE) $(BUILD)/bin/fovea-headset $(BUILD)/bin/fovea-replay
 	@BUILD=$(BUILD) tests/hil/run.sh
 
 # Cross leg: build everything for aarch64 and run the core's tests under qemu-aarch64.
