@@ -1112,9 +1112,7 @@ static int cmd_headset(int argc, char **argv)
         fprintf(stderr, "usage: fovea-hil headset CHIP_DEV LINE PULL_ATTR CTL_TTY LATENCY_CSV -- PROGRAM ARGS...\n");
         return 2;
     }
-    const char *pull = argv[4], *csv = argv[6];
-    (void)argv[2];
-    (void)argv[3]; /* the chip and line are in the program's --vsync; named here for the log */
+    const char *pull = argv[4], *csv = argv[6]; /* CHIP_DEV and LINE: the program's --vsync names them */
     char err[512];
     if (write_attr(pull, "pull-down")) {
         result("headset-run", 0, "reason=\"write %s: %s\"", pull, strerror(errno));
@@ -1192,7 +1190,7 @@ static int cmd_headset(int argc, char **argv)
     int n_edge_rows = 0;
     for (long i = 0; i < nr; i++)
         n_edge_rows += r[i].photon_edge;
-    /* enough frames to say something: a frame costs ~0.3 s under TCG at the default size */
+    /* enough frames to say something: a frame costs 0.1-0.6 s under TCG at the default size */
     const int run_ok = exit_ok && nr >= 5 && n_edge_rows >= 3 && shot_in_run;
     result("headset-run", run_ok,
            "exit=%d frames=%ld measured_edge=%d run_s=%.2f kernel_edges=%ld written=%ld late_skipped=%ld "
@@ -1209,7 +1207,8 @@ static int cmd_headset(int argc, char **argv)
 
     /* The offset o (the program's start on CLOCK_MONOTONIC): between exec and exit, and such
      * that the measured photon times land on kernel edges. Every (first measured photon, edge)
-     * pair is a candidate; the best must match every measured photon and be the only one. */
+     * pair is a candidate; the best must be the only best, and every measured photon must then
+     * lie on an edge. */
     long i0 = 0;
     while (!r[i0].photon_edge)
         i0++;
