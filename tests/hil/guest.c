@@ -1287,10 +1287,10 @@ static int cmd_headset(int argc, char **argv)
             edges_in_run += edges.t[j] >= flips.t[0] && edges.t[j] <= flips.t[flips.n - 1] + VS_PERIOD_NS;
     const int on_edge = count_matches(r, nr, &edges, o_best, HS_ON_EDGE_NS);
     /* Photons: every measured one on a kernel edge, one offset only, a frame per edge; and the
-     * offset agrees with the page flips, which must follow their frame's end by no more than
-     * the conversion to the display (a wrong offset moves them by whole periods). */
-    const int vs_ok = run_ok && on_edge == n_edge_rows && m_second < m_best && shared == 0 && flip_missing == 0 &&
-                      max_lag_ms < 100.0;
+     * offset agrees with the page flips: each frame has one after its end (the flip's delay,
+     * the conversion to the display, 4-46 ms under TCG, is reported; headset-flip checks that
+     * it comes before the next frame's end). */
+    const int vs_ok = run_ok && on_edge == n_edge_rows && m_second < m_best && shared == 0 && flip_missing == 0;
     result("headset-vsync", vs_ok,
            "measured=%d on_edge=%d fit_50us=%d runner_up=%d max_residual_us=%.1f distinct_edges=%d predicted=%ld "
            "start_after_exec_s=%.3f max_flip_after_done_ms=%.2f",
