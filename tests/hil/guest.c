@@ -1086,6 +1086,127 @@ static int count_matches(const hs_row *r, long nr, const tvec *edges, int64_t o,
     return m;
 }
 
+typedef struct hs_verdict {
+    int64_t o;           /* the program's start on CLOCK_MONOTONIC */
+    int measured;        /* rows with photon_edge 1 */
+    int fit, runner_up;  /* photons within HS_FIT_NS of an edge at the best / the next-best offset */
+    int on_edge;         /* photons within HS_ON_EDGE_NS of an edge at the best offset */
+    double max_res_us, max_lag_ms, max_late_ms, min_slack_ms;
+    long shared, flip_missing, flip_unordered, flip_after, late_flip_after, n_late, edges_in_run;
+    int vs_ok, flip_ok;
+} hs_verdict;
+
+/* Judges the latency CSV's rows (times relative to the program's start) against the kernel's
+ * edges and page flips (CLOCK_MONOTONIC), the program having run between t_exec and t_exit.
+ * verbose: one line per frame on stderr. */
+static void hs_judge(const hs_row *r, long nr, const tvec *edges_v, const tvec *flips_v, int64_t t_exec,
+                     int64_t t_exit, int verbose, hs_verdict *v)
+{
+    const tvec edges = *edges_v, flips = *flips_v;
+    memset(v, 0, sizeof *v);
+    v->min_slack_ms = 1e9;
+    for (long i = 0; i < nr; i++) {
+        v->measured += r[i].photon_edge;
+        v->n_late += r[i].late;
+    }
+    if (nr <= 0 || v->measured == 0 || edges.n == 0)
+        return;
+    /* The offset o (the program's start on CLOCK_MONOTONIC): between exec and exit, and such
+     * that the measured photon times land on kernel edges. Every (first measured photon, edge)
+     * pair is a candidate; the best must be the only best, and every measured photon must then
+     * lie on an edge. */
+    long i0 = 0;
+    while (!r[i0].photon_edge)
+        i0++;
+    int64_t o_best = 0;
+    int m_best = -1, m_second = 0;
+    for (long j = 0; j < edges.n; j++) {
+        int64_t o = edges.t[j] - r[i0].photon;
+        if (o < t_exec || o + r[nr - 1].photon > t_exit)
+            continue;
+        int m = count_matches(r, nr, &edges, o, HS_FIT_NS);
+        if (m > m_best) {
+            m_second = m_best < 0 ? 0 : m_best;
+            m_best = m;
+            o_best = o;
+        } else if (m > m_second) {
+            m_second = m;
+        }
+    }
+    if (m_best < 0)
+        m_best = 0;
+    /* per frame: its edge (distinct), the residual, the flip that showed it */
+    double max_res_us = 0;
+    long prev_edge = -1, shared = 0, flip_idx = 0, flip_after = 0, late_flip_after = 0, flip_missing = 0;
+    long flip_unordered = 0;
+    double min_slack_ms = 1e9, max_late_ms = 0, max_lag_ms = 0;
+    for (long i = 0; i < nr; i++) {
+        const int64_t ph = r[i].photon + o_best;
+        if (r[i].photon_edge) {
+            long j = nearest(&edges, ph);
+            double res = (double)llabs(edges.t[j] - ph) / 1e3;
+            if (res > max_res_us)
+                max_res_us = res;
+            if (j <= prev_edge)
+                shared++;
+            prev_edge = j;
+        }
+        /* the flip that presented frame i: the first page-flip ioctl after its rendering ended */
+        while (flip_idx < flips.n && flips.t[flip_idx] < r[i].done + o_best)
+            flip_idx++;
+        if (flip_idx >= flips.n) {
+            flip_missing++;
+            continue;
+        }
+        const int64_t f = flips.t[flip_idx++];
+        if (i + 1 < nr && f >= r[i + 1].done + o_best)
+            flip_unordered++; /* not flipped before the next frame was done: not this frame's flip */
+        const double lag_ms = (double)(f - (r[i].done + o_best)) / 1e6;
+        if (lag_ms > max_lag_ms)
+            max_lag_ms = lag_ms;
+        /* the frames on the kernel's clock, for the console (ms since the program's start) */
+        if (verbose)
+            fprintf(stderr, "headset frame %ld: done %.3f target %.3f photon %.3f (%s) late %d flip %.3f nearest_edge %.3f\n",
+                    r[i].frame, (double)r[i].done / 1e6, (double)r[i].target / 1e6, (double)r[i].photon / 1e6,
+                    r[i].photon_edge ? "edge" : "predicted", r[i].late, (double)(f - o_best) / 1e6,
+                    (double)(edges.t[nearest(&edges, ph)] - o_best) / 1e6);
+        if (f >= ph) {
+            /* on a real panel, shown one refresh later than the CSV says */
+            if (r[i].late)
+                late_flip_after++;
+            else
+                flip_after++;
+            double l = (double)(f - ph) / 1e6;
+            if (l > max_late_ms)
+                max_late_ms = l;
+        } else {
+            double s = (double)(ph - f) / 1e6;
+            if (s < min_slack_ms)
+                min_slack_ms = s;
+        }
+    }
+    /* edges the kernel saw while the program flipped frames */
+    long edges_in_run = 0;
+    if (flips.n)
+        for (long j = 0; j < edges.n; j++)
+            edges_in_run += edges.t[j] >= flips.t[0] && edges.t[j] <= flips.t[flips.n - 1] + VS_PERIOD_NS;
+    const int on_edge = count_matches(r, nr, &edges, o_best, HS_ON_EDGE_NS);
+    const int n_edge_rows = v->measured;
+    /* Photons: every measured one on a kernel edge, one offset only, a frame per edge. */
+    const int vs_ok = on_edge == n_edge_rows && m_second < m_best && shared == 0;
+    /* Flips (on that offset, which they confirm): one per frame, each between its frame's end
+     * and the next frame's end (the delay, the conversion to the display, 4-46 ms under TCG, is
+     * reported), no more flips than edges. A flip that came after the edge the CSV gives as its
+     * frame's photon time is counted, not judged: the frame loop does not budget for the present
+     * (docs/hil.md, "Found"), so under TCG it happens to on-time and late frames alike. */
+    const int flip_ok = vs_ok && flips.n == nr && flip_missing == 0 && flip_unordered == 0 && flips.n <= edges_in_run;
+    *v = (hs_verdict){.o = o_best, .measured = n_edge_rows, .fit = m_best, .runner_up = m_second, .on_edge = on_edge,
+                      .max_res_us = max_res_us, .max_lag_ms = max_lag_ms, .max_late_ms = max_late_ms,
+                      .min_slack_ms = min_slack_ms, .shared = shared, .flip_missing = flip_missing,
+                      .flip_unordered = flip_unordered, .flip_after = flip_after, .late_flip_after = late_flip_after,
+                      .n_late = v->n_late, .edges_in_run = edges_in_run, .vs_ok = vs_ok, .flip_ok = flip_ok};
+}
+
 typedef struct host_wait {
     const char *tty;
     volatile int answered;
@@ -1205,112 +1326,144 @@ static int cmd_headset(int argc, char **argv)
         return 1;
     }
 
-    /* The offset o (the program's start on CLOCK_MONOTONIC): between exec and exit, and such
-     * that the measured photon times land on kernel edges. Every (first measured photon, edge)
-     * pair is a candidate; the best must be the only best, and every measured photon must then
-     * lie on an edge. */
-    long i0 = 0;
-    while (!r[i0].photon_edge)
-        i0++;
-    int64_t o_best = 0;
-    int m_best = -1, m_second = 0;
-    for (long j = 0; j < edges.n; j++) {
-        int64_t o = edges.t[j] - r[i0].photon;
-        if (o < t_exec || o + r[nr - 1].photon > t_exit)
-            continue;
-        int m = count_matches(r, nr, &edges, o, HS_FIT_NS);
-        if (m > m_best) {
-            m_second = m_best < 0 ? 0 : m_best;
-            m_best = m;
-            o_best = o;
-        } else if (m > m_second) {
-            m_second = m;
-        }
-    }
-    if (m_best < 0)
-        m_best = 0;
-    /* per frame: its edge (distinct), the residual, the flip that showed it */
-    double max_res_us = 0;
-    long prev_edge = -1, shared = 0, flip_idx = 0, flip_after = 0, late_flip_after = 0, flip_missing = 0;
-    long flip_unordered = 0, n_late = 0;
-    for (long i = 0; i < nr; i++)
-        n_late += r[i].late;
-    double min_slack_ms = 1e9, max_late_ms = 0, max_lag_ms = 0;
-    for (long i = 0; i < nr; i++) {
-        const int64_t ph = r[i].photon + o_best;
-        if (r[i].photon_edge) {
-            long j = nearest(&edges, ph);
-            double res = (double)llabs(edges.t[j] - ph) / 1e3;
-            if (res > max_res_us)
-                max_res_us = res;
-            if (j <= prev_edge)
-                shared++;
-            prev_edge = j;
-        }
-        /* the flip that presented frame i: the first page-flip ioctl after its rendering ended */
-        while (flip_idx < flips.n && flips.t[flip_idx] < r[i].done + o_best)
-            flip_idx++;
-        if (flip_idx >= flips.n) {
-            flip_missing++;
-            continue;
-        }
-        const int64_t f = flips.t[flip_idx++];
-        if (i + 1 < nr && f >= r[i + 1].done + o_best)
-            flip_unordered++; /* not flipped before the next frame was done: not this frame's flip */
-        const double lag_ms = (double)(f - (r[i].done + o_best)) / 1e6;
-        if (lag_ms > max_lag_ms)
-            max_lag_ms = lag_ms;
-        /* the frames on the kernel's clock, for the console (ms since the program's start) */
-        fprintf(stderr, "headset frame %ld: done %.3f target %.3f photon %.3f (%s) late %d flip %.3f nearest_edge %.3f\n",
-                r[i].frame, (double)r[i].done / 1e6, (double)r[i].target / 1e6, (double)r[i].photon / 1e6,
-                r[i].photon_edge ? "edge" : "predicted", r[i].late, (double)(f - o_best) / 1e6,
-                (double)(edges.t[nearest(&edges, ph)] - o_best) / 1e6);
-        if (f >= ph) {
-            /* on a real panel, shown one refresh later than the CSV says */
-            if (r[i].late)
-                late_flip_after++;
-            else
-                flip_after++;
-            double l = (double)(f - ph) / 1e6;
-            if (l > max_late_ms)
-                max_late_ms = l;
-        } else {
-            double s = (double)(ph - f) / 1e6;
-            if (s < min_slack_ms)
-                min_slack_ms = s;
-        }
-    }
-    /* edges the kernel saw while the program flipped frames */
-    long edges_in_run = 0;
-    if (flips.n)
-        for (long j = 0; j < edges.n; j++)
-            edges_in_run += edges.t[j] >= flips.t[0] && edges.t[j] <= flips.t[flips.n - 1] + VS_PERIOD_NS;
-    const int on_edge = count_matches(r, nr, &edges, o_best, HS_ON_EDGE_NS);
-    /* Photons: every measured one on a kernel edge, one offset only, a frame per edge; and the
-     * offset agrees with the page flips: each frame has one after its end (the flip's delay,
-     * the conversion to the display, 4-46 ms under TCG, is reported; headset-flip checks that
-     * it comes before the next frame's end). */
-    const int vs_ok = run_ok && on_edge == n_edge_rows && m_second < m_best && shared == 0 && flip_missing == 0;
-    result("headset-vsync", vs_ok,
+    hs_verdict v;
+    hs_judge(r, nr, &edges, &flips, t_exec, t_exit, 1, &v);
+    result("headset-vsync", run_ok && v.vs_ok,
            "measured=%d on_edge=%d fit_50us=%d runner_up=%d max_residual_us=%.1f distinct_edges=%d predicted=%ld "
            "start_after_exec_s=%.3f max_flip_after_done_ms=%.2f",
-           n_edge_rows, on_edge, m_best, m_second, max_res_us, shared == 0, nr - n_edge_rows, (double)(o_best - t_exec) / 1e9,
-           max_lag_ms);
-    /* Flips: one per frame, each between its frame's end and the next frame's end, no more
-     * flips than edges. A flip that came after the edge the CSV gives as its frame's photon time
-     * is counted, not judged: the frame loop does not budget for the present (docs/hil.md,
-     * "Found"), so under TCG it happens to on-time and late frames alike. */
-    const int flip_ok = vs_ok && flips.n == nr && flip_unordered == 0 && flips.n <= edges_in_run;
-    result("headset-flip", flip_ok,
+           v.measured, v.on_edge, v.fit, v.runner_up, v.max_res_us, v.shared == 0, nr - v.measured,
+           (double)(v.o - t_exec) / 1e9, v.max_lag_ms);
+    result("headset-flip", run_ok && v.vs_ok && v.flip_ok,
            "flips=%ld frames=%ld out_of_order=%ld edges_during_flips=%ld flip_after_photon_ontime=%ld/%ld "
            "flip_after_photon_late=%ld/%ld max_flip_after_photon_ms=%.2f min_flip_lead_ms=%.2f",
-           flips.n, nr, flip_unordered, edges_in_run, flip_after, nr - n_late, late_flip_after, n_late, max_late_ms,
-           min_slack_ms);
+           flips.n, nr, v.flip_unordered, v.edges_in_run, v.flip_after, nr - v.n_late, v.late_flip_after, v.n_late,
+           v.max_late_ms, v.min_slack_ms);
+    const int vs_ok = run_ok && v.vs_ok, flip_ok = vs_ok && v.flip_ok;
     free(r);
     free(edges.t);
     free(flips.t);
     free(tg.late_us);
     return run_ok && vs_ok && flip_ok ? 0 : 1;
+}
+
+/* Host side: the headset checks' own test, on synthetic runs whose answer is known: kernel
+ * edges at 90 Hz late by a pseudo-random 0-400 us (the toggler's wake-up) with every 23rd left
+ * out, a program started 5.3 s after its exec, 20 frames whose photon is the first edge 8 ms or
+ * more after the frame's end (one frame with a predicted photon instead),
+ * a flip 5 ms after each frame's end; the CSV's times rounded to microseconds as
+ * fv_latency_csv_write writes them. Then the same run with one fault each, which must fail.
+ * Also the tracer's line format. Prints `HIL headset-selftest PASS|FAIL`. */
+
+typedef struct hs_synth {
+    tvec edges, flips;
+    hs_row r[20];
+    long nr;
+    int64_t t_exec, t_exit, o;
+} hs_synth;
+
+static int synth_run(hs_synth *z, int jitter)
+{
+    memset(z, 0, sizeof *z);
+    const int64_t start = 1000000000; /* edge k scheduled at start + k * period */
+    uint32_t seed = 12345;
+    for (long k = 0; k < 900; k++) {
+        seed = seed * 1664525u + 1013904223u;
+        if (k % VS_DROP_EVERY == 0)
+            continue;
+        if (tvec_push(&z->edges, start + k * VS_PERIOD_NS + (jitter ? (int64_t)(seed >> 8) % 400000 : 0)))
+            return -1;
+    }
+    z->t_exec = start + 5 * VS_PERIOD_NS;
+    z->o = z->t_exec + 5300000000LL;
+    z->nr = 20;
+    for (long i = 0; i < z->nr; i++) {
+        hs_row *q = &z->r[i];
+        const int64_t done_abs = z->o + 100000000 + i * 150000000 + (i % 3) * 7000000;
+        long j = 0;
+        while (j < z->edges.n && z->edges.t[j] < done_abs + 8000000)
+            j++;
+        if (j >= z->edges.n)
+            return -1;
+        const int64_t sched = start + ((z->edges.t[j] - start) / VS_PERIOD_NS) * VS_PERIOD_NS;
+        const int predicted = i == 7; /* its photon the edge's schedule, as if the edge had not come */
+        const int64_t photon_abs = predicted ? sched : z->edges.t[j];
+        q->frame = i;
+        q->done = (done_abs - z->o) / 1000 * 1000;
+        q->target = (photon_abs - z->o) / 1000 * 1000;
+        q->photon = (photon_abs - z->o) / 1000 * 1000;
+        q->photon_edge = !predicted;
+        q->late = i == 11;
+        if (tvec_push(&z->flips, done_abs + 5000000))
+            return -1;
+    }
+    z->t_exit = z->o + z->r[z->nr - 1].photon + 500000000;
+    return 0;
+}
+
+static int cmd_headset_selftest(void)
+{
+    int fails = 0, cases = 0;
+    char why[256] = "";
+#define EXPECT(cond, what)                                                                                      \
+    do {                                                                                                        \
+        cases++;                                                                                                \
+        if (!(cond)) {                                                                                          \
+            fails++;                                                                                            \
+            if (!*why)                                                                                          \
+                snprintf(why, sizeof why, "%s", what);                                                          \
+        }                                                                                                       \
+    } while (0)
+    hs_synth z;
+    hs_verdict v;
+    /* 1. the clean run: passes, the start found to the microsecond */
+    if (synth_run(&z, 1))
+        return 1;
+    hs_judge(z.r, z.nr, &z.edges, &z.flips, z.t_exec, z.t_exit, 0, &v);
+    EXPECT(v.vs_ok && v.flip_ok && v.measured == 19 && v.on_edge == 19 && v.fit == 19, "clean-run-fails");
+    EXPECT(llabs(v.o - z.o) <= 1000, "clean-run-wrong-offset");
+    EXPECT(v.runner_up < v.fit && v.flip_after == 0 && v.late_flip_after == 0, "clean-run-figures");
+    /* 2. one measured photon 2 ms off its edge */
+    z.r[12].photon += 2000000;
+    hs_judge(z.r, z.nr, &z.edges, &z.flips, z.t_exec, z.t_exit, 0, &v);
+    EXPECT(!v.vs_ok && v.on_edge == 18, "photon-off-edge-passes");
+    /* 3. two frames on one edge */
+    synth_run(&z, 1);
+    z.r[13].photon = z.r[12].photon;
+    hs_judge(z.r, z.nr, &z.edges, &z.flips, z.t_exec, z.t_exit, 0, &v);
+    EXPECT(!v.vs_ok && v.shared == 1, "shared-edge-passes");
+    /* 4. a perfectly regular line: every offset a whole number of periods off fits as well */
+    synth_run(&z, 0);
+    hs_judge(z.r, z.nr, &z.edges, &z.flips, z.t_exec, z.t_exit, 0, &v);
+    EXPECT(!v.vs_ok && v.runner_up == v.fit, "ambiguous-offset-passes");
+    /* 5. a frame with no flip, and 6. a flip after its photon edge (counted, not judged) */
+    synth_run(&z, 1);
+    memmove(z.flips.t + 4, z.flips.t + 5, (size_t)(z.flips.n - 5) * sizeof *z.flips.t);
+    z.flips.n--;
+    hs_judge(z.r, z.nr, &z.edges, &z.flips, z.t_exec, z.t_exit, 0, &v);
+    EXPECT(v.vs_ok && !v.flip_ok && v.flip_unordered >= 1, "missing-flip-passes");
+    synth_run(&z, 1);
+    z.flips.t[3] = z.o + z.r[3].photon + 1000000;
+    hs_judge(z.r, z.nr, &z.edges, &z.flips, z.t_exec, z.t_exit, 0, &v);
+    EXPECT(v.vs_ok && v.flip_ok && v.flip_after == 1 && fabs(v.max_late_ms - 1.0) < 0.002, "late-flip-not-counted");
+    /* 7. the tracer's lines (function tracer, trace_clock mono) */
+    const char *text = "# tracer: function\n"
+                       "#           TASK-PID     CPU#  |||||  TIMESTAMP  FUNCTION\n"
+                       "          <idle>-0       [000] d.h2.    25.123456: lineevent_irq_handler <-__handle_irq_event_percpu\n"
+                       "   fovea-headset-311     [000] .....    25.200001: drm_mode_page_flip_ioctl <-drm_ioctl_kernel\n"
+                       "     kworker/0:1-30      [000] d.h1.   125.000007: lineevent_irq_handler <-__handle_irq_event_percpu\n";
+    tvec e = {0}, f = {0};
+    EXPECT(!trace_times(text, "lineevent_irq_handler", &e) && e.n == 2 && e.t[0] == 25123456000LL &&
+               e.t[1] == 125000007000LL,
+           "trace-edges-parse");
+    EXPECT(!trace_times(text, "drm_mode_page_flip_ioctl", &f) && f.n == 1 && f.t[0] == 25200001000LL,
+           "trace-flips-parse");
+#undef EXPECT
+    free(e.t);
+    free(f.t);
+    free(z.edges.t);
+    free(z.flips.t);
+    result("headset-selftest", fails == 0, "cases=%d failed=%d%s%s", cases, fails, *why ? " first=" : "", why);
+    return fails ? 1 : 0;
 }
 
 /* Host side: QEMU's screendump (binary PPM) against the pattern. */
@@ -1478,6 +1631,8 @@ int main(int argc, char **argv)
         return cmd_kms(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "headset"))
         return cmd_headset(argc, argv);
+    if (argc == 2 && !strcmp(argv[1], "headset-selftest"))
+        return cmd_headset_selftest();
     if (argc >= 2 && !strcmp(argv[1], "headset-compare"))
         return cmd_headset_compare(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "kms-compare"))

@@ -173,6 +173,8 @@ tr -d '\r' < "$console" > "$run/console.txt"
 if [ $shot_done = 1 ]; then
     "$guest_bin" kms-compare "$run/shot.ppm" "$kms_w" "$kms_h" >> "$run/console.txt" || true
 fi
+# the headset checks' own test on synthetic runs (host side)
+"$guest_bin" headset-selftest >> "$run/console.txt" 2>&1 || true
 if [ $hs_shot_done = 1 ]; then
     # the same frame on the host: fovea-replay, same scene, size, view (the default), gaze (the
     # centre) and reprojection off
@@ -185,8 +187,8 @@ if [ $hs_shot_done = 1 ]; then
         echo "HIL headset-readback FAIL reason=\"fovea-replay failed: $(tail -n1 "$run/headset-ref.log")\"" >> "$run/console.txt"
     fi
 fi
-checks="boot modules v4l2-loop v4l2-track v4l2-buf-error v4l2-reopen gpio-lock gpio-dropped headset-run headset-vsync
-    headset-flip headset-readback kms-flip kms-readback"
+checks="boot modules v4l2-loop v4l2-track v4l2-buf-error v4l2-reopen gpio-lock gpio-dropped headset-selftest
+    headset-run headset-vsync headset-flip headset-readback kms-flip kms-readback"
 pass=0 fail=0
 for c in $checks; do
     line=$(grep -m1 "^HIL $c " "$run/console.txt" || true)
