@@ -168,8 +168,10 @@ test: deps
 	@BUILD=$(BUILD) SHARED=$(SHARED) tests/run.sh
 
 # Hardware in the loop (docs/hil.md): Debian's kernel under QEMU (TCG) with vivid, gpio-sim and
-# bochs-drm; the guest program is linked statically (busybox initramfs). tools/hil/prepare.sh
-# installs what it needs and caches the kernel and the gpio-sim module under $(BUILD)/hil.
+# bochs-drm; the guest program is linked statically (busybox initramfs); fovea-headset runs there
+# with its shared libraries on range.glb (fovea-replay renders the host's reference).
+# tools/hil/prepare.sh installs what it needs and caches the kernel and the gpio-sim module
+# under $(BUILD)/hil.
 HIL_GUEST := $(BUILD)/hil/fovea-hil
 $(HIL_GUEST): tests/hil/guest.c tests/hil/pattern.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)

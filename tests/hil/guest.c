@@ -3,12 +3,16 @@
  * the host-side comparison of the KMS screendump. Linked statically (busybox initramfs, no libc).
  * It drives the project's own code: platform/v4l2.c (capture), core/eyetrack (tracking),
  * platform/vsync_gpio.c + core/vsyncpred.c (GPIO vsync and its predictor), platform/display_kms.c
- * (KMS). Only vivid's output side (no project code writes V4L2 output) uses raw ioctls here.
+ * (KMS), and runs fovea-headset itself (`headset`). Only vivid's output side (no project code
+ * writes V4L2 output) uses raw ioctls here.
  *
  *   fovea-hil v4l2 CAP_DEV OUT_DEV VIDEO.y4m TRUTH.csv FRAMES
  *   fovea-hil gpio CHIP_DEV LINE PULL_ATTR SECONDS
+ *   fovea-hil headset CHIP_DEV LINE PULL_ATTR CTL_TTY LATENCY_CSV -- PROGRAM ARGS...
  *   fovea-hil kms CARD_DEV CTL_TTY
  *   fovea-hil kms-compare SHOT.ppm W H          (host side)
+ *   fovea-hil headset-compare SHOT.ppm REFERENCE.png CROP_OUT.png   (host side)
+ *   fovea-hil headset-selftest                  (host side)
  *
  * Every check prints one line `HIL <name> PASS|FAIL key=value ...` on stdout, which the host
  * parses; diagnostics go to stderr (the console too). Exit 0 when all of the subcommand's checks

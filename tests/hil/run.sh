@@ -1,7 +1,7 @@
 #!/bin/bash
 # make test-hil: boots Debian's kernel in QEMU (TCG) from a small initramfs and runs the
 # hardware-in-the-loop checks of tests/hil/guest.c against real kernel drivers (vivid, gpio-sim,
-# bochs-drm). docs/hil.md says what runs and how.
+# bochs-drm), fovea-headset itself among them. docs/hil.md says what runs and how.
 #
 #   BUILD=build tests/hil/run.sh      (make test-hil builds $BUILD/hil/fovea-hil first)
 #
