@@ -1199,7 +1199,7 @@ static void hs_judge(const hs_row *r, long nr, const tvec *edges_v, const tvec *
     /* Photons: every measured one on a kernel edge, one offset only, a frame per edge. */
     const int vs_ok = on_edge == n_edge_rows && m_second < m_best && shared == 0;
     /* Flips (on that offset, which they confirm): one per frame, each between its frame's end
-     * and the next frame's end (the delay, the conversion to the display, 4-46 ms under TCG, is
+     * and the next frame's end (the delay, the conversion to the display, 4-48 ms under TCG, is
      * reported), no more flips than edges. A flip that came after the edge the CSV gives as its
      * frame's photon time is counted, not judged: the frame loop does not budget for the present
      * (docs/hil.md, "Found"), so under TCG it happens to on-time and late frames alike. */
