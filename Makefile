@@ -180,8 +180,10 @@ test: deps
 	@BUILD=$(BUILD) SHARED=$(SHARED) tests/run.sh
 
 # Hardware in the loop (docs/hil.md): Debian's kernel under QEMU (TCG) with vivid, gpio-sim and
-# bochs-drm; the guest program is linked statically (busybox initramfs). tools/hil/prepare.sh
-# installs what it needs and caches the kernel and the gpio-sim module under $(BUILD)/hil.
+# bochs-drm; the guest program is linked statically (busybox initramfs); fovea-headset runs there
+# with its shared libraries on range.glb (fovea-replay renders the host's reference).
+# tools/hil/prepare.sh installs what it needs and caches the kernel and the gpio-sim module
+# under $(BUILD)/hil.
 HIL_GUEST := $(BUILD)/hil/fovea-hil
 $(HIL_GUEST): tests/hil/guest.c tests/hil/pattern.h $(PLIB) $(LIB)
 	@mkdir -p $(dir $@)
@@ -190,7 +192,7 @@ $(HIL_GUEST): tests/hil/guest.c tests/hil/pattern.h $(PLIB) $(LIB)
 
 test-hil:
 	@tools/deps.sh
-	@$(MAKE) --no-print-directory $(HIL_GUEST) $(EYE_SYNTH)
+	@$(MAKE) --no-print-directory $(HIL_GUEST) $(EYE_SYNTH) $(RANGE) $(BUILD)/bin/fovea-headset $(BUILD)/bin/fovea-replay
 	@BUILD=$(BUILD) tests/hil/run.sh
 
 # Cross leg: build everything for aarch64 and run the core's tests under qemu-aarch64.

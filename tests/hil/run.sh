@@ -1,7 +1,7 @@
 #!/bin/bash
 # make test-hil: boots Debian's kernel in QEMU (TCG) from a small initramfs and runs the
 # hardware-in-the-loop checks of tests/hil/guest.c against real kernel drivers (vivid, gpio-sim,
-# bochs-drm). docs/hil.md says what runs and how.
+# bochs-drm), fovea-headset itself among them. docs/hil.md says what runs and how.
 #
 #   BUILD=build tests/hil/run.sh      (make test-hil builds $BUILD/hil/fovea-hil first)
 #
@@ -16,6 +16,12 @@ TIMEOUT=${HIL_TIMEOUT:-240}
 FRAMES=${HIL_FRAMES:-60}
 GPIO_SECONDS=${HIL_GPIO_SECONDS:-4}
 SMP=${HIL_SMP:-1}
+# fovea-headset in the guest: eye size and run time (a 128x144 stereo frame takes ~0.3 s under TCG)
+HS_SIZE=${HIL_HS_SIZE:-64x72}
+HS_SECONDS=${HIL_HS_SECONDS:-4}
+# the headset's vsync source, default the gpio-sim line; HIL_HS_VSYNC=timer:90 is the negative
+# control of the vsync check (photons on a timer, not on the line's edges: it must fail)
+HS_VSYNC=${HIL_HS_VSYNC:+HIL_HS_VSYNC=$HIL_HS_VSYNC }
 # extra QEMU options, e.g. HIL_QEMU_EXTRA="-icount shift=auto"
 QEMU_EXTRA=${HIL_QEMU_EXTRA:-}
 guest_bin=$BUILD/hil/fovea-hil
@@ -41,6 +47,34 @@ file_type=$(od -An -c -N4 "$run/initrd/bin/busybox" | tr -d ' ')
 [ "$file_type" = '177ELF' ] || die "/bin/busybox is not an ELF (busybox-static)"
 cp "$guest_bin" "$run/initrd/bin/fovea-hil"
 cp tests/hil/init "$run/initrd/init"
+# fovea-headset as make all built it, with its shared libraries (ldd: Embree, TBB and tinygltf
+# exist only as shared libraries in Debian, so no static link) and the dynamic loader. The
+# libraries (66 MB, 45 of them for SDL2, which the program links for --display window) go into
+# a second cpio archive, cached while the ldd list and the files are unchanged; the kernel
+# unpacks the two archives one after the other.
+headset_bin=$BUILD/bin/fovea-headset
+[ -x "$headset_bin" ] || die "$headset_bin missing (make test-hil builds it)"
+ldd "$headset_bin" | grep -q 'not found' && die "ldd $headset_bin: a library was not found"
+cp "$headset_bin" "$run/initrd/bin/fovea-headset"
+interp=$(ldd "$headset_bin" | awk '$1 ~ /^\/.*ld-linux/ { print $1 }')
+[ -n "$interp" ] || die "ldd $headset_bin names no dynamic loader"
+libs=$(ldd "$headset_bin" | awk '$2 == "=>" && $3 ~ /^\// { print $3 }')
+# shellcheck disable=SC2086
+key=$(for f in "$interp" $libs; do printf '%s %s\n' "$f" "$(stat -L -c '%s %Y' "$f")"; done | md5sum | cut -c1-16)
+libs_cpio=$(cd "$HIL_DIR" && pwd)/libs-$key.cpio.gz
+if [ ! -s "$libs_cpio" ]; then
+    rm -rf "$HIL_DIR/libs-tree" "$HIL_DIR"/libs-*.cpio.gz
+    mkdir -p "$HIL_DIR/libs-tree/lib64" "$HIL_DIR/libs-tree/lib/x86_64-linux-gnu"
+    cp -L "$interp" "$HIL_DIR/libs-tree/lib64/$(basename "$interp")"
+    for l in $libs; do
+        cp -L "$l" "$HIL_DIR/libs-tree/lib/x86_64-linux-gnu/$(basename "$l")"
+    done
+    (cd "$HIL_DIR/libs-tree" && find . | LC_ALL=C sort | cpio -o -H newc --quiet | gzip -1 > "$libs_cpio.tmp")
+    mv "$libs_cpio.tmp" "$libs_cpio"
+    rm -rf "$HIL_DIR/libs-tree"
+fi
+n_libs=$(echo "$libs" | wc -l)
+cp assets/range.glb "$run/initrd/data/range.glb"
 chmod 755 "$run/initrd/init"
 # the first FRAMES frames of the eye video (header line + FRAMES x ("FRAME\n" + 320x240 luma))
 head -n1 assets/eye_synth.y4m | grep -q '^YUV4MPEG2 W320 H240 .*Cmono' ||
@@ -65,9 +99,11 @@ for p in $mods; do
         *) echo "$b" ;;
     esac >> "$run/initrd/modules.list"
 done
-(cd "$run/initrd" && find . | LC_ALL=C sort | cpio -o -H newc --quiet | gzip -1 > ../initrd.gz)
+(cd "$run/initrd" && find . | LC_ALL=C sort | cpio -o -H newc --quiet | gzip -1 > ../initrd-main.gz)
+cat "$libs_cpio" "$run/initrd-main.gz" > "$run/initrd.gz"
 say "kernel $HIL_KVER ($HIL_IMG_PKG $HIL_IMG_VER), initramfs $(($(stat -c %s "$run/initrd.gz") / 1024)) KiB," \
-    "$(wc -l < "$run/initrd/modules.list") modules: $(awk '{printf "%s%s", sep, $1; sep=" "}' "$run/initrd/modules.list")"
+    "$(wc -l < "$run/initrd/modules.list") modules: $(awk '{printf "%s%s", sep, $1; sep=" "}' "$run/initrd/modules.list");" \
+    "fovea-headset with $n_libs shared libraries ($(($(stat -c %s "$libs_cpio") / 1024)) KiB of it)"
 t_initrd=$(date +%s.%N)
 
 # --- QEMU: console on ttyS0 (a file), the host's answers on ttyS1, the monitor on a pipe
@@ -82,15 +118,36 @@ qemu_args=(-accel tcg -cpu max -m 512 -smp "$SMP" $QEMU_EXTRA -nodefaults -no-re
     -chardev "pipe,id=ctl,path=$run/ctl" -serial chardev:ctl
     -chardev "pipe,id=mon,path=$run/mon" -mon chardev=mon,mode=readline
     -kernel "$HIL_VMLINUX" -initrd "$run/initrd.gz"
-    -append "console=ttyS0 quiet panic=-1 rdinit=/init HIL_FRAMES=$FRAMES HIL_GPIO_SECONDS=$GPIO_SECONDS")
+    -append "console=ttyS0 quiet panic=-1 rdinit=/init $HS_VSYNC""HIL_HS_SIZE=$HS_SIZE HIL_HS_SECONDS=$HS_SECONDS HIL_FRAMES=$FRAMES HIL_GPIO_SECONDS=$GPIO_SECONDS")
 say "booting: qemu-system-x86_64 ${qemu_args[*]}"
 t_boot=$(date +%s.%N)
 timeout --kill-after=5 "$TIMEOUT" qemu-system-x86_64 "${qemu_args[@]}" > "$run/qemu.log" 2>&1 &
 qpid=$!
 trap 'kill "$qpid" 2>/dev/null || true' EXIT INT TERM # no QEMU left behind if this script is stopped
-shot_done=0
+shot_done=0 hs_shot_done=0
 kms_w='' kms_h=''
+# waits until QEMU has written the screendump $1 (its size is only known from its header: poll
+# until it stops growing)
+wait_dump() {
+    local last=-1 cur
+    for _ in $(seq 100); do
+        cur=$(stat -c %s "$1" 2>/dev/null || echo -1)
+        [ "$cur" -gt 0 ] && [ "$cur" = "$last" ] && return 0
+        last=$cur
+        sleep 0.1
+    done
+}
 while kill -0 "$qpid" 2>/dev/null; do
+    if [ $hs_shot_done = 0 ] && grep -q '^HIL-READY headset' "$console" 2>/dev/null; then
+        # stop the VM for the screendump: the guest's clocks stand still, so the frame loop
+        # under test does not see it
+        rm -f "$run/headset.ppm"
+        printf 'stop\nscreendump %s\n' "$run/headset.ppm" >&5
+        wait_dump "$run/headset.ppm"
+        echo cont >&5
+        echo >&3
+        hs_shot_done=1
+    fi
     if [ $shot_done = 0 ] && line=$(grep -m1 '^HIL-READY kms ' "$console" 2>/dev/null); then
         read -r _ _ kms_w kms_h <<< "$line"
         kms_h=${kms_h%$'\r'}
@@ -116,7 +173,22 @@ tr -d '\r' < "$console" > "$run/console.txt"
 if [ $shot_done = 1 ]; then
     "$guest_bin" kms-compare "$run/shot.ppm" "$kms_w" "$kms_h" >> "$run/console.txt" || true
 fi
-checks="boot modules v4l2-loop v4l2-track v4l2-buf-error v4l2-reopen gpio-lock gpio-dropped kms-flip kms-readback"
+# the headset checks' own test on synthetic runs (host side)
+"$guest_bin" headset-selftest >> "$run/console.txt" 2>&1 || true
+if [ $hs_shot_done = 1 ]; then
+    # the same frame on the host: fovea-replay, same scene, size, view (the default), gaze (the
+    # centre) and reprojection off
+    rm -rf "$run/headset-ref"
+    if "$BUILD/bin/fovea-replay" --scene assets/range.glb --size "$HS_SIZE" --reproject off --stereo --frames 1 \
+        --out "$run/headset-ref" --quiet > "$run/headset-ref.log" 2>&1; then
+        "$guest_bin" headset-compare "$run/headset.ppm" "$run/headset-ref/frame_00000.png" "$run/headset-shot.png" \
+            >> "$run/console.txt" || true
+    else
+        echo "HIL headset-readback FAIL reason=\"fovea-replay failed: $(tail -n1 "$run/headset-ref.log")\"" >> "$run/console.txt"
+    fi
+fi
+checks="boot modules v4l2-loop v4l2-track v4l2-buf-error v4l2-reopen gpio-lock gpio-dropped headset-selftest
+    headset-run headset-vsync headset-flip headset-readback kms-flip kms-readback"
 pass=0 fail=0
 for c in $checks; do
     line=$(grep -m1 "^HIL $c " "$run/console.txt" || true)
