@@ -78,6 +78,13 @@ static void usage(FILE *f)
 enum { OPT_SCENE = 1, OPT_CAMERA, OPT_VSYNC, OPT_DISPLAY, OPT_CALIB, OPT_SECONDS, OPT_TRACE, OPT_LENS, OPT_CSV,
        OPT_HZ, OPT_CAMFPS, OPT_TRACE_OUT, OPT_TIMEWARP, OPT_WARP_THREADS, OPT_HELP, OPT_CALIBRATE, OPT_CALIB_DWELL };
 
+/* Records kept for the summary: the newest HS_KEEP (12 minutes at 90 Hz); older ones are folded
+ * into running totals. Their CSV rows are written as they complete, so memory stays flat for a
+ * run of any length (a 10-minute soak grew 9.5 MiB/h when every record was kept). */
+#ifndef HS_KEEP /* (a build can lower it to exercise the folding) */
+#define HS_KEEP (1L << 16)
+#endif
+
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig)
 {
@@ -129,9 +136,9 @@ typedef struct app {
     uint8_t *helper_dst;
     long helper_holes;
     int stop;           /* the render thread ends (atomic) */
-    int64_t *done_ns;   /* completion time of every rendered frame (render thread; read after join) */
+    int64_t *done_ns;   /* completion times of the newest rendered frames (render thread; read after join) */
     double *render_ms;
-    long ndone, capdone;
+    long ndone, capdone, done_base; /* frames rendered; entries held; frame of done_ns[0] */
 } app;
 
 static int64_t a_now(void *c)
@@ -313,7 +320,12 @@ static void *render_main(void *arg)
             a->meta[s].g = g;
         a->meta[s].start_ns = start;
         a->meta[s].done_ns = done;
-        if (a->ndone == a->capdone) { /* the summary's record (only this thread touches it until the join) */
+        if (a->ndone - a->done_base == HS_KEEP) { /* keep the newest half: memory stays flat */
+            memmove(a->done_ns, a->done_ns + HS_KEEP / 2, sizeof *a->done_ns * (size_t)(HS_KEEP / 2));
+            memmove(a->render_ms, a->render_ms + HS_KEEP / 2, sizeof *a->render_ms * (size_t)(HS_KEEP / 2));
+            a->done_base += HS_KEEP / 2;
+        }
+        if (a->ndone - a->done_base == a->capdone) { /* the summary's record (only this thread touches it until the join) */
             const long cap = a->capdone ? 2 * a->capdone : 1024;
             int64_t *d = realloc(a->done_ns, (size_t)cap * sizeof *d);
             if (d)
@@ -322,9 +334,9 @@ static void *render_main(void *arg)
             if (r)
                 a->render_ms = r, a->capdone = cap;
         }
-        if (a->ndone < a->capdone) {
-            a->done_ns[a->ndone] = done;
-            a->render_ms[a->ndone] = (double)(done - start) * 1e-6;
+        if (a->ndone - a->done_base < a->capdone) {
+            a->done_ns[a->ndone - a->done_base] = done;
+            a->render_ms[a->ndone - a->done_base] = (double)(done - start) * 1e-6;
         }
         fv_mailbox_publish(&a->mb, s, a->ndone);
         a->ndone++;
@@ -598,6 +610,19 @@ int main(int argc, char **argv)
     long nrec = 0, caprec = 0;
     fv_refresh_record *rr = NULL; /* --timewarp on: one per refresh */
     long nrr = 0, caprr = 0;
+    long folded_frames = 0, folded_late = 0, folded_refreshes = 0; /* records dropped from memory (HS_KEEP) */
+    int pending_markers = 0;
+    fv_afile csv = {0}; /* --latency-csv: rows written as each record completes */
+    if (csv_path) {
+        if (fv_afile_open(&csv, csv_path, err, sizeof err)) {
+            fprintf(stderr, "%s: %s\n", prog, err);
+            goto done;
+        }
+        if (timewarp)
+            fv_refresh_csv_header(csv.f);
+        else
+            fv_latency_csv_header(csv.f);
+    }
     a.img[0] = calloc((size_t)a.W * 2 * a.H, 3);
     a.img[1] = calloc((size_t)a.W * 2 * a.H, 3);
     if (!a.img[0] || !a.img[1]) {
@@ -632,6 +657,13 @@ int main(int argc, char **argv)
     if (!timewarp) {
         fv_frameloop_init(&loop, &lp, &ops, &ring);
         for (;;) {
+            if (nrec == HS_KEEP) { /* fold the oldest half into the totals */
+                fv_latency_summary h;
+                fv_latency_summarise(rec, HS_KEEP / 2, &h);
+                folded_frames += h.frames, folded_late += h.late;
+                memmove(rec, rec + HS_KEEP / 2, sizeof *rec * (size_t)(HS_KEEP / 2));
+                nrec -= HS_KEEP / 2;
+            }
             if (nrec == caprec) {
                 caprec = caprec ? 2 * caprec : 1024;
                 fv_frame_record *n = realloc(rec, (size_t)caprec * sizeof *n);
@@ -653,6 +685,8 @@ int main(int argc, char **argv)
             }
             if (prof) /* gaze latch, vsync (photon) and late markers of this frame */
                 fv_prof_frame_markers(prof, q->frame, q->ray_start_ns, q->photon_ns, q->late);
+            if (csv.f)
+                fv_latency_csv_row(csv.f, q, a.t_start_ns);
             nrec++;
         }
         pred = &loop.pred;
@@ -692,6 +726,13 @@ int main(int argc, char **argv)
         fv_displayloop_ops dops = {&a, a_now, a_sleep, a_wait_edge, a_compose};
         fv_displayloop_init(&dl, &dp, &dops);
         for (;;) {
+            if (nrr == HS_KEEP) { /* fold the oldest half into the totals */
+                fv_display_summary h;
+                fv_display_summarise(rr, HS_KEEP / 2, 2.0 * a.W * a.H, period, &h);
+                folded_frames += h.displayed, folded_late += h.missed, folded_refreshes += HS_KEEP / 2;
+                memmove(rr, rr + HS_KEEP / 2, sizeof *rr * (size_t)(HS_KEEP / 2));
+                nrr -= HS_KEEP / 2;
+            }
             if (nrr == caprr) {
                 caprr = caprr ? 2 * caprr : 4096;
                 fv_refresh_record *n = realloc(rr, (size_t)caprr * sizeof *n);
@@ -710,6 +751,10 @@ int main(int argc, char **argv)
                 q->pose_err_deg = fv_pose_angle_deg(&a.head_pred, &truth);
                 q->pose_err_mm = fv_pose_dist_m(&a.head_pred, &truth) * 1e3;
             }
+            if (csv.f)
+                fv_refresh_csv_row(csv.f, q, a.t_start_ns);
+            if (prof && q->frame >= 0) /* (written after the run: the recorder's slot 0 is a worker's while rendering) */
+                pending_markers = 1;
             nrr++;
         }
         if (a.helper_on) {
@@ -726,7 +771,7 @@ int main(int argc, char **argv)
         a.render_failed = __atomic_load_n(&a.render_failed, __ATOMIC_ACQUIRE);
         pred = &dl.pred;
         source_dead = dl.source_dead;
-        if (prof) /* markers after the run: the recorder's slot 0 is a worker's while rendering */
+        if (prof && pending_markers) /* markers after the run: the recorder's slot 0 is a worker's while rendering */
             for (long k = 0; k < nrr; k++)
                 if (rr[k].frame >= 0)
                     fv_prof_frame_markers(prof, rr[k].refresh, rr[k].frame_start_ns, rr[k].photon_ns, rr[k].late);
@@ -737,7 +782,7 @@ int main(int argc, char **argv)
     const double run_s = (double)(fv_time_ns() - a.t_start_ns) * 1e-9;
     const char *disp_kind = a.disp ? fv_display_kind(a.disp) : "none";
     if (!timewarp) {
-        const long skip = nrec > 40 ? 20 : 0;
+        const long skip = nrec > 40 && !folded_frames ? 20 : 0; /* (folded: the first frames are long gone) */
         fv_latency_summary s;
         fv_latency_summarise(rec + skip, nrec - skip, &s);
         double *v = malloc((size_t)(nrec + 1) * sizeof *v);
@@ -755,10 +800,12 @@ int main(int argc, char **argv)
             free(v);
         }
         /* every frame rendered is shown: displayed = rendered */
-        printf("fovea-headset: displayed %ld frames (%.2f Hz), rendered %ld frames (%.2f Hz), late %ld\n", s.frames,
-               s.fps, s.frames, s.fps, s.late);
-        printf("  %ld frames in %.2f s, %dx%d per eye, vsync %s (%.2f Hz nominal), display %s, timewarp off\n", nrec,
-               run_s, a.W, a.H, vsync_spec, run_hz, disp_kind);
+        printf("fovea-headset: displayed %ld frames (%.2f Hz), rendered %ld frames (%.2f Hz), late %ld\n",
+               s.frames + folded_frames, s.fps, s.frames + folded_frames, s.fps, s.late + folded_late);
+        printf("  %ld frames in %.2f s, %dx%d per eye, vsync %s (%.2f Hz nominal), display %s, timewarp off\n",
+               nrec + folded_frames, run_s, a.W, a.H, vsync_spec, run_hz, disp_kind);
+        if (folded_frames)
+            printf("  rates and percentiles over the newest %ld frames (older ones are counted, not kept)\n", nrec);
         printf("  ");
         summary_line("motion-to-photon", mtp50, mtp99);
         printf("; ");
@@ -770,15 +817,19 @@ int main(int argc, char **argv)
         if (has_head(&a))
             printf("  head pose prediction error at the photon time p50 %.3f deg, p99 %.3f deg\n", pe50, pe99);
     } else {
-        const long skip = nrr > 40 ? 20 : 0;
+        const long skip = nrr > 40 && !folded_refreshes ? 20 : 0; /* (folded: the first refreshes are long gone) */
         fv_display_summary s;
         fv_display_summarise(rr + skip, nrr - skip, 2.0 * a.W * a.H, period, &s);
         /* rendered frames completed within the summarised photon span */
         long rendered = 0;
         double rhz = NAN, rp50 = NAN, rp99 = NAN;
-        const long nd = a.ndone < a.capdone ? a.ndone : a.capdone;
+        const long nd = a.ndone - a.done_base < a.capdone ? a.ndone - a.done_base : a.capdone;
         if (nrr - skip > 1) {
-            const int64_t t0 = rr[skip].photon_ns, t1 = rr[nrr - 1].photon_ns;
+            /* the span both records still cover (the render times kept may start later) */
+            int64_t t0 = rr[skip].photon_ns;
+            const int64_t t1 = rr[nrr - 1].photon_ns;
+            if (a.done_base && nd && a.done_ns[0] > t0)
+                t0 = a.done_ns[0];
             double *v = malloc((size_t)(nd + 1) * sizeof *v);
             long m = 0;
             for (long k = 0; k < nd; k++)
@@ -795,11 +846,14 @@ int main(int argc, char **argv)
             }
         }
         /* late: vsyncs without a newly composed image (composed after its vsync, or skipped) */
-        printf("fovea-headset: displayed %ld frames (%.2f Hz), rendered %ld frames (%.2f Hz), late %ld\n", s.displayed,
-               s.displayed_hz, rendered, rhz, s.missed);
+        printf("fovea-headset: displayed %ld frames (%.2f Hz), rendered %ld frames (%.2f Hz), late %ld\n",
+               s.displayed + folded_frames, s.displayed_hz, folded_refreshes ? a.ndone : rendered, rhz,
+               s.missed + folded_late);
         printf("  %ld refreshes in %.2f s (%ld frames rendered in all), %dx%d per eye, vsync %s (%.2f Hz nominal), "
                "display %s, timewarp on, display thread %s\n",
-               nrr, run_s, a.ndone, a.W, a.H, vsync_spec, run_hz, disp_kind, prio);
+               nrr + folded_refreshes, run_s, a.ndone, a.W, a.H, vsync_spec, run_hz, disp_kind, prio);
+        if (folded_refreshes)
+            printf("  rates and percentiles over the newest %ld refreshes (older ones are counted, not kept)\n", nrr);
         printf("  ");
         summary_line("motion-to-photon", s.mtp_p50_ms, s.mtp_p99_ms);
         printf("; ");
@@ -823,13 +877,9 @@ int main(int argc, char **argv)
     if (a.cam)
         printf("  camera: %ld frames tracked%s\n", fv_gazesrc_frames(a.cam),
                fv_gazesrc_failed(a.cam) ? " (failed mid-run)" : "");
-    if (csv_path) {
-        const int rc = timewarp ? fv_refresh_csv_write(csv_path, rr, nrr, a.t_start_ns, err, sizeof err)
-                                : fv_latency_csv_write(csv_path, rec, nrec, a.t_start_ns, err, sizeof err);
-        if (rc) {
-            fprintf(stderr, "%s: %s\n", prog, err);
-            status = FV_EXIT_FAIL;
-        }
+    if (csv.f && fv_afile_commit(&csv, err, sizeof err)) { /* every row is complete: the run's file */
+        fprintf(stderr, "%s: %s\n", prog, err);
+        status = FV_EXIT_FAIL;
     }
     if (prof) {
         char label[600];
@@ -841,6 +891,7 @@ int main(int argc, char **argv)
         }
     }
 done:
+    fv_afile_abort(&csv); /* (nothing when committed) */
     fv_pipeline_set_prof(a.pl, NULL);
     fv_prof_destroy(prof);
     fv_gazesrc_stop(a.cam);

@@ -397,40 +397,89 @@ void fv_stats_csv_row(FILE *f, long frame, double t_ms, float gaze_x, float gaze
 }
 
 /* ---- fovea-headset's latency CSV ---- */
+void fv_latency_csv_header(FILE *f)
+{
+    fprintf(f, "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,render_ms,late,"
+               "photon_edge,vsync_state,budget_ms,gaze_x,gaze_y,head_t_ms,motion_to_photon_ms,pose_err_deg\n");
+}
+
+void fv_latency_csv_row(FILE *out, const fv_frame_record *q, int64_t t0)
+{
+#define MS(t) ((double)((t) - t0) * 1e-6)
+    fprintf(out, "%ld,", q->frame);
+    if (q->has_gaze)
+        fprintf(out, "%.3f", MS(q->gaze_t_ns));
+    fprintf(out, ",%.3f,%.3f,%.3f,%.3f,", MS(q->ray_start_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
+    if (q->has_gaze) /* empty without a gaze sample */
+        fprintf(out, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
+    fprintf(out, ",%.3f,%d,%d,%s,%.3f,", (double)(q->done_ns - q->ray_start_ns) * 1e-6, q->late, q->photon_edge,
+            fv_vsync_state_name(q->vsync_state), (double)q->budget_ns * 1e-6);
+    if (q->has_gaze)
+        fprintf(out, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
+    else
+        fputc(',', out);
+    fputc(',', out);
+    if (q->head_t_ns)
+        fprintf(out, "%.3f,%.3f", MS(q->head_t_ns), (double)(q->photon_ns - q->head_t_ns) * 1e-6);
+    else
+        fputc(',', out);
+    fputc(',', out);
+    if (q->pose_err_deg == q->pose_err_deg && q->head_t_ns)
+        fprintf(out, "%.4f", q->pose_err_deg);
+    fputc('\n', out);
+#undef MS
+}
+
 int fv_latency_csv_write(const char *path, const fv_frame_record *r, long n, int64_t t0, char *err, size_t err_len)
 {
     fv_afile f;
     if (fv_afile_open(&f, path, err, err_len))
         return -1;
-    fprintf(f.f, "frame,gaze_t_ms,ray_start_ms,done_ms,target_ms,photon_ms,gaze_to_photon_ms,render_ms,late,"
-                 "photon_edge,vsync_state,budget_ms,gaze_x,gaze_y,head_t_ms,motion_to_photon_ms,pose_err_deg\n");
-#define MS(t) ((double)((t) - t0) * 1e-6)
-    for (long i = 0; i < n; i++) {
-        const fv_frame_record *q = &r[i];
-        fprintf(f.f, "%ld,", q->frame);
-        if (q->has_gaze)
-            fprintf(f.f, "%.3f", MS(q->gaze_t_ns));
-        fprintf(f.f, ",%.3f,%.3f,%.3f,%.3f,", MS(q->ray_start_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
-        if (q->has_gaze) /* empty without a gaze sample */
-            fprintf(f.f, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
-        fprintf(f.f, ",%.3f,%d,%d,%s,%.3f,", (double)(q->done_ns - q->ray_start_ns) * 1e-6, q->late, q->photon_edge,
-                fv_vsync_state_name(q->vsync_state), (double)q->budget_ns * 1e-6);
-        if (q->has_gaze)
-            fprintf(f.f, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
-        else
-            fputc(',', f.f);
-        fputc(',', f.f);
-        if (q->head_t_ns)
-            fprintf(f.f, "%.3f,%.3f", MS(q->head_t_ns), (double)(q->photon_ns - q->head_t_ns) * 1e-6);
-        else
-            fputc(',', f.f);
-        fputc(',', f.f);
-        if (q->pose_err_deg == q->pose_err_deg && q->head_t_ns)
-            fprintf(f.f, "%.4f", q->pose_err_deg);
-        fputc('\n', f.f);
-    }
-#undef MS
+    fv_latency_csv_header(f.f);
+    for (long i = 0; i < n; i++)
+        fv_latency_csv_row(f.f, &r[i], t0);
     return fv_afile_commit(&f, err, err_len);
+}
+
+void fv_refresh_csv_header(FILE *f)
+{
+    fprintf(f, "refresh,frame,reused,late,head_t_ms,gaze_t_ms,frame_start_ms,frame_done_ms,compose_start_ms,"
+               "compose_done_ms,target_ms,photon_ms,motion_to_photon_ms,gaze_to_photon_ms,photon_edge,vsync_state,"
+               "margin_ms,disoccluded,pose_err_deg,gaze_x,gaze_y\n");
+}
+
+void fv_refresh_csv_row(FILE *out, const fv_refresh_record *q, int64_t t0)
+{
+#define MS(t) ((double)((t) - t0) * 1e-6)
+    const int shown = q->frame >= 0;
+    fprintf(out, "%ld,%ld,%d,%d,", q->refresh, q->frame, q->reused, q->late);
+    if (shown && q->head_t_ns)
+        fprintf(out, "%.3f", MS(q->head_t_ns));
+    fputc(',', out);
+    if (shown && q->has_gaze)
+        fprintf(out, "%.3f", MS(q->gaze_t_ns));
+    fputc(',', out);
+    if (shown)
+        fprintf(out, "%.3f,%.3f", MS(q->frame_start_ns), MS(q->frame_done_ns));
+    else
+        fputc(',', out);
+    fprintf(out, ",%.3f,%.3f,%.3f,%.3f,", MS(q->wake_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
+    if (shown && q->head_t_ns)
+        fprintf(out, "%.3f", (double)(q->photon_ns - q->head_t_ns) * 1e-6);
+    fputc(',', out);
+    if (shown && q->has_gaze)
+        fprintf(out, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
+    fprintf(out, ",%d,%s,%.3f,%ld,", q->photon_edge, fv_vsync_state_name(q->vsync_state), (double)q->margin_ns * 1e-6,
+            q->disoccluded);
+    if (q->pose_err_deg == q->pose_err_deg)
+        fprintf(out, "%.4f", q->pose_err_deg);
+    fputc(',', out);
+    if (shown && q->has_gaze)
+        fprintf(out, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
+    else
+        fputc(',', out);
+    fputc('\n', out);
+#undef MS
 }
 
 int fv_refresh_csv_write(const char *path, const fv_refresh_record *r, long n, int64_t t0, char *err, size_t err_len)
@@ -438,41 +487,8 @@ int fv_refresh_csv_write(const char *path, const fv_refresh_record *r, long n, i
     fv_afile f;
     if (fv_afile_open(&f, path, err, err_len))
         return -1;
-    fprintf(f.f, "refresh,frame,reused,late,head_t_ms,gaze_t_ms,frame_start_ms,frame_done_ms,compose_start_ms,"
-                 "compose_done_ms,target_ms,photon_ms,motion_to_photon_ms,gaze_to_photon_ms,photon_edge,vsync_state,"
-                 "margin_ms,disoccluded,pose_err_deg,gaze_x,gaze_y\n");
-#define MS(t) ((double)((t) - t0) * 1e-6)
-    for (long i = 0; i < n; i++) {
-        const fv_refresh_record *q = &r[i];
-        const int shown = q->frame >= 0;
-        fprintf(f.f, "%ld,%ld,%d,%d,", q->refresh, q->frame, q->reused, q->late);
-        if (shown && q->head_t_ns)
-            fprintf(f.f, "%.3f", MS(q->head_t_ns));
-        fputc(',', f.f);
-        if (shown && q->has_gaze)
-            fprintf(f.f, "%.3f", MS(q->gaze_t_ns));
-        fputc(',', f.f);
-        if (shown)
-            fprintf(f.f, "%.3f,%.3f", MS(q->frame_start_ns), MS(q->frame_done_ns));
-        else
-            fputc(',', f.f);
-        fprintf(f.f, ",%.3f,%.3f,%.3f,%.3f,", MS(q->wake_ns), MS(q->done_ns), MS(q->target_ns), MS(q->photon_ns));
-        if (shown && q->head_t_ns)
-            fprintf(f.f, "%.3f", (double)(q->photon_ns - q->head_t_ns) * 1e-6);
-        fputc(',', f.f);
-        if (shown && q->has_gaze)
-            fprintf(f.f, "%.3f", (double)(q->photon_ns - q->gaze_t_ns) * 1e-6);
-        fprintf(f.f, ",%d,%s,%.3f,%ld,", q->photon_edge, fv_vsync_state_name(q->vsync_state), (double)q->margin_ns * 1e-6,
-                q->disoccluded);
-        if (q->pose_err_deg == q->pose_err_deg)
-            fprintf(f.f, "%.4f", q->pose_err_deg);
-        fputc(',', f.f);
-        if (shown && q->has_gaze)
-            fprintf(f.f, "%.4f,%.4f", (double)q->gaze_x, (double)q->gaze_y);
-        else
-            fputc(',', f.f);
-        fputc('\n', f.f);
-    }
-#undef MS
+    fv_refresh_csv_header(f.f);
+    for (long i = 0; i < n; i++)
+        fv_refresh_csv_row(f.f, &r[i], t0);
     return fv_afile_commit(&f, err, err_len);
 }

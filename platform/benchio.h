@@ -75,6 +75,11 @@ void fv_stats_csv_row(FILE *f, long frame, double t_ms, float gaze_x, float gaze
 
 /* fovea-headset's --latency-csv: one line per frame record, times in ms since t0_ns; written
  * atomically. 0, or -1 with a reason. */
+/* The same one row at a time, for a run that streams its rows as they complete. */
+void fv_latency_csv_header(FILE *f);
+void fv_latency_csv_row(FILE *f, const fv_frame_record *r, int64_t t0_ns);
+void fv_refresh_csv_header(FILE *f);
+void fv_refresh_csv_row(FILE *f, const fv_refresh_record *r, int64_t t0_ns);
 int fv_latency_csv_write(const char *path, const fv_frame_record *r, long n, int64_t t0_ns, char *err,
                          size_t err_len);
 /* --timewarp on: one row per refresh (displayloop.h): refresh,frame,reused,late,head_t_ms,
