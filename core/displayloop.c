@@ -98,40 +98,23 @@ int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
     return (int64_t)((double)worst * l->p.margin_scale) + l->p.margin_extra_ns;
 }
 
-/* as the frame loop's: edges until deadline; 1 with an edge in [lo, hi] */
+/* the vsync side of this loop (fv_vsync_edges_take, fv_vsync_edges_wait) */
+static fv_vsync_edges edges_of(fv_displayloop *l)
+{
+    return (fv_vsync_edges){l->ops.ctx, l->ops.now_ns, l->ops.sleep_until, l->ops.wait_edge, &l->pred, &l->source_dead,
+                            &l->edges};
+}
+
 static int take_edges(fv_displayloop *l, int64_t deadline, int64_t lo, int64_t hi, int64_t *t)
 {
-    for (;;) {
-        if (l->source_dead) {
-            if (l->ops.now_ns(l->ops.ctx) < deadline)
-                l->ops.sleep_until(l->ops.ctx, deadline);
-            return 0;
-        }
-        int64_t te;
-        const int rc = l->ops.wait_edge(l->ops.ctx, deadline, &te);
-        if (rc < 0) {
-            l->source_dead = 1;
-            continue;
-        }
-        if (rc == 0)
-            return 0;
-        l->edges++;
-        fv_vsync_pred_edge(&l->pred, te);
-        if (te >= lo && te <= hi) {
-            *t = te;
-            return 1;
-        }
-        if (te > hi)
-            return 0;
-    }
+    const fv_vsync_edges e = edges_of(l);
+    return fv_vsync_edges_take(&e, deadline, lo, hi, t);
 }
 
 static int64_t wait_vsync(fv_displayloop *l, int64_t v, int *measured)
 {
-    int64_t te;
-    const int64_t half = l->p.nominal_period_ns / 2;
-    *measured = take_edges(l, v + l->p.edge_grace_ns, v - half, v + half, &te);
-    return *measured ? te : v;
+    const fv_vsync_edges e = edges_of(l);
+    return fv_vsync_edges_wait(&e, v, l->p.nominal_period_ns, l->p.edge_grace_ns, measured);
 }
 
 int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec)

@@ -77,43 +77,23 @@ int64_t fv_frameloop_budget_ns(const fv_frameloop *l)
     return (int64_t)((double)worst * l->p.budget_scale) + l->p.budget_margin_ns;
 }
 
-/* Waits for edges until deadline, feeding the predictor. Returns 1 when an edge in [lo, hi]
- * came (its time in *t); an edge after hi ends the wait with 0 (that vsync has passed without
- * its edge). A failing source is dropped; the rest of the wait is then a sleep. */
-static int take_edges(fv_frameloop *l, int64_t deadline, int64_t lo, int64_t hi, int64_t *t)
+/* the vsync side of this loop (fv_vsync_edges_take, fv_vsync_edges_wait) */
+static fv_vsync_edges edges_of(fv_frameloop *l)
 {
-    for (;;) {
-        if (l->source_dead) {
-            if (l->ops.now_ns(l->ops.ctx) < deadline)
-                l->ops.sleep_until(l->ops.ctx, deadline);
-            return 0;
-        }
-        int64_t te;
-        int rc = l->ops.wait_edge(l->ops.ctx, deadline, &te);
-        if (rc < 0) {
-            l->source_dead = 1;
-            continue;
-        }
-        if (rc == 0)
-            return 0;
-        l->edges++;
-        fv_vsync_pred_edge(&l->pred, te);
-        if (te >= lo && te <= hi) {
-            *t = te;
-            return 1;
-        }
-        if (te > hi)
-            return 0;
-    }
+    return (fv_vsync_edges){l->ops.ctx, l->ops.now_ns, l->ops.sleep_until, l->ops.wait_edge, &l->pred, &l->source_dead,
+                            &l->edges};
 }
 
-/* Waits for the edge of vsync v (within half a period of it); the edge time, or v predicted. */
+static int take_edges(fv_frameloop *l, int64_t deadline, int64_t lo, int64_t hi, int64_t *t)
+{
+    const fv_vsync_edges e = edges_of(l);
+    return fv_vsync_edges_take(&e, deadline, lo, hi, t);
+}
+
 static int64_t wait_vsync(fv_frameloop *l, int64_t v, int *measured)
 {
-    int64_t te;
-    const int64_t half = l->p.nominal_period_ns / 2;
-    *measured = take_edges(l, v + l->p.edge_grace_ns, v - half, v + half, &te);
-    return *measured ? te : v;
+    const fv_vsync_edges e = edges_of(l);
+    return fv_vsync_edges_wait(&e, v, l->p.nominal_period_ns, l->p.edge_grace_ns, measured);
 }
 
 int fv_frameloop_frame(fv_frameloop *l, fv_frame_record *rec)

@@ -196,3 +196,38 @@ const char *fv_vsync_state_name(int state)
     static const char *const names[] = {"acquire", "locked", "coast", "timer"};
     return state >= 0 && state <= FV_VSYNC_TIMER ? names[state] : "?";
 }
+
+int fv_vsync_edges_take(const fv_vsync_edges *e, int64_t deadline, int64_t lo, int64_t hi, int64_t *t)
+{
+    for (;;) {
+        if (*e->source_dead) {
+            if (e->now_ns(e->ctx) < deadline)
+                e->sleep_until(e->ctx, deadline);
+            return 0;
+        }
+        int64_t te;
+        const int rc = e->wait_edge(e->ctx, deadline, &te);
+        if (rc < 0) {
+            *e->source_dead = 1;
+            continue;
+        }
+        if (rc == 0)
+            return 0;
+        (*e->edges)++;
+        fv_vsync_pred_edge(e->pred, te);
+        if (te >= lo && te <= hi) {
+            *t = te;
+            return 1;
+        }
+        if (te > hi)
+            return 0;
+    }
+}
+
+int64_t fv_vsync_edges_wait(const fv_vsync_edges *e, int64_t v, int64_t nominal_period_ns, int64_t grace_ns, int *measured)
+{
+    int64_t te;
+    const int64_t half = nominal_period_ns / 2;
+    *measured = fv_vsync_edges_take(e, v + grace_ns, v - half, v + half, &te);
+    return *measured ? te : v;
+}

@@ -56,4 +56,24 @@ double fv_vsync_pred_period_ns(const fv_vsync_pred *v);
 double fv_vsync_pred_jitter_ns(const fv_vsync_pred *v);
 const char *fv_vsync_state_name(int state);
 
+/* The vsync side both frame loops share (core/frameloop.c, core/displayloop.c): their clock and
+ * edge source and the predictor the edges feed. */
+typedef struct fv_vsync_edges {
+    void *ctx;
+    int64_t (*now_ns)(void *ctx);
+    void (*sleep_until)(void *ctx, int64_t t_ns);
+    /* next edge until deadline_ns: 1 with its time, 0 none, -1 the source failed; NULL: none */
+    int (*wait_edge)(void *ctx, int64_t deadline_ns, int64_t *t_ns);
+    fv_vsync_pred *pred;
+    int *source_dead; /* set when the source fails: the rest of every wait is a sleep */
+    long *edges;      /* edges seen */
+} fv_vsync_edges;
+
+/* Waits for edges until deadline, feeding the predictor. 1 when an edge in [lo, hi] came (its
+ * time in *t); an edge after hi ends the wait with 0 (that vsync has passed without its edge). */
+int fv_vsync_edges_take(const fv_vsync_edges *e, int64_t deadline, int64_t lo, int64_t hi, int64_t *t);
+/* Waits for the edge of vsync v (within half a nominal period of it, until v + grace): its time,
+ * or v (predicted) with *measured 0. */
+int64_t fv_vsync_edges_wait(const fv_vsync_edges *e, int64_t v, int64_t nominal_period_ns, int64_t grace_ns, int *measured);
+
 #endif
