@@ -79,6 +79,12 @@ printf 't_ms,gaze_x,gaze_y,head_px,head_py,head_pz,head_qx,head_qy,head_qz,head_
 expect_usage "replay head position 1e30" 'far.csv:2: head position head_py = 1e\+30 m out of range' $R --scene $SCENE --out "$T/o3" --trace "$T/far.csv"
 [ ! -e "$T/o3" ] && ok || bad "1e30 head position left output behind"
 expect_usage "replay trace from /dev/zero" '/dev/zero: not a text file' $R --scene $SCENE --out "$T/o3" --trace /dev/zero
+# sizes judged before reading: a sparse 2 GiB trace and a zero-filled 2 GiB .gltf (read whole for 12 s before)
+truncate -s 2G "$T/huge.csv" && truncate -s 2G "$T/huge.gltf"
+expect_usage "replay 2 GiB trace" 'huge.csv: 2147483648 bytes, larger than the 1024 MiB limit' $R --scene $SCENE --out "$T/o3" --trace "$T/huge.csv"
+expect_usage "replay 2 GiB zero gltf" 'huge.gltf: not a glTF file' $R --scene "$T/huge.gltf" --out "$T/o3"
+[ ! -e "$T/o3" ] && ok || bad "oversized inputs left output behind"
+rm -f "$T/huge.csv" "$T/huge.gltf"
 # a scene's external files stay in its folder tree: a URI leading out is refused and named (exit 2);
 # --asset-root widens the tree
 mkdir -p "$T/esc/scene"
