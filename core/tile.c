@@ -7,6 +7,7 @@
 #include "base/clock.h"
 #include "prof.h"
 #include "raycast.h"
+#include "sampling_dof.h"
 
 typedef struct {
     const fv_scene *scene;
@@ -21,6 +22,8 @@ typedef struct {
     atomic_long rays;
     atomic_llong taa_ns;
     struct fv_prof *prof; /* NULL: no trace recording */
+    const struct fv_dofsamp_frame *dofs;
+    uint32_t *rows_out;
 } tile_job;
 
 static void run_tile(void *ctx, int index, int thread_id)
@@ -39,6 +42,11 @@ static void run_tile(void *ctx, int index, int thread_id)
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++)
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
+    if (j->dofs) /* fewer rays where the depth of field will blur (core/sampling_dof.h) */
+        fv_dofsamp_tile(j->dofs, x0, y0, tw, th, rows);
+    if (j->rows_out)
+        for (int y = 0; y < FV_TILE; y++)
+            j->rows_out[(size_t)index * FV_TILE + y] = y < th ? rows[y] : 0u;
 
     /* writes every weight of the tile: pixels without a sample get 0 */
     const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
@@ -71,6 +79,8 @@ long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler 
         j.taa = opt->taa;
         j.taa_prm = opt->taa_prm;
         j.prof = opt->prof;
+        j.dofs = opt->dofs;
+        j.rows_out = opt->rows_out;
     }
     j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
     j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;

@@ -29,6 +29,7 @@ enum {
     FV_OPT_DOF, FV_OPT_DOF_MODEL, FV_OPT_REPROJECT, FV_OPT_TAA_ALPHA, FV_OPT_TAA_TOL, FV_OPT_TAA_FILL,
     FV_OPT_PATTERN, FV_OPT_FOCUS_M, FV_OPT_PUPIL_MM, FV_OPT_GAZE_ERR, FV_OPT_DOF_TOL, FV_OPT_ACCOMMODATION,
     FV_OPT_CONTRAST, FV_OPT_CHROMA,
+    FV_OPT_DOF_SAMPLING, FV_OPT_DOF_SAMPLING_KAPPA, /* depth-of-field-driven sampling */
 };
 #define FV_COMMON_LONGOPTS                                                                     \
     {"size", required_argument, 0, FV_OPT_SIZE}, {"threads", required_argument, 0, FV_OPT_THREADS}, \
@@ -42,7 +43,9 @@ enum {
     {"pupil-mm", required_argument, 0, FV_OPT_PUPIL_MM}, {"gaze-error-deg", required_argument, 0, FV_OPT_GAZE_ERR}, \
     {"dof-tolerance-m", required_argument, 0, FV_OPT_DOF_TOL},                                   \
     {"accommodation-ms", required_argument, 0, FV_OPT_ACCOMMODATION},                            \
-    {"contrast-gain", required_argument, 0, FV_OPT_CONTRAST}, {"chroma", required_argument, 0, FV_OPT_CHROMA}
+    {"contrast-gain", required_argument, 0, FV_OPT_CONTRAST}, {"chroma", required_argument, 0, FV_OPT_CHROMA}, \
+    {"dof-sampling", required_argument, 0, FV_OPT_DOF_SAMPLING},                                 \
+    {"dof-sampling-kappa", required_argument, 0, FV_OPT_DOF_SAMPLING_KAPPA}
 #define FV_COMMON_HELP                                                                             \
     "  --size WxH         eye image size in pixels (default 1280x1440)\n"                          \
     "  --fov DEG          vertical field of view (default 100)\n"                                  \
@@ -68,7 +71,11 @@ enum {
     "  --accommodation-ms T  focus time constant (default 370; 0 = instant)\n"                   \
     "  --dof-tolerance-m T   depth range kept sharp around the focus, +-T (default 0.2)\n"      \
     "  --contrast-gain G  peripheral contrast enhancement (Patney 2016; default 0 = off)\n" \
-    "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n"
+    "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n" \
+    "  --dof-sampling on|off   fewer rays where the depth of field blurs (density falls\n" \
+    "                     with the CoC's area; needs --dof and reprojection; default on)\n" \
+    "  --dof-sampling-kappa K  samples across a CoC's diameter it keeps (default 2;\n" \
+    "                     density (K / CoC_px)^2 where below the acuity model's)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
 /* After getopt_long: no stray words, a scene was given, option combinations agree (r0 <= r1);
  * exits 2 with a reason otherwise. */

@@ -1,0 +1,164 @@
+/* fovea: depth-of-field-driven sampling: thins the acuity sampler's bits (sampling_dof.h). */
+#include "sampling_dof.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "tile.h"
+
+_Static_assert(FV_TILE == 16, "fv_dofsamp_tile works on 16x16 tiles of 8x8 2x2 blocks");
+
+void fv_dofsamp_params_default(fv_dofsamp_params *p)
+{
+    p->enabled = 1;
+    p->kappa = 2.0f;
+    p->coc_cap_px = 32.0f;
+}
+
+void fv_dofsamp_frame_setup(fv_dofsamp_frame *f, const fv_dofsamp_params *prm, const fv_taa_frame *taa,
+                            const fv_sampler *smp, int gx, int gy, float focus_a_m, float focus_b_m,
+                            float tolerance_m, float px_per_dpt, uint32_t frame)
+{
+    memset(f, 0, sizeof *f);
+    f->taa = taa;
+    f->smp = smp;
+    f->gx = gx;
+    f->gy = gy;
+    const float nr = fminf(focus_a_m, focus_b_m) - tolerance_m, fr = fmaxf(focus_a_m, focus_b_m) + tolerance_m;
+    /* Weier's band [d_o - t, d_o + t] in dioptres; a band reaching the eye keeps everything nearer sharp */
+    f->lo_dpt = 1.0f / fr;
+    f->hi_dpt = nr > 0.0f ? 1.0f / nr : INFINITY;
+    f->px_per_dpt = px_per_dpt;
+    f->kappa = prm->kappa;
+    f->coc_cap_px = prm->coc_cap_px;
+    f->seed = frame;
+}
+
+/* Dioptres of defocus beyond the sharp band (0 inside it). */
+static inline float defocus_dpt(const fv_dofsamp_frame *f, float depth_m)
+{
+    const float D = 1.0f / (depth_m > 0.05f ? depth_m : 0.05f); /* FV_COC_MIN_DEPTH_M */
+    return D < f->lo_dpt ? f->lo_dpt - D : D > f->hi_dpt ? D - f->hi_dpt : 0.0f;
+}
+
+float fv_dofsamp_coc_px(const fv_dofsamp_frame *f, float depth_m) { return f->px_per_dpt * defocus_dpt(f, depth_m); }
+
+float fv_dofsamp_density(const fv_dofsamp_frame *f, float c_px)
+{
+    const float c = c_px < f->coc_cap_px ? c_px : f->coc_cap_px;
+    const float s = f->kappa / c; /* c = 0: inf, density 1 */
+    return s < 1.0f ? s * s : 1.0f;
+}
+
+float fv_dofsamp_keep(const fv_dofsamp_frame *f, float p, float c_px)
+{
+    const float d = fv_dofsamp_density(f, c_px);
+    return d < p ? d / p : 1.0f;
+}
+
+/* lowbias32 (C. Wellons): a full-avalanche 32-bit mix */
+static inline uint32_t mix32(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+uint32_t fv_dofsamp_hash(int x, int y, uint32_t seed)
+{
+    return mix32(mix32((uint32_t)x | (uint32_t)y << 16) ^ (seed * 0x9e3779b9u + 0x632be5abu));
+}
+
+static inline int floor_shr(int v, int s) { return v >= 0 ? v >> s : -((-v + (1 << s) - 1) >> s); }
+
+/* The tile's motion to the history (as fv_taa_prefetch guesses it): the previous frame's depth
+ * at the tile (one texel of the tile level) projected into the previous view; whole pixels. */
+static void tile_flow(const fv_taa_frame *t, int x0, int y0, int tw, int th, int *dx, int *dy)
+{
+    *dx = *dy = 0;
+    if (t->identity)
+        return;
+    const int l = t->hist->levels - 1 < FV_TILE_PULL_LEVELS ? t->hist->levels - 1 : FV_TILE_PULL_LEVELS;
+    const fv_pyr_level *hl = &t->hist->lv[l];
+    const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
+    int hx = (int)cx >> l, hy = (int)cy >> l;
+    hx = hx < hl->w ? hx : hl->w - 1;
+    hy = hy < hl->h ? hy : hl->h - 1;
+    float u, v;
+    if (fv_taa_project(t, cx, cy, hl->rgbd[4 * ((ptrdiff_t)hy * hl->stride + hx) + 3], &u, &v) <= 0.0f ||
+        !(fabsf(u - cx) < 4096.0f && fabsf(v - cy) < 4096.0f))
+        return;
+    *dx = (int)floorf(u - cx + 0.5f);
+    *dy = (int)floorf(v - cy + 0.5f);
+}
+
+float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th, uint32_t rows[16])
+{
+    const fv_taa_frame *t = f->taa;
+    /* the acuity probability at the tile's point farthest from the gaze: the tile's lowest p, so
+     * the nearer pixels (higher p) get at least the density asked for */
+    const float ax = (float)x0 - (float)f->gx, bx = (float)(x0 + tw) - (float)f->gx;
+    const float ay = (float)y0 - (float)f->gy, by = (float)(y0 + th) - (float)f->gy;
+    const float p = fv_sampler_probability(f->smp, fabsf(ax) > fabsf(bx) ? ax : bx, fabsf(ay) > fabsf(by) ? ay : by);
+    if (!(f->kappa / f->coc_cap_px < sqrtf(p))) /* even the largest CoC needs every sample */
+        return 1.0f;
+
+    /* Defocus of the history's level-1 texels around the tile (moved by the tile's flow), one
+     * texel of margin: 10 x 10. Beyond the history's border (it holds the edge pixels), or
+     * behind its eye: unknown, kept sharp. */
+    int fx, fy;
+    tile_flow(t, x0, y0, tw, th, &fx, &fy);
+    const fv_pyr_level *h1 = &t->hist->lv[t->hist->levels > 1 ? 1 : 0];
+    const int sh = t->hist->levels > 1 ? 1 : 0;
+    const int ix0 = floor_shr(x0 + fx, sh) - 1, iy0 = floor_shr(y0 + fy, sh) - 1;
+    float e[10][10];
+    for (int j = 0; j < 10; j++) {
+        const int iy = iy0 + j;
+        for (int i = 0; i < 10; i++) {
+            const int ix = ix0 + i;
+            e[j][i] = 0.0f;
+            if (ix < -1 || iy < -1 || ix > h1->w || iy > h1->h) /* the border: the edge, replicated */
+                continue;
+            /* the texel's depth in this frame's view: (previous pixel, depth) -> current (N rows) */
+            const float z = h1->rgbd[4 * ((ptrdiff_t)iy * h1->stride + ix) + 3];
+            const float u = ((float)ix + 0.5f) * (float)(1 << sh), v = ((float)iy + 0.5f) * (float)(1 << sh);
+            const float zc = t->T2[2] + z * ((t->N0[2] + v * t->NY[2]) + u * t->NX[2]);
+            if (zc > 0.0f)
+                e[j][i] = defocus_dpt(f, zc);
+        }
+    }
+    /* per 2x2 block: the smallest defocus of its 3x3 texel neighbourhood -> keep threshold */
+    uint32_t thr[8][8];
+    double qsum = 0.0;
+    int any = 0;
+    for (int j = 0; j < 8; j++)
+        for (int i = 0; i < 8; i++) {
+            float m = e[j][i];
+            for (int b = 0; b < 3; b++)
+                for (int a = 0; a < 3; a++)
+                    m = e[j + b][i + a] < m ? e[j + b][i + a] : m;
+            const float q = fv_dofsamp_keep(f, p, f->px_per_dpt * m);
+            /* q = 1: every bit survives (UINT32_MAX marks it, the test below never drops it) */
+            thr[j][i] = q < 1.0f ? (uint32_t)((double)q * 4294967296.0) : UINT32_MAX;
+            any |= q < 1.0f;
+            const int npx = (2 * i < tw ? (2 * i + 1 < tw ? 2 : 1) : 0) * (2 * j < th ? (2 * j + 1 < th ? 2 : 1) : 0);
+            qsum += (double)q * npx;
+        }
+    if (!any)
+        return 1.0f;
+    for (int y = 0; y < th; y++) {
+        uint32_t r = rows[y], out = r;
+        while (r) {
+            const int x = __builtin_ctz(r);
+            r &= r - 1;
+            const uint32_t th_ = thr[y >> 1][x >> 1];
+            if (th_ != UINT32_MAX && fv_dofsamp_hash(x0 + x, y0 + y, f->seed) >= th_)
+                out &= ~(1u << x);
+        }
+        rows[y] = out;
+    }
+    return (float)(qsum / (double)(tw * th));
+}

@@ -1,0 +1,78 @@
+/* fovea: depth-of-field-driven sampling (issue 15 item 4; Liu et al.'s "Russian roulette on the
+ * DoF sampling distribution", eq. (10)-(11), with a density that falls with the CoC's area
+ * instead of Liu's depth-linear eq. (10)).
+ *
+ * Per tile, after the acuity sampler has set its bits and before the rays are cast, every set
+ * bit survives with a keep-probability q, so a pixel the DoF filter will blur over a CoC of
+ * c pixels is sampled at density
+ *     d(c) = min(p, max(d_floor, (kappa / min(c, c_cap))^2)),   q = d / p,
+ * p the acuity model's probability (fv_sampler_probability): kappa samples across the CoC's
+ * diameter (one sample per (c / kappa)^2 pixels), never fewer than the filter's largest CoC
+ * c_cap needs (d_floor = (kappa / c_cap)^2), never more than the acuity sampler gives. Pixels in
+ * focus (c <= kappa sqrt(p)) keep every acuity sample: the fovea's in-focus region stays fully
+ * sampled.
+ *
+ * The expected CoC comes before the frame is traced: the previous frame's reconstructed depth
+ * (the reprojection history, level 1, mapped to this view through the tile's flow and the
+ * inverse camera mapping) and the focus the eye can have this frame: between last frame's
+ * accommodated focus and last frame's target (the eye accommodates from one towards the other),
+ * widened by Weier's tracking tolerance t. c is Weier's eq. (3), which simplifies to
+ * c = k_m focal_px e_scale |1/d_bound - 1/g| (docs/dof.md): the smallest CoC of the models (the
+ * others have no tolerance band), so no model blurs less than assumed. The CoC of each 2x2
+ * block is the smallest over its 3x3 level-1 neighbourhood, so a misregistered depth edge keeps
+ * the in-focus side dense.
+ *
+ * The roulette (eq. (11): keep when eps <= q) draws eps from a hash of the pixel and the frame
+ * number: the same bytes for any thread count, a different subset every frame (the history
+ * accumulates them). Kept samples keep weight 1: pull-push normalises its weights and the
+ * reprojection's blend recognises samples by weight 1; each tile reports its mean keep
+ * probability instead, for the reprojection's history density. Pure: no OS calls. */
+#ifndef FOVEA_SAMPLING_DOF_H
+#define FOVEA_SAMPLING_DOF_H
+
+#include <stdint.h>
+
+#include "reproject.h"
+#include "sampling.h"
+
+typedef struct fv_dofsamp_params {
+    int enabled;     /* --dof-sampling on|off: default 1 (acts only with DoF on and a history) */
+    float kappa;     /* samples across the CoC's diameter, default 2 */
+    float coc_cap_px; /* the largest CoC the filter applies (Weier: far sigma 8 px = c / 4), 32 */
+} fv_dofsamp_params;
+
+void fv_dofsamp_params_default(fv_dofsamp_params *p);
+
+/* One eye's frame: what every tile reads. */
+typedef struct fv_dofsamp_frame {
+    const fv_taa_frame *taa;   /* the history and the camera mappings */
+    const fv_sampler *smp;     /* the acuity sampler in force */
+    int gx, gy;                /* its point of regard, pixels */
+    float lo_dpt, hi_dpt;      /* dioptres seen sharp: [1 / (far + t), 1 / (near - t)] */
+    float px_per_dpt;          /* CoC pixels per dioptre of defocus: k_m focal_px e_scale */
+    float kappa, coc_cap_px;
+    uint32_t seed;             /* the frame number, hashed with each pixel */
+} fv_dofsamp_frame;
+
+/* focus_a_m, focus_b_m: the focus range the eye can have this frame (either order);
+ * tolerance_m: Weier's t; px_per_dpt: k_m focal_px e_scale; frame: the eye's frame number. */
+void fv_dofsamp_frame_setup(fv_dofsamp_frame *f, const fv_dofsamp_params *prm, const fv_taa_frame *taa,
+                            const fv_sampler *smp, int gx, int gy, float focus_a_m, float focus_b_m,
+                            float tolerance_m, float px_per_dpt, uint32_t frame);
+
+/* The expected CoC diameter in pixels at view depth depth_m (>= 0: the magnitude). */
+float fv_dofsamp_coc_px(const fv_dofsamp_frame *f, float depth_m);
+/* The sampling density the DoF needs at CoC c_px: max(d_floor, (kappa / min(c, c_cap))^2),
+ * at most 1. */
+float fv_dofsamp_density(const fv_dofsamp_frame *f, float c_px);
+/* The keep-probability of an acuity sample of probability p at CoC c_px: min(1, density / p). */
+float fv_dofsamp_keep(const fv_dofsamp_frame *f, float p, float c_px);
+/* The roulette's variate for pixel (x, y) in frame `seed`, uniform in [0, 2^32). */
+uint32_t fv_dofsamp_hash(int x, int y, uint32_t seed);
+
+/* Thins the tile [x0, x0+tw) x [y0, y0+th) (tw, th <= 16): bit x of rows[y] (pixel x0+x, y0+y)
+ * survives when hash < q 2^32. Returns the tile's mean keep-probability over its pixels
+ * (1 when nothing is thinned). */
+float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th, uint32_t rows[16]);
+
+#endif
