@@ -42,8 +42,8 @@ static void run_tile(void *ctx, int index, int thread_id)
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++)
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
-    if (j->dofs) /* fewer rays where the depth of field will blur (core/sampling_dof.h) */
-        fv_dofsamp_tile(j->dofs, x0, y0, tw, th, rows);
+    /* fewer rays where the depth of field will blur (core/sampling_dof.h); keep: their share */
+    const float keep = j->dofs ? fv_dofsamp_tile(j->dofs, x0, y0, tw, th, rows) : 1.0f;
     if (j->rows_out)
         for (int y = 0; y < FV_TILE; y++)
             j->rows_out[(size_t)index * FV_TILE + y] = y < th ? rows[y] : 0u;
@@ -52,7 +52,8 @@ static void run_tile(void *ctx, int index, int thread_id)
     const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
-        fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th);
+        fv_taa_tile_run_keep(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th,
+                             keep);
         const int64_t t1 = fv_time_ns();
         atomic_fetch_add_explicit(&j->taa_ns, t1 - t0, memory_order_relaxed);
         if (j->prof)
