@@ -323,7 +323,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
             const float fa = 1.0f / fmaxf(es->focus.focus_dpt, 1e-6f), fb = 1.0f / fmaxf(es->focus.target_dpt, 1e-6f);
             fv_dofsamp_frame_setup(&dsf, &p->cfg.dofsamp, &tf, p->smp_cur, gx, gy, fa, fb, dp->tolerance_m,
                                    dp->pupil_mm * 1e-3f * es->cam.focal_px * fv_dof_presets[dp->preset].e_scale,
-                                   (uint32_t)es->frame);
+                                   (uint32_t)es->frame, opt.phase);
             opt.dofs = &dsf;
             opt.rows_out = es->rows;
         }

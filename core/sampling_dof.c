@@ -17,7 +17,7 @@ void fv_dofsamp_params_default(fv_dofsamp_params *p)
 
 void fv_dofsamp_frame_setup(fv_dofsamp_frame *f, const fv_dofsamp_params *prm, const fv_taa_frame *taa,
                             const fv_sampler *smp, int gx, int gy, float focus_a_m, float focus_b_m,
-                            float tolerance_m, float px_per_dpt, uint32_t frame)
+                            float tolerance_m, float px_per_dpt, uint32_t frame, int phase)
 {
     memset(f, 0, sizeof *f);
     f->taa = taa;
@@ -32,6 +32,7 @@ void fv_dofsamp_frame_setup(fv_dofsamp_frame *f, const fv_dofsamp_params *prm, c
     f->kappa = prm->kappa;
     f->coc_cap_px = prm->coc_cap_px;
     f->seed = frame;
+    f->phase = phase;
 }
 
 /* Dioptres of defocus beyond the sharp band (0 inside it). */
@@ -149,13 +150,31 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
         }
     if (!any)
         return 1.0f;
+    /* S_out's pixels (outside the r1 disc) are ranked by their lattice value: the kept ones are
+     * a thinner copy of the same even dither (no clumps, no holes), the band of ranks moving by
+     * the golden ratio each frame so the frames together still visit every pixel */
+    const fv_sampler *smp = f->smp;
+    const double r1sq = (double)smp->r1_px * smp->r1_px, inv_p = 1.0 / (double)smp->prm.p_min;
+    const double g = (double)f->seed * 0.6180339887498949;
     for (int y = 0; y < th; y++) {
         uint32_t r = rows[y], out = r;
+        const double dy = (double)(y0 + y - f->gy);
         while (r) {
             const int x = __builtin_ctz(r);
             r &= r - 1;
             const uint32_t th_ = thr[y >> 1][x >> 1];
-            if (th_ != UINT32_MAX && fv_dofsamp_hash(x0 + x, y0 + y, f->seed) >= th_)
+            if (th_ == UINT32_MAX)
+                continue;
+            const double dx = (double)(x0 + x - f->gx);
+            uint32_t u;
+            if (!smp->prm.full && dx * dx + dy * dy >= r1sq) {
+                double v = fv_sampler_lattice(smp, x0 + x, y0 + y, f->phase) * inv_p + g;
+                v -= floor(v);
+                u = (uint32_t)(v * 4294967296.0);
+            } else {
+                u = fv_dofsamp_hash(x0 + x, y0 + y, f->seed);
+            }
+            if (u >= th_)
                 out &= ~(1u << x);
         }
         rows[y] = out;

@@ -22,9 +22,12 @@
  * block is the smallest over its 3x3 level-1 neighbourhood, so a misregistered depth edge keeps
  * the in-focus side dense.
  *
- * The roulette (eq. (11): keep when eps <= q) draws eps from a hash of the pixel and the frame
- * number: the same bytes for any thread count, a different subset every frame (the history
- * accumulates them). Kept samples keep weight 1: pull-push normalises its weights and the
+ * The roulette (eq. (11): keep when eps < q) draws eps per pixel and frame, the same bytes for
+ * any thread count, a different subset every frame (the history accumulates them): in the
+ * periphery (S_out, outside r1) eps is the pixel's rank in S_out's lattice dither
+ * (fv_sampler_lattice / p_min) shifted by the frame times the golden ratio, so the kept samples
+ * are the same even dither at density p q; inside r1 (Halton points, the fovea) a hash of pixel
+ * and frame. Kept samples keep weight 1: pull-push normalises its weights and the
  * reprojection's blend recognises samples by weight 1; each tile reports its mean keep
  * probability instead, for the reprojection's history density. Pure: no OS calls. */
 #ifndef FOVEA_SAMPLING_DOF_H
@@ -52,13 +55,15 @@ typedef struct fv_dofsamp_frame {
     float px_per_dpt;          /* CoC pixels per dioptre of defocus: k_m focal_px e_scale */
     float kappa, coc_cap_px;
     uint32_t seed;             /* the frame number, hashed with each pixel */
+    int phase;                 /* the sampler's pattern phase this frame (fv_sampler_row) */
 } fv_dofsamp_frame;
 
 /* focus_a_m, focus_b_m: the focus range the eye can have this frame (either order);
- * tolerance_m: Weier's t; px_per_dpt: k_m focal_px e_scale; frame: the eye's frame number. */
+ * tolerance_m: Weier's t; px_per_dpt: k_m focal_px e_scale; frame: the eye's frame number;
+ * phase: the sampler's pattern phase. */
 void fv_dofsamp_frame_setup(fv_dofsamp_frame *f, const fv_dofsamp_params *prm, const fv_taa_frame *taa,
                             const fv_sampler *smp, int gx, int gy, float focus_a_m, float focus_b_m,
-                            float tolerance_m, float px_per_dpt, uint32_t frame);
+                            float tolerance_m, float px_per_dpt, uint32_t frame, int phase);
 
 /* The expected CoC diameter in pixels at view depth depth_m (>= 0: the magnitude). */
 float fv_dofsamp_coc_px(const fv_dofsamp_frame *f, float depth_m);

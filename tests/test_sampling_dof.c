@@ -88,7 +88,7 @@ static const int far_gx = -100000, far_gy = -100000;
 static void setup_frame(fixture *fx, fv_dofsamp_frame *f, uint32_t frame)
 {
     const int gx = fx->smp.prm.full ? W / 2 : far_gx, gy = fx->smp.prm.full ? H / 2 : far_gy;
-    fv_dofsamp_frame_setup(f, &fx->prm, &fx->tf, &fx->smp, gx, gy, FOCUS_M, FOCUS_M, TOL_M, PX_PER_DPT, frame);
+    fv_dofsamp_frame_setup(f, &fx->prm, &fx->tf, &fx->smp, gx, gy, FOCUS_M, FOCUS_M, TOL_M, PX_PER_DPT, frame, 0);
 }
 
 /* One frame: every tile's acuity rows, thinned; kept[band] and acuity[band] count the interior
@@ -134,14 +134,14 @@ static void test_coc_is_weier(void **st)
         for (int i = 0; i < 4; i++)
             for (int j = 0; j < 8; j++) {
                 fv_dofsamp_frame f;
-                fv_dofsamp_frame_setup(&f, &prm, NULL, NULL, 0, 0, focus[i], focus[i], w.tolerance_m, a, 0);
+                fv_dofsamp_frame_setup(&f, &prm, NULL, NULL, 0, 0, focus[i], focus[i], w.tolerance_m, a, 0, 0);
                 const float ref = fabsf(fv_coc_weier_px(&w, focus[i], depth[j]));
                 assert_float_equal(fv_dofsamp_coc_px(&f, depth[j]), ref, 1e-3f * ref + 1e-4f);
             }
     }
     /* a focus range: the band's near end from the nearer focus, far end from the farther */
     fv_dofsamp_frame f;
-    fv_dofsamp_frame_setup(&f, &prm, NULL, NULL, 0, 0, 2.0f, 0.5f, 0.2f, 10.0f, 0);
+    fv_dofsamp_frame_setup(&f, &prm, NULL, NULL, 0, 0, 2.0f, 0.5f, 0.2f, 10.0f, 0, 0);
     assert_float_equal(fv_dofsamp_coc_px(&f, 0.25f), 10.0f * (4.0f - 1.0f / 0.3f), 1e-4f);
     assert_float_equal(fv_dofsamp_coc_px(&f, 1.0f), 0.0f, 0.0f);
     assert_float_equal(fv_dofsamp_coc_px(&f, 10.0f), 10.0f * (1.0f / 2.2f - 0.1f), 1e-4f);
@@ -193,27 +193,29 @@ static void test_density_periphery(void **st)
     density_case(0);
 }
 
-/* Russian roulette: a kept sample weighted 1/q makes every pixel's expected weight 1, the
- * acuity sampler's. Summed over the image and 32 frames, sum(keep / q) / sum(1) = 1 within
+/* Russian roulette: a kept sample weighted 1/q makes every acuity sample's expected weight 1,
+ * as without thinning. Summed over the image and 32 frames, sum(keep / q) / sum(1) = 1 within
  * 4.5 sigma, where sigma^2 = sum((1 - q) / q) / N^2. */
-static void test_roulette_unbiased(void **st)
+static void roulette_case(int full)
 {
-    (void)st;
     fixture fx;
-    fixture_init(&fx, 1);
+    fixture_init(&fx, full);
+    const double p = full ? 1.0 : fx.smp.prm.p_min;
     double num = 0.0, var = 0.0, n = 0.0;
     for (uint32_t fr = 100; fr < 132; fr++) {
         fv_dofsamp_frame f;
         setup_frame(&fx, &f, fr);
         for (int ty = 0; ty < H / 16; ty++)
             for (int tx = 0; tx < W / 16; tx++) {
-                uint32_t rows[16];
+                uint32_t rows[16], acu[16];
                 for (int y = 0; y < 16; y++)
-                    rows[y] = 0xffffu;
+                    rows[y] = acu[y] = (uint32_t)fv_sampler_row(&fx.smp, tx * 16, ty * 16 + y, 16, f.gx, f.gy, 0);
                 fv_dofsamp_tile(&f, tx * 16, ty * 16, 16, 16, rows);
-                const double q = expect_density(expect_coc(band_m[tx]));
+                const double de = expect_density(expect_coc(band_m[tx])), q = de < p ? de / p : 1.0;
                 for (int y = 0; y < 16; y++)
                     for (int x = 2; x < 14; x++) {
+                        if (!(acu[y] >> x & 1u))
+                            continue;
                         num += (rows[y] >> x & 1u) / q;
                         var += (1.0 - q) / q;
                         n += 1.0;
@@ -226,6 +228,12 @@ static void test_roulette_unbiased(void **st)
         fail();
     }
     fixture_free(&fx);
+}
+static void test_roulette_unbiased(void **st)
+{
+    (void)st;
+    roulette_case(1); /* hashed */
+    roulette_case(0); /* the periphery's lattice ranks */
 }
 
 /* In focus: every acuity bit survives, and so does every bit within the 3x3 texel reach of an
@@ -263,6 +271,57 @@ static void test_in_focus_untouched(void **st)
     fv_dofsamp_tile(&f, 16, 16, 16, 16, rows);
     for (int y = 0; y < 16; y++)
         assert_int_equal(rows[y], 0u);
+    fixture_free(&fx);
+}
+
+/* The periphery is thinned along S_out's own lattice dither: the kept samples are evenly spread
+ * at density p q, no window of side ceil(2 / sqrt(p q)) is empty (white-noise thinning leaves
+ * ~e^-4 of them empty, hundreds here); and fv_sampler_lattice is S_out's membership. */
+static void test_periphery_thinned_evenly(void **st)
+{
+    (void)st;
+    fixture fx;
+    fixture_init(&fx, 0);
+    const fv_pyr_level *l1 = &fx.hist.lv[1];
+    for (int y = -1; y <= l1->h; y++) /* one depth: 0.5 m, c = 15 px, d = (2 / 15)^2 */
+        for (int x = -1; x <= l1->w; x++)
+            l1->rgbd[4 * (y * l1->stride + x) + 3] = 0.5f;
+    const double d = expect_density(expect_coc(0.5));
+    const int win = (int)ceil(2.0 / sqrt(d));
+    for (uint32_t fr = 0; fr < 3; fr++) {
+        fv_dofsamp_frame f;
+        setup_frame(&fx, &f, fr);
+        static uint32_t mask[H][W / 16];
+        long kept = 0;
+        for (int ty = 0; ty < H / 16; ty++)
+            for (int tx = 0; tx < W / 16; tx++) {
+                uint32_t rows[16];
+                for (int y = 0; y < 16; y++) {
+                    rows[y] = (uint32_t)fv_sampler_row(&fx.smp, tx * 16, ty * 16 + y, 16, far_gx, far_gy, 0);
+                    for (int x = 0; x < 16; x++)
+                        assert_int_equal(rows[y] >> x & 1u,
+                                         fv_sampler_lattice(&fx.smp, tx * 16 + x, ty * 16 + y, 0) < fx.smp.prm.p_min);
+                }
+                fv_dofsamp_tile(&f, tx * 16, ty * 16, 16, 16, rows);
+                for (int y = 0; y < 16; y++) {
+                    mask[ty * 16 + y][tx] = rows[y];
+                    kept += __builtin_popcount(rows[y]);
+                }
+            }
+        assert_float_equal((double)kept / (W * H), d, 0.1 * d);
+        int empty = 0;
+        for (int y = 0; y + win <= H; y++)
+            for (int x = 0; x + win <= W; x++) {
+                int any = 0;
+                for (int j = 0; j < win && !any; j++)
+                    for (int i = 0; i < win && !any; i++)
+                        any = mask[y + j][(x + i) / 16] >> ((x + i) % 16) & 1u;
+                empty += !any;
+            }
+        if (empty)
+            printf("frame %u: %d empty %dx%d windows at density %.4f\n", fr, empty, win, win, d);
+        assert_int_equal(empty, 0);
+    }
     fixture_free(&fx);
 }
 
@@ -446,6 +505,7 @@ int main(void)
         cmocka_unit_test(test_density_periphery),
         cmocka_unit_test(test_roulette_unbiased),
         cmocka_unit_test(test_in_focus_untouched),
+        cmocka_unit_test(test_periphery_thinned_evenly),
         cmocka_unit_test(test_constant_image_reconstruction),
         cmocka_unit_test(test_pipeline_fewer_rays),
         cmocka_unit_test(test_pipeline_thread_determinism),
