@@ -126,10 +126,8 @@ int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const 
 
 double fv_sampler_lattice(const fv_sampler *s, int x, int y, int phase)
 {
-    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532; /* R2: 1/g, 1/g^2 (g^3 = g + 1) */
     const int k = (phase % s->phases + s->phases) % s->phases;
-    const double v = a1 * x + a2 * y + (double)k / s->phases;
-    return v - floor(v);
+    return fv_sampler_lattice_at(x, y, (double)k / s->phases);
 }
 
 float fv_sampler_probability(const fv_sampler *s, float dx_px, float dy_px)

@@ -6,7 +6,7 @@
 
 #include "tile.h"
 
-_Static_assert(FV_TILE == 16, "fv_dofsamp_tile works on 16x16 tiles of 8x8 2x2 blocks");
+_Static_assert(FV_TILE == 16, "fv_dofsamp_tile works on 16x16 tiles");
 
 void fv_dofsamp_params_default(fv_dofsamp_params *p)
 {
@@ -107,46 +107,67 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
     if (!(f->kappa / f->coc_cap_px < sqrtf(p))) /* even the largest CoC needs every sample */
         return 1.0f;
 
-    /* Defocus of the history's level-1 texels around the tile (moved by the tile's flow), one
-     * texel of margin: 10 x 10. Beyond the history's border (it holds the edge pixels), or
-     * behind its eye: unknown, kept sharp. */
+    /* Defocus of the history's level-2 texels (4x4 pixels) around the tile, moved by the tile's
+     * flow, one texel of margin: 6 x 6 (fewer on a pyramid that small). Beyond the history's
+     * border (it holds the edge pixels), or behind its eye: unknown, kept sharp. */
     int fx, fy;
     tile_flow(t, x0, y0, tw, th, &fx, &fy);
-    const fv_pyr_level *h1 = &t->hist->lv[t->hist->levels > 1 ? 1 : 0];
-    const int sh = t->hist->levels > 1 ? 1 : 0;
+    const int sh = t->hist->levels - 1 < FV_DOFSAMP_LEVEL ? t->hist->levels - 1 : FV_DOFSAMP_LEVEL;
+    const fv_pyr_level *hl = &t->hist->lv[sh];
+    const int nb = 16 >> sh, ng = nb + 2; /* blocks per tile side, texels per grid side */
     const int ix0 = floor_shr(x0 + fx, sh) - 1, iy0 = floor_shr(y0 + fy, sh) - 1;
-    float e[10][10];
-    for (int j = 0; j < 10; j++) {
+    /* gather the texels' depths and their view-depth factors (N rows: previous pixel and depth ->
+     * current), then the defocus of all of them in one branch-free loop */
+    float z[18 * 18], k[18 * 18], e[18 * 18];
+    for (int j = 0; j < ng; j++) {
         const int iy = iy0 + j;
-        for (int i = 0; i < 10; i++) {
+        const float v = ((float)iy + 0.5f) * (float)(1 << sh);
+        for (int i = 0; i < ng; i++) {
             const int ix = ix0 + i;
-            e[j][i] = 0.0f;
-            if (ix < -1 || iy < -1 || ix > h1->w || iy > h1->h) /* the border: the edge, replicated */
-                continue;
-            /* the texel's depth in this frame's view: (previous pixel, depth) -> current (N rows) */
-            const float z = h1->rgbd[4 * ((ptrdiff_t)iy * h1->stride + ix) + 3];
-            const float u = ((float)ix + 0.5f) * (float)(1 << sh), v = ((float)iy + 0.5f) * (float)(1 << sh);
-            const float zc = t->T2[2] + z * ((t->N0[2] + v * t->NY[2]) + u * t->NX[2]);
-            if (zc > 0.0f)
-                e[j][i] = defocus_dpt(f, zc);
+            const float u = ((float)ix + 0.5f) * (float)(1 << sh);
+            const int in = ix >= -1 && iy >= -1 && ix <= hl->w && iy <= hl->h; /* the border: the edge */
+            z[ng * j + i] = in ? hl->rgbd[4 * ((ptrdiff_t)iy * hl->stride + ix) + 3] : 0.0f;
+            k[ng * j + i] = (t->N0[2] + v * t->NY[2]) + u * t->NX[2];
         }
     }
-    /* per 2x2 block: the smallest defocus of its 3x3 texel neighbourhood -> keep threshold */
-    uint32_t thr[8][8];
+    float emax = 0.0f;
+    const float lo = f->lo_dpt, hi = f->hi_dpt, T = t->T2[2];
+    for (int n = 0; n < ng * ng; n++) {
+        const float zc = T + z[n] * k[n];
+        const float D = 1.0f / (zc > 0.05f ? zc : 0.05f); /* FV_COC_MIN_DEPTH_M */
+        const float a = lo - D, b = D - hi, m = a > b ? a : b;
+        /* no depth there, or behind the eye: unknown, kept sharp */
+        const float ev = z[n] > 0.0f && zc > 0.0f && m > 0.0f ? m : 0.0f;
+        e[n] = ev;
+        emax = ev > emax ? ev : emax;
+    }
+    /* CoCs up to kappa / sqrt(p) keep every sample: most tiles stop here */
+    const float c_keep = f->kappa / sqrtf(p);
+    if (!(f->px_per_dpt * emax > c_keep))
+        return 1.0f;
+    /* per block: the smallest defocus of its 3x3 texel neighbourhood (separable) -> keep
+     * threshold */
+    float eh[18 * 16];
+    for (int j = 0; j < ng; j++)
+        for (int i = 0; i < nb; i++) {
+            const float *r = e + ng * j + i;
+            const float a = r[0] < r[1] ? r[0] : r[1];
+            eh[nb * j + i] = a < r[2] ? a : r[2];
+        }
+    uint32_t thr[16][16];
     double qsum = 0.0;
     int any = 0;
-    for (int j = 0; j < 8; j++)
-        for (int i = 0; i < 8; i++) {
-            float m = e[j][i];
-            for (int b = 0; b < 3; b++)
-                for (int a = 0; a < 3; a++)
-                    m = e[j + b][i + a] < m ? e[j + b][i + a] : m;
-            const float q = fv_dofsamp_keep(f, p, f->px_per_dpt * m);
+    for (int j = 0; j < nb; j++)
+        for (int i = 0; i < nb; i++) {
+            const float *c3 = eh + nb * j + i;
+            const float a = c3[0] < c3[nb] ? c3[0] : c3[nb];
+            const float c = f->px_per_dpt * (a < c3[2 * nb] ? a : c3[2 * nb]);
+            const float q = c > c_keep ? fv_dofsamp_keep(f, p, c) : 1.0f;
             /* q = 1: every bit survives (UINT32_MAX marks it, the test below never drops it) */
             thr[j][i] = q < 1.0f ? (uint32_t)((double)q * 4294967296.0) : UINT32_MAX;
             any |= q < 1.0f;
-            const int npx = (2 * i < tw ? (2 * i + 1 < tw ? 2 : 1) : 0) * (2 * j < th ? (2 * j + 1 < th ? 2 : 1) : 0);
-            qsum += (double)q * npx;
+            const int bx = tw - (i << sh), by = th - (j << sh), B = 1 << sh;
+            qsum += (double)q * (bx < 0 ? 0 : bx < B ? bx : B) * (by < 0 ? 0 : by < B ? by : B);
         }
     if (!any)
         return 1.0f;
@@ -155,21 +176,23 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
      * the golden ratio each frame so the frames together still visit every pixel */
     const fv_sampler *smp = f->smp;
     const double r1sq = (double)smp->r1_px * smp->r1_px, inv_p = 1.0 / (double)smp->prm.p_min;
-    const double g = (double)f->seed * 0.6180339887498949;
+    const double g = (double)(f->seed % 1000003u) * 0.6180339887498949; /* small: exact enough */
+    const int kph = (f->phase % smp->phases + smp->phases) % smp->phases;
+    const double koff = (double)kph / smp->phases;
     for (int y = 0; y < th; y++) {
         uint32_t r = rows[y], out = r;
         const double dy = (double)(y0 + y - f->gy);
         while (r) {
             const int x = __builtin_ctz(r);
             r &= r - 1;
-            const uint32_t th_ = thr[y >> 1][x >> 1];
+            const uint32_t th_ = thr[y >> sh][x >> sh];
             if (th_ == UINT32_MAX)
                 continue;
             const double dx = (double)(x0 + x - f->gx);
             uint32_t u;
             if (!smp->prm.full && dx * dx + dy * dy >= r1sq) {
-                double v = fv_sampler_lattice(smp, x0 + x, y0 + y, f->phase) * inv_p + g;
-                v -= floor(v);
+                double v = fv_sampler_lattice_at(x0 + x, y0 + y, koff) * inv_p + g;
+                v -= (double)(long long)v;
                 u = (uint32_t)(v * 4294967296.0);
             } else {
                 u = fv_dofsamp_hash(x0 + x, y0 + y, f->seed);

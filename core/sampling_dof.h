@@ -13,13 +13,13 @@
  * sampled.
  *
  * The expected CoC comes before the frame is traced: the previous frame's reconstructed depth
- * (the reprojection history, level 1, mapped to this view through the tile's flow and the
- * inverse camera mapping) and the focus the eye can have this frame: between last frame's
+ * (the reprojection history, level FV_DOFSAMP_LEVEL, mapped to this view through the tile's flow
+ * and the inverse camera mapping) and the focus the eye can have this frame: between last frame's
  * accommodated focus and last frame's target (the eye accommodates from one towards the other),
  * widened by Weier's tracking tolerance t. c is Weier's eq. (3), which simplifies to
  * c = k_m focal_px e_scale |1/d_bound - 1/g| (docs/dof.md): the smallest CoC of the models (the
- * others have no tolerance band), so no model blurs less than assumed. The CoC of each 2x2
- * block is the smallest over its 3x3 level-1 neighbourhood, so a misregistered depth edge keeps
+ * others have no tolerance band), so no model blurs less than assumed. The CoC of each 4x4
+ * block is the smallest over its 3x3 texel neighbourhood, so a misregistered depth edge keeps
  * the in-focus side dense.
  *
  * The roulette (eq. (11): keep when eps < q) draws eps per pixel and frame, the same bytes for
@@ -37,6 +37,9 @@
 
 #include "reproject.h"
 #include "sampling.h"
+
+/* The history level the CoC is read from: 4x4-pixel texels, thinned per 4x4 block. */
+#define FV_DOFSAMP_LEVEL 2
 
 typedef struct fv_dofsamp_params {
     int enabled;     /* --dof-sampling on|off: default 1 (acts only with DoF on and a history) */

@@ -51,7 +51,7 @@ typedef struct {
     fv_dofsamp_params prm;
 } fixture;
 
-/* A history whose level 1 holds band_m per column band, the same camera twice (identity map),
+/* A history whose levels 1-4 hold band_m per column band, the same camera twice (identity map),
  * and an acuity sampler: full, or the periphery only (gaze far outside the image). */
 static void fixture_init(fixture *fx, int full)
 {
@@ -62,10 +62,12 @@ static void fixture_init(fixture *fx, int full)
     d.fov_y_deg = 90.0f;
     assert_int_equal(fv_camera_setup(&fx->cam, &d, &origin), 0);
     assert_int_equal(fv_pyramid_init(&fx->hist, W, H), 0);
-    const fv_pyr_level *l1 = &fx->hist.lv[1];
-    for (int y = -1; y <= l1->h; y++) /* with the border, as pull-push leaves it: the edge replicated */
-        for (int x = -1; x <= l1->w; x++)
-            l1->rgbd[4 * (y * l1->stride + x) + 3] = band_m[2 * (x < 0 ? 0 : x < l1->w ? x : l1->w - 1) / 16];
+    for (int l = 1; l <= 4; l++) { /* texels of 16 px and less lie in one band */
+        const fv_pyr_level *L = &fx->hist.lv[l];
+        for (int y = -1; y <= L->h; y++) /* with the border, as pull-push leaves it: the edge replicated */
+            for (int x = -1; x <= L->w; x++)
+                L->rgbd[4 * (y * L->stride + x) + 3] = band_m[((x < 0 ? 0 : x < L->w ? x : L->w - 1) << l) / 16];
+    }
     fv_taa_frame_setup(&fx->tf, &fx->cam, &fx->cam, &fx->hist, 0.03f);
     assert_true(fx->tf.identity);
     fv_sampling_params sp;
@@ -91,8 +93,12 @@ static void setup_frame(fixture *fx, fv_dofsamp_frame *f, uint32_t frame)
     fv_dofsamp_frame_setup(f, &fx->prm, &fx->tf, &fx->smp, gx, gy, FOCUS_M, FOCUS_M, TOL_M, PX_PER_DPT, frame, 0);
 }
 
+/* Thinning blocks (and history texels) are B x B pixels; a block's 3x3 texel minimum reaches
+ * B pixels past it. */
+#define B (1 << FV_DOFSAMP_LEVEL)
+
 /* One frame: every tile's acuity rows, thinned; kept[band] and acuity[band] count the interior
- * pixels of each band (2 px clear of its sides: the 3x3 texel minimum reaches that far). */
+ * pixels of each band (B px clear of its sides: the 3x3 texel minimum reaches that far). */
 static void run_frame(fixture *fx, uint32_t frame, double kept[W / 16], double acuity[W / 16], double *qsum)
 {
     fv_dofsamp_frame f;
@@ -108,7 +114,7 @@ static void run_frame(fixture *fx, uint32_t frame, double kept[W / 16], double a
                 qsum[tx] += q;
             for (int y = 0; y < 16; y++) {
                 assert_int_equal(rows[y] & ~before[y], 0); /* only ever drops acuity bits */
-                for (int x = 2; x < 14; x++) {
+                for (int x = B; x < 16 - B; x++) {
                     acuity[tx] += before[y] >> x & 1u;
                     kept[tx] += rows[y] >> x & 1u;
                 }
@@ -168,8 +174,8 @@ static void density_case(int full)
             printf("band %d (%.2f m): kept %.5f, expected %.5f (sigma %.5f)\n", b, (double)band_m[b], m, q, sig);
             fail();
         }
-        /* the tiles' mean keep-probability: blocks 1-6 see the band alone, block 0 (7) also the
-         * last (first) texel of the band on its left (right): the smaller CoC of the two */
+        /* the tiles' mean keep-probability: the inner blocks see the band alone, the first (last)
+         * also the last (first) texel of the band on its left (right): the smaller CoC of the two */
         double qb[2];
         for (int side = 0; side < 2; side++) {
             const int nb = side ? (b + 1 < W / 16 ? b + 1 : b) : (b > 0 ? b - 1 : b);
@@ -177,7 +183,7 @@ static void density_case(int full)
             const double de = expect_density(c0 < c1 ? c0 : c1);
             qb[side] = de < p ? de / p : 1.0;
         }
-        const double qr = qsum[b] / (FRAMES * (H / 16)), qe = (qb[0] + 6.0 * q + qb[1]) / 8.0;
+        const double qr = qsum[b] / (FRAMES * (H / 16)), qe = (qb[0] + (16 / B - 2) * q + qb[1]) / (16 / B);
         assert_float_equal(qr, qe, 1e-5 + 1e-5 * qe);
     }
     fixture_free(&fx);
@@ -213,7 +219,7 @@ static void roulette_case(int full)
                 fv_dofsamp_tile(&f, tx * 16, ty * 16, 16, 16, rows);
                 const double de = expect_density(expect_coc(band_m[tx])), q = de < p ? de / p : 1.0;
                 for (int y = 0; y < 16; y++)
-                    for (int x = 2; x < 14; x++) {
+                    for (int x = B; x < 16 - B; x++) {
                         if (!(acu[y] >> x & 1u))
                             continue;
                         num += (rows[y] >> x & 1u) / q;
@@ -257,10 +263,10 @@ static void test_in_focus_untouched(void **st)
             for (int y = 0; y < 16; y++) {
                 if (sharp)
                     assert_int_equal(rows[y], 0xffffu);
-                if (left_sharp) /* pixels 0, 1 share a block whose neighbourhood reaches the band */
-                    assert_int_equal(rows[y] & 3u, 3u);
+                if (left_sharp) /* pixels 0 .. B-1 share a block whose neighbourhood reaches the band */
+                    assert_int_equal(rows[y] & ((1u << B) - 1u), (1u << B) - 1u);
                 if (right_sharp)
-                    assert_int_equal(rows[y] & 0xc000u, 0xc000u);
+                    assert_int_equal(rows[y] >> (16 - B), (1u << B) - 1u);
             }
             if (sharp)
                 assert_float_equal(q, 1.0f, 0.0f);
@@ -282,10 +288,12 @@ static void test_periphery_thinned_evenly(void **st)
     (void)st;
     fixture fx;
     fixture_init(&fx, 0);
-    const fv_pyr_level *l1 = &fx.hist.lv[1];
-    for (int y = -1; y <= l1->h; y++) /* one depth: 0.5 m, c = 15 px, d = (2 / 15)^2 */
-        for (int x = -1; x <= l1->w; x++)
-            l1->rgbd[4 * (y * l1->stride + x) + 3] = 0.5f;
+    for (int l = 1; l <= 4; l++) { /* one depth: 0.5 m, c = 15 px, d = (2 / 15)^2 */
+        const fv_pyr_level *L = &fx.hist.lv[l];
+        for (int y = -1; y <= L->h; y++)
+            for (int x = -1; x <= L->w; x++)
+                L->rgbd[4 * (y * L->stride + x) + 3] = 0.5f;
+    }
     const double d = expect_density(expect_coc(0.5));
     const int win = (int)ceil(2.0 / sqrt(d));
     for (uint32_t fr = 0; fr < 3; fr++) {
