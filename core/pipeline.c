@@ -43,6 +43,7 @@ struct fv_pipeline {
     int taa;           /* reprojection runs (enabled and foveated) */
     int dof;           /* the depth-of-field stages run */
     int dofsamp;       /* DoF-driven sampling thins the rays (DoF and reprojection on) */
+    float *dofsamp_map; /* its defocus map (shared by the eyes, rendered one after the other) */
     fv_dof_model_fn dof_fn;
     fv_dof_work dof_work;    /* scratch shared by the eyes (rendered one after the other) */
     float *enh_fp;           /* contrast enhancement footprint per eccentricity step */
@@ -150,6 +151,10 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
                 fv_err(err, err_len, "out of memory");
                 goto bad;
             }
+        if (p->dofsamp && !(p->dofsamp_map = malloc(fv_dofsamp_map_len(&p->eyes[0].pyr[0]) * sizeof(float)))) {
+            fv_err(err, err_len, "out of memory");
+            goto bad;
+        }
         if (!cfg->samp.full) {
             /* Patney's enhancement kernel: the footprint of one sample, 1 / sqrt(density), per 4 px */
             const float diag = sqrtf((float)cfg->cam.width * cfg->cam.width + (float)cfg->cam.height * cfg->cam.height);
@@ -191,6 +196,7 @@ void fv_pipeline_destroy(fv_pipeline *p)
         free(p->eyes[e].rows);
     }
     fv_dof_work_free(&p->dof_work);
+    free(p->dofsamp_map);
     free(p->enh_fp);
     free(p);
 }
@@ -207,6 +213,15 @@ void fv_pipeline_reset_history(fv_pipeline *p)
 }
 
 void fv_pipeline_set_time_ns(fv_pipeline *p, int64_t t_ns) { p->t_ns = t_ns; }
+
+/* DoF-driven sampling's defocus map, in row bands over the pool (each band its own rows) */
+#define DOFSAMP_BANDS 16
+static void dofsamp_map_band(void *ctx, int band, int thread_id)
+{
+    (void)thread_id;
+    const fv_dofsamp_frame *f = ctx;
+    fv_dofsamp_map_rows(f, f->map_h * band / DOFSAMP_BANDS, f->map_h * (band + 1) / DOFSAMP_BANDS);
+}
 
 /* The focus estimator's view of the reconstruction: level 0's depth at the nearest pixel. */
 static float pyr_depth(void *ctx, float x, float y)
@@ -324,6 +339,8 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
             fv_dofsamp_frame_setup(&dsf, &p->cfg.dofsamp, &tf, p->smp_cur, gx, gy, fa, fb, dp->tolerance_m,
                                    dp->pupil_mm * 1e-3f * es->cam.focal_px * fv_dof_presets[dp->preset].e_scale,
                                    (uint32_t)es->frame, opt.phase);
+            fv_dofsamp_map_attach(&dsf, p->dofsamp_map);
+            fv_pool_run(p->pool, DOFSAMP_BANDS, dofsamp_map_band, &dsf);
             opt.dofs = &dsf;
             opt.rows_out = es->rows;
         }

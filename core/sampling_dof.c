@@ -96,6 +96,46 @@ static void tile_flow(const fv_taa_frame *t, int x0, int y0, int tw, int th, int
     *dy = (int)floorf(v - cy + 0.5f);
 }
 
+size_t fv_dofsamp_map_len(const fv_pyramid *hist)
+{
+    const int l = hist->levels - 1 < FV_DOFSAMP_LEVEL ? hist->levels - 1 : FV_DOFSAMP_LEVEL;
+    return (size_t)(hist->lv[l].w + 2) * (size_t)(hist->lv[l].h + 2);
+}
+
+void fv_dofsamp_map_attach(fv_dofsamp_frame *f, float *map)
+{
+    const fv_pyramid *h = f->taa->hist;
+    f->map_level = h->levels - 1 < FV_DOFSAMP_LEVEL ? h->levels - 1 : FV_DOFSAMP_LEVEL;
+    f->map = map;
+    f->map_w = h->lv[f->map_level].w + 2;
+    f->map_h = h->lv[f->map_level].h + 2;
+}
+
+/* Map row j is history row j - 1 (the border rows included): the texel's depth converted to
+ * this frame's view (N rows: previous pixel and depth -> current), then its defocus; no depth
+ * or behind the eye: 0 (unknown, kept sharp). Branch-free, so the compiler vectorises it. */
+void fv_dofsamp_map_rows(const fv_dofsamp_frame *f, int j0, int j1)
+{
+    const fv_taa_frame *t = f->taa;
+    const fv_pyr_level *hl = &t->hist->lv[f->map_level];
+    const float scale = (float)(1 << f->map_level);
+    const float lo = f->lo_dpt, hi = f->hi_dpt, T = t->T2[2];
+    for (int j = j0; j < j1; j++) {
+        const int iy = j - 1;
+        const float v = ((float)iy + 0.5f) * scale;
+        const float k0 = t->N0[2] + v * t->NY[2], kx = t->NX[2];
+        const float *src = hl->rgbd + 4 * ((ptrdiff_t)iy * hl->stride - 1);
+        float *dst = f->map + (ptrdiff_t)j * f->map_w;
+        for (int i = 0; i < f->map_w; i++) {
+            const float z = src[4 * i + 3], u = ((float)(i - 1) + 0.5f) * scale;
+            const float zc = T + z * (k0 + u * kx);
+            const float D = 1.0f / (zc > 0.05f ? zc : 0.05f); /* FV_COC_MIN_DEPTH_M */
+            const float a = lo - D, b = D - hi, m = a > b ? a : b;
+            dst[i] = z > 0.0f && zc > 0.0f && m > 0.0f ? m : 0.0f;
+        }
+    }
+}
+
 float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th, uint32_t rows[16])
 {
     const fv_taa_frame *t = f->taa;
@@ -107,39 +147,23 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
     if (!(f->kappa / f->coc_cap_px < sqrtf(p))) /* even the largest CoC needs every sample */
         return 1.0f;
 
-    /* Defocus of the history's level-2 texels (4x4 pixels) around the tile, moved by the tile's
-     * flow, one texel of margin: 6 x 6 (fewer on a pyramid that small). Beyond the history's
-     * border (it holds the edge pixels), or behind its eye: unknown, kept sharp. */
+    /* Defocus of the history's texels around the tile (fv_dofsamp_map), moved by the tile's
+     * flow, one texel of margin: 6 x 6. Beyond the history's border: unknown, kept sharp. */
     int fx, fy;
     tile_flow(t, x0, y0, tw, th, &fx, &fy);
-    const int sh = t->hist->levels - 1 < FV_DOFSAMP_LEVEL ? t->hist->levels - 1 : FV_DOFSAMP_LEVEL;
-    const fv_pyr_level *hl = &t->hist->lv[sh];
+    const int sh = f->map_level;
     const int nb = 16 >> sh, ng = nb + 2; /* blocks per tile side, texels per grid side */
     const int ix0 = floor_shr(x0 + fx, sh) - 1, iy0 = floor_shr(y0 + fy, sh) - 1;
-    /* gather the texels' depths and their view-depth factors (N rows: previous pixel and depth ->
-     * current), then the defocus of all of them in one branch-free loop */
-    float z[18 * 18], k[18 * 18], e[18 * 18];
+    float e[18 * 18], emax = 0.0f;
     for (int j = 0; j < ng; j++) {
         const int iy = iy0 + j;
-        const float v = ((float)iy + 0.5f) * (float)(1 << sh);
         for (int i = 0; i < ng; i++) {
             const int ix = ix0 + i;
-            const float u = ((float)ix + 0.5f) * (float)(1 << sh);
-            const int in = ix >= -1 && iy >= -1 && ix <= hl->w && iy <= hl->h; /* the border: the edge */
-            z[ng * j + i] = in ? hl->rgbd[4 * ((ptrdiff_t)iy * hl->stride + ix) + 3] : 0.0f;
-            k[ng * j + i] = (t->N0[2] + v * t->NY[2]) + u * t->NX[2];
+            const int in = ix >= -1 && iy >= -1 && ix <= f->map_w - 2 && iy <= f->map_h - 2;
+            const float ev = in ? f->map[(ptrdiff_t)(iy + 1) * f->map_w + ix + 1] : 0.0f;
+            e[ng * j + i] = ev;
+            emax = ev > emax ? ev : emax;
         }
-    }
-    float emax = 0.0f;
-    const float lo = f->lo_dpt, hi = f->hi_dpt, T = t->T2[2];
-    for (int n = 0; n < ng * ng; n++) {
-        const float zc = T + z[n] * k[n];
-        const float D = 1.0f / (zc > 0.05f ? zc : 0.05f); /* FV_COC_MIN_DEPTH_M */
-        const float a = lo - D, b = D - hi, m = a > b ? a : b;
-        /* no depth there, or behind the eye: unknown, kept sharp */
-        const float ev = z[n] > 0.0f && zc > 0.0f && m > 0.0f ? m : 0.0f;
-        e[n] = ev;
-        emax = ev > emax ? ev : emax;
     }
     /* CoCs up to kappa / sqrt(p) keep every sample: most tiles stop here */
     const float c_keep = f->kappa / sqrtf(p);

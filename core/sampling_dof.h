@@ -33,6 +33,7 @@
 #ifndef FOVEA_SAMPLING_DOF_H
 #define FOVEA_SAMPLING_DOF_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "reproject.h"
@@ -59,6 +60,9 @@ typedef struct fv_dofsamp_frame {
     float kappa, coc_cap_px;
     uint32_t seed;             /* the frame number, hashed with each pixel */
     int phase;                 /* the sampler's pattern phase this frame (fv_sampler_row) */
+    float *map;                /* defocus (dioptres outside the sharp band) of every history texel
+                                * of level map_level, border included: map_w x map_h */
+    int map_w, map_h, map_level;
 } fv_dofsamp_frame;
 
 /* focus_a_m, focus_b_m: the focus range the eye can have this frame (either order);
@@ -77,6 +81,14 @@ float fv_dofsamp_density(const fv_dofsamp_frame *f, float c_px);
 float fv_dofsamp_keep(const fv_dofsamp_frame *f, float p, float c_px);
 /* The roulette's variate for pixel (x, y) in frame `seed`, uniform in [0, 2^32). */
 uint32_t fv_dofsamp_hash(int x, int y, uint32_t seed);
+
+/* The defocus map: computed once per frame from the history (sequential reads; the tiles then
+ * read 6 x 6 of it from cache instead of missing on the history six times each).
+ * fv_dofsamp_map_len: floats it needs for this history; attach: the buffer (after setup); rows:
+ * fills map rows [j0, j1) (0 .. map_h; any split, e.g. bands over a pool). Then the tiles. */
+size_t fv_dofsamp_map_len(const fv_pyramid *hist);
+void fv_dofsamp_map_attach(fv_dofsamp_frame *f, float *map);
+void fv_dofsamp_map_rows(const fv_dofsamp_frame *f, int j0, int j1);
 
 /* Thins the tile [x0, x0+tw) x [y0, y0+th) (tw, th <= 16): bit x of rows[y] (pixel x0+x, y0+y)
  * survives when hash < q 2^32. Returns the tile's mean keep-probability over its pixels

@@ -49,6 +49,7 @@ typedef struct {
     fv_taa_frame tf;
     fv_sampler smp;
     fv_dofsamp_params prm;
+    float *map; /* the defocus map */
 } fixture;
 
 /* A history whose levels 1-4 hold band_m per column band, the same camera twice (identity map),
@@ -70,6 +71,8 @@ static void fixture_init(fixture *fx, int full)
     }
     fv_taa_frame_setup(&fx->tf, &fx->cam, &fx->cam, &fx->hist, 0.03f);
     assert_true(fx->tf.identity);
+    fx->map = malloc(fv_dofsamp_map_len(&fx->hist) * sizeof(float));
+    assert_non_null(fx->map);
     fv_sampling_params sp;
     fv_sampling_params_default(&sp);
     sp.full = full;
@@ -83,6 +86,7 @@ static void fixture_free(fixture *fx)
 {
     fv_pyramid_free(&fx->hist);
     fv_sampler_free(&fx->smp);
+    free(fx->map);
 }
 
 static const int far_gx = -100000, far_gy = -100000;
@@ -91,6 +95,9 @@ static void setup_frame(fixture *fx, fv_dofsamp_frame *f, uint32_t frame)
 {
     const int gx = fx->smp.prm.full ? W / 2 : far_gx, gy = fx->smp.prm.full ? H / 2 : far_gy;
     fv_dofsamp_frame_setup(f, &fx->prm, &fx->tf, &fx->smp, gx, gy, FOCUS_M, FOCUS_M, TOL_M, PX_PER_DPT, frame, 0);
+    fv_dofsamp_map_attach(f, fx->map);
+    fv_dofsamp_map_rows(f, 0, f->map_h / 3); /* in two pieces, as bands would */
+    fv_dofsamp_map_rows(f, f->map_h / 3, f->map_h);
 }
 
 /* Thinning blocks (and history texels) are B x B pixels; a block's 3x3 texel minimum reaches
