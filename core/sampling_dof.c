@@ -11,7 +11,7 @@ _Static_assert(FV_TILE == 16, "fv_dofsamp_tile works on 16x16 tiles");
 void fv_dofsamp_params_default(fv_dofsamp_params *p)
 {
     p->enabled = 1;
-    p->kappa = 2.0f;
+    p->kappa = 4.0f;
     p->coc_cap_px = 32.0f;
 }
 

@@ -44,7 +44,8 @@
 
 typedef struct fv_dofsamp_params {
     int enabled;     /* --dof-sampling on|off: default 1 (acts only with DoF on and a history) */
-    float kappa;     /* samples across the CoC's diameter, default 2 */
+    float kappa;     /* samples across the CoC's diameter, default 4: a sample every c / 4 = sigma of
+                      * the filter's Gaussian (2 left thin high-contrast edges visibly ragged) */
     float coc_cap_px; /* the largest CoC the filter applies (Weier: far sigma 8 px = c / 4), 32 */
 } fv_dofsamp_params;
 

@@ -74,7 +74,7 @@ enum {
     "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n" \
     "  --dof-sampling on|off   fewer rays where the depth of field blurs (density falls\n" \
     "                     with the CoC's area; needs --dof and reprojection; default on)\n" \
-    "  --dof-sampling-kappa K  samples across a CoC's diameter it keeps (default 2;\n" \
+    "  --dof-sampling-kappa K  samples across a CoC's diameter it keeps (default 4;\n" \
     "                     density (K / CoC_px)^2 where below the acuity model's)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
 /* After getopt_long: no stray words, a scene was given, option combinations agree (r0 <= r1);

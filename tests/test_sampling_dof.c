@@ -412,6 +412,7 @@ static void dof_config(fv_pipeline_config *cfg, int dofsamp, int threads)
     cfg->dof.preset = FV_DOF_STRONG;
     cfg->dof.focus.fixed_m = 1.0f;
     cfg->dofsamp.enabled = dofsamp;
+    cfg->dofsamp.kappa = 2.0f; /* the wall (c 6 px) is thinned too, not only the near card */
     cfg->threads = threads;
 }
 
