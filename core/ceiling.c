@@ -66,7 +66,7 @@ static void ceil_tile(void *ctx, int index, int thread_id)
     /* the tile's pixels in the real stage's order (fv_raycast_pixels): the same packets */
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++)
-        rows[y] = j->o.smp ? (uint32_t)fv_sampler_row(j->o.smp, x0, y0 + y, tw, j->o.gx, j->o.gy, j->o.phase) : ~0u;
+        rows[y] = j->o.rows ? j->o.rows[(size_t)index * FV_TILE + y] : j->o.smp ? (uint32_t)fv_sampler_row(j->o.smp, x0, y0 + y, tw, j->o.gx, j->o.gy, j->o.phase) : ~0u;
     uint8_t px[FV_TILE * FV_TILE + 8];
     const int n = fv_raycast_pixels(rows, tw, th, px);
     if (n == 0)

@@ -15,6 +15,8 @@ typedef struct fv_ceiling_opts {
     int packet;             /* 8 (rtcIntersect8) or 16 (rtcIntersect16); 0 = 16 */
     const fv_sampler *smp;  /* NULL: every pixel; else its pixels for the point of regard gx, gy */
     int gx, gy, phase;
+    const uint32_t *rows;   /* NULL, or the frame's own sample bits (tile i's FV_TILE rows at
+                             * [FV_TILE * i], fv_pipeline_last_rows), used instead of smp */
 } fv_ceiling_opts;
 
 /* Traces the rays and returns how many; with depth_m (w x h floats, row-major) each traced

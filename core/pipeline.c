@@ -25,6 +25,8 @@ typedef struct {
     int64_t last_t_ns; /* the time of its last frame (focus filter) */
     fv_lens_lca *lca;  /* lateral chromatic aberration tables (a lens with per-channel scales) */
     uint8_t *rgb8;     /* the last frame in the display format: sRGB 8-bit RGB, rows 3 w bytes */
+    uint32_t *rows;    /* DoF-driven sampling: the last frame's sample bits per tile (ceiling) */
+    int rows_valid;    /* the last frame was thinned: rows holds its bits */
 } eye_state;
 
 struct fv_pipeline {
@@ -40,6 +42,8 @@ struct fv_pipeline {
     int fovea_step;
     int taa;           /* reprojection runs (enabled and foveated) */
     int dof;           /* the depth-of-field stages run */
+    int dofsamp;       /* DoF-driven sampling thins the rays (DoF and reprojection on) */
+    float *dofsamp_map; /* its defocus map (shared by the eyes, rendered one after the other) */
     fv_dof_model_fn dof_fn;
     fv_dof_work dof_work;    /* scratch shared by the eyes (rendered one after the other) */
     float *enh_fp;           /* contrast enhancement footprint per eccentricity step */
@@ -60,6 +64,7 @@ void fv_pipeline_config_default(fv_pipeline_config *c)
     c->samp.rotate = 1;
     fv_taa_params_default(&c->taa);
     fv_dof_params_default(&c->dof);
+    fv_dofsamp_params_default(&c->dofsamp);
     c->threads = 0;
     c->isa_mask = ~0u;
 }
@@ -133,6 +138,23 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
                 goto bad;
             }
         }
+        /* DoF-driven sampling needs the history's depth, so reprojection */
+        p->dofsamp = cfg->dofsamp.enabled && p->taa;
+        if (p->dofsamp && !(cfg->dofsamp.kappa > 0.0f && cfg->dofsamp.coc_cap_px >= cfg->dofsamp.kappa)) {
+            fv_err(err, err_len, "DoF sampling parameters out of range: need kappa > 0, CoC cap >= kappa");
+            goto bad;
+        }
+        const size_t tiles = (size_t)((cfg->cam.width + FV_TILE - 1) / FV_TILE) *
+                             (size_t)((cfg->cam.height + FV_TILE - 1) / FV_TILE);
+        for (int e = 0; e < 2 && p->dofsamp; e++)
+            if (!(p->eyes[e].rows = malloc(tiles * FV_TILE * sizeof(uint32_t)))) {
+                fv_err(err, err_len, "out of memory");
+                goto bad;
+            }
+        if (p->dofsamp && !(p->dofsamp_map = malloc(fv_dofsamp_map_len(&p->eyes[0].pyr[0]) * sizeof(float)))) {
+            fv_err(err, err_len, "out of memory");
+            goto bad;
+        }
         if (!cfg->samp.full) {
             /* Patney's enhancement kernel: the footprint of one sample, 1 / sqrt(density), per 4 px */
             const float diag = sqrtf((float)cfg->cam.width * cfg->cam.width + (float)cfg->cam.height * cfg->cam.height);
@@ -171,8 +193,10 @@ void fv_pipeline_destroy(fv_pipeline *p)
         free(p->eyes[e].out);
         free(p->eyes[e].lca);
         free(p->eyes[e].rgb8);
+        free(p->eyes[e].rows);
     }
     fv_dof_work_free(&p->dof_work);
+    free(p->dofsamp_map);
     free(p->enh_fp);
     free(p);
 }
@@ -189,6 +213,15 @@ void fv_pipeline_reset_history(fv_pipeline *p)
 }
 
 void fv_pipeline_set_time_ns(fv_pipeline *p, int64_t t_ns) { p->t_ns = t_ns; }
+
+/* DoF-driven sampling's defocus map, in row bands over the pool (each band its own rows) */
+#define DOFSAMP_BANDS 16
+static void dofsamp_map_band(void *ctx, int band, int thread_id)
+{
+    (void)thread_id;
+    const fv_dofsamp_frame *f = ctx;
+    fv_dofsamp_map_rows(f, f->map_h * band / DOFSAMP_BANDS, f->map_h * (band + 1) / DOFSAMP_BANDS);
+}
 
 /* The focus estimator's view of the reconstruction: level 0's depth at the nearest pixel. */
 static float pyr_depth(void *ctx, float x, float y)
@@ -290,12 +323,29 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     fv_tile_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa,
                            .prof = p->prof};
     const int64_t t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME), tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
+    /* The S_in pattern moves by whole pixels with the point of regard. */
+    int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
+    fv_dofsamp_frame dsf;
     if (p->taa && es->hist_valid) {
         fv_taa_frame_setup(&tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
         opt.taa = &tf;
+        /* The focus this frame is not estimated yet (it needs this frame's depth): the eye
+         * accommodates from last frame's focus towards last frame's target, so the frame's focus
+         * lies between them unless the target jumps (a saccade to another depth, then the focus
+         * moves 1 - exp(-dt / tau) of the way: 3 % at 90 Hz). */
+        if (p->dofsamp && es->focus.valid) {
+            const fv_dof_params *dp = &p->cfg.dof;
+            const float fa = 1.0f / fmaxf(es->focus.focus_dpt, 1e-6f), fb = 1.0f / fmaxf(es->focus.target_dpt, 1e-6f);
+            fv_dofsamp_frame_setup(&dsf, &p->cfg.dofsamp, &tf, p->smp_cur, gx, gy, fa, fb, dp->tolerance_m,
+                                   dp->pupil_mm * 1e-3f * es->cam.focal_px * fv_dof_presets[dp->preset].e_scale,
+                                   (uint32_t)es->frame, opt.phase);
+            fv_dofsamp_map_attach(&dsf, p->dofsamp_map);
+            fv_pool_run(p->pool, DOFSAMP_BANDS, dofsamp_map_band, &dsf);
+            opt.dofs = &dsf;
+            opt.rows_out = es->rows;
+        }
     }
-    /* The S_in pattern moves by whole pixels with the point of regard. */
-    int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
+    es->rows_valid = opt.dofs != NULL;
     double taa_ms = NAN;
     st->samples = fv_tile_pass(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
@@ -343,6 +393,11 @@ const fv_pyramid *fv_pipeline_pyramid(const fv_pipeline *p, fv_eye eye)
 }
 const fv_camera *fv_pipeline_camera(const fv_pipeline *p, fv_eye eye) { return &p->eyes[slot(eye)].cam; }
 const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p) { return p->smp_cur; }
+const uint32_t *fv_pipeline_last_rows(const fv_pipeline *p, fv_eye eye)
+{
+    const eye_state *es = &p->eyes[slot(eye)];
+    return es->rows_valid ? es->rows : NULL;
+}
 int fv_pipeline_last_phase(const fv_pipeline *p, fv_eye eye)
 {
     const eye_state *es = &p->eyes[slot(eye)];

@@ -13,6 +13,7 @@
 #include "pullpush.h"
 #include "reproject.h"
 #include "sampling.h"
+#include "sampling_dof.h"
 #include "scene.h"
 #include "stage.h"
 
@@ -21,6 +22,7 @@ typedef struct fv_pipeline_config {
     fv_sampling_params samp; /* r0, r1, p_min, full; rotate (default 1) with reprojection */
     fv_taa_params taa;       /* temporal reprojection (foveated only; full sampling needs none) */
     fv_dof_params dof;       /* depth of field (preset none: off) */
+    fv_dofsamp_params dofsamp; /* DoF-driven sampling (with DoF and reprojection; default on) */
     int threads;             /* 0 = online CPUs */
     unsigned isa_mask;       /* kernels allowed (FV_ISA_* bits); ~0u = the best this CPU runs */
 } fv_pipeline_config;
@@ -57,6 +59,10 @@ const fv_sampler *fv_pipeline_sampler(const fv_pipeline *p);
  * reprojection): with fv_pipeline_sampler and the camera, the exact pixel set that frame traced
  * (the bench's ceiling retraces it). */
 int fv_pipeline_last_phase(const fv_pipeline *p, fv_eye eye);
+/* The sample bits the eye's last frame traced when DoF-driven sampling thinned them (tile i's
+ * FV_TILE rows at [FV_TILE * i], tiles row-major; core/tile.h), else NULL: then the sampler and
+ * the phase give them. */
+const uint32_t *fv_pipeline_last_rows(const fv_pipeline *p, fv_eye eye);
 /* Widens the fovea for the following frames (both eyes) when the gaze is doubtful: r0 and r1
  * times `scale` (r1 capped at 90 deg), the scale rounded to a step of 0.25 in [1, 2] (below 1:
  * 1; NaN: 2), as fv_fovea_radius_scale (eyetrack/gazefilter.h) gives it for the gaze filter's

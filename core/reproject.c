@@ -108,9 +108,16 @@ float fv_taa_project(const fv_taa_frame *f, float px, float py, float d, float *
 void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
                      const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th)
 {
+    fv_taa_tile_run_keep(f, prm, smp, gx, gy, l0, dsp, x0, y0, tw, th, 1.0f);
+}
+
+void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx,
+                          int gy, const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
+                          float keep)
+{
     fv_taa_tile tt;
     const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
-    fv_taa_tile_setup(&tt, prm, fv_sampler_probability(smp, cx - (float)gx, cy - (float)gy), smp->prm.p_min,
+    fv_taa_tile_setup(&tt, prm, fv_sampler_probability(smp, cx - (float)gx, cy - (float)gy) * keep, smp->prm.p_min,
                       smp->phases);
     fv_taa_flow fl = {0.0f, 0.0f, 0.0f};
     const ptrdiff_t o = (ptrdiff_t)y0 * l0->stride + x0;

@@ -82,6 +82,11 @@ void fv_taa_tile_setup(fv_taa_tile *t, const fv_taa_params *prm, float p, float 
 struct fv_sampler;
 void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
                      const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th);
+/* The same for a tile whose samples were thinned to a share `keep` of the acuity sampler's
+ * (DoF-driven sampling, core/sampling_dof.h): the tile's sampling probability is p * keep. */
+void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx,
+                          int gy, const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
+                          float keep);
 
 /* Prefetches the level-0 history that fv_taa_tile_run of the tile [x0, x0+tw) x [y0, y0+th) will
  * read, guessing the tile's motion from the history's depth at coarse_level (the level where the

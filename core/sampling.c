@@ -106,15 +106,12 @@ int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const 
     /* S_out: rank-1 lattice dither (the R2 sequence, Roberts 2018): a pixel is sampled when
      * frac(a1 x + a2 y + k/K) < p_min. Exact density p_min with evenly spread samples and no
      * clumps or large holes, unlike white noise. */
-    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
     for (int k = 0; k < K; k++)
         for (int y = 0; y < height; y++) {
             uint64_t *row = s->s_out + ((size_t)k * height + y) * s->out_stride;
-            for (int x = 0; x < width; x++) {
-                double v = a1 * x + a2 * y + (double)k / K;
-                if (v - floor(v) < p->p_min)
+            for (int x = 0; x < width; x++)
+                if (fv_sampler_lattice(s, x, y, k) < p->p_min)
                     set_bit(row, x);
-            }
         }
 
     /* S_in: every offset inside r0, then Halton (2, 3) points placed with eq. (1)-(2); phase k
@@ -148,6 +145,12 @@ int fv_sampler_init(fv_sampler *s, int width, int height, float focal_px, const 
             }
     }
     return 0;
+}
+
+double fv_sampler_lattice(const fv_sampler *s, int x, int y, int phase)
+{
+    const int k = (phase % s->phases + s->phases) % s->phases;
+    return fv_sampler_lattice_at(x, y, (double)k / s->phases);
 }
 
 float fv_sampler_probability(const fv_sampler *s, float dx_px, float dy_px)

@@ -82,6 +82,17 @@ float fv_sampling_transition_density(const fv_sampling_params *p, float r_deg);
  * clamped to its nearest pixel (the table reaches every pixel from any pixel). */
 uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy, int phase);
 
+/* S_out's lattice value at pixel (x, y) in pattern phase `phase`, frac(a1 x + a2 y + k / K) in
+ * [0, 1): the pixel is in S_out when it is below p_min. S_out's pixels whose value is below
+ * p_min * q form the same even dither at density p_min * q (DoF-driven sampling thins by it). */
+double fv_sampler_lattice(const fv_sampler *s, int x, int y, int phase);
+/* The same with the phase's offset k / K given (x, y >= 0): R2's a1 = 1/g, a2 = 1/g^2, g^3 = g + 1. */
+static inline double fv_sampler_lattice_at(int x, int y, double k_over_k)
+{
+    const double v = 0.7548776662466927 * x + 0.5698402909980532 * y + k_over_k;
+    return v - (double)(long long)v; /* v >= 0: truncation is floor */
+}
+
 /* The acuity model's sampling probability per frame at pixel offset (dx, dy) from the point of
  * regard: 1 inside r0, eq. (1)'s density lambda(r) (clamped to [p_min, 1]) in r0..r1, p_min
  * outside; 1 everywhere with full. Liu: min(1, lambda(eccentricity)) of sampling_liu.h. */

@@ -7,6 +7,7 @@
 #include "base/clock.h"
 #include "prof.h"
 #include "raycast.h"
+#include "sampling_dof.h"
 
 typedef struct {
     const fv_scene *scene;
@@ -21,6 +22,8 @@ typedef struct {
     atomic_long rays;
     atomic_llong taa_ns;
     struct fv_prof *prof; /* NULL: no trace recording */
+    const struct fv_dofsamp_frame *dofs;
+    uint32_t *rows_out;
 } tile_job;
 
 static void run_tile(void *ctx, int index, int thread_id)
@@ -39,12 +42,18 @@ static void run_tile(void *ctx, int index, int thread_id)
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++)
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
+    /* fewer rays where the depth of field will blur (core/sampling_dof.h); keep: their share */
+    const float keep = j->dofs ? fv_dofsamp_tile(j->dofs, x0, y0, tw, th, rows) : 1.0f;
+    if (j->rows_out)
+        for (int y = 0; y < FV_TILE; y++)
+            j->rows_out[(size_t)index * FV_TILE + y] = y < th ? rows[y] : 0u;
 
     /* writes every weight of the tile: pixels without a sample get 0 */
     const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
-        fv_taa_tile_run(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th);
+        fv_taa_tile_run_keep(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th,
+                             keep);
         const int64_t t1 = fv_time_ns();
         atomic_fetch_add_explicit(&j->taa_ns, t1 - t0, memory_order_relaxed);
         if (j->prof)
@@ -71,6 +80,8 @@ long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler 
         j.taa = opt->taa;
         j.taa_prm = opt->taa_prm;
         j.prof = opt->prof;
+        j.dofs = opt->dofs;
+        j.rows_out = opt->rows_out;
     }
     j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
     j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;

@@ -27,12 +27,17 @@ static inline int fv_tile_pulled_levels(const fv_pyramid *p)
     return p->levels - 1 < FV_TILE_PULL_LEVELS ? p->levels - 1 : FV_TILE_PULL_LEVELS;
 }
 
+struct fv_dofsamp_frame;
 typedef struct fv_tile_opts {
     int phase;                    /* sampling pattern phase (fv_sampler_row) */
     const fv_taa_frame *taa;      /* NULL: no temporal reprojection */
     const fv_taa_params *taa_prm; /* with taa */
     struct fv_prof *prof;         /* trace recorder (core/prof.h): a "tile" span per tile (arg: its
                                    * index) on the worker's track, "reproject" inside; NULL = off */
+    const struct fv_dofsamp_frame *dofs; /* DoF-driven thinning of the sampler's bits
+                                          * (core/sampling_dof.h); NULL = off */
+    uint32_t *rows_out;           /* NULL, or every tile's final sample bits: tile i's rows at
+                                   * rows_out + FV_TILE * i (the bench's ceiling retraces them) */
 } fv_tile_opts;
 
 /* Runs every tile of the eye image: the sampler's pixels around the point of regard (gx, gy

@@ -76,7 +76,8 @@ int fv_bench_run_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, c
             const fv_ceiling_opts co = {.smp = full ? NULL : fv_pipeline_sampler(pl),
                                         .gx = (int)floorf(0.5f * (float)cam->width),
                                         .gy = (int)floorf(0.5f * (float)cam->height),
-                                        .phase = fv_pipeline_last_phase(pl, FV_EYE_CENTER)};
+                                        .phase = fv_pipeline_last_phase(pl, FV_EYE_CENTER),
+                                        .rows = fv_pipeline_last_rows(pl, FV_EYE_CENTER)};
             const int64_t c0 = fv_time_ns();
             const long n = fv_ceiling_trace(scene, cam, fv_pipeline_pool(pl), &co, NULL);
             const double ms = (double)(fv_time_ns() - c0) * 1e-6;

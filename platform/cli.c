@@ -164,6 +164,12 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
         if (cfg->samp.liu_density > 0.0f && cfg->samp.liu_density < 1.0f)
             fv_usage_error(prog, "--liu-density %s: must be 0 (Weier's ray count) or at least 1 (a full fovea)", arg);
         return 1;
+    case FV_OPT_DOF_SAMPLING: /* depth-of-field-driven sampling (core/sampling_dof.h) */
+        cfg->dofsamp.enabled = fv_arg_onoff(prog, "--dof-sampling", arg);
+        return 1;
+    case FV_OPT_DOF_SAMPLING_KAPPA:
+        cfg->dofsamp.kappa = fv_arg_float(prog, "--dof-sampling-kappa", arg, 0.25f, 32.0f);
+        return 1;
     }
     return 0;
 }

@@ -30,6 +30,7 @@ enum {
     FV_OPT_PATTERN, FV_OPT_FOCUS_M, FV_OPT_PUPIL_MM, FV_OPT_GAZE_ERR, FV_OPT_DOF_TOL, FV_OPT_ACCOMMODATION,
     FV_OPT_CONTRAST, FV_OPT_CHROMA,
     FV_OPT_SAMPLING, FV_OPT_LIU_DENSITY,
+    FV_OPT_DOF_SAMPLING, FV_OPT_DOF_SAMPLING_KAPPA, /* depth-of-field-driven sampling */
 };
 #define FV_COMMON_LONGOPTS                                                                     \
     {"size", required_argument, 0, FV_OPT_SIZE}, {"threads", required_argument, 0, FV_OPT_THREADS}, \
@@ -44,7 +45,9 @@ enum {
     {"dof-tolerance-m", required_argument, 0, FV_OPT_DOF_TOL},                                   \
     {"accommodation-ms", required_argument, 0, FV_OPT_ACCOMMODATION},                            \
     {"contrast-gain", required_argument, 0, FV_OPT_CONTRAST}, {"chroma", required_argument, 0, FV_OPT_CHROMA}, \
-    {"sampling", required_argument, 0, FV_OPT_SAMPLING}, {"liu-density", required_argument, 0, FV_OPT_LIU_DENSITY}
+    {"sampling", required_argument, 0, FV_OPT_SAMPLING}, {"liu-density", required_argument, 0, FV_OPT_LIU_DENSITY}, \
+    {"dof-sampling", required_argument, 0, FV_OPT_DOF_SAMPLING},                                 \
+    {"dof-sampling-kappa", required_argument, 0, FV_OPT_DOF_SAMPLING_KAPPA}
 #define FV_COMMON_HELP                                                                             \
     "  --size WxH         eye image size in pixels (default 1280x1440)\n"                          \
     "  --fov DEG          vertical field of view (default 100)\n"                                  \
@@ -74,7 +77,11 @@ enum {
     "  --accommodation-ms T  focus time constant (default 370; 0 = instant)\n"                   \
     "  --dof-tolerance-m T   depth range kept sharp around the focus, +-T (default 0.2)\n"      \
     "  --contrast-gain G  peripheral contrast enhancement (Patney 2016; default 0 = off)\n" \
-    "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n"
+    "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n" \
+    "  --dof-sampling on|off   fewer rays where the depth of field blurs (density falls\n" \
+    "                     with the CoC's area; needs --dof and reprojection; default on)\n" \
+    "  --dof-sampling-kappa K  samples across a CoC's diameter it keeps (default 4;\n" \
+    "                     density (K / CoC_px)^2 where below the acuity model's)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
 /* --lens FILE (replay, bench, headset): loads the HMD lens profile into *lens (which must outlive
  * the pipeline) and points cfg->cam.lens at it; the lens also places each eye's optical axis (an

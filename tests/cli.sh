@@ -47,6 +47,8 @@ for p in fovea-replay fovea-bench; do
     expect_usage "$p bad contrast gain" '--contrast-gain: 5 is out of range' $B/$p --scene $SCENE $O --dof weak --contrast-gain 5
     expect_usage "$p bad gaze error" '--gaze-error-deg: -1 is out of range' $B/$p --scene $SCENE $O --dof weak --gaze-error-deg -1
     expect_usage "$p bad chroma" '--chroma: .yes. is not one of on, off' $B/$p --scene $SCENE $O --chroma yes
+    expect_usage "$p bad dof-sampling" '--dof-sampling: .yes. is not one of on, off' $B/$p --scene $SCENE $O --dof-sampling yes
+    expect_usage "$p bad dof-sampling-kappa" '--dof-sampling-kappa: 0 is out of range' $B/$p --scene $SCENE $O --dof-sampling-kappa 0
     expect_usage "$p dof bad" '--dof: .blurry. is not one of' $B/$p --scene $SCENE $O --dof blurry
     expect_usage "$p stray arg" 'unexpected argument .extra.' $B/$p --scene $SCENE $O extra
     expect_usage "$p bad reproject" '--reproject: .maybe. is not one of on, off' $B/$p --scene $SCENE $O --reproject maybe
@@ -318,6 +320,18 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
     else
         bad "--ceiling bench failed: $(cat "$T/err")"
     fi
+    # DoF-driven sampling (issue 15 item 4): fewer rays than the acuity sampler alone where the
+    # blur is strong (focus fixed near, everything behind blurred), and the ceiling retraces the
+    # frame's own thinned rays (the bench fails if the counts differ)
+    for ds in off on; do
+        $B/fovea-bench --scene $SCENE --size 160x180 --fov 30 --frames 3 --warmup 1 --threads 2 --mode foveated \
+            --dof strong --focus-m 0.3 --dof-sampling $ds --ceiling --counters off --json "$T/ds_$ds.json" \
+            >"$T/out" 2>"$T/err" || bad "--dof-sampling $ds bench failed: $(cat "$T/err")"
+    done
+    n_off=$(sed -n 's/.*"samples_per_frame": \([0-9]*\).*/\1/p' "$T/ds_off.json")
+    n_on=$(sed -n 's/.*"samples_per_frame": \([0-9]*\).*/\1/p' "$T/ds_on.json")
+    [ -n "$n_on" ] && [ -n "$n_off" ] && [ "$n_on" -lt $((n_off * 3 / 4)) ] && ok ||
+        bad "--dof-sampling on: $n_on rays per frame, off: $n_off"
 else
     bad "bench failed: $(cat "$T/err")"
 fi
@@ -542,6 +556,7 @@ if cmp -s "$T/lens1/frame_00001.png" "$T/lens2/frame_00001.png" && ! cmp -s "$T/
 else bad "replay --lens: frames differ between thread counts, or equal the lensless frame"; fi
 $B/fovea-bench --scene $SCENE --size 64x72 --frames 1 --warmup 0 --lens assets/hmd_example.lens --counters off >"$T/out" 2>&1 &&
     grep -q '^foveated' "$T/out" && ok || bad "bench --lens: $(tail -n 3 "$T/out")"
+expect_usage "headset bad dof-sampling" '--dof-sampling: .1. is not one of on, off' $HS $HO --dof-sampling 1
 expect_usage "headset no scene" '--scene FILE is required' $HS --size 64x72
 
 # good runs: the summary's contract lines (DESIGN.md), a latency CSV with one row per refresh
