@@ -67,9 +67,12 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                 d.vertex_count = p->vertex_count, d.index_count = p->index_count;
                 d.base_color[0] = d.base_color[1] = d.base_color[2] = d.base_color[3] = 1.0f;
                 d.texture = -1;
+                d.metallic = d.roughness = d.specular = 1.0f; /* the glTF default material */
                 if (p->material >= 0) {
                     const fv_gltf_material *mat = &g->materials[p->material];
                     memcpy(d.base_color, mat->base_color, sizeof d.base_color);
+                    d.metallic = mat->metallic, d.roughness = mat->roughness, d.specular = mat->specular;
+                    memcpy(d.emissive, mat->emissive, sizeof d.emissive);
                     const int img = mat->image;
                     if (img >= 0 && p->uvs && g->images[img].rgba8) { /* no uvs: factor only */
                         if (tex_of_image[img] < 0)

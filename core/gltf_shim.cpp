@@ -487,7 +487,34 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
     for (size_t i = 0; i < m.materials.size(); i++) {
         const std::string at = "material " + str(i);
         const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
-        fv_gltf_material mat = {{1, 1, 1, 1}, -1};
+        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}};
+        const tinygltf::Material &mt = m.materials[i];
+        auto unit = [&](double d, const char *name) {
+            const float f = to_float(d, at + " " + name);
+            if (!(f >= 0.0f && f <= 1.0f)) throw Fail(at + ": " + name + " " + std::to_string(d) + " is outside [0, 1]");
+            return f;
+        };
+        mat.metallic = unit(pbr.metallicFactor, "metallicFactor");
+        mat.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+        float strength = 1.0f;
+        auto ext_number = [&](const char *ext, const char *key, float *out) {
+            auto it = mt.extensions.find(ext);
+            if (it == mt.extensions.end() || !it->second.IsObject() || !it->second.Has(key)) return;
+            const tinygltf::Value &v = it->second.Get(key);
+            if (!v.IsNumber()) throw Fail(at + ": " + ext + " " + key + " is not a number");
+            *out = to_float(v.GetNumberAsDouble(), at + " " + ext + " " + key);
+        };
+        ext_number("KHR_materials_emissive_strength", "emissiveStrength", &strength);
+        if (!(strength >= 0.0f)) throw Fail(at + ": negative emissiveStrength");
+        ext_number("KHR_materials_specular", "specularFactor", &mat.specular);
+        if (!(mat.specular >= 0.0f && mat.specular <= 1.0f)) throw Fail(at + ": specularFactor is outside [0, 1]");
+        if (!mt.emissiveFactor.empty()) {
+            if (mt.emissiveFactor.size() != 3) throw Fail(at + ": emissiveFactor needs 3 numbers");
+            for (int c = 0; c < 3; c++) {
+                mat.emissive[c] = unit(mt.emissiveFactor[size_t(c)], "emissiveFactor") * strength;
+                if (!std::isfinite(mat.emissive[c])) throw Fail(at + ": emissive strength overflows");
+            }
+        }
         if (!pbr.baseColorFactor.empty()) {
             if (pbr.baseColorFactor.size() != 4) throw Fail(at + ": baseColorFactor needs 4 numbers");
             for (int c = 0; c < 4; c++) mat.base_color[c] = to_float(pbr.baseColorFactor[size_t(c)], at + " baseColorFactor");

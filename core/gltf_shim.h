@@ -38,6 +38,9 @@ typedef struct fv_gltf_node {
 typedef struct fv_gltf_material {
     float base_color[4]; /* pbrMetallicRoughness.baseColorFactor, linear RGBA */
     int image;           /* base colour texture's image (decoded), or -1 */
+    float metallic, roughness; /* pbrMetallicRoughness factors, [0, 1] (default 1, 1) */
+    float specular;      /* KHR_materials_specular specularFactor, [0, 1] (default 1) */
+    float emissive[3];   /* emissiveFactor x KHR_materials_emissive_strength, >= 0 */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {

@@ -10,15 +10,16 @@
 
 typedef struct fv_scene fv_scene;
 
-/* Ambient term of fv_scene_shade, a fraction of the base colour. */
+/* Radiance of the uniform white environment fv_scene_shade reflects (docs/materials.md): a
+ * matte surface gets this fraction of its base colour where no light reaches it. */
 #define FV_SCENE_AMBIENT 0.15f
 
 /* Loads a .gltf or .glb. Returns NULL and writes a one-line reason into err on failure
  * (missing file, malformed JSON, bad accessor, out-of-range index, unsupported required
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
- * transforms; skins, morph targets, animations, samplers' wrap modes and materials beyond
- * the base colour are ignored. The first perspective camera in depth-first node order
+ * transforms; skins, morph targets, animations, samplers' wrap modes and the material maps
+ * other than base colour are ignored (docs/materials.md lists what is read). The first perspective camera in depth-first node order
  * becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
 /* The same, with the folder the scene's external files must lie in (NULL: the scene file's own
@@ -39,6 +40,12 @@ typedef struct fv_mesh_desc {
     size_t vertex_count, index_count;
     float base_color[4];    /* linear RGBA factor */
     int texture;            /* index from fv_scene_add_texture, or -1 */
+    /* glTF metallic-roughness (docs/materials.md). All zero (memset) is the matte material:
+     * pure Lambert, no highlight, no emission. */
+    float metallic;         /* [0, 1] */
+    float roughness;        /* [0, 1] (clamped to FV_MIN_ROUGHNESS, core/brdf.h, when shading) */
+    float specular;         /* [0, 1] weight of the dielectric Fresnel: 1 for glTF materials, 0 matte */
+    float emissive[3];      /* linear RGB added to the shaded colour (>= 0), emissive strength applied */
     float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
 } fv_mesh_desc;
 fv_scene *fv_scene_create(void);
@@ -74,9 +81,12 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out);
  * quat is x,y,z,w, rotating eye space (looking down -Z, +Y up) into world space. */
 int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, float pos[3], float quat[4]);
 
-/* Shades one hit: base colour (factor x texture, bilinear, mip level from the ray footprint)
- * x Lambert over the scene's lights, plus ambient. Without KHR_lights_punctual a head light
- * at eye_pos is used. footprint_rad is the angular size of one pixel along this ray (the
+/* Shades one hit: the glTF metallic-roughness BRDF (core/brdf.h, docs/materials.md) with base
+ * colour (factor x texture, bilinear, mip level from the ray footprint), metallic, roughness and
+ * specular weight over the scene's lights, plus a uniform ambient term (FV_SCENE_AMBIENT, the
+ * BRDF's normal-incidence reflectance) and emission. Without KHR_lights_punctual a head light
+ * of irradiance 1 at eye_pos is used; a light's pi f n.l is scaled so that a white matte
+ * surface facing irradiance 1 gives 1. footprint_rad is the angular size of one pixel along this ray (the
  * ray-cone spread), so the footprint at the hit is about t*|dir|*footprint_rad metres.
  * KHR light contributions are scaled by one exposure per scene, fixed at commit so that the
  * brightest light gives irradiance 1.0 at the bounds' centre (glTF intensities are often in

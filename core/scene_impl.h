@@ -45,6 +45,8 @@ typedef struct fv_mesh_rec {
     size_t vertex_count, tri_count;
     float base_color[4];
     int texture;
+    float metallic, a2, specular; /* the BRDF's (core/brdf.h); a2 = fv_ggx_a2(roughness) */
+    float emissive[3];            /* emitted radiance, strength applied */
 } fv_mesh_rec;
 
 struct fv_scene {

@@ -3,6 +3,7 @@
  * per-triangle texel density for mip selection, attached to the Embree scene. */
 #include "scene_impl.h"
 #include "base/err.h"
+#include "brdf.h"
 
 #include <float.h>
 #include <math.h>
@@ -56,6 +57,18 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
             fv_err(err, err_len, "base colour is not finite");
             return -1;
         }
+    const float unit[3] = {m->metallic, m->roughness, m->specular};
+    for (int c = 0; c < 3; c++)
+        if (!(unit[c] >= 0.0f && unit[c] <= 1.0f)) { /* also NaN */
+            fv_err(err, err_len, "%s %g is outside [0, 1]", c == 0 ? "metallic" : c == 1 ? "roughness" : "specular",
+                   (double)unit[c]);
+            return -1;
+        }
+    for (int c = 0; c < 3; c++)
+        if (!(m->emissive[c] >= 0.0f) || !isfinite(m->emissive[c])) {
+            fv_err(err, err_len, "emissive is negative or not finite");
+            return -1;
+        }
     double M[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     int all_zero = 1;
     for (int i = 0; i < 16; i++) {
@@ -76,6 +89,8 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     memset(&r, 0, sizeof r);
     r.vertex_count = nv, r.tri_count = nt, r.texture = m->texture;
     memcpy(r.base_color, m->base_color, sizeof r.base_color);
+    r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular;
+    memcpy(r.emissive, m->emissive, sizeof r.emissive);
     float *pos = malloc(nv * 3 * sizeof(float));
     uint32_t *tri = malloc(nt * 3 * sizeof(uint32_t));
     float *normals = calloc(nv * 3, sizeof(float));

@@ -1,17 +1,12 @@
-/* fovea: shading one hit (fv_scene_shade): base colour x Lambert over the lights, plus ambient. */
+/* fovea: shading hits (fv_scene_shade, one; fv_scene_shade_packet, an Embree packet): the
+ * material's inputs gathered here, the BRDF and lights in core/shade_lane.h / the kernels. */
 #include "scene_impl.h"
+#include "shade_lane.h"
 #include "base/util.h"
 
 #include <math.h>
 
 _Static_assert(FV_SHADE_LANES == 16, "fv_hit_packet (scene.h) holds 16 lanes");
-
-static float smoothstepf(float e0, float e1, float x)
-{
-    if (e1 <= e0) return x >= e1 ? 1.0f : 0.0f;
-    const float t = fv_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
 
 /* A textured hit's texture coordinates and mip level (from the ray footprint: footprint_rad is
  * the pixel's angle along the ray). */
@@ -56,9 +51,6 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     const uint32_t *tri = m->tri + 3 * (size_t)prim_id;
     const float w = 1.0f - u - v; /* Embree: u weights vertex 1, v vertex 2 */
 
-    /* The hot path (untextured, head light) costs one sqrt and one divide: the normal stays
-     * unnormalised and the Lambert term divides by |n||L| once. Scalar sqrt/div chains were
-     * most of the shading time. */
     float n[3];
     const fv_tri_attr *at = &m->attr[prim_id];
     const float *n0 = at->n, *n1 = at->n + 3, *n2 = at->n + 6;
@@ -74,46 +66,9 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         cross3(e1, e2, n);
         nn = dot3(n, n);
     }
-    if (dot3(n, dir) > 0.0f)
-        for (int k = 0; k < 3; k++) n[k] = -n[k];
-
-    float base[3];
-    base_colour(s, m, prim_id, u, v, w, dir, t, footprint_rad, base);
-
-    const float p[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
-    float light[3] = {FV_SCENE_AMBIENT, FV_SCENE_AMBIENT, FV_SCENE_AMBIENT};
-    if (s->light_count == 0) { /* head light: unit intensity, no falloff */
-        float L[3] = {eye_pos[0] - p[0], eye_pos[1] - p[1], eye_pos[2] - p[2]};
-        const float nl = dot3(n, L), ll = dot3(L, L);
-        if (nl > 0.0f && ll > 0.0f) {
-            const float lam = nl / sqrtf(nn * ll);
-            for (int k = 0; k < 3; k++) light[k] += lam;
-        }
-    } else {
-        const float inv_n = nn > 0.0f ? 1.0f / sqrtf(nn) : 0.0f;
-        for (int k = 0; k < 3; k++) n[k] *= inv_n;
-        for (int i = 0; i < s->light_count; i++) {
-            const fv_light_rec *lr = &s->lights[i];
-            const fv_light *l = &lr->l;
-            float L[3], atten = 1.0f;
-            if (l->type == FV_LIGHT_DIRECTIONAL) {
-                for (int k = 0; k < 3; k++) L[k] = -l->dir[k];
-            } else {
-                for (int k = 0; k < 3; k++) L[k] = l->pos[k] - p[k];
-                const float d = len3(L);
-                if (!(d > 0.0f)) continue;
-                for (int k = 0; k < 3; k++) L[k] /= d;
-                atten = range_window(d, l->range) / (d * d);
-                if (l->type == FV_LIGHT_SPOT)
-                    atten *= smoothstepf(lr->cos_outer, lr->cos_inner, -dot3(l->dir, L));
-            }
-            const float lam = fmaxf(0.0f, dot3(n, L));
-            const float e = lam * atten * l->intensity * s->light_exposure;
-            if (!(e > 0.0f) || !isfinite(e)) continue;
-            for (int k = 0; k < 3; k++) light[k] += l->color[k] * e;
-        }
-    }
-    for (int k = 0; k < 3; k++) rgb[k] = base[k] * light[k];
+    fv_brdf_mat mat = {{0}, m->metallic, m->a2, m->specular};
+    base_colour(s, m, prim_id, u, v, w, dir, t, footprint_rad, mat.base);
+    fv_shade_lane(&mat, m->emissive, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure, rgb);
 }
 
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
@@ -152,7 +107,8 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
         for (int k = 0; k < 3; k++) pk.dir[k][q] = dir[k];
         const float fp = m->texture >= 0 ? px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]) : 0.0f;
-        for (int k = 0; k < 3; k++) pk.base[k][q] = m->base_color[k];
+        for (int k = 0; k < 3; k++) pk.base[k][q] = m->base_color[k], pk.emit[k][q] = m->emissive[k];
+        pk.metal[q] = m->metallic, pk.a2[q] = m->a2, pk.spec[q] = m->specular;
         if (m->texture >= 0) { /* the texel fetches of all lanes are asked for before any is used */
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
@@ -174,7 +130,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     }
     const fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
                               .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
-    unsigned rest = dsp->lambert(&pk, &env, rgb) & hits;
+    unsigned rest = dsp->brdf(&pk, &env, rgb) & hits;
     while (rest) { /* degenerate smooth normals: the scalar path's face normal */
         const int q = __builtin_ctz(rest);
         rest &= rest - 1;

@@ -693,7 +693,10 @@ static void test_gltf_hierarchy(void **state)
     assert_near(h.t, 5.0f, 1e-5f);
     assert_near(h.u, 0.25f, 1e-5f);
     assert_near(h.v, 0.25f, 1e-5f);
-    assert_rgb(rgb, 0.5f * 1.15f, 0.25f * 1.15f, 1.15f, 1e-5f, __LINE__);
+    /* The material gives only baseColorFactor, so metallic and roughness take the glTF
+     * defaults (1, 1): a rough metal. Head-on (n = l = v = h) with a2 = 1: D = 1/pi, V = 1/4,
+     * F = base, so the head light adds pi V D base = base/4 and the ambient 0.15 base. */
+    assert_rgb(rgb, 0.5f * 0.4f, 0.25f * 0.4f, 0.4f, 1e-5f, __LINE__);
     /* Without the rotation the triangle would be in the plane z = -5 at x in [0,1]. */
     const float o2[3] = {0.25f, 0.25f, 0}, d2[3] = {0, 0, -1};
     assert_false(cast(s, o2, d2, &h));
@@ -878,6 +881,78 @@ static void test_packet_shading_matches_scalar(void **state)
     s = commit_or_fail(s);
     check_packets(s, 3);
     fv_scene_free(s);
+}
+
+/* ---- glTF materials ------------------------------------------------------------------ */
+
+/* Four unit-normal quads [-1,1]^2 at z = 0 (nodes at x = 0, 3, 6, 9), each with its own
+ * material, seen head-on from z = 5 with the head light at the eye (n = l = v = h, Schlick
+ * weight 0). Expected values (tests/test_brdf.c works the BRDF out the same way):
+ *   0 dielectric base 0.5 roughness 0.5: pi V D = 4, 0.96 x 0.5 + 0.04 x 4 = 0.64; ambient
+ *     0.15 (0.96 x 0.5 + 0.04) = 0.078: 0.718
+ *   1 metal base 0.5 roughness 0.5: 4 x 0.5 = 2; ambient 0.15 x 0.5: 2.075
+ *   2 black rough dielectric, emissive (0.2, 0.4, 0.1) x KHR_materials_emissive_strength 5:
+ *     0.04 x 1/4 + 0.15 x 0.04 + emission = (1.016, 2.016, 0.516)
+ *   3 KHR_materials_specular specularFactor 0, base 0.5: matte, 0.5 + 0.075 = 0.575 */
+static void test_gltf_pbr_materials(void **state)
+{
+    (void)state;
+    unsigned char bin[60];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, idx, 12);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"extensionsUsed\":[\"KHR_materials_emissive_strength\",\"KHR_materials_specular\"],"
+        "\"materials\":["
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":0,\"roughnessFactor\":0.5}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":1,\"roughnessFactor\":0.5}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0},\"emissiveFactor\":[0.2,0.4,0.1],"
+        "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":5}}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":0},"
+        "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":1}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":2}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":3}]}],"
+        "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[3,0,0]},{\"mesh\":2,\"translation\":[6,0,0]},"
+        "{\"mesh\":3,\"translation\":[9,0,0]}],\"scenes\":[{\"nodes\":[0,1,2,3]}],\"scene\":0";
+    char *dir = tmpdir_make(), p[512], err[512];
+    path_join(p, sizeof p, dir, "pbr.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    static const float want[4][3] = {{0.718f, 0.718f, 0.718f}, {2.075f, 2.075f, 2.075f},
+                                     {1.016f, 2.016f, 0.516f}, {0.575f, 0.575f, 0.575f}};
+    for (int i = 0; i < 4; i++) {
+        const float o[3] = {3.0f * (float)i + 0.3f, -0.2f, 5}, d[3] = {0, 0, -1};
+        hit h;
+        float rgb[3];
+        cast_shade(s, o, d, 0, &h, rgb);
+        assert_int_equal(h.geom, (unsigned)i);
+        assert_rgb(rgb, want[i][0], want[i][1], want[i][2], 2e-6f * 4, __LINE__);
+    }
+    check_packets(s, 4); /* every ISA's kernel gives these bits from other directions too */
+    fv_scene_free(s);
+
+    /* out-of-range factors are refused, naming them */
+    char bad[4096];
+    snprintf(bad, sizeof bad, "%s", json);
+    char *m = strstr(bad, "\"metallicFactor\":1");
+    assert_non_null(m);
+    memcpy(m, "\"metallicFactor\":2", 18);
+    write_gltf(p, bin, sizeof bin, bad);
+    expect_load_fails(p, "metallicFactor");
+    const char *e5 = strstr(json, "\"emissiveStrength\":5");
+    assert_non_null(e5);
+    snprintf(bad, sizeof bad, "%.*s\"emissiveStrength\":-5%s", (int)(e5 - json), json, e5 + 20);
+    write_gltf(p, bin, sizeof bin, bad);
+    expect_load_fails(p, "negative emissiveStrength");
+    tmpdir_remove(dir);
 }
 
 /* ---- hostile files ------------------------------------------------------------------- */
@@ -1346,6 +1421,7 @@ int main(void)
         cmocka_unit_test(test_gltf_hierarchy),
         cmocka_unit_test(test_gltf_camera),
         cmocka_unit_test(test_gltf_sparse),
+        cmocka_unit_test(test_gltf_pbr_materials),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),

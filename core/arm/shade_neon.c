@@ -28,7 +28,7 @@ static inline int mbits(uint32x4_t m)
     return (int)vaddvq_u32(vandq_u32(m, vld1q_u32(bit)));
 }
 #define MBITS mbits
-#define SHADE_FN lambert_neon
+#define SHADE_FN brdf_neon
 #include "shade_tmpl.h"
 
-void fv_shade_dsp_init_neon(fv_shade_dsp *d) { d->lambert = lambert_neon; }
+void fv_shade_dsp_init_neon(fv_shade_dsp *d) { d->brdf = brdf_neon; }

@@ -49,5 +49,5 @@ typedef __m128 V;
 #define MBITS(m) _mm_movemask_ps(m)
 #endif
 typedef V M;
-#define SHADE_FN FV_X86_FN(lambert)
+#define SHADE_FN FV_X86_FN(brdf)
 #include "../shade_tmpl.h"
