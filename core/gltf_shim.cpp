@@ -471,7 +471,7 @@ struct Holder {
     std::vector<fv_gltf_material> materials;
     std::vector<fv_gltf_image> images;
     std::vector<fv_gltf_light> lights;
-    std::vector<int> material_texcoord; // TEXCOORD_n set of each material's base colour texture
+    std::vector<int> material_texcoord; // TEXCOORD_n set of each material's textures
     size_t skipped_prims = 0;           // points and lines
     std::string warning;
 };
@@ -487,7 +487,7 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
     for (size_t i = 0; i < m.materials.size(); i++) {
         const std::string at = "material " + str(i);
         const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
-        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}};
+        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1};
         const tinygltf::Material &mt = m.materials[i];
         auto unit = [&](double d, const char *name) {
             const float f = to_float(d, at + " " + name);
@@ -519,18 +519,27 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
             if (pbr.baseColorFactor.size() != 4) throw Fail(at + ": baseColorFactor needs 4 numbers");
             for (int c = 0; c < 4; c++) mat.base_color[c] = to_float(pbr.baseColorFactor[size_t(c)], at + " baseColorFactor");
         }
-        int texcoord = 0;
-        const int ti = pbr.baseColorTexture.index;
-        if (ti >= 0) {
-            if (size_t(ti) >= m.textures.size()) throw Fail(at + ": base colour texture " + str(ti) + " does not exist");
+        int texcoord = -1; // the first texture's set; a map on another set is left out
+        auto texture = [&](int ti, int tc, const char *what, int *image) {
+            if (ti < 0) return;
+            if (size_t(ti) >= m.textures.size()) throw Fail(at + ": " + what + " texture " + str(ti) + " does not exist");
             const int src = m.textures[size_t(ti)].source;
             if (src >= 0 && size_t(src) >= m.images.size())
                 throw Fail("texture " + str(ti) + ": image " + str(src) + " does not exist");
-            texcoord = pbr.baseColorTexture.texCoord;
-            if (texcoord < 0) throw Fail(at + ": negative texCoord");
-            mat.image = src; // -1 (e.g. an extension-only source) means factor only
-            if (src >= 0) (*image_used)[size_t(src)] = 1;
-        }
+            if (tc < 0) throw Fail(at + ": negative texCoord");
+            if (src < 0) return; // (e.g. an extension-only source): factor only
+            if (texcoord < 0) texcoord = tc;
+            if (tc != texcoord) return;
+            *image = src;
+            (*image_used)[size_t(src)] = 1;
+        };
+        texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, "base colour", &mat.image);
+        texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, "metallic-roughness",
+                &mat.mr_image);
+        texture(mt.occlusionTexture.index, mt.occlusionTexture.texCoord, "occlusion", &mat.occlusion_image);
+        texture(mt.emissiveTexture.index, mt.emissiveTexture.texCoord, "emissive", &mat.emissive_image);
+        if (texcoord < 0) texcoord = 0;
+        if (mat.occlusion_image >= 0) mat.occlusion_strength = unit(mt.occlusionTexture.strength, "occlusion strength");
         h.materials.push_back(mat);
         h.material_texcoord.push_back(texcoord);
     }
@@ -612,7 +621,9 @@ void convert_meshes(const tinygltf::Model &m, Holder &h)
                 return keep(h, std::move(v));
             };
             out.normals = attr("NORMAL", 3);
-            const int set = out.material >= 0 && h.materials[size_t(out.material)].image >= 0
+            const fv_gltf_material *pm = out.material >= 0 ? &h.materials[size_t(out.material)] : nullptr;
+            const int set = pm && (pm->image >= 0 || pm->mr_image >= 0 || pm->occlusion_image >= 0 ||
+                                   pm->emissive_image >= 0)
                                 ? h.material_texcoord[size_t(out.material)] : -1;
             out.uvs = set >= 0 ? attr("TEXCOORD_" + str(set), 2) : nullptr;
 

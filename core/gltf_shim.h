@@ -16,7 +16,7 @@ extern "C" {
 typedef struct fv_gltf_prim {
     const float *positions;  /* 3 per vertex, mesh-local, all finite */
     const float *normals;    /* 3 per vertex, or NULL */
-    const float *uvs;        /* 2 per vertex (the set the material's base colour texture uses), or NULL */
+    const float *uvs;        /* 2 per vertex (the set the material's textures use), or NULL */
     const uint32_t *indices; /* index_count, each < vertex_count; NULL: non-indexed */
     size_t vertex_count, index_count; /* index_count (or vertex_count if non-indexed) % 3 == 0 */
     int material;            /* index into materials, or -1 (glTF default material) */
@@ -41,10 +41,14 @@ typedef struct fv_gltf_material {
     float metallic, roughness; /* pbrMetallicRoughness factors, [0, 1] (default 1, 1) */
     float specular;      /* KHR_materials_specular specularFactor, [0, 1] (default 1) */
     float emissive[3];   /* emissiveFactor x KHR_materials_emissive_strength, >= 0 */
+    /* metallicRoughnessTexture, occlusionTexture, emissiveTexture images (decoded), or -1; only
+     * those on the same TEXCOORD set as the material's first texture (prim uvs) are kept */
+    int mr_image, occlusion_image, emissive_image;
+    float occlusion_strength; /* occlusionTexture.strength, [0, 1] */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {
-    const uint8_t *rgba8; /* sRGB RGBA8, width*height*4; NULL if no material uses it as base colour */
+    const uint8_t *rgba8; /* RGBA8 as stored, width*height*4; NULL if no material uses it */
     int width, height;
 } fv_gltf_image;
 

@@ -18,8 +18,9 @@ typedef struct fv_scene fv_scene;
  * (missing file, malformed JSON, bad accessor, out-of-range index, unsupported required
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
- * transforms; skins, morph targets, animations, samplers' wrap modes and the material maps
- * other than base colour are ignored (docs/materials.md lists what is read). The first perspective camera in depth-first node order
+ * transforms; materials as docs/materials.md says (metallic-roughness with its base colour,
+ * metallic-roughness, occlusion and emissive maps; normal maps, alpha, texture transforms and
+ * samplers' wrap modes are not read yet); skins, morph targets and animations are ignored. The first perspective camera in depth-first node order
  * becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
 /* The same, with the folder the scene's external files must lie in (NULL: the scene file's own
@@ -32,6 +33,15 @@ const char *fv_scene_warning(const fv_scene *s);
 void fv_scene_set_warning(fv_scene *s, const char *w);
 
 /* Building a scene by hand (tests, generators): create, add meshes, commit. */
+/* A material's texture maps besides base colour (glTF's, read as the specification says): each
+ * a texture index (fv_scene_add_texture_linear for metallic-roughness and occlusion,
+ * fv_scene_add_texture for emissive) or -1. They use the mesh's uvs. */
+typedef struct fv_material_maps {
+    int metallic_roughness; /* G: roughness, B: metallic, multiplying the factors */
+    int occlusion;          /* R: ambient occlusion, applied as 1 + strength (R - 1) */
+    int emissive;           /* RGB (sRGB), multiplying the emissive factor */
+    float occlusion_strength; /* [0, 1] */
+} fv_material_maps;
 typedef struct fv_mesh_desc {
     const float *positions; /* 3 floats per vertex, world space (the transform below is applied) */
     const float *normals;   /* 3 per vertex, or NULL: computed (area-weighted smooth) */
@@ -46,11 +56,14 @@ typedef struct fv_mesh_desc {
     float roughness;        /* [0, 1] (clamped to FV_MIN_ROUGHNESS, core/brdf.h, when shading) */
     float specular;         /* [0, 1] weight of the dielectric Fresnel: 1 for glTF materials, 0 matte */
     float emissive[3];      /* linear RGB added to the shaded colour (>= 0), emissive strength applied */
+    const fv_material_maps *maps; /* NULL: none */
     float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
 } fv_mesh_desc;
 fv_scene *fv_scene_create(void);
 /* rgba8 is sRGB-encoded 8-bit RGBA, copied. Returns the texture index or -1. */
 int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h);
+/* The same for data (metallic-roughness, occlusion): the bytes are linear, v / 255. */
+int fv_scene_add_texture_linear(fv_scene *s, const uint8_t *rgba8, int w, int h);
 /* Validates (indices < vertex_count, counts multiple of 3, finite data, texture index) and
  * flattens the mesh to world space. Returns 0, or -1 with err (the scene is unchanged).
  * Meshes get Embree geometry IDs 0, 1, 2, ... in the order they were added successfully. */

@@ -37,6 +37,7 @@ typedef struct fv_tri_face {
     float ng[3], ng_len;
 } fv_tri_face;
 
+enum { FV_MAP_MR, FV_MAP_OCC, FV_MAP_EMIS };
 typedef struct fv_mesh_rec {
     const float *pos;      /* world positions, 3 per vertex: Embree's vertex buffer */
     const uint32_t *tri;   /* 3 per triangle: Embree's index buffer */
@@ -46,7 +47,12 @@ typedef struct fv_mesh_rec {
     float base_color[4];
     int texture;
     float metallic, a2, specular; /* the BRDF's (core/brdf.h); a2 = fv_ggx_a2(roughness) */
+    float roughness;              /* the factor (a metallic-roughness map multiplies it) */
     float emissive[3];            /* emitted radiance, strength applied */
+    int map[3];                   /* FV_MAP_*: texture index or -1 */
+    float occlusion_strength;
+    int tex_ref;                  /* the texture texel_density counts (first of texture, map[]), or -1 */
+    float lod_bias[4];            /* base colour, map[0..2]: log2 of the texel ratio to tex_ref */
 } fv_mesh_rec;
 
 struct fv_scene {

@@ -48,8 +48,22 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         fv_err(err, err_len, "texture %d does not exist", m->texture);
         return -1;
     }
-    if (m->texture >= 0 && !m->uvs) {
+    const int map[3] = {m->maps ? m->maps->metallic_roughness : -1, m->maps ? m->maps->occlusion : -1,
+                        m->maps ? m->maps->emissive : -1};
+    int tex_ref = m->texture;
+    for (int j = 0; j < 3; j++) {
+        if (map[j] < -1 || map[j] >= s->texture_count) {
+            fv_err(err, err_len, "material map texture %d does not exist", map[j]);
+            return -1;
+        }
+        if (tex_ref < 0) tex_ref = map[j];
+    }
+    if (tex_ref >= 0 && !m->uvs) {
         fv_err(err, err_len, "texture without uvs");
+        return -1;
+    }
+    if (m->maps && !(m->maps->occlusion_strength >= 0.0f && m->maps->occlusion_strength <= 1.0f)) {
+        fv_err(err, err_len, "occlusion strength %g is outside [0, 1]", (double)m->maps->occlusion_strength);
         return -1;
     }
     for (int c = 0; c < 4; c++)
@@ -89,17 +103,31 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     memset(&r, 0, sizeof r);
     r.vertex_count = nv, r.tri_count = nt, r.texture = m->texture;
     memcpy(r.base_color, m->base_color, sizeof r.base_color);
-    r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular;
+    r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular, r.roughness = m->roughness;
+    r.tex_ref = tex_ref;
+    r.occlusion_strength = m->maps ? m->maps->occlusion_strength : 0.0f;
+    for (int j = 0; j < 4; j++) { /* a map with 4x the texels of tex_ref is one mip level further down at the same footprint */
+        const int tx = j == 0 ? m->texture : map[j - 1];
+        if (j > 0) r.map[j - 1] = tx;
+        r.lod_bias[j] = 0.0f;
+        if (tx >= 0 && tx != tex_ref) {
+            const fv_texture *a = &s->textures[tx], *b = &s->textures[tex_ref];
+            r.lod_bias[j] = (float)(0.5 * log2(((double)a->w[0] * a->h[0]) / ((double)b->w[0] * b->h[0])));
+        }
+    }
+    /* maps that cannot change the result are not sampled */
+    if (r.occlusion_strength == 0.0f) r.map[FV_MAP_OCC] = -1;
+    if (m->emissive[0] == 0.0f && m->emissive[1] == 0.0f && m->emissive[2] == 0.0f) r.map[FV_MAP_EMIS] = -1;
     memcpy(r.emissive, m->emissive, sizeof r.emissive);
     float *pos = malloc(nv * 3 * sizeof(float));
     uint32_t *tri = malloc(nt * 3 * sizeof(uint32_t));
     float *normals = calloc(nv * 3, sizeof(float));
     float *uvs = m->uvs ? malloc(nv * 2 * sizeof(float)) : NULL;
-    float *density = m->texture >= 0 ? malloc(nt * sizeof(float)) : NULL;
+    float *density = tex_ref >= 0 ? malloc(nt * sizeof(float)) : NULL;
     r.attr = aligned_alloc(64, nt * sizeof *r.attr);
-    r.face = m->texture >= 0 ? malloc(nt * sizeof *r.face) : NULL;
+    r.face = tex_ref >= 0 ? malloc(nt * sizeof *r.face) : NULL;
     RTCGeometry g = NULL;
-    if (!pos || !tri || !normals || !r.attr || (m->texture >= 0 && !r.face) || (m->uvs && !uvs) || (m->texture >= 0 && !density)) {
+    if (!pos || !tri || !normals || !r.attr || (tex_ref >= 0 && !r.face) || (m->uvs && !uvs) || (tex_ref >= 0 && !density)) {
         fv_err(err, err_len, "out of memory");
         goto fail;
     }
@@ -164,7 +192,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         memcpy(uvs, m->uvs, nv * 2 * sizeof(float));
     }
     if (density) {
-        const fv_texture *tx = &s->textures[m->texture];
+        const fv_texture *tx = &s->textures[tex_ref];
         const double texels = (double)tx->w[0] * (double)tx->h[0];
         for (size_t t = 0; t < nt; t++) {
             float e1[3], e2[3], fn[3];

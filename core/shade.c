@@ -27,17 +27,41 @@ static void tex_coords(const fv_mesh_rec *m, unsigned prim, float u, float v, fl
     }
 }
 
-/* The material's base colour at the hit, times its texture (trilinear). */
-static void base_colour(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
-                        const float dir[3], float t, float footprint_rad, float base[3])
+/* The material's inputs at a hit from the texels of its maps (NULL: no such map); the one
+ * definition both paths use. glTF: metallic in B, roughness in G, occlusion in R. */
+static void material_at(const fv_mesh_rec *m, const float *base_tx, const float *mr, const float *oc, const float *em,
+                        fv_brdf_mat *mat, float *occ, float emit[3])
 {
-    base[0] = m->base_color[0], base[1] = m->base_color[1], base[2] = m->base_color[2];
-    if (m->texture < 0)
-        return;
-    float tu, tv, lod, texel[4];
-    tex_coords(m, prim, u, v, w, dir, t, footprint_rad, &tu, &tv, &lod);
-    fv_texture_sample(&s->textures[m->texture], tu, tv, lod, texel);
-    for (int k = 0; k < 3; k++) base[k] *= texel[k];
+    for (int k = 0; k < 3; k++) mat->base[k] = base_tx ? m->base_color[k] * base_tx[k] : m->base_color[k];
+    mat->metallic = m->metallic, mat->a2 = m->a2, mat->specular = m->specular;
+    if (mr) {
+        mat->metallic = m->metallic * mr[2];
+        mat->a2 = fv_ggx_a2(m->roughness * mr[1]);
+    }
+    *occ = oc ? 1.0f + m->occlusion_strength * (oc[0] - 1.0f) : 1.0f;
+    for (int k = 0; k < 3; k++) emit[k] = em ? m->emissive[k] * em[k] : m->emissive[k];
+}
+
+/* Slot j's texture: 0 base colour, 1 + FV_MAP_*. */
+static int slot_texture(const fv_mesh_rec *m, int j) { return j == 0 ? m->texture : m->map[j - 1]; }
+
+/* The material at the hit, every map sampled trilinearly at the footprint's mip level. */
+static void material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
+                     const float dir[3], float t, float footprint_rad, fv_brdf_mat *mat, float *occ, float emit[3])
+{
+    float texel[4][4];
+    const float *tx[4] = {NULL, NULL, NULL, NULL};
+    if (m->tex_ref >= 0) {
+        float tu, tv, lod;
+        tex_coords(m, prim, u, v, w, dir, t, footprint_rad, &tu, &tv, &lod);
+        for (int j = 0; j < 4; j++) {
+            const int id = slot_texture(m, j);
+            if (id < 0) continue;
+            fv_texture_sample(&s->textures[id], tu, tv, lod + m->lod_bias[j], texel[j]);
+            tx[j] = texel[j];
+        }
+    }
+    material_at(m, tx[0], tx[1], tx[2], tx[3], mat, occ, emit);
 }
 
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
@@ -66,9 +90,10 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         cross3(e1, e2, n);
         nn = dot3(n, n);
     }
-    fv_brdf_mat mat = {{0}, m->metallic, m->a2, m->specular};
-    base_colour(s, m, prim_id, u, v, w, dir, t, footprint_rad, mat.base);
-    fv_shade_lane(&mat, m->emissive, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure, rgb);
+    fv_brdf_mat mat;
+    float occ, emit[3];
+    material(s, m, prim_id, u, v, w, dir, t, footprint_rad, &mat, &occ, emit);
+    fv_shade_lane(&mat, occ, emit, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure, rgb);
 }
 
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
@@ -88,7 +113,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     /* Per thread, zero at start: lanes of misses keep whatever an earlier packet left there
      * (finite, initialised: their results are not used), so a miss costs no stores. */
     static _Thread_local _Alignas(64) fv_shade_packet pk;
-    fv_tex_taps taps[FV_SHADE_LANES];
+    fv_tex_taps taps[4][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
     for (int q = 0; q < n; q++) {
         const unsigned g = h->geom[q], prim = h->prim[q];
@@ -106,22 +131,40 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
         pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
         for (int k = 0; k < 3; k++) pk.dir[k][q] = dir[k];
-        const float fp = m->texture >= 0 ? px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]) : 0.0f;
-        for (int k = 0; k < 3; k++) pk.base[k][q] = m->base_color[k], pk.emit[k][q] = m->emissive[k];
-        pk.metal[q] = m->metallic, pk.a2[q] = m->a2, pk.spec[q] = m->specular;
-        if (m->texture >= 0) { /* the texel fetches of all lanes are asked for before any is used */
+        if (m->tex_ref >= 0) { /* the texel fetches of all lanes are asked for before any is used */
+            const float fp = px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
-            fv_texture_taps(&s->textures[m->texture], tu, tv, lod, &taps[q]);
-            fv_texture_taps_prefetch(&taps[q]);
+            for (int j = 0; j < 4; j++) {
+                const int id = slot_texture(m, j);
+                if (id < 0) continue;
+                fv_texture_taps(&s->textures[id], tu, tv, lod + m->lod_bias[j], &taps[j][q]);
+                fv_texture_taps_prefetch(&taps[j][q]);
+            }
             textured |= 1u << q;
+        } else {
+            fv_brdf_mat mat;
+            float occ, emit[3];
+            material_at(m, NULL, NULL, NULL, NULL, &mat, &occ, emit);
+            for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
+            pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
         }
     }
     for (unsigned r = textured; r; r &= r - 1) {
         const int q = __builtin_ctz(r);
-        float texel[4];
-        fv_texture_blend(&taps[q], texel);
-        for (int k = 0; k < 3; k++) pk.base[k][q] *= texel[k];
+        const fv_mesh_rec *m = &s->meshes[h->geom[q]];
+        float texel[4][4];
+        const float *tx[4] = {NULL, NULL, NULL, NULL};
+        for (int j = 0; j < 4; j++)
+            if (slot_texture(m, j) >= 0) {
+                fv_texture_blend(&taps[j][q], texel[j]);
+                tx[j] = texel[j];
+            }
+        fv_brdf_mat mat;
+        float occ, emit[3];
+        material_at(m, tx[0], tx[1], tx[2], tx[3], &mat, &occ, emit);
+        for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
+        pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
     }
     if (!hits) { /* all misses: nothing to shade */
         for (; black; black &= black - 1)

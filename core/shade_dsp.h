@@ -40,6 +40,7 @@ typedef struct fv_shade_packet {
     float a2[FV_SHADE_LANES];      /* fv_ggx_a2(roughness) (core/brdf.h) */
     float spec[FV_SHADE_LANES];    /* dielectric Fresnel weight: 1 glTF, 0 matte */
     float emit[3][FV_SHADE_LANES]; /* emitted radiance, linear RGB */
+    float occl[FV_SHADE_LANES];    /* ambient occlusion, 1 = none */
 } fv_shade_packet;
 
 /* brdf: rgb of every one of the FV_SHADE_LANES lanes (all lanes are read and written: pad a

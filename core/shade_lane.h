@@ -44,9 +44,10 @@ static inline void fv_lane_add_light(const fv_brdf_mat *m, const float n[3], con
     for (int k = 0; k < 3; k++) rgb[k] += f[k] * (color[k] * e);
 }
 
-/* n: the interpolated (or face) normal, unnormalised, nn = |n|^2 > 0; the hit is org + t dir.
+/* occlusion: the material's ambient occlusion (1 none) at the hit.
+ * n: the interpolated (or face) normal, unnormalised, nn = |n|^2 > 0; the hit is org + t dir.
  * Normals are turned to face the ray (every material is shaded two-sided). */
-static inline void fv_shade_lane(const fv_brdf_mat *m, const float emit[3], const float n_in[3], float nn,
+static inline void fv_shade_lane(const fv_brdf_mat *m, float occlusion, const float emit[3], const float n_in[3], float nn,
                                  const float org[3], const float dir[3], float t, const float eye[3],
                                  const fv_light_rec *lights, int nlights, float exposure, float rgb[3])
 {
@@ -59,7 +60,7 @@ static inline void fv_shade_lane(const fv_brdf_mat *m, const float emit[3], cons
     const float v[3] = {-dir[0] * inv_d, -dir[1] * inv_d, -dir[2] * inv_d};
     const float nv = fv_lane_dot3(n, v);
     const float hit[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
-    fv_brdf_ambient(m, FV_SCENE_AMBIENT, rgb);
+    fv_brdf_ambient(m, FV_SCENE_AMBIENT * occlusion, rgb); /* occlusion darkens the surround only */
     if (nlights == 0) { /* head light: irradiance 1, white, no falloff */
         float L[3] = {eye[0] - hit[0], eye[1] - hit[1], eye[2] - hit[2]};
         const float ll = fv_lane_dot3(L, L);

@@ -100,9 +100,10 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
         V out[3];
         { /* fv_brdf_ambient */
             const V f0 = VMUL(specw, VS(FV_DIELECTRIC_F0));
+            const V amb = VMUL(VS(FV_SCENE_AMBIENT), VLD(p->occl + i));
             for (int k = 0; k < 3; k++) {
                 const V diel = VADD(VMUL(VSUB(one, f0), base[k]), f0);
-                out[k] = VMUL(VS(FV_SCENE_AMBIENT), VADD(VMUL(VSUB(one, metal), diel), VMUL(metal, base[k])));
+                out[k] = VMUL(amb, VADD(VMUL(VSUB(one, metal), diel), VMUL(metal, base[k])));
             }
         }
         if (env->nlights == 0) { /* head light: irradiance 1, white, no falloff */

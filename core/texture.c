@@ -1,4 +1,4 @@
-/* fovea: scene textures: sRGB 8-bit RGBA stored as linear float RGBA with a box-filtered mip
+/* fovea: scene textures: sRGB (or linear data) 8-bit RGBA stored as linear float RGBA with a box-filtered mip
  * chain, sampled trilinearly with REPEAT addressing. */
 #include "scene_impl.h"
 
@@ -35,7 +35,7 @@ static void downsample(const float *src, int sw, int sh, float *dst, int dw, int
     }
 }
 
-int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h)
+static int add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h, int srgb)
 {
     if (!s || !rgba8 || w < 1 || h < 1 || w > FV_TEX_MAX_SIDE || h > FV_TEX_MAX_SIDE ||
         (size_t)w * (size_t)h > FV_TEX_MAX_TEXELS)
@@ -59,7 +59,7 @@ int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h)
     float lut[256]; /* sRGB -> linear */
     for (int i = 0; i < 256; i++) {
         float c = (float)i / 255.0f;
-        lut[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+        lut[i] = !srgb ? c : c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
     }
     const size_t n = (size_t)w * (size_t)h;
     for (size_t i = 0; i < n; i++) {
@@ -71,6 +71,12 @@ int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h)
         downsample(t.data + offs[l - 1], t.w[l - 1], t.h[l - 1], t.data + offs[l], t.w[l], t.h[l]);
     s->textures[s->texture_count] = t;
     return s->texture_count++;
+}
+
+int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h) { return add_texture(s, rgba8, w, h, 1); }
+int fv_scene_add_texture_linear(fv_scene *s, const uint8_t *rgba8, int w, int h)
+{
+    return add_texture(s, rgba8, w, h, 0);
 }
 
 /* Bilinear, REPEAT addressing; uv (0,0) is the first texel of the first row (glTF). */

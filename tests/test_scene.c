@@ -7,6 +7,8 @@
 #include "scene.h"
 #include "shade_dsp.h"
 
+#include <stb/stb_image_write.h>
+
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -955,6 +957,57 @@ static void test_gltf_pbr_materials(void **state)
     tmpdir_remove(dir);
 }
 
+/* A quad [-1,1]^2 (uv = ((x+1)/2, (y+1)/2)) with 2x1 maps, sampled at texel centres (u 0.25 and
+ * 0.75, v 0.5) head-on with the head light; base colour factor 0.5, roughness factor 0.5.
+ * metallicRoughnessTexture (linear; G roughness, B metallic) also the occlusionTexture (R):
+ *   left  (0, 255, 0): roughness 0.5, dielectric, occlusion 0 (no ambient): 0.64
+ *   right (255, 255, 255): roughness 0.5, metal, occlusion 1: 2 + 0.15 x 0.5 = 2.075
+ * emissiveTexture (sRGB) (255, 0, 0) left, black right, emissiveFactor 1: left gains (1, 0, 0).
+ * The head-on values are worked out in test_gltf_pbr_materials. */
+static void test_gltf_material_maps(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char mr[8] = {0, 255, 0, 255, 255, 255, 255, 255}, em[8] = {255, 0, 0, 255, 0, 0, 0, 255};
+    path_join(p, sizeof p, dir, "mr.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, mr, 8) != 0);
+    path_join(p, sizeof p, dir, "em.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, em, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+        "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+        "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"images\":[{\"uri\":\"mr.png\"},{\"uri\":\"em.png\"}],\"textures\":[{\"source\":0},{\"source\":1}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"roughnessFactor\":0.5,"
+        "\"metallicRoughnessTexture\":{\"index\":0}},\"occlusionTexture\":{\"index\":0},"
+        "\"emissiveTexture\":{\"index\":1},\"emissiveFactor\":[1,1,1]}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0";
+    path_join(p, sizeof p, dir, "maps.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    const float d[3] = {0, 0, -1}, left[3] = {-0.5f, 0, 5}, right[3] = {0.5f, 0, 5};
+    hit h;
+    float rgb[3];
+    cast_shade(s, left, d, 0, &h, rgb);
+    assert_rgb(rgb, 1.64f, 0.64f, 0.64f, 1e-5f, __LINE__);
+    cast_shade(s, right, d, 0, &h, rgb);
+    assert_rgb(rgb, 2.075f, 2.075f, 2.075f, 1e-5f, __LINE__);
+    check_packets(s, 5); /* the maps through the packet path: the same bits */
+    fv_scene_free(s);
+    tmpdir_remove(dir);
+}
+
 /* ---- hostile files ------------------------------------------------------------------- */
 
 /* A scene's external files stay inside its folder tree (or --asset-root's): `..`, percent-escaped
@@ -1422,6 +1475,7 @@ int main(void)
         cmocka_unit_test(test_gltf_camera),
         cmocka_unit_test(test_gltf_sparse),
         cmocka_unit_test(test_gltf_pbr_materials),
+        cmocka_unit_test(test_gltf_material_maps),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),

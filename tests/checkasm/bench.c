@@ -483,7 +483,8 @@ static void *shade_setup(void)
             for (int k = 0; k < 9; k++) p->nrm[k][q] = frand(&s, -1.0f, 1.0f);
             for (int k = 0; k < 3; k++)
                 p->dir[k][q] = k == 2 ? -1.0f : frand(&s, -1.0f, 1.0f), p->base[k][q] = frand(&s, 0.0f, 1.0f);
-            p->metal[q] = q & 1 ? 1.0f : 0.0f, p->a2[q] = frand(&s, 0.0f, 1.0f), p->spec[q] = 1.0f; /* glTF */
+            p->metal[q] = q & 1 ? 1.0f : 0.0f, p->a2[q] = frand(&s, 0.0f, 1.0f); /* glTF materials */
+            p->spec[q] = 1.0f, p->occl[q] = 1.0f;
         }
     t->lights[0].l = (fv_light){.type = FV_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .dir = {0, -1, 0}};
     t->lights[1].l = (fv_light){.type = FV_LIGHT_POINT, .color = {1, 0.8f, 0.6f}, .intensity = 50, .pos = {2, 5, 1},

@@ -52,6 +52,7 @@ static void gen_packet(fv_shade_packet *p, int mode)
         static const float roughs[] = {0.0f, FV_MIN_ROUGHNESS, 1.0f, 0.5f};
         const float r = mode == M_EDGE ? roughs[checkasm_rand() % 4] : rnd(0.0f, 1.0f);
         p->a2[q] = fv_ggx_a2(r);
+        p->occl[q] = checkasm_rand() % 2 ? 1.0f : rnd(0.0f, 1.0f);
     }
 }
 
