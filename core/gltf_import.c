@@ -88,6 +88,7 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                     const fv_gltf_material *mat = &g->materials[p->material];
                     memcpy(d.base_color, mat->base_color, sizeof d.base_color);
                     d.metallic = mat->metallic, d.roughness = mat->roughness, d.specular = mat->specular;
+                    d.alpha_cutoff = mat->alpha_cutoff;
                     memcpy(d.emissive, mat->emissive, sizeof d.emissive);
                     /* no uvs: factors only */
                     const int img[4] = {mat->image, mat->mr_image, mat->occlusion_image, mat->emissive_image};

@@ -45,6 +45,7 @@ typedef struct fv_gltf_material {
      * those on the same TEXCOORD set as the material's first texture (prim uvs) are kept */
     int mr_image, occlusion_image, emissive_image;
     float occlusion_strength; /* occlusionTexture.strength, [0, 1] */
+    float alpha_cutoff;  /* alphaMode MASK: alphaCutoff (default 0.5); OPAQUE and BLEND: 0 */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {

@@ -19,7 +19,7 @@ typedef struct fv_scene fv_scene;
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
  * transforms; materials as docs/materials.md says (metallic-roughness with its base colour,
- * metallic-roughness, occlusion and emissive maps; normal maps, alpha, texture transforms and
+ * metallic-roughness, occlusion and emissive maps, alpha MASK; normal maps, BLEND, texture transforms and
  * samplers' wrap modes are not read yet); skins, morph targets and animations are ignored. The first perspective camera in depth-first node order
  * becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
@@ -57,6 +57,8 @@ typedef struct fv_mesh_desc {
     float specular;         /* [0, 1] weight of the dielectric Fresnel: 1 for glTF materials, 0 matte */
     float emissive[3];      /* linear RGB added to the shaded colour (>= 0), emissive strength applied */
     const fv_material_maps *maps; /* NULL: none */
+    float alpha_cutoff;     /* > 0: glTF alpha MASK: rays pass through where the base alpha (factor x
+                             * texture, bilinear at mip 0) is below it; 0: opaque */
     float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
 } fv_mesh_desc;
 fv_scene *fv_scene_create(void);

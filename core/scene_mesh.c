@@ -62,6 +62,10 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         fv_err(err, err_len, "texture without uvs");
         return -1;
     }
+    if (!(m->alpha_cutoff >= 0.0f && m->alpha_cutoff <= 1.0f)) {
+        fv_err(err, err_len, "alpha cutoff %g is outside [0, 1]", (double)m->alpha_cutoff);
+        return -1;
+    }
     if (m->maps && !(m->maps->occlusion_strength >= 0.0f && m->maps->occlusion_strength <= 1.0f)) {
         fv_err(err, err_len, "occlusion strength %g is outside [0, 1]", (double)m->maps->occlusion_strength);
         return -1;
@@ -105,6 +109,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     memcpy(r.base_color, m->base_color, sizeof r.base_color);
     r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular, r.roughness = m->roughness;
     r.tex_ref = tex_ref;
+    r.alpha_cutoff = m->alpha_cutoff;
     r.occlusion_strength = m->maps ? m->maps->occlusion_strength : 0.0f;
     for (int j = 0; j < 4; j++) { /* a map with 4x the texels of tex_ref is one mip level further down at the same footprint */
         const int tx = j == 0 ? m->texture : map[j - 1];

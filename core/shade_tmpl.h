@@ -4,7 +4,6 @@
  *   VLD(p) VST(p, v) VS(x)    load, store (unaligned), broadcast
  *   VADD VSUB VMUL VDIV VSQRT IEEE, exactly rounded
  *   VNEG(a)                   sign flipped
- *   VMAX0(a)                  max(a, 0) (a NaN lane may give 0 or NaN: both add no light)
  *   VGT VGE VLT (a, b)        ordered comparisons (false for NaN)
  *   MAND(a, b)                both
  *   VSEL(m, a, b)             m ? a : b per lane

@@ -1008,6 +1008,80 @@ static void test_gltf_material_maps(void **state)
     tmpdir_remove(dir);
 }
 
+/* Alpha MASK (cutoff 0.6) in the ray query: a quad at z = 0 whose 2x1 base colour texture has
+ * alpha 0 on the left half and 1 on the right, in front of a wall at z = -2 (the same quad,
+ * opaque). From z = 5 straight down, a ray through the left half passes the cut-out and reaches
+ * the wall (t = 7), one through the right half stops at the quad (t = 5), through rtcIntersect1
+ * and rtcIntersect16 alike. A third, untextured quad at z = 2 (x + 3) with base alpha 0.5 <
+ * 0.6 lets every ray through; the same quad as BLEND (not composited yet) is opaque. */
+static void test_gltf_alpha_mask(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char px[8] = {255, 255, 255, 0, 255, 255, 255, 255};
+    path_join(p, sizeof p, dir, "a.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    char json[4096];
+    for (int blend = 0; blend < 2; blend++) {
+        snprintf(json, sizeof json,
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"images\":[{\"uri\":\"a.png\"}],\"textures\":[{\"source\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}},\"alphaMode\":\"MASK\","
+                 "\"alphaCutoff\":0.6},{},"
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,0.5]},\"alphaMode\":\"%s\",\"alphaCutoff\":0.6}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2,\"material\":1}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2,\"material\":2}]}],"
+                 "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[0,0,-2]},{\"mesh\":1,\"translation\":[3,0,-2]},"
+                 "{\"mesh\":2,\"translation\":[3,0,2]}],\"scenes\":[{\"nodes\":[0,1,2,3]}],\"scene\":0",
+                 blend ? "BLEND" : "MASK");
+        path_join(p, sizeof p, dir, "mask.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        const float d[3] = {0, 0, -1}, xs[4] = {-0.5f, 0.5f, 2.5f, 3.5f};
+        const float want_t[2][4] = {{7, 5, 7, 7}, {7, 5, 3, 3}};
+        hit h;
+        for (int i = 0; i < 4; i++) {
+            const float o[3] = {xs[i], 0.1f, 5};
+            assert_true(cast(s, o, d, &h));
+            assert_near(h.t, want_t[blend][i], 1e-5f);
+        }
+        /* the same rays as one packet of 16 (4 copies each) */
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        _Alignas(64) struct RTCRayHit16 rh;
+        memset(&rh, 0, sizeof rh);
+        _Alignas(64) int valid[16];
+        for (int q = 0; q < 16; q++) {
+            valid[q] = -1;
+            rh.ray.org_x[q] = xs[q % 4], rh.ray.org_y[q] = 0.1f, rh.ray.org_z[q] = 5;
+            rh.ray.dir_z[q] = -1, rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
+            rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+        for (int q = 0; q < 16; q++) assert_near(rh.ray.tfar[q], want_t[blend][q % 4], 1e-5f);
+        fv_scene_free(s);
+    }
+    /* a cutoff out of range is refused */
+    char *c = strstr(json, "\"alphaCutoff\":0.6");
+    memcpy(c, "\"alphaCutoff\":1.6", 17);
+    write_gltf(p, bin, sizeof bin, json);
+    expect_load_fails(p, "alphaCutoff");
+    tmpdir_remove(dir);
+}
+
 /* ---- hostile files ------------------------------------------------------------------- */
 
 /* A scene's external files stay inside its folder tree (or --asset-root's): `..`, percent-escaped
@@ -1476,6 +1550,7 @@ int main(void)
         cmocka_unit_test(test_gltf_sparse),
         cmocka_unit_test(test_gltf_pbr_materials),
         cmocka_unit_test(test_gltf_material_maps),
+        cmocka_unit_test(test_gltf_alpha_mask),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),

@@ -16,7 +16,6 @@ typedef uint32x4_t M;
 #define VDIV vdivq_f32
 #define VSQRT vsqrtq_f32
 #define VNEG vnegq_f32
-#define VMAX0(a) vmaxnmq_f32(a, vdupq_n_f32(0.0f))
 #define VGT vcgtq_f32
 #define VGE vcgeq_f32
 #define VLT vcltq_f32
