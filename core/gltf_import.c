@@ -80,6 +80,7 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                 fv_material_maps maps;
                 memset(&d, 0, sizeof d);
                 d.positions = p->positions, d.normals = p->normals, d.uvs = p->uvs, d.indices = p->indices;
+                d.colors = p->colors;
                 d.vertex_count = p->vertex_count, d.index_count = p->index_count;
                 d.base_color[0] = d.base_color[1] = d.base_color[2] = d.base_color[3] = 1.0f;
                 d.texture = -1;

@@ -622,6 +622,17 @@ void convert_meshes(const tinygltf::Model &m, Holder &h)
                 return keep(h, std::move(v));
             };
             out.normals = attr("NORMAL", 3);
+            auto col_it = p.attributes.find("COLOR_0");
+            if (col_it != p.attributes.end()) { // VEC3 or VEC4 (float, normalized ubyte/ushort)
+                const int ai = col_it->second;
+                const int comps = ai >= 0 && size_t(ai) < m.accessors.size() &&
+                                  m.accessors[size_t(ai)].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+                const float *c = attr("COLOR_0", comps);
+                std::vector<float> rgb(out.vertex_count * 3);
+                for (size_t i = 0; i < out.vertex_count; i++)
+                    for (int k = 0; k < 3; k++) rgb[3 * i + size_t(k)] = c[size_t(comps) * i + size_t(k)];
+                out.colors = keep(h, std::move(rgb));
+            }
             const fv_gltf_material *pm = out.material >= 0 ? &h.materials[size_t(out.material)] : nullptr;
             const int set = pm && (pm->image >= 0 || pm->mr_image >= 0 || pm->occlusion_image >= 0 ||
                                    pm->emissive_image >= 0)

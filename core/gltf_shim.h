@@ -17,6 +17,7 @@ typedef struct fv_gltf_prim {
     const float *positions;  /* 3 per vertex, mesh-local, all finite */
     const float *normals;    /* 3 per vertex, or NULL */
     const float *uvs;        /* 2 per vertex (the set the material's textures use), or NULL */
+    const float *colors;     /* 3 per vertex: COLOR_0's RGB (linear; alpha dropped), or NULL */
     const uint32_t *indices; /* index_count, each < vertex_count; NULL: non-indexed */
     size_t vertex_count, index_count; /* index_count (or vertex_count if non-indexed) % 3 == 0 */
     int material;            /* index into materials, or -1 (glTF default material) */

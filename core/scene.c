@@ -85,6 +85,7 @@ void fv_scene_free(fv_scene *s)
     for (size_t i = 0; i < s->mesh_count; i++) {
         free(s->meshes[i].attr);
         free(s->meshes[i].face);
+        free(s->meshes[i].col);
     }
     free(s->meshes);
     for (int i = 0; i < s->texture_count; i++) free(s->textures[i].data);

@@ -19,7 +19,7 @@ typedef struct fv_scene fv_scene;
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
  * transforms; materials as docs/materials.md says (metallic-roughness with its base colour,
- * metallic-roughness, occlusion and emissive maps, alpha MASK; normal maps, BLEND, texture transforms and
+ * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK; normal maps, BLEND, texture transforms and
  * samplers' wrap modes are not read yet); skins, morph targets and animations are ignored. The first perspective camera in depth-first node order
  * becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
@@ -46,6 +46,7 @@ typedef struct fv_mesh_desc {
     const float *positions; /* 3 floats per vertex, world space (the transform below is applied) */
     const float *normals;   /* 3 per vertex, or NULL: computed (area-weighted smooth) */
     const float *uvs;       /* 2 per vertex, or NULL */
+    const float *colors;    /* 3 per vertex, linear RGB multiplying the base colour (glTF COLOR_0), or NULL */
     const uint32_t *indices;/* 3 per triangle, or NULL: non-indexed, vertex_count/3 triangles */
     size_t vertex_count, index_count;
     float base_color[4];    /* linear RGBA factor */

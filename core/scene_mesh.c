@@ -188,6 +188,21 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
                 o[0] = o[1] = o[2] = 0.0f; /* shading falls back to the geometric normal */
         }
     }
+    if (m->colors) {
+        r.col = malloc(nt * 9 * sizeof(float));
+        if (!r.col) {
+            fv_err(err, err_len, "out of memory");
+            goto fail;
+        }
+        for (size_t i = 0; i < 3 * nv; i++)
+            if (!isfinite(m->colors[i])) {
+                fv_err(err, err_len, "vertex %zu colour is not finite", i / 3);
+                goto fail;
+            }
+        for (size_t t = 0; t < nt; t++)
+            for (int c = 0; c < 3; c++)
+                memcpy(r.col + 9 * t + 3 * c, m->colors + 3 * (size_t)tri[3 * t + (size_t)c], 3 * sizeof(float));
+    }
     if (m->uvs) {
         for (size_t i = 0; i < 2 * nv; i++)
             if (!isfinite(m->uvs[i])) {
@@ -268,5 +283,6 @@ fail:
     free(density);
     free(r.attr);
     free(r.face);
+    free(r.col);
     return -1;
 }

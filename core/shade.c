@@ -29,10 +29,14 @@ static void tex_coords(const fv_mesh_rec *m, unsigned prim, float u, float v, fl
 
 /* The material's inputs at a hit from the texels of its maps (NULL: no such map); the one
  * definition both paths use. glTF: metallic in B, roughness in G, occlusion in R. */
-static void material_at(const fv_mesh_rec *m, const float *base_tx, const float *mr, const float *oc, const float *em,
-                        fv_brdf_mat *mat, float *occ, float emit[3])
+static void material_at(const fv_mesh_rec *m, unsigned prim, float u, float v, float w, const float *base_tx,
+                        const float *mr, const float *oc, const float *em, fv_brdf_mat *mat, float *occ, float emit[3])
 {
     for (int k = 0; k < 3; k++) mat->base[k] = base_tx ? m->base_color[k] * base_tx[k] : m->base_color[k];
+    if (m->col) { /* vertex colours (glTF COLOR_0), interpolated */
+        const float *c = m->col + 9 * (size_t)prim;
+        for (int k = 0; k < 3; k++) mat->base[k] *= w * c[k] + u * c[3 + k] + v * c[6 + k];
+    }
     mat->metallic = m->metallic, mat->a2 = m->a2, mat->specular = m->specular;
     if (mr) {
         mat->metallic = m->metallic * mr[2];
@@ -61,7 +65,7 @@ static void material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, flo
             tx[j] = texel[j];
         }
     }
-    material_at(m, tx[0], tx[1], tx[2], tx[3], mat, occ, emit);
+    material_at(m, prim, u, v, w, tx[0], tx[1], tx[2], tx[3], mat, occ, emit);
 }
 
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
@@ -145,7 +149,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         } else {
             fv_brdf_mat mat;
             float occ, emit[3];
-            material_at(m, NULL, NULL, NULL, NULL, &mat, &occ, emit);
+            material_at(m, prim, u, v, 1.0f - u - v, NULL, NULL, NULL, NULL, &mat, &occ, emit);
             for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
             pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
         }
@@ -162,7 +166,8 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             }
         fv_brdf_mat mat;
         float occ, emit[3];
-        material_at(m, tx[0], tx[1], tx[2], tx[3], &mat, &occ, emit);
+        const float u = h->u[q], v = h->v[q];
+        material_at(m, h->prim[q], u, v, 1.0f - u - v, tx[0], tx[1], tx[2], tx[3], &mat, &occ, emit);
         for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
         pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
     }

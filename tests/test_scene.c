@@ -1082,6 +1082,49 @@ static void test_gltf_alpha_mask(void **state)
     tmpdir_remove(dir);
 }
 
+/* COLOR_0 multiplies the base colour, interpolated: corners red, green, blue, white (VEC4
+ * float; alpha dropped) on the quad [-1,1]^2, matte (specularFactor 0, metallic 0), head-on:
+ * base x (1 + 0.15). (0.5, -0.5) lies in triangle (0, 1, 2) at u = 0.5, v = 0.25, w = 0.25:
+ * colour (0.25, 0.5, 0.25) x 1.15. In triangle (0, 2, 3), (-0.5, 0.5) is at u = 0.25
+ * (corner 2, blue) and v = 0.5 (corner 3, white): (0.75, 0.5, 0.75) x 1.15. */
+static void test_gltf_vertex_colours(void **state)
+{
+    (void)state;
+    unsigned char bin[124];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const float col[16] = {1, 0, 0, 0.5f, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, col, 64);
+    memcpy(bin + 112, idx, 12);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":64},"
+        "{\"buffer\":0,\"byteOffset\":112,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"},"
+        "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0},"
+        "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"COLOR_0\":1},\"indices\":2,\"material\":0}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0";
+    char *dir = tmpdir_make(), p[512], err[512];
+    path_join(p, sizeof p, dir, "col.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    const float d[3] = {0, 0, -1}, a[3] = {0.5f, -0.5f, 5}, b[3] = {-0.5f, 0.5f, 5};
+    hit h;
+    float rgb[3];
+    cast_shade(s, a, d, 0, &h, rgb);
+    assert_rgb(rgb, 0.25f * 1.15f, 0.5f * 1.15f, 0.25f * 1.15f, 1e-5f, __LINE__);
+    cast_shade(s, b, d, 0, &h, rgb);
+    assert_rgb(rgb, 0.75f * 1.15f, 0.5f * 1.15f, 0.75f * 1.15f, 1e-5f, __LINE__);
+    check_packets(s, 6);
+    fv_scene_free(s);
+    tmpdir_remove(dir);
+}
+
 /* ---- hostile files ------------------------------------------------------------------- */
 
 /* A scene's external files stay inside its folder tree (or --asset-root's): `..`, percent-escaped
@@ -1551,6 +1594,7 @@ int main(void)
         cmocka_unit_test(test_gltf_pbr_materials),
         cmocka_unit_test(test_gltf_material_maps),
         cmocka_unit_test(test_gltf_alpha_mask),
+        cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),
