@@ -1229,7 +1229,7 @@ static fv_scene *mode_scene(const char *dir, const char *name, int mode, const u
     static const float pos[15] = {0, 0, 0, 1, -1, 0, 1, 1, 0, -0.2f, 1.6f, 0, -1, 0.8f, 0};
     unsigned char bin[60 + 16];
     memcpy(bin, pos, sizeof pos);
-    memcpy(bin + 60, idx, (size_t)nidx);
+    if (nidx) memcpy(bin + 60, idx, (size_t)nidx); /* idx is NULL for a non-indexed scene */
     char members[1024], p[512];
     snprintf(members, sizeof members,
              "\"bufferViews\":[{\"buffer\":0,\"byteLength\":60}%s],"
