@@ -42,17 +42,21 @@ static void matrix_quat(const double wm[16], float q[4])
     q[0] = (float)x, q[1] = (float)y, q[2] = (float)z, q[3] = (float)w;
 }
 
-/* The scene texture of image img (decoded once per colour space: tex[2 * img + linear]),
- * -1 for none (no image, or no uvs to sample it with); -2 on failure. */
-static int image_texture(fv_scene *s, const fv_gltf_model *g, int *tex, int img, int linear, const float *uvs)
+/* The scene texture of image img, decoded once per colour space and pair of wrap modes
+ * (tex[18 * img + 9 * linear + 3 * wrap_s + wrap_t]); -1 for none (no image, or no uvs to
+ * sample it with); -2 on failure. */
+static int image_texture(fv_scene *s, const fv_gltf_model *g, int *tex, int img, int linear, const int wrap[2],
+                         const float *uvs)
 {
     if (img < 0 || !uvs || !g->images[img].rgba8) return -1;
-    int *t = &tex[2 * img + linear];
+    const int ws = wrap[0] >= 0 && wrap[0] <= 2 ? wrap[0] : 0, wt = wrap[1] >= 0 && wrap[1] <= 2 ? wrap[1] : 0;
+    int *t = &tex[18 * img + 9 * linear + 3 * ws + wt];
     if (*t < 0) {
         const fv_gltf_image *im = &g->images[img];
         *t = linear ? fv_scene_add_texture_linear(s, im->rgba8, im->width, im->height)
                     : fv_scene_add_texture(s, im->rgba8, im->width, im->height);
         if (*t < 0) return -2;
+        fv_scene_set_texture_wrap(s, *t, (fv_wrap)ws, (fv_wrap)wt);
     }
     return *t;
 }
@@ -62,12 +66,12 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
 {
     int *tex_of_image = NULL;
     if (g->image_count) {
-        tex_of_image = malloc(2 * g->image_count * sizeof *tex_of_image);
+        tex_of_image = malloc(18 * g->image_count * sizeof *tex_of_image);
         if (!tex_of_image) {
             fv_err(err, err_len, "out of memory");
             return -1;
         }
-        for (size_t i = 0; i < 2 * g->image_count; i++) tex_of_image[i] = -1;
+        for (size_t i = 0; i < 18 * g->image_count; i++) tex_of_image[i] = -1;
     }
     int have_camera = 0, rc = 0;
     for (size_t ni = 0; ni < g->node_count && rc == 0; ni++) {
@@ -95,7 +99,7 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                     const int img[4] = {mat->image, mat->mr_image, mat->occlusion_image, mat->emissive_image};
                     int tx[4];
                     for (int j = 0; j < 4 && rc == 0; j++) {
-                        tx[j] = image_texture(s, g, tex_of_image, img[j], j == 1 || j == 2, p->uvs);
+                        tx[j] = image_texture(s, g, tex_of_image, img[j], j == 1 || j == 2, mat->wrap[j], p->uvs);
                         if (tx[j] == -2) {
                             fv_err(err, err_len, "image %d: cannot add texture", img[j]);
                             rc = -1;

@@ -487,7 +487,7 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
     for (size_t i = 0; i < m.materials.size(); i++) {
         const std::string at = "material " + str(i);
         const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
-        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1, 0};
+        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1, 0, {{0, 0}, {0, 0}, {0, 0}, {0, 0}}};
         const tinygltf::Material &mt = m.materials[i];
         auto unit = [&](double d, const char *name) {
             const float f = to_float(d, at + " " + name);
@@ -520,7 +520,8 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
             for (int c = 0; c < 4; c++) mat.base_color[c] = to_float(pbr.baseColorFactor[size_t(c)], at + " baseColorFactor");
         }
         int texcoord = -1; // the first texture's set; a map on another set is left out
-        auto texture = [&](int ti, int tc, const char *what, int *image) {
+        auto wrap_of = [](int gl) { return gl == 33071 ? 1 : gl == 33648 ? 2 : 0; }; // CLAMP_TO_EDGE, MIRRORED
+        auto texture = [&](int slot, int ti, int tc, const char *what, int *image) {
             if (ti < 0) return;
             if (size_t(ti) >= m.textures.size()) throw Fail(at + ": " + what + " texture " + str(ti) + " does not exist");
             const int src = m.textures[size_t(ti)].source;
@@ -532,12 +533,17 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
             if (tc != texcoord) return;
             *image = src;
             (*image_used)[size_t(src)] = 1;
+            const int si = m.textures[size_t(ti)].sampler;
+            if (si >= 0 && size_t(si) < m.samplers.size()) {
+                mat.wrap[slot][0] = wrap_of(m.samplers[size_t(si)].wrapS);
+                mat.wrap[slot][1] = wrap_of(m.samplers[size_t(si)].wrapT);
+            }
         };
-        texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, "base colour", &mat.image);
-        texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, "metallic-roughness",
+        texture(0, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, "base colour", &mat.image);
+        texture(1, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, "metallic-roughness",
                 &mat.mr_image);
-        texture(mt.occlusionTexture.index, mt.occlusionTexture.texCoord, "occlusion", &mat.occlusion_image);
-        texture(mt.emissiveTexture.index, mt.emissiveTexture.texCoord, "emissive", &mat.emissive_image);
+        texture(2, mt.occlusionTexture.index, mt.occlusionTexture.texCoord, "occlusion", &mat.occlusion_image);
+        texture(3, mt.emissiveTexture.index, mt.emissiveTexture.texCoord, "emissive", &mat.emissive_image);
         if (texcoord < 0) texcoord = 0;
         if (mt.alphaMode == "MASK") mat.alpha_cutoff = unit(mt.alphaCutoff, "alphaCutoff");
         if (mat.occlusion_image >= 0) mat.occlusion_strength = unit(mt.occlusionTexture.strength, "occlusion strength");

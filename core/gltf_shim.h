@@ -47,6 +47,8 @@ typedef struct fv_gltf_material {
     int mr_image, occlusion_image, emissive_image;
     float occlusion_strength; /* occlusionTexture.strength, [0, 1] */
     float alpha_cutoff;  /* alphaMode MASK: alphaCutoff (default 0.5); OPAQUE and BLEND: 0 */
+    int wrap[4][2];      /* base colour, metallic-roughness, occlusion, emissive textures' sampler
+                          * wrapS, wrapT: 0 REPEAT, 1 CLAMP_TO_EDGE, 2 MIRRORED_REPEAT (fv_wrap) */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {

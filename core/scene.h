@@ -18,10 +18,11 @@ typedef struct fv_scene fv_scene;
  * (missing file, malformed JSON, bad accessor, out-of-range index, unsupported required
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
- * transforms; materials as docs/materials.md says (metallic-roughness with its base colour,
- * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK; normal maps, BLEND, texture transforms and
- * samplers' wrap modes are not read yet); skins, morph targets and animations are ignored. The first perspective camera in depth-first node order
- * becomes the default view. */
+ * transforms. Materials as docs/materials.md says: metallic-roughness with base colour,
+ * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK and sampler wrap
+ * modes (normal maps, BLEND, texture transforms and filter modes are not read yet). Skins,
+ * morph targets and animations are ignored. The first perspective camera in depth-first node
+ * order becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
 /* The same, with the folder the scene's external files must lie in (NULL: the scene file's own
  * folder, which fv_scene_load uses): a URI leading elsewhere is refused, naming it. */
@@ -67,6 +68,10 @@ fv_scene *fv_scene_create(void);
 int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h);
 /* The same for data (metallic-roughness, occlusion): the bytes are linear, v / 255. */
 int fv_scene_add_texture_linear(fv_scene *s, const uint8_t *rgba8, int w, int h);
+/* Texture addressing outside [0, 1] (glTF sampler wrapS / wrapT); a new texture repeats. */
+typedef enum { FV_WRAP_REPEAT, FV_WRAP_CLAMP, FV_WRAP_MIRROR } fv_wrap;
+/* Sets texture tex's wrap modes; 0, or -1 if tex does not exist. */
+int fv_scene_set_texture_wrap(fv_scene *s, int tex, fv_wrap wrap_s, fv_wrap wrap_t);
 /* Validates (indices < vertex_count, counts multiple of 3, finite data, texture index) and
  * flattens the mesh to world space. Returns 0, or -1 with err (the scene is unchanged).
  * Meshes get Embree geometry IDs 0, 1, 2, ... in the order they were added successfully. */

@@ -21,6 +21,7 @@ typedef struct fv_texture {
     int w[FV_TEX_MAX_LEVELS], h[FV_TEX_MAX_LEVELS];
     const float *level[FV_TEX_MAX_LEVELS]; /* linear RGBA, rows top to bottom, into data */
     float *data;
+    fv_wrap wrap_s, wrap_t; /* addressing along u and v */
 } fv_texture;
 
 /* A triangle's shading inputs, one cache line: its corners' normals (world, unit or zero if
@@ -84,7 +85,8 @@ struct fv_scene {
 int fv_scene_grow(void **p, size_t *cap, size_t n, size_t elem);
 /* Returns 1 and copies the first recorded Embree error into err, or 0 if none. */
 int fv_scene_take_rtc_error(fv_scene *s, char *err, size_t err_len);
-/* Trilinear between the two mip levels around lod (lod 0 = full resolution), REPEAT addressing. */
+/* Trilinear between the two mip levels around lod (lod 0 = full resolution), with the texture's
+ * wrap modes. */
 void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4]);
 /* fv_texture_sample in two steps, so a packet's texel fetches can be asked for before they are
  * used: the taps (texel addresses and weights), then the blend; the same bits. */

@@ -1125,6 +1125,62 @@ static void test_gltf_vertex_colours(void **state)
     tmpdir_remove(dir);
 }
 
+/* Sampler wrap modes: a quad [-1,1]^2 with u = 1.5 x + 0.5 (so u runs -1 .. 2) and a 2x1 base
+ * colour texture black | white, matte, head-on (rgb = 1.15 x texel), at lod 0. With
+ * x = -8/15 (u = -0.3) and x = 0.8 (u = 1.7), the bilinear tap x = u w - 0.5 gives:
+ *   REPEAT: u -> 0.7 (x 0.9: 0.1 black + 0.9 white = 0.9) both times
+ *   CLAMP_TO_EDGE: u -> 0 (x -0.5, both taps the black edge texel: 0) and 1 (white: 1)
+ *   MIRRORED_REPEAT: -0.3 -> 0.3 and 1.7 -> 0.3 (x 0.1: 0.9 black + 0.1 white = 0.1)
+ * The v coordinate (0.5) samples the only row. */
+static void test_gltf_sampler_wrap(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char px[8] = {0, 0, 0, 255, 255, 255, 255, 255};
+    path_join(p, sizeof p, dir, "bw.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {-1, 0.5f, 2, 0.5f, 2, 0.5f, -1, 0.5f};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    static const int gl[3] = {10497, 33071, 33648};
+    static const float want[3][2] = {{0.9f, 0.9f}, {0.0f, 1.0f}, {0.1f, 0.1f}};
+    for (int mode = 0; mode < 3; mode++) {
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"images\":[{\"uri\":\"bw.png\"}],\"samplers\":[{\"wrapS\":%d,\"wrapT\":%d}],"
+                 "\"textures\":[{\"source\":0,\"sampler\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+                 "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0",
+                 gl[mode], gl[(mode + 1) % 3]);
+        path_join(p, sizeof p, dir, "wrap.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        const float d[3] = {0, 0, -1}, xs[2] = {-8.0f / 15.0f, 0.8f};
+        for (int i = 0; i < 2; i++) {
+            const float o[3] = {xs[i], 0.3f, 5};
+            hit h;
+            float rgb[3];
+            cast_shade(s, o, d, 0, &h, rgb);
+            assert_near(rgb[1], 1.15f * want[mode][i], 1e-4f);
+        }
+        check_packets(s, 7 + (uint64_t)mode);
+        fv_scene_free(s);
+    }
+    tmpdir_remove(dir);
+}
+
 /* ---- hostile files ------------------------------------------------------------------- */
 
 /* A scene's external files stay inside its folder tree (or --asset-root's): `..`, percent-escaped
@@ -1595,6 +1651,7 @@ int main(void)
         cmocka_unit_test(test_gltf_material_maps),
         cmocka_unit_test(test_gltf_alpha_mask),
         cmocka_unit_test(test_gltf_vertex_colours),
+        cmocka_unit_test(test_gltf_sampler_wrap),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),
