@@ -107,7 +107,11 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                     }
                     if (rc) break;
                     d.texture = tx[0];
-                    maps = (fv_material_maps){tx[1], tx[2], tx[3], mat->occlusion_strength};
+                    memset(&maps, 0, sizeof maps);
+                    maps.metallic_roughness = tx[1], maps.occlusion = tx[2], maps.emissive = tx[3];
+                    maps.occlusion_strength = mat->occlusion_strength;
+                    maps.has_uv_transform = mat->has_uvx;
+                    memcpy(maps.uv_transform, mat->uvx, sizeof maps.uv_transform);
                     d.maps = &maps;
                 }
                 for (int k = 0; k < 16; k++) d.transform[k] = (float)nd->world[k];

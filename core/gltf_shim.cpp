@@ -487,7 +487,8 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
     for (size_t i = 0; i < m.materials.size(); i++) {
         const std::string at = "material " + str(i);
         const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
-        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1, 0, {{0, 0}, {0, 0}, {0, 0}, {0, 0}}};
+        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1, 0, {{0, 0}, {0, 0}, {0, 0}, {0, 0}},
+                                0, {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}}};
         const tinygltf::Material &mt = m.materials[i];
         auto unit = [&](double d, const char *name) {
             const float f = to_float(d, at + " " + name);
@@ -521,8 +522,35 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
         }
         int texcoord = -1; // the first texture's set; a map on another set is left out
         auto wrap_of = [](int gl) { return gl == 33071 ? 1 : gl == 33648 ? 2 : 0; }; // CLAMP_TO_EDGE, MIRRORED
-        auto texture = [&](int slot, int ti, int tc, const char *what, int *image) {
+        // KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv; its texCoord overrides
+        auto transform = [&](int slot, const tinygltf::ExtensionMap &ext, int *tc) {
+            auto it = ext.find("KHR_texture_transform");
+            if (it == ext.end() || !it->second.IsObject()) return;
+            const tinygltf::Value &t = it->second;
+            auto num = [&](const tinygltf::Value &v, const char *what) {
+                if (!v.IsNumber()) throw Fail(at + ": KHR_texture_transform " + what + " is not a number");
+                return to_float(v.GetNumberAsDouble(), at + " KHR_texture_transform " + what);
+            };
+            auto pair = [&](const char *key, float *o) {
+                if (!t.Has(key)) return;
+                const tinygltf::Value &a = t.Get(key);
+                if (!a.IsArray() || a.ArrayLen() != 2) throw Fail(at + ": KHR_texture_transform " + key + " needs 2 numbers");
+                o[0] = num(a.Get(0), key), o[1] = num(a.Get(1), key);
+            };
+            float off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+            pair("offset", off);
+            pair("scale", sc);
+            if (t.Has("rotation")) rot = num(t.Get("rotation"), "rotation");
+            if (t.Has("texCoord")) *tc = int(num(t.Get("texCoord"), "texCoord"));
+            const double c = std::cos(double(rot)), s = std::sin(double(rot));
+            float *x = mat.uvx[slot];
+            x[0] = float(c * sc[0]), x[1] = float(s * sc[1]), x[2] = off[0];
+            x[3] = float(-s * sc[0]), x[4] = float(c * sc[1]), x[5] = off[1];
+            mat.has_uvx = 1;
+        };
+        auto texture = [&](int slot, int ti, int tc, const tinygltf::ExtensionMap &ext, const char *what, int *image) {
             if (ti < 0) return;
+            transform(slot, ext, &tc);
             if (size_t(ti) >= m.textures.size()) throw Fail(at + ": " + what + " texture " + str(ti) + " does not exist");
             const int src = m.textures[size_t(ti)].source;
             if (src >= 0 && size_t(src) >= m.images.size())
@@ -539,11 +567,12 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
                 mat.wrap[slot][1] = wrap_of(m.samplers[size_t(si)].wrapT);
             }
         };
-        texture(0, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, "base colour", &mat.image);
-        texture(1, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, "metallic-roughness",
+        texture(0, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions, "base colour", &mat.image);
+        texture(1, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                pbr.metallicRoughnessTexture.extensions, "metallic-roughness",
                 &mat.mr_image);
-        texture(2, mt.occlusionTexture.index, mt.occlusionTexture.texCoord, "occlusion", &mat.occlusion_image);
-        texture(3, mt.emissiveTexture.index, mt.emissiveTexture.texCoord, "emissive", &mat.emissive_image);
+        texture(2, mt.occlusionTexture.index, mt.occlusionTexture.texCoord, mt.occlusionTexture.extensions, "occlusion", &mat.occlusion_image);
+        texture(3, mt.emissiveTexture.index, mt.emissiveTexture.texCoord, mt.emissiveTexture.extensions, "emissive", &mat.emissive_image);
         if (texcoord < 0) texcoord = 0;
         if (mt.alphaMode == "MASK") mat.alpha_cutoff = unit(mt.alphaCutoff, "alphaCutoff");
         if (mat.occlusion_image >= 0) mat.occlusion_strength = unit(mt.occlusionTexture.strength, "occlusion strength");
@@ -915,7 +944,8 @@ Declared prescan(const unsigned char *s, size_t n)
 // silently wrong geometry or textures.
 bool extension_supported(const std::string &ext)
 {
-    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" || ext.rfind("KHR_materials_", 0) == 0;
+    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" || ext == "KHR_texture_transform" ||
+           ext.rfind("KHR_materials_", 0) == 0;
 }
 
 std::string extension_hint(const std::string &ext)

@@ -49,6 +49,8 @@ typedef struct fv_gltf_material {
     float alpha_cutoff;  /* alphaMode MASK: alphaCutoff (default 0.5); OPAQUE and BLEND: 0 */
     int wrap[4][2];      /* base colour, metallic-roughness, occlusion, emissive textures' sampler
                           * wrapS, wrapT: 0 REPEAT, 1 CLAMP_TO_EDGE, 2 MIRRORED_REPEAT (fv_wrap) */
+    int has_uvx;         /* some texture has KHR_texture_transform: */
+    float uvx[4][6];     /* per texture as wrap[]: u' = [0] u + [1] v + [2], v' = [3] u + [4] v + [5] */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {

@@ -177,9 +177,12 @@ static void mask_filter(const struct RTCFilterFunctionNArguments *a)
         if (m->mask_tex) {
             const float u = hu[i], v = hv[i], w = 1.0f - u - v;
             const float *uv = m->attr[prim].uv;
-            float texel[4];
-            fv_texture_sample(m->mask_tex, w * uv[0] + u * uv[2] + v * uv[4], w * uv[1] + u * uv[3] + v * uv[5], 0.0f,
-                              texel);
+            float tu = w * uv[0] + u * uv[2] + v * uv[4], tv = w * uv[1] + u * uv[3] + v * uv[5], texel[4];
+            if (m->has_uvx) { /* the base colour's KHR_texture_transform */
+                const float *x = m->uvx[0], su = x[0] * tu + x[1] * tv + x[2];
+                tv = x[3] * tu + x[4] * tv + x[5], tu = su;
+            }
+            fv_texture_sample(m->mask_tex, tu, tv, 0.0f, texel);
             alpha *= texel[3];
         }
         if (!(alpha >= m->alpha_cutoff)) a->valid[i] = 0;

@@ -19,8 +19,8 @@ typedef struct fv_scene fv_scene;
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
  * transforms. Materials as docs/materials.md says: metallic-roughness with base colour,
- * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK and sampler wrap
- * modes (normal maps, BLEND, texture transforms and filter modes are not read yet). Skins,
+ * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK, sampler wrap
+ * modes and KHR_texture_transform (normal maps, BLEND and filter modes are not read yet). Skins,
  * morph targets and animations are ignored. The first perspective camera in depth-first node
  * order becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
@@ -42,6 +42,11 @@ typedef struct fv_material_maps {
     int occlusion;          /* R: ambient occlusion, applied as 1 + strength (R - 1) */
     int emissive;           /* RGB (sRGB), multiplying the emissive factor */
     float occlusion_strength; /* [0, 1] */
+    /* KHR_texture_transform of the base colour, metallic-roughness, occlusion and emissive
+     * textures when has_uv_transform: u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]
+     * (the mip level is not adjusted for the scale) */
+    int has_uv_transform;
+    float uv_transform[4][6];
 } fv_material_maps;
 typedef struct fv_mesh_desc {
     const float *positions; /* 3 floats per vertex, world space (the transform below is applied) */

@@ -54,6 +54,8 @@ typedef struct fv_mesh_rec {
     float occlusion_strength;
     int tex_ref;                  /* the texture texel_density counts (first of texture, map[]), or -1 */
     float lod_bias[4];            /* base colour, map[0..2]: log2 of the texel ratio to tex_ref */
+    int has_uvx;                  /* uvx is used */
+    float uvx[4][6];              /* per slot (base colour, map[]): fv_material_maps.uv_transform */
     float *col;                   /* per triangle 9 floats, its corners' vertex colours, or NULL */
     float alpha_cutoff;           /* > 0: alpha MASK (an Embree intersect filter, set at commit) */
     const fv_texture *mask_tex;   /* the base colour texture the filter reads (set at commit), or NULL */

@@ -110,6 +110,16 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular, r.roughness = m->roughness;
     r.tex_ref = tex_ref;
     r.alpha_cutoff = m->alpha_cutoff;
+    if (m->maps && m->maps->has_uv_transform) {
+        for (int j = 0; j < 4; j++)
+            for (int k = 0; k < 6; k++)
+                if (!isfinite(m->maps->uv_transform[j][k])) {
+                    fv_err(err, err_len, "uv transform is not finite");
+                    return -1;
+                }
+        r.has_uvx = 1;
+        memcpy(r.uvx, m->maps->uv_transform, sizeof r.uvx);
+    }
     r.occlusion_strength = m->maps ? m->maps->occlusion_strength : 0.0f;
     for (int j = 0; j < 4; j++) { /* a map with 4x the texels of tex_ref is one mip level further down at the same footprint */
         const int tx = j == 0 ? m->texture : map[j - 1];

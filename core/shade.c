@@ -49,6 +49,18 @@ static void material_at(const fv_mesh_rec *m, unsigned prim, float u, float v, f
 /* Slot j's texture: 0 base colour, 1 + FV_MAP_*. */
 static int slot_texture(const fv_mesh_rec *m, int j) { return j == 0 ? m->texture : m->map[j - 1]; }
 
+/* Slot j's texture coordinates: the mesh's, through its KHR_texture_transform if any. */
+static void slot_uv(const fv_mesh_rec *m, int j, float tu, float tv, float *su, float *sv)
+{
+    if (!m->has_uvx) {
+        *su = tu, *sv = tv;
+        return;
+    }
+    const float *x = m->uvx[j];
+    *su = x[0] * tu + x[1] * tv + x[2];
+    *sv = x[3] * tu + x[4] * tv + x[5];
+}
+
 /* The material at the hit, every map sampled trilinearly at the footprint's mip level. */
 static void material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
                      const float dir[3], float t, float footprint_rad, fv_brdf_mat *mat, float *occ, float emit[3])
@@ -61,7 +73,9 @@ static void material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, flo
         for (int j = 0; j < 4; j++) {
             const int id = slot_texture(m, j);
             if (id < 0) continue;
-            fv_texture_sample(&s->textures[id], tu, tv, lod + m->lod_bias[j], texel[j]);
+            float su, sv;
+            slot_uv(m, j, tu, tv, &su, &sv);
+            fv_texture_sample(&s->textures[id], su, sv, lod + m->lod_bias[j], texel[j]);
             tx[j] = texel[j];
         }
     }
@@ -142,7 +156,9 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             for (int j = 0; j < 4; j++) {
                 const int id = slot_texture(m, j);
                 if (id < 0) continue;
-                fv_texture_taps(&s->textures[id], tu, tv, lod + m->lod_bias[j], &taps[j][q]);
+                float su, sv;
+                slot_uv(m, j, tu, tv, &su, &sv);
+                fv_texture_taps(&s->textures[id], su, sv, lod + m->lod_bias[j], &taps[j][q]);
                 fv_texture_taps_prefetch(&taps[j][q]);
             }
             textured |= 1u << q;

@@ -1181,6 +1181,64 @@ static void test_gltf_sampler_wrap(void **state)
     tmpdir_remove(dir);
 }
 
+/* KHR_texture_transform on the base colour: a quad [-1,1]^2 with u = (x + 1)/2, v = 0.5 and the
+ * 2x1 black | white texture (REPEAT), matte, head-on (rgb = 1.15 x texel). At x = -0.5 and 0.5
+ * (u = 0.25 and 0.75, the texel centres):
+ *   none: 0, 1;   offset [0.5, 0]: u' = 0.75, 1.25 -> white, black: 1, 0
+ *   rotation pi: u' = -u, v' = -v: 0.75 and 0.25: 1, 0
+ *   scale [0.5, 1]: u' = 0.125 (tap x = -0.25: 0.25 of the wrapped white texel) and 0.375
+ *   (x = 0.25: 0.25 white): 0.25, 0.25 */
+static void test_gltf_texture_transform(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char px[8] = {0, 0, 0, 255, 255, 255, 255, 255};
+    path_join(p, sizeof p, dir, "bw.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0.5f, 1, 0.5f, 1, 0.5f, 0, 0.5f};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    static const char *const xf[4] = {"", ",\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0]}}",
+                                      ",\"extensions\":{\"KHR_texture_transform\":{\"rotation\":3.14159265}}",
+                                      ",\"extensions\":{\"KHR_texture_transform\":{\"scale\":[0.5,1]}}"};
+    static const float want[4][2] = {{0, 1}, {1, 0}, {1, 0}, {0.25f, 0.25f}};
+    for (int c = 0; c < 4; c++) {
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"extensionsUsed\":[\"KHR_texture_transform\"],\"extensionsRequired\":[\"KHR_texture_transform\"],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"images\":[{\"uri\":\"bw.png\"}],\"textures\":[{\"source\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0%s},\"metallicFactor\":0},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+                 "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0",
+                 xf[c]);
+        path_join(p, sizeof p, dir, "xf.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        const float d[3] = {0, 0, -1}, xs[2] = {-0.5f, 0.5f};
+        for (int i = 0; i < 2; i++) {
+            const float o[3] = {xs[i], 0.3f, 5};
+            hit h;
+            float rgb[3];
+            cast_shade(s, o, d, 0, &h, rgb);
+            assert_near(rgb[1], 1.15f * want[c][i], 1e-4f);
+        }
+        check_packets(s, 10 + (uint64_t)c);
+        fv_scene_free(s);
+    }
+    tmpdir_remove(dir);
+}
+
 /* ---- hostile files ------------------------------------------------------------------- */
 
 /* A scene's external files stay inside its folder tree (or --asset-root's): `..`, percent-escaped
@@ -1652,6 +1710,7 @@ int main(void)
         cmocka_unit_test(test_gltf_alpha_mask),
         cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_gltf_sampler_wrap),
+        cmocka_unit_test(test_gltf_texture_transform),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),
