@@ -42,17 +42,36 @@ static void matrix_quat(const double wm[16], float q[4])
     q[0] = (float)x, q[1] = (float)y, q[2] = (float)z, q[3] = (float)w;
 }
 
+/* The scene texture of image img, decoded once per colour space and pair of wrap modes
+ * (tex[18 * img + 9 * linear + 3 * wrap_s + wrap_t]); -1 for none (no image, or no uvs to
+ * sample it with); -2 on failure. */
+static int image_texture(fv_scene *s, const fv_gltf_model *g, int *tex, int img, int linear, const int wrap[2],
+                         const float *uvs)
+{
+    if (img < 0 || !uvs || !g->images[img].rgba8) return -1;
+    const int ws = wrap[0] >= 0 && wrap[0] <= 2 ? wrap[0] : 0, wt = wrap[1] >= 0 && wrap[1] <= 2 ? wrap[1] : 0;
+    int *t = &tex[18 * img + 9 * linear + 3 * ws + wt];
+    if (*t < 0) {
+        const fv_gltf_image *im = &g->images[img];
+        *t = linear ? fv_scene_add_texture_linear(s, im->rgba8, im->width, im->height)
+                    : fv_scene_add_texture(s, im->rgba8, im->width, im->height);
+        if (*t < 0) return -2;
+        fv_scene_set_texture_wrap(s, *t, (fv_wrap)ws, (fv_wrap)wt);
+    }
+    return *t;
+}
+
 /* Adds the glTF's meshes, lights and first camera through the builder. 0 on success. */
 static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_len)
 {
     int *tex_of_image = NULL;
     if (g->image_count) {
-        tex_of_image = malloc(g->image_count * sizeof *tex_of_image);
+        tex_of_image = malloc(18 * g->image_count * sizeof *tex_of_image);
         if (!tex_of_image) {
             fv_err(err, err_len, "out of memory");
             return -1;
         }
-        for (size_t i = 0; i < g->image_count; i++) tex_of_image[i] = -1;
+        for (size_t i = 0; i < 18 * g->image_count; i++) tex_of_image[i] = -1;
     }
     int have_camera = 0, rc = 0;
     for (size_t ni = 0; ni < g->node_count && rc == 0; ni++) {
@@ -62,26 +81,38 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
             for (size_t pi = 0; pi < gm->prim_count; pi++) {
                 const fv_gltf_prim *p = &gm->prims[pi];
                 fv_mesh_desc d;
+                fv_material_maps maps;
                 memset(&d, 0, sizeof d);
                 d.positions = p->positions, d.normals = p->normals, d.uvs = p->uvs, d.indices = p->indices;
+                d.colors = p->colors;
                 d.vertex_count = p->vertex_count, d.index_count = p->index_count;
                 d.base_color[0] = d.base_color[1] = d.base_color[2] = d.base_color[3] = 1.0f;
                 d.texture = -1;
+                d.metallic = d.roughness = d.specular = 1.0f; /* the glTF default material */
                 if (p->material >= 0) {
                     const fv_gltf_material *mat = &g->materials[p->material];
                     memcpy(d.base_color, mat->base_color, sizeof d.base_color);
-                    const int img = mat->image;
-                    if (img >= 0 && p->uvs && g->images[img].rgba8) { /* no uvs: factor only */
-                        if (tex_of_image[img] < 0)
-                            tex_of_image[img] = fv_scene_add_texture(s, g->images[img].rgba8, g->images[img].width,
-                                                                     g->images[img].height);
-                        if (tex_of_image[img] < 0) {
-                            fv_err(err, err_len, "image %d: cannot add texture", img);
+                    d.metallic = mat->metallic, d.roughness = mat->roughness, d.specular = mat->specular;
+                    d.alpha_cutoff = mat->alpha_cutoff;
+                    memcpy(d.emissive, mat->emissive, sizeof d.emissive);
+                    /* no uvs: factors only */
+                    const int img[4] = {mat->image, mat->mr_image, mat->occlusion_image, mat->emissive_image};
+                    int tx[4];
+                    for (int j = 0; j < 4 && rc == 0; j++) {
+                        tx[j] = image_texture(s, g, tex_of_image, img[j], j == 1 || j == 2, mat->wrap[j], p->uvs);
+                        if (tx[j] == -2) {
+                            fv_err(err, err_len, "image %d: cannot add texture", img[j]);
                             rc = -1;
-                            break;
                         }
-                        d.texture = tex_of_image[img];
                     }
+                    if (rc) break;
+                    d.texture = tx[0];
+                    memset(&maps, 0, sizeof maps);
+                    maps.metallic_roughness = tx[1], maps.occlusion = tx[2], maps.emissive = tx[3];
+                    maps.occlusion_strength = mat->occlusion_strength;
+                    maps.has_uv_transform = mat->has_uvx;
+                    memcpy(maps.uv_transform, mat->uvx, sizeof maps.uv_transform);
+                    d.maps = &maps;
                 }
                 for (int k = 0; k < 16; k++) d.transform[k] = (float)nd->world[k];
                 char e[192];

@@ -471,7 +471,7 @@ struct Holder {
     std::vector<fv_gltf_material> materials;
     std::vector<fv_gltf_image> images;
     std::vector<fv_gltf_light> lights;
-    std::vector<int> material_texcoord; // TEXCOORD_n set of each material's base colour texture
+    std::vector<int> material_texcoord; // TEXCOORD_n set of each material's textures
     size_t skipped_prims = 0;           // points and lines
     std::string warning;
 };
@@ -487,23 +487,95 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
     for (size_t i = 0; i < m.materials.size(); i++) {
         const std::string at = "material " + str(i);
         const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
-        fv_gltf_material mat = {{1, 1, 1, 1}, -1};
+        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1, 0, {{0, 0}, {0, 0}, {0, 0}, {0, 0}},
+                                0, {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}}};
+        const tinygltf::Material &mt = m.materials[i];
+        auto unit = [&](double d, const char *name) {
+            const float f = to_float(d, at + " " + name);
+            if (!(f >= 0.0f && f <= 1.0f)) throw Fail(at + ": " + name + " " + std::to_string(d) + " is outside [0, 1]");
+            return f;
+        };
+        mat.metallic = unit(pbr.metallicFactor, "metallicFactor");
+        mat.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+        float strength = 1.0f;
+        auto ext_number = [&](const char *ext, const char *key, float *out) {
+            auto it = mt.extensions.find(ext);
+            if (it == mt.extensions.end() || !it->second.IsObject() || !it->second.Has(key)) return;
+            const tinygltf::Value &v = it->second.Get(key);
+            if (!v.IsNumber()) throw Fail(at + ": " + ext + " " + key + " is not a number");
+            *out = to_float(v.GetNumberAsDouble(), at + " " + ext + " " + key);
+        };
+        ext_number("KHR_materials_emissive_strength", "emissiveStrength", &strength);
+        if (!(strength >= 0.0f)) throw Fail(at + ": negative emissiveStrength");
+        ext_number("KHR_materials_specular", "specularFactor", &mat.specular);
+        if (!(mat.specular >= 0.0f && mat.specular <= 1.0f)) throw Fail(at + ": specularFactor is outside [0, 1]");
+        if (!mt.emissiveFactor.empty()) {
+            if (mt.emissiveFactor.size() != 3) throw Fail(at + ": emissiveFactor needs 3 numbers");
+            for (int c = 0; c < 3; c++) {
+                mat.emissive[c] = unit(mt.emissiveFactor[size_t(c)], "emissiveFactor") * strength;
+                if (!std::isfinite(mat.emissive[c])) throw Fail(at + ": emissive strength overflows");
+            }
+        }
         if (!pbr.baseColorFactor.empty()) {
             if (pbr.baseColorFactor.size() != 4) throw Fail(at + ": baseColorFactor needs 4 numbers");
             for (int c = 0; c < 4; c++) mat.base_color[c] = to_float(pbr.baseColorFactor[size_t(c)], at + " baseColorFactor");
         }
-        int texcoord = 0;
-        const int ti = pbr.baseColorTexture.index;
-        if (ti >= 0) {
-            if (size_t(ti) >= m.textures.size()) throw Fail(at + ": base colour texture " + str(ti) + " does not exist");
+        int texcoord = -1; // the first texture's set; a map on another set is left out
+        auto wrap_of = [](int gl) { return gl == 33071 ? 1 : gl == 33648 ? 2 : 0; }; // CLAMP_TO_EDGE, MIRRORED
+        // KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv; its texCoord overrides
+        auto transform = [&](int slot, const tinygltf::ExtensionMap &ext, int *tc) {
+            auto it = ext.find("KHR_texture_transform");
+            if (it == ext.end() || !it->second.IsObject()) return;
+            const tinygltf::Value &t = it->second;
+            auto num = [&](const tinygltf::Value &v, const char *what) {
+                if (!v.IsNumber()) throw Fail(at + ": KHR_texture_transform " + what + " is not a number");
+                return to_float(v.GetNumberAsDouble(), at + " KHR_texture_transform " + what);
+            };
+            auto pair = [&](const char *key, float *o) {
+                if (!t.Has(key)) return;
+                const tinygltf::Value &a = t.Get(key);
+                if (!a.IsArray() || a.ArrayLen() != 2) throw Fail(at + ": KHR_texture_transform " + key + " needs 2 numbers");
+                o[0] = num(a.Get(0), key), o[1] = num(a.Get(1), key);
+            };
+            float off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+            pair("offset", off);
+            pair("scale", sc);
+            if (t.Has("rotation")) rot = num(t.Get("rotation"), "rotation");
+            if (t.Has("texCoord")) *tc = int(num(t.Get("texCoord"), "texCoord"));
+            const double c = std::cos(double(rot)), s = std::sin(double(rot));
+            float *x = mat.uvx[slot];
+            x[0] = float(c * sc[0]), x[1] = float(s * sc[1]), x[2] = off[0];
+            x[3] = float(-s * sc[0]), x[4] = float(c * sc[1]), x[5] = off[1];
+            mat.has_uvx = 1;
+        };
+        auto texture = [&](int slot, int ti, int tc, const tinygltf::ExtensionMap &ext, const char *what, int *image) {
+            if (ti < 0) return;
+            transform(slot, ext, &tc);
+            if (size_t(ti) >= m.textures.size()) throw Fail(at + ": " + what + " texture " + str(ti) + " does not exist");
             const int src = m.textures[size_t(ti)].source;
             if (src >= 0 && size_t(src) >= m.images.size())
                 throw Fail("texture " + str(ti) + ": image " + str(src) + " does not exist");
-            texcoord = pbr.baseColorTexture.texCoord;
-            if (texcoord < 0) throw Fail(at + ": negative texCoord");
-            mat.image = src; // -1 (e.g. an extension-only source) means factor only
-            if (src >= 0) (*image_used)[size_t(src)] = 1;
-        }
+            if (tc < 0) throw Fail(at + ": negative texCoord");
+            if (src < 0) return; // (e.g. an extension-only source): factor only
+            if (texcoord < 0) texcoord = tc;
+            if (tc != texcoord) return;
+            *image = src;
+            (*image_used)[size_t(src)] = 1;
+            const int si = m.textures[size_t(ti)].sampler;
+            if (si >= 0 && size_t(si) < m.samplers.size()) {
+                mat.wrap[slot][0] = wrap_of(m.samplers[size_t(si)].wrapS);
+                mat.wrap[slot][1] = wrap_of(m.samplers[size_t(si)].wrapT);
+            }
+        };
+        texture(0, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions, "base colour", &mat.image);
+        texture(1, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                pbr.metallicRoughnessTexture.extensions, "metallic-roughness",
+                &mat.mr_image);
+        texture(2, mt.occlusionTexture.index, mt.occlusionTexture.texCoord, mt.occlusionTexture.extensions, "occlusion", &mat.occlusion_image);
+        texture(3, mt.emissiveTexture.index, mt.emissiveTexture.texCoord, mt.emissiveTexture.extensions, "emissive", &mat.emissive_image);
+        if (texcoord < 0) texcoord = 0;
+        if (mt.alphaMode == "MASK") mat.alpha_cutoff = unit(mt.alphaCutoff, "alphaCutoff");
+        if (mat.occlusion_image >= 0) mat.occlusion_strength = unit(mt.occlusionTexture.strength, "occlusion strength");
         h.materials.push_back(mat);
         h.material_texcoord.push_back(texcoord);
     }
@@ -585,7 +657,20 @@ void convert_meshes(const tinygltf::Model &m, Holder &h)
                 return keep(h, std::move(v));
             };
             out.normals = attr("NORMAL", 3);
-            const int set = out.material >= 0 && h.materials[size_t(out.material)].image >= 0
+            auto col_it = p.attributes.find("COLOR_0");
+            if (col_it != p.attributes.end()) { // VEC3 or VEC4 (float, normalized ubyte/ushort)
+                const int ai = col_it->second;
+                const int comps = ai >= 0 && size_t(ai) < m.accessors.size() &&
+                                  m.accessors[size_t(ai)].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+                const float *c = attr("COLOR_0", comps);
+                std::vector<float> rgb(out.vertex_count * 3);
+                for (size_t i = 0; i < out.vertex_count; i++)
+                    for (int k = 0; k < 3; k++) rgb[3 * i + size_t(k)] = c[size_t(comps) * i + size_t(k)];
+                out.colors = keep(h, std::move(rgb));
+            }
+            const fv_gltf_material *pm = out.material >= 0 ? &h.materials[size_t(out.material)] : nullptr;
+            const int set = pm && (pm->image >= 0 || pm->mr_image >= 0 || pm->occlusion_image >= 0 ||
+                                   pm->emissive_image >= 0)
                                 ? h.material_texcoord[size_t(out.material)] : -1;
             out.uvs = set >= 0 ? attr("TEXCOORD_" + str(set), 2) : nullptr;
 
@@ -859,7 +944,8 @@ Declared prescan(const unsigned char *s, size_t n)
 // silently wrong geometry or textures.
 bool extension_supported(const std::string &ext)
 {
-    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" || ext.rfind("KHR_materials_", 0) == 0;
+    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" || ext == "KHR_texture_transform" ||
+           ext.rfind("KHR_materials_", 0) == 0;
 }
 
 std::string extension_hint(const std::string &ext)

@@ -85,6 +85,7 @@ void fv_scene_free(fv_scene *s)
     for (size_t i = 0; i < s->mesh_count; i++) {
         free(s->meshes[i].attr);
         free(s->meshes[i].face);
+        free(s->meshes[i].col);
     }
     free(s->meshes);
     for (int i = 0; i < s->texture_count; i++) free(s->textures[i].data);
@@ -158,6 +159,36 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out)
     return 0;
 }
 
+/* glTF alpha MASK as an Embree intersect filter: a hit where the base colour's alpha (factor x
+ * texture, bilinear at mip 0: the filter does not know the ray's footprint) is below the cutoff
+ * is rejected, so the ray goes on to whatever lies behind the cut-out. */
+static void mask_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    const fv_mesh_rec *m = a->geometryUserPtr;
+    const unsigned n = a->N;
+    /* RTCHitN is N-wide SoA: Ng x y z, u, v, primID, ... (the C++-only RTCHitN_* accessors) */
+    const float *hu = (const float *)a->hit + 3 * n, *hv = (const float *)a->hit + 4 * n;
+    const unsigned *hprim = (const unsigned *)a->hit + 5 * n;
+    for (unsigned i = 0; i < n; i++) {
+        if (a->valid[i] != -1) continue;
+        const unsigned prim = hprim[i];
+        if (prim >= m->tri_count) continue;
+        float alpha = m->base_color[3];
+        if (m->mask_tex) {
+            const float u = hu[i], v = hv[i], w = 1.0f - u - v;
+            const float *uv = m->attr[prim].uv;
+            float tu = w * uv[0] + u * uv[2] + v * uv[4], tv = w * uv[1] + u * uv[3] + v * uv[5], texel[4];
+            if (m->has_uvx) { /* the base colour's KHR_texture_transform */
+                const float *x = m->uvx[0], su = x[0] * tu + x[1] * tv + x[2];
+                tv = x[3] * tu + x[4] * tv + x[5], tu = su;
+            }
+            fv_texture_sample(m->mask_tex, tu, tv, 0.0f, texel);
+            alpha *= texel[3];
+        }
+        if (!(alpha >= m->alpha_cutoff)) a->valid[i] = 0;
+    }
+}
+
 int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
 {
     if (!s) {
@@ -166,6 +197,15 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
     }
     if (s->committed) return 0;
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
+    for (size_t i = 0; i < s->mesh_count; i++) { /* the arrays no longer move: hand out pointers */
+        fv_mesh_rec *m = &s->meshes[i];
+        if (!(m->alpha_cutoff > 0.0f)) continue;
+        m->mask_tex = m->texture >= 0 ? &s->textures[m->texture] : NULL;
+        RTCGeometry g = rtcGetGeometry(s->rtc, (unsigned)i);
+        rtcSetGeometryUserData(g, m);
+        rtcSetGeometryIntersectFilterFunction(g, mask_filter);
+        rtcCommitGeometry(g);
+    }
     rtcCommitScene(s->rtc);
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     update_exposure(s);

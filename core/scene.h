@@ -10,16 +10,19 @@
 
 typedef struct fv_scene fv_scene;
 
-/* Ambient term of fv_scene_shade, a fraction of the base colour. */
+/* Radiance of the uniform white environment fv_scene_shade reflects (docs/materials.md): a
+ * matte surface gets this fraction of its base colour where no light reaches it. */
 #define FV_SCENE_AMBIENT 0.15f
 
 /* Loads a .gltf or .glb. Returns NULL and writes a one-line reason into err on failure
  * (missing file, malformed JSON, bad accessor, out-of-range index, unsupported required
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
- * transforms; skins, morph targets, animations, samplers' wrap modes and materials beyond
- * the base colour are ignored. The first perspective camera in depth-first node order
- * becomes the default view. */
+ * transforms. Materials as docs/materials.md says: metallic-roughness with base colour,
+ * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK, sampler wrap
+ * modes and KHR_texture_transform (normal maps, BLEND and filter modes are not read yet). Skins,
+ * morph targets and animations are ignored. The first perspective camera in depth-first node
+ * order becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
 /* The same, with the folder the scene's external files must lie in (NULL: the scene file's own
  * folder, which fv_scene_load uses): a URI leading elsewhere is refused, naming it. */
@@ -31,19 +34,49 @@ const char *fv_scene_warning(const fv_scene *s);
 void fv_scene_set_warning(fv_scene *s, const char *w);
 
 /* Building a scene by hand (tests, generators): create, add meshes, commit. */
+/* A material's texture maps besides base colour (glTF's, read as the specification says): each
+ * a texture index (fv_scene_add_texture_linear for metallic-roughness and occlusion,
+ * fv_scene_add_texture for emissive) or -1. They use the mesh's uvs. */
+typedef struct fv_material_maps {
+    int metallic_roughness; /* G: roughness, B: metallic, multiplying the factors */
+    int occlusion;          /* R: ambient occlusion, applied as 1 + strength (R - 1) */
+    int emissive;           /* RGB (sRGB), multiplying the emissive factor */
+    float occlusion_strength; /* [0, 1] */
+    /* KHR_texture_transform of the base colour, metallic-roughness, occlusion and emissive
+     * textures when has_uv_transform: u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]
+     * (the mip level is not adjusted for the scale) */
+    int has_uv_transform;
+    float uv_transform[4][6];
+} fv_material_maps;
 typedef struct fv_mesh_desc {
     const float *positions; /* 3 floats per vertex, world space (the transform below is applied) */
     const float *normals;   /* 3 per vertex, or NULL: computed (area-weighted smooth) */
     const float *uvs;       /* 2 per vertex, or NULL */
+    const float *colors;    /* 3 per vertex, linear RGB multiplying the base colour (glTF COLOR_0), or NULL */
     const uint32_t *indices;/* 3 per triangle, or NULL: non-indexed, vertex_count/3 triangles */
     size_t vertex_count, index_count;
     float base_color[4];    /* linear RGBA factor */
     int texture;            /* index from fv_scene_add_texture, or -1 */
+    /* glTF metallic-roughness (docs/materials.md). All zero (memset) is the matte material:
+     * pure Lambert, no highlight, no emission. */
+    float metallic;         /* [0, 1] */
+    float roughness;        /* [0, 1] (clamped to FV_MIN_ROUGHNESS, core/brdf.h, when shading) */
+    float specular;         /* [0, 1] weight of the dielectric Fresnel: 1 for glTF materials, 0 matte */
+    float emissive[3];      /* linear RGB added to the shaded colour (>= 0), emissive strength applied */
+    const fv_material_maps *maps; /* NULL: none */
+    float alpha_cutoff;     /* > 0: glTF alpha MASK: rays pass through where the base alpha (factor x
+                             * texture, bilinear at mip 0) is below it; 0: opaque */
     float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
 } fv_mesh_desc;
 fv_scene *fv_scene_create(void);
 /* rgba8 is sRGB-encoded 8-bit RGBA, copied. Returns the texture index or -1. */
 int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h);
+/* The same for data (metallic-roughness, occlusion): the bytes are linear, v / 255. */
+int fv_scene_add_texture_linear(fv_scene *s, const uint8_t *rgba8, int w, int h);
+/* Texture addressing outside [0, 1] (glTF sampler wrapS / wrapT); a new texture repeats. */
+typedef enum { FV_WRAP_REPEAT, FV_WRAP_CLAMP, FV_WRAP_MIRROR } fv_wrap;
+/* Sets texture tex's wrap modes; 0, or -1 if tex does not exist. */
+int fv_scene_set_texture_wrap(fv_scene *s, int tex, fv_wrap wrap_s, fv_wrap wrap_t);
 /* Validates (indices < vertex_count, counts multiple of 3, finite data, texture index) and
  * flattens the mesh to world space. Returns 0, or -1 with err (the scene is unchanged).
  * Meshes get Embree geometry IDs 0, 1, 2, ... in the order they were added successfully. */
@@ -74,9 +107,12 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out);
  * quat is x,y,z,w, rotating eye space (looking down -Z, +Y up) into world space. */
 int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, float pos[3], float quat[4]);
 
-/* Shades one hit: base colour (factor x texture, bilinear, mip level from the ray footprint)
- * x Lambert over the scene's lights, plus ambient. Without KHR_lights_punctual a head light
- * at eye_pos is used. footprint_rad is the angular size of one pixel along this ray (the
+/* Shades one hit: the glTF metallic-roughness BRDF (core/brdf.h, docs/materials.md) with base
+ * colour (factor x texture, bilinear, mip level from the ray footprint), metallic, roughness and
+ * specular weight over the scene's lights, plus a uniform ambient term (FV_SCENE_AMBIENT, the
+ * BRDF's normal-incidence reflectance) and emission. Without KHR_lights_punctual a head light
+ * of irradiance 1 at eye_pos is used; a light's pi f n.l is scaled so that a white matte
+ * surface facing irradiance 1 gives 1. footprint_rad is the angular size of one pixel along this ray (the
  * ray-cone spread), so the footprint at the hit is about t*|dir|*footprint_rad metres.
  * KHR light contributions are scaled by one exposure per scene, fixed at commit so that the
  * brightest light gives irradiance 1.0 at the bounds' centre (glTF intensities are often in

@@ -21,6 +21,7 @@ typedef struct fv_texture {
     int w[FV_TEX_MAX_LEVELS], h[FV_TEX_MAX_LEVELS];
     const float *level[FV_TEX_MAX_LEVELS]; /* linear RGBA, rows top to bottom, into data */
     float *data;
+    fv_wrap wrap_s, wrap_t; /* addressing along u and v */
 } fv_texture;
 
 /* A triangle's shading inputs, one cache line: its corners' normals (world, unit or zero if
@@ -37,6 +38,7 @@ typedef struct fv_tri_face {
     float ng[3], ng_len;
 } fv_tri_face;
 
+enum { FV_MAP_MR, FV_MAP_OCC, FV_MAP_EMIS };
 typedef struct fv_mesh_rec {
     const float *pos;      /* world positions, 3 per vertex: Embree's vertex buffer */
     const uint32_t *tri;   /* 3 per triangle: Embree's index buffer */
@@ -45,6 +47,18 @@ typedef struct fv_mesh_rec {
     size_t vertex_count, tri_count;
     float base_color[4];
     int texture;
+    float metallic, a2, specular; /* the BRDF's (core/brdf.h); a2 = fv_ggx_a2(roughness) */
+    float roughness;              /* the factor (a metallic-roughness map multiplies it) */
+    float emissive[3];            /* emitted radiance, strength applied */
+    int map[3];                   /* FV_MAP_*: texture index or -1 */
+    float occlusion_strength;
+    int tex_ref;                  /* the texture texel_density counts (first of texture, map[]), or -1 */
+    float lod_bias[4];            /* base colour, map[0..2]: log2 of the texel ratio to tex_ref */
+    int has_uvx;                  /* uvx is used */
+    float uvx[4][6];              /* per slot (base colour, map[]): fv_material_maps.uv_transform */
+    float *col;                   /* per triangle 9 floats, its corners' vertex colours, or NULL */
+    float alpha_cutoff;           /* > 0: alpha MASK (an Embree intersect filter, set at commit) */
+    const fv_texture *mask_tex;   /* the base colour texture the filter reads (set at commit), or NULL */
 } fv_mesh_rec;
 
 struct fv_scene {
@@ -73,7 +87,8 @@ struct fv_scene {
 int fv_scene_grow(void **p, size_t *cap, size_t n, size_t elem);
 /* Returns 1 and copies the first recorded Embree error into err, or 0 if none. */
 int fv_scene_take_rtc_error(fv_scene *s, char *err, size_t err_len);
-/* Trilinear between the two mip levels around lod (lod 0 = full resolution), REPEAT addressing. */
+/* Trilinear between the two mip levels around lod (lod 0 = full resolution), with the texture's
+ * wrap modes. */
 void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4]);
 /* fv_texture_sample in two steps, so a packet's texel fetches can be asked for before they are
  * used: the taps (texel addresses and weights), then the blend; the same bits. */

@@ -3,6 +3,7 @@
  * per-triangle texel density for mip selection, attached to the Embree scene. */
 #include "scene_impl.h"
 #include "base/err.h"
+#include "brdf.h"
 
 #include <float.h>
 #include <math.h>
@@ -47,13 +48,43 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         fv_err(err, err_len, "texture %d does not exist", m->texture);
         return -1;
     }
-    if (m->texture >= 0 && !m->uvs) {
+    const int map[3] = {m->maps ? m->maps->metallic_roughness : -1, m->maps ? m->maps->occlusion : -1,
+                        m->maps ? m->maps->emissive : -1};
+    int tex_ref = m->texture;
+    for (int j = 0; j < 3; j++) {
+        if (map[j] < -1 || map[j] >= s->texture_count) {
+            fv_err(err, err_len, "material map texture %d does not exist", map[j]);
+            return -1;
+        }
+        if (tex_ref < 0) tex_ref = map[j];
+    }
+    if (tex_ref >= 0 && !m->uvs) {
         fv_err(err, err_len, "texture without uvs");
+        return -1;
+    }
+    if (!(m->alpha_cutoff >= 0.0f && m->alpha_cutoff <= 1.0f)) {
+        fv_err(err, err_len, "alpha cutoff %g is outside [0, 1]", (double)m->alpha_cutoff);
+        return -1;
+    }
+    if (m->maps && !(m->maps->occlusion_strength >= 0.0f && m->maps->occlusion_strength <= 1.0f)) {
+        fv_err(err, err_len, "occlusion strength %g is outside [0, 1]", (double)m->maps->occlusion_strength);
         return -1;
     }
     for (int c = 0; c < 4; c++)
         if (!isfinite(m->base_color[c])) {
             fv_err(err, err_len, "base colour is not finite");
+            return -1;
+        }
+    const float unit[3] = {m->metallic, m->roughness, m->specular};
+    for (int c = 0; c < 3; c++)
+        if (!(unit[c] >= 0.0f && unit[c] <= 1.0f)) { /* also NaN */
+            fv_err(err, err_len, "%s %g is outside [0, 1]", c == 0 ? "metallic" : c == 1 ? "roughness" : "specular",
+                   (double)unit[c]);
+            return -1;
+        }
+    for (int c = 0; c < 3; c++)
+        if (!(m->emissive[c] >= 0.0f) || !isfinite(m->emissive[c])) {
+            fv_err(err, err_len, "emissive is negative or not finite");
             return -1;
         }
     double M[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -76,15 +107,42 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     memset(&r, 0, sizeof r);
     r.vertex_count = nv, r.tri_count = nt, r.texture = m->texture;
     memcpy(r.base_color, m->base_color, sizeof r.base_color);
+    r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular, r.roughness = m->roughness;
+    r.tex_ref = tex_ref;
+    r.alpha_cutoff = m->alpha_cutoff;
+    if (m->maps && m->maps->has_uv_transform) {
+        for (int j = 0; j < 4; j++)
+            for (int k = 0; k < 6; k++)
+                if (!isfinite(m->maps->uv_transform[j][k])) {
+                    fv_err(err, err_len, "uv transform is not finite");
+                    return -1;
+                }
+        r.has_uvx = 1;
+        memcpy(r.uvx, m->maps->uv_transform, sizeof r.uvx);
+    }
+    r.occlusion_strength = m->maps ? m->maps->occlusion_strength : 0.0f;
+    for (int j = 0; j < 4; j++) { /* a map with 4x the texels of tex_ref is one mip level further down at the same footprint */
+        const int tx = j == 0 ? m->texture : map[j - 1];
+        if (j > 0) r.map[j - 1] = tx;
+        r.lod_bias[j] = 0.0f;
+        if (tx >= 0 && tx != tex_ref) {
+            const fv_texture *a = &s->textures[tx], *b = &s->textures[tex_ref];
+            r.lod_bias[j] = (float)(0.5 * log2(((double)a->w[0] * a->h[0]) / ((double)b->w[0] * b->h[0])));
+        }
+    }
+    /* maps that cannot change the result are not sampled */
+    if (r.occlusion_strength == 0.0f) r.map[FV_MAP_OCC] = -1;
+    if (m->emissive[0] == 0.0f && m->emissive[1] == 0.0f && m->emissive[2] == 0.0f) r.map[FV_MAP_EMIS] = -1;
+    memcpy(r.emissive, m->emissive, sizeof r.emissive);
     float *pos = malloc(nv * 3 * sizeof(float));
     uint32_t *tri = malloc(nt * 3 * sizeof(uint32_t));
     float *normals = calloc(nv * 3, sizeof(float));
     float *uvs = m->uvs ? malloc(nv * 2 * sizeof(float)) : NULL;
-    float *density = m->texture >= 0 ? malloc(nt * sizeof(float)) : NULL;
+    float *density = tex_ref >= 0 ? malloc(nt * sizeof(float)) : NULL;
     r.attr = aligned_alloc(64, nt * sizeof *r.attr);
-    r.face = m->texture >= 0 ? malloc(nt * sizeof *r.face) : NULL;
+    r.face = tex_ref >= 0 ? malloc(nt * sizeof *r.face) : NULL;
     RTCGeometry g = NULL;
-    if (!pos || !tri || !normals || !r.attr || (m->texture >= 0 && !r.face) || (m->uvs && !uvs) || (m->texture >= 0 && !density)) {
+    if (!pos || !tri || !normals || !r.attr || (tex_ref >= 0 && !r.face) || (m->uvs && !uvs) || (tex_ref >= 0 && !density)) {
         fv_err(err, err_len, "out of memory");
         goto fail;
     }
@@ -140,6 +198,21 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
                 o[0] = o[1] = o[2] = 0.0f; /* shading falls back to the geometric normal */
         }
     }
+    if (m->colors) {
+        r.col = malloc(nt * 9 * sizeof(float));
+        if (!r.col) {
+            fv_err(err, err_len, "out of memory");
+            goto fail;
+        }
+        for (size_t i = 0; i < 3 * nv; i++)
+            if (!isfinite(m->colors[i])) {
+                fv_err(err, err_len, "vertex %zu colour is not finite", i / 3);
+                goto fail;
+            }
+        for (size_t t = 0; t < nt; t++)
+            for (int c = 0; c < 3; c++)
+                memcpy(r.col + 9 * t + 3 * c, m->colors + 3 * (size_t)tri[3 * t + (size_t)c], 3 * sizeof(float));
+    }
     if (m->uvs) {
         for (size_t i = 0; i < 2 * nv; i++)
             if (!isfinite(m->uvs[i])) {
@@ -149,7 +222,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         memcpy(uvs, m->uvs, nv * 2 * sizeof(float));
     }
     if (density) {
-        const fv_texture *tx = &s->textures[m->texture];
+        const fv_texture *tx = &s->textures[tex_ref];
         const double texels = (double)tx->w[0] * (double)tx->h[0];
         for (size_t t = 0; t < nt; t++) {
             float e1[3], e2[3], fn[3];
@@ -220,5 +293,6 @@ fail:
     free(density);
     free(r.attr);
     free(r.face);
+    free(r.col);
     return -1;
 }

@@ -1,17 +1,12 @@
-/* fovea: shading one hit (fv_scene_shade): base colour x Lambert over the lights, plus ambient. */
+/* fovea: shading hits (fv_scene_shade, one; fv_scene_shade_packet, an Embree packet): the
+ * material's inputs gathered here, the BRDF and lights in core/shade_lane.h / the kernels. */
 #include "scene_impl.h"
+#include "shade_lane.h"
 #include "base/util.h"
 
 #include <math.h>
 
 _Static_assert(FV_SHADE_LANES == 16, "fv_hit_packet (scene.h) holds 16 lanes");
-
-static float smoothstepf(float e0, float e1, float x)
-{
-    if (e1 <= e0) return x >= e1 ? 1.0f : 0.0f;
-    const float t = fv_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
 
 /* A textured hit's texture coordinates and mip level (from the ray footprint: footprint_rad is
  * the pixel's angle along the ray). */
@@ -32,17 +27,59 @@ static void tex_coords(const fv_mesh_rec *m, unsigned prim, float u, float v, fl
     }
 }
 
-/* The material's base colour at the hit, times its texture (trilinear). */
-static void base_colour(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
-                        const float dir[3], float t, float footprint_rad, float base[3])
+/* The material's inputs at a hit from the texels of its maps (NULL: no such map); the one
+ * definition both paths use. glTF: metallic in B, roughness in G, occlusion in R. */
+static void material_at(const fv_mesh_rec *m, unsigned prim, float u, float v, float w, const float *base_tx,
+                        const float *mr, const float *oc, const float *em, fv_brdf_mat *mat, float *occ, float emit[3])
 {
-    base[0] = m->base_color[0], base[1] = m->base_color[1], base[2] = m->base_color[2];
-    if (m->texture < 0)
+    for (int k = 0; k < 3; k++) mat->base[k] = base_tx ? m->base_color[k] * base_tx[k] : m->base_color[k];
+    if (m->col) { /* vertex colours (glTF COLOR_0), interpolated */
+        const float *c = m->col + 9 * (size_t)prim;
+        for (int k = 0; k < 3; k++) mat->base[k] *= w * c[k] + u * c[3 + k] + v * c[6 + k];
+    }
+    mat->metallic = m->metallic, mat->a2 = m->a2, mat->specular = m->specular;
+    if (mr) {
+        mat->metallic = m->metallic * mr[2];
+        mat->a2 = fv_ggx_a2(m->roughness * mr[1]);
+    }
+    *occ = oc ? 1.0f + m->occlusion_strength * (oc[0] - 1.0f) : 1.0f;
+    for (int k = 0; k < 3; k++) emit[k] = em ? m->emissive[k] * em[k] : m->emissive[k];
+}
+
+/* Slot j's texture: 0 base colour, 1 + FV_MAP_*. */
+static int slot_texture(const fv_mesh_rec *m, int j) { return j == 0 ? m->texture : m->map[j - 1]; }
+
+/* Slot j's texture coordinates: the mesh's, through its KHR_texture_transform if any. */
+static void slot_uv(const fv_mesh_rec *m, int j, float tu, float tv, float *su, float *sv)
+{
+    if (!m->has_uvx) {
+        *su = tu, *sv = tv;
         return;
-    float tu, tv, lod, texel[4];
-    tex_coords(m, prim, u, v, w, dir, t, footprint_rad, &tu, &tv, &lod);
-    fv_texture_sample(&s->textures[m->texture], tu, tv, lod, texel);
-    for (int k = 0; k < 3; k++) base[k] *= texel[k];
+    }
+    const float *x = m->uvx[j];
+    *su = x[0] * tu + x[1] * tv + x[2];
+    *sv = x[3] * tu + x[4] * tv + x[5];
+}
+
+/* The material at the hit, every map sampled trilinearly at the footprint's mip level. */
+static void material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
+                     const float dir[3], float t, float footprint_rad, fv_brdf_mat *mat, float *occ, float emit[3])
+{
+    float texel[4][4];
+    const float *tx[4] = {NULL, NULL, NULL, NULL};
+    if (m->tex_ref >= 0) {
+        float tu, tv, lod;
+        tex_coords(m, prim, u, v, w, dir, t, footprint_rad, &tu, &tv, &lod);
+        for (int j = 0; j < 4; j++) {
+            const int id = slot_texture(m, j);
+            if (id < 0) continue;
+            float su, sv;
+            slot_uv(m, j, tu, tv, &su, &sv);
+            fv_texture_sample(&s->textures[id], su, sv, lod + m->lod_bias[j], texel[j]);
+            tx[j] = texel[j];
+        }
+    }
+    material_at(m, prim, u, v, w, tx[0], tx[1], tx[2], tx[3], mat, occ, emit);
 }
 
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
@@ -56,9 +93,6 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     const uint32_t *tri = m->tri + 3 * (size_t)prim_id;
     const float w = 1.0f - u - v; /* Embree: u weights vertex 1, v vertex 2 */
 
-    /* The hot path (untextured, head light) costs one sqrt and one divide: the normal stays
-     * unnormalised and the Lambert term divides by |n||L| once. Scalar sqrt/div chains were
-     * most of the shading time. */
     float n[3];
     const fv_tri_attr *at = &m->attr[prim_id];
     const float *n0 = at->n, *n1 = at->n + 3, *n2 = at->n + 6;
@@ -74,46 +108,10 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         cross3(e1, e2, n);
         nn = dot3(n, n);
     }
-    if (dot3(n, dir) > 0.0f)
-        for (int k = 0; k < 3; k++) n[k] = -n[k];
-
-    float base[3];
-    base_colour(s, m, prim_id, u, v, w, dir, t, footprint_rad, base);
-
-    const float p[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
-    float light[3] = {FV_SCENE_AMBIENT, FV_SCENE_AMBIENT, FV_SCENE_AMBIENT};
-    if (s->light_count == 0) { /* head light: unit intensity, no falloff */
-        float L[3] = {eye_pos[0] - p[0], eye_pos[1] - p[1], eye_pos[2] - p[2]};
-        const float nl = dot3(n, L), ll = dot3(L, L);
-        if (nl > 0.0f && ll > 0.0f) {
-            const float lam = nl / sqrtf(nn * ll);
-            for (int k = 0; k < 3; k++) light[k] += lam;
-        }
-    } else {
-        const float inv_n = nn > 0.0f ? 1.0f / sqrtf(nn) : 0.0f;
-        for (int k = 0; k < 3; k++) n[k] *= inv_n;
-        for (int i = 0; i < s->light_count; i++) {
-            const fv_light_rec *lr = &s->lights[i];
-            const fv_light *l = &lr->l;
-            float L[3], atten = 1.0f;
-            if (l->type == FV_LIGHT_DIRECTIONAL) {
-                for (int k = 0; k < 3; k++) L[k] = -l->dir[k];
-            } else {
-                for (int k = 0; k < 3; k++) L[k] = l->pos[k] - p[k];
-                const float d = len3(L);
-                if (!(d > 0.0f)) continue;
-                for (int k = 0; k < 3; k++) L[k] /= d;
-                atten = range_window(d, l->range) / (d * d);
-                if (l->type == FV_LIGHT_SPOT)
-                    atten *= smoothstepf(lr->cos_outer, lr->cos_inner, -dot3(l->dir, L));
-            }
-            const float lam = fmaxf(0.0f, dot3(n, L));
-            const float e = lam * atten * l->intensity * s->light_exposure;
-            if (!(e > 0.0f) || !isfinite(e)) continue;
-            for (int k = 0; k < 3; k++) light[k] += l->color[k] * e;
-        }
-    }
-    for (int k = 0; k < 3; k++) rgb[k] = base[k] * light[k];
+    fv_brdf_mat mat;
+    float occ, emit[3];
+    material(s, m, prim_id, u, v, w, dir, t, footprint_rad, &mat, &occ, emit);
+    fv_shade_lane(&mat, occ, emit, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure, rgb);
 }
 
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
@@ -133,7 +131,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     /* Per thread, zero at start: lanes of misses keep whatever an earlier packet left there
      * (finite, initialised: their results are not used), so a miss costs no stores. */
     static _Thread_local _Alignas(64) fv_shade_packet pk;
-    fv_tex_taps taps[FV_SHADE_LANES];
+    fv_tex_taps taps[4][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
     for (int q = 0; q < n; q++) {
         const unsigned g = h->geom[q], prim = h->prim[q];
@@ -151,21 +149,43 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
         pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
         for (int k = 0; k < 3; k++) pk.dir[k][q] = dir[k];
-        const float fp = m->texture >= 0 ? px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]) : 0.0f;
-        for (int k = 0; k < 3; k++) pk.base[k][q] = m->base_color[k];
-        if (m->texture >= 0) { /* the texel fetches of all lanes are asked for before any is used */
+        if (m->tex_ref >= 0) { /* the texel fetches of all lanes are asked for before any is used */
+            const float fp = px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
-            fv_texture_taps(&s->textures[m->texture], tu, tv, lod, &taps[q]);
-            fv_texture_taps_prefetch(&taps[q]);
+            for (int j = 0; j < 4; j++) {
+                const int id = slot_texture(m, j);
+                if (id < 0) continue;
+                float su, sv;
+                slot_uv(m, j, tu, tv, &su, &sv);
+                fv_texture_taps(&s->textures[id], su, sv, lod + m->lod_bias[j], &taps[j][q]);
+                fv_texture_taps_prefetch(&taps[j][q]);
+            }
             textured |= 1u << q;
+        } else {
+            fv_brdf_mat mat;
+            float occ, emit[3];
+            material_at(m, prim, u, v, 1.0f - u - v, NULL, NULL, NULL, NULL, &mat, &occ, emit);
+            for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
+            pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
         }
     }
     for (unsigned r = textured; r; r &= r - 1) {
         const int q = __builtin_ctz(r);
-        float texel[4];
-        fv_texture_blend(&taps[q], texel);
-        for (int k = 0; k < 3; k++) pk.base[k][q] *= texel[k];
+        const fv_mesh_rec *m = &s->meshes[h->geom[q]];
+        float texel[4][4];
+        const float *tx[4] = {NULL, NULL, NULL, NULL};
+        for (int j = 0; j < 4; j++)
+            if (slot_texture(m, j) >= 0) {
+                fv_texture_blend(&taps[j][q], texel[j]);
+                tx[j] = texel[j];
+            }
+        fv_brdf_mat mat;
+        float occ, emit[3];
+        const float u = h->u[q], v = h->v[q];
+        material_at(m, h->prim[q], u, v, 1.0f - u - v, tx[0], tx[1], tx[2], tx[3], &mat, &occ, emit);
+        for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
+        pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
     }
     if (!hits) { /* all misses: nothing to shade */
         for (; black; black &= black - 1)
@@ -174,7 +194,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     }
     const fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
                               .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
-    unsigned rest = dsp->lambert(&pk, &env, rgb) & hits;
+    unsigned rest = dsp->brdf(&pk, &env, rgb) & hits;
     while (rest) { /* degenerate smooth normals: the scalar path's face normal */
         const int q = __builtin_ctz(rest);
         rest &= rest - 1;

@@ -1,10 +1,10 @@
 /* fovea: the shading kernels (one table per module, dav1d style; core/cpu.h has the pattern and
  * the contract every ISA version keeps). The ray stage shades a whole Embree packet at once: the
  * scene's driver (fv_scene_shade_packet, core/shade.c) gathers each hit's vertex normals and base
- * colour (texture applied) into a structure of arrays, and the kernel does the arithmetic of
- * every lane together: normal interpolation and orientation, the head light or the KHR lights,
- * ambient, base x light. C reference: core/shade_ref.c; the body every ISA shares:
- * core/shade_tmpl.h. Same IEEE operations in the same order as the scalar fv_scene_shade (true
+ * colour (texture applied) and material into a structure of arrays, and the kernel does the
+ * arithmetic of every lane together: normal interpolation and orientation, the glTF
+ * metallic-roughness BRDF (core/brdf.h) over the head light or the KHR lights, the ambient term
+ * and emission. C reference: core/shade_ref.c; the body every ISA shares: core/shade_tmpl.h. Same IEEE operations in the same order as the scalar fv_scene_shade (true
  * division and square root, no FMA): every ISA gives the reference's bits, and the reference
  * gives fv_scene_shade's. */
 #ifndef FOVEA_SHADE_DSP_H
@@ -36,23 +36,28 @@ typedef struct fv_shade_packet {
     float t[FV_SHADE_LANES];       /* hit distance along dir */
     float dir[3][FV_SHADE_LANES];  /* ray direction (unnormalised) */
     float base[3][FV_SHADE_LANES]; /* base colour, texture applied */
+    float metal[FV_SHADE_LANES];   /* metallic */
+    float a2[FV_SHADE_LANES];      /* fv_ggx_a2(roughness) (core/brdf.h) */
+    float spec[FV_SHADE_LANES];    /* dielectric Fresnel weight: 1 glTF, 0 matte */
+    float emit[3][FV_SHADE_LANES]; /* emitted radiance, linear RGB */
+    float occl[FV_SHADE_LANES];    /* ambient occlusion, 1 = none */
 } fv_shade_packet;
 
-/* lambert: rgb of every one of the FV_SHADE_LANES lanes (all lanes are read and written: pad a
+/* brdf: rgb of every one of the FV_SHADE_LANES lanes (all lanes are read and written: pad a
  * short packet with copies of a real lane). Returns the lanes whose interpolated normal is
  * degenerate (|n|^2 <= 1e-24 or NaN; bit i: lane i): their rgb is unspecified, the caller shades
  * them with the face normal (fv_scene_shade). Bound against the reference: exact. */
-typedef unsigned (*fv_shade_lambert_fn)(const fv_shade_packet *p, const fv_shade_env *env,
+typedef unsigned (*fv_shade_brdf_fn)(const fv_shade_packet *p, const fv_shade_env *env,
                                         float rgb[3][FV_SHADE_LANES]);
 typedef struct fv_shade_dsp {
-    fv_shade_lambert_fn lambert;
+    fv_shade_brdf_fn brdf;
 } fv_shade_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references). */
 void fv_shade_dsp_init(fv_shade_dsp *d, unsigned isa_mask);
 
 /* ---- internal: references and per-ISA fillers ---- */
-unsigned fv_shade_lambert_c(const fv_shade_packet *p, const fv_shade_env *env, float rgb[3][FV_SHADE_LANES]);
+unsigned fv_shade_brdf_c(const fv_shade_packet *p, const fv_shade_env *env, float rgb[3][FV_SHADE_LANES]);
 #if defined(__x86_64__)
 void fv_shade_dsp_init_sse41(fv_shade_dsp *d);
 void fv_shade_dsp_init_avx2(fv_shade_dsp *d);

@@ -1,18 +1,19 @@
-/* fovea: the body of the packet shading kernel (shade_dsp.h: lambert) that every ISA shares. The
+/* fovea: the body of the packet shading kernel (shade_dsp.h: brdf) that every ISA shares. The
  * includer defines a vector of SW floats and its operations, then includes this once:
  *   V, M                      float vector, lane mask
  *   VLD(p) VST(p, v) VS(x)    load, store (unaligned), broadcast
  *   VADD VSUB VMUL VDIV VSQRT IEEE, exactly rounded
  *   VNEG(a)                   sign flipped
- *   VMAX0(a)                  max(a, 0) (a NaN lane may give 0 or NaN: both add no light)
  *   VGT VGE VLT (a, b)        ordered comparisons (false for NaN)
  *   MAND(a, b)                both
  *   VSEL(m, a, b)             m ? a : b per lane
  *   MBITS(m)                  the lanes of m as the low SW bits
  *   SHADE_FN                  the kernel's name
- * Each line does what core/shade_ref.c does for one lane, in the same order, so the bits agree. */
+ * Each line does what core/shade_lane.h (fv_shade_lane, core/brdf.h) does for one lane, in the same
+ * order, so the bits agree. */
 #include <math.h> /* INFINITY */
 
+#include "brdf.h"  /* the constants */
 #include "scene.h" /* FV_SCENE_AMBIENT */
 
 static inline V dot3v(const V a[3], const V b[3]) { return VADD(VADD(VMUL(a[0], b[0]), VMUL(a[1], b[1])), VMUL(a[2], b[2])); }
@@ -27,12 +28,53 @@ static inline V smoothstepv(float e0, float e1, V x)
     return VMUL(VMUL(t, t), VSUB(VS(3.0f), VMUL(VS(2.0f), t)));
 }
 
+/* fv_clamp01: NaN gives 0 */
+static inline V clamp01v(V x) { return VSEL(VGT(x, VS(0.0f)), VSEL(VLT(x, VS(1.0f)), x, VS(1.0f)), VS(0.0f)); }
+
+/* fv_brdf_cos (core/brdf.h) */
+static inline void brdf_cosv(const V base[3], V metal, V a2, V specw, V nl, V nv, V nh, V vh, V out[3])
+{
+    nv = clamp01v(nv), nh = clamp01v(nh);
+    const V one = VS(1.0f);
+    const V gv = VMUL(nl, VSQRT(VADD(VMUL(VMUL(nv, nv), VSUB(one, a2)), a2)));
+    const V gl = VMUL(nv, VSQRT(VADD(VMUL(VMUL(nl, nl), VSUB(one, a2)), a2)));
+    const V s = VADD(gv, gl);
+    const V vis = VSEL(VGT(s, VS(0.0f)), VDIV(VS(0.5f), s), VS(0.0f));
+    const V dd = VADD(VMUL(VSUB(one, nh), VADD(one, nh)), VMUL(VMUL(nh, nh), a2));
+    const V dist = VDIV(a2, VMUL(VS(FV_PI_F), VMUL(dd, dd)));
+    const V spec = VMUL(VS(FV_PI_F), VMUL(vis, dist));
+    const V x = VSUB(one, clamp01v(vh)), x2 = VMUL(x, x);
+    const V w = VMUL(VMUL(x2, x2), x);
+    const V fd = VMUL(specw, VADD(VS(FV_DIELECTRIC_F0), VMUL(VS(1.0f - FV_DIELECTRIC_F0), w)));
+    for (int k = 0; k < 3; k++) {
+        const V diel = VADD(VMUL(VSUB(one, fd), base[k]), VMUL(fd, spec));
+        const V met = VMUL(spec, VADD(base[k], VMUL(VSUB(one, base[k]), w)));
+        out[k] = VMUL(VADD(VMUL(VSUB(one, metal), diel), VMUL(metal, met)), nl);
+    }
+}
+
+/* fv_lane_add_light (core/shade_lane.h), on the lanes of ok only */
+static inline void add_lightv(const V base[3], V metal, V a2, V specw, const V n[3], const V v[3], V nv,
+                              const V L[3], V nl, const V col_e[3], M ok, V rgb[3])
+{
+    V h[3] = {VADD(L[0], v[0]), VADD(L[1], v[1]), VADD(L[2], v[2])};
+    const V hl = VSQRT(dot3v(h, h));
+    const V ih = VSEL(VGT(hl, VS(0.0f)), VDIV(VS(1.0f), hl), VS(0.0f));
+    for (int k = 0; k < 3; k++)
+        h[k] = VMUL(h[k], ih);
+    V f[3];
+    brdf_cosv(base, metal, a2, specw, nl, nv, dot3v(n, h), dot3v(v, h), f);
+    for (int k = 0; k < 3; k++)
+        rgb[k] = VSEL(ok, VADD(rgb[k], VMUL(f[k], col_e[k])), rgb[k]);
+}
+
 static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, float rgb[3][FV_SHADE_LANES])
 {
     unsigned degenerate = 0;
+    const V one = VS(1.0f);
     for (int i = 0; i < FV_SHADE_LANES; i += SW) {
         const V u = VLD(p->u + i), v = VLD(p->v + i);
-        const V w = VSUB(VSUB(VS(1.0f), u), v);
+        const V w = VSUB(VSUB(one, u), v);
         V n[3];
         for (int k = 0; k < 3; k++)
             n[k] = VADD(VADD(VMUL(w, VLD(p->nrm[k] + i)), VMUL(u, VLD(p->nrm[3 + k] + i))),
@@ -43,27 +85,43 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
         const M flip = VGT(dot3v(n, d), VS(0.0f));
         for (int k = 0; k < 3; k++)
             n[k] = VSEL(flip, VNEG(n[k]), n[k]);
+        const V inv_n = VDIV(one, VSQRT(nn));
+        for (int k = 0; k < 3; k++)
+            n[k] = VMUL(n[k], inv_n);
+        const V inv_d = VDIV(one, VSQRT(dot3v(d, d)));
+        const V vw[3] = {VMUL(VNEG(d[0]), inv_d), VMUL(VNEG(d[1]), inv_d), VMUL(VNEG(d[2]), inv_d)};
+        const V nv = dot3v(n, vw);
         const V t = VLD(p->t + i);
         const V hit[3] = {VADD(VS(env->eye[0]), VMUL(t, d[0])), VADD(VS(env->eye[1]), VMUL(t, d[1])),
                           VADD(VS(env->eye[2]), VMUL(t, d[2]))};
-        V light[3];
-        if (env->nlights == 0) { /* head light: unit intensity, no falloff */
-            const V L[3] = {VSUB(VS(env->eye[0]), hit[0]), VSUB(VS(env->eye[1]), hit[1]),
-                            VSUB(VS(env->eye[2]), hit[2])};
-            const V nl = dot3v(n, L), ll = dot3v(L, L);
-            const V lam = VDIV(nl, VSQRT(VMUL(nn, ll)));
-            const V a = VS(FV_SCENE_AMBIENT);
-            light[0] = light[1] = light[2] = VSEL(MAND(VGT(nl, VS(0.0f)), VGT(ll, VS(0.0f))), VADD(a, lam), a);
-        } else {
-            const V inv_n = VDIV(VS(1.0f), VSQRT(nn)); /* nn > 0 on every lane that counts */
+        const V base[3] = {VLD(p->base[0] + i), VLD(p->base[1] + i), VLD(p->base[2] + i)};
+        const V metal = VLD(p->metal + i), a2 = VLD(p->a2 + i), specw = VLD(p->spec + i);
+        V out[3];
+        { /* fv_brdf_ambient */
+            const V f0 = VMUL(specw, VS(FV_DIELECTRIC_F0));
+            const V amb = VMUL(VS(FV_SCENE_AMBIENT), VLD(p->occl + i));
+            for (int k = 0; k < 3; k++) {
+                const V diel = VADD(VMUL(VSUB(one, f0), base[k]), f0);
+                out[k] = VMUL(amb, VADD(VMUL(VSUB(one, metal), diel), VMUL(metal, base[k])));
+            }
+        }
+        if (env->nlights == 0) { /* head light: irradiance 1, white, no falloff */
+            V L[3] = {VSUB(VS(env->eye[0]), hit[0]), VSUB(VS(env->eye[1]), hit[1]), VSUB(VS(env->eye[2]), hit[2])};
+            const V ll = dot3v(L, L);
+            const V il = VDIV(one, VSQRT(ll));
             for (int k = 0; k < 3; k++)
-                n[k] = VMUL(n[k], inv_n);
-            light[0] = light[1] = light[2] = VS(FV_SCENE_AMBIENT);
+                L[k] = VMUL(L[k], il);
+            const V nl = dot3v(n, L);
+            const V ce = VMUL(one, one); /* colour x e, as the scalar code multiplies it */
+            const V col_e[3] = {ce, ce, ce};
+            add_lightv(base, metal, a2, specw, n, vw, nv, L, nl, col_e, MAND(VGT(ll, VS(0.0f)), VGT(nl, VS(0.0f))),
+                       out);
+        } else {
             for (int j = 0; j < env->nlights; j++) {
                 const fv_light_rec *lr = &env->lights[j];
                 const fv_light *l = &lr->l;
-                V L[3], atten = VS(1.0f);
-                M ok = VGE(VS(1.0f), VS(0.0f)); /* every lane */
+                V L[3], atten = one;
+                M ok = VGE(one, VS(0.0f)); /* every lane */
                 if (l->type == FV_LIGHT_DIRECTIONAL) {
                     for (int k = 0; k < 3; k++)
                         L[k] = VS(-l->dir[k]);
@@ -74,11 +132,11 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
                     ok = VGT(dist, VS(0.0f));
                     for (int k = 0; k < 3; k++)
                         L[k] = VDIV(L[k], dist);
-                    V win = VS(1.0f); /* range_window (scene_impl.h) */
+                    V win = one; /* fv_lane_window */
                     if (l->range > 0.0f) {
                         const V x = VDIV(dist, VS(l->range));
                         const V x4 = VMUL(VMUL(VMUL(x, x), x), x);
-                        win = VSEL(VGE(x4, VS(1.0f)), VS(0.0f), VSUB(VS(1.0f), x4));
+                        win = VSEL(VGE(x4, one), VS(0.0f), VSUB(one, x4));
                     }
                     atten = VDIV(win, VMUL(dist, dist));
                     if (l->type == FV_LIGHT_SPOT) {
@@ -86,15 +144,15 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
                         atten = VMUL(atten, smoothstepv(lr->cos_outer, lr->cos_inner, VNEG(dot3v(ld, L))));
                     }
                 }
-                const V lam = VMAX0(dot3v(n, L));
-                const V e = VMUL(VMUL(VMUL(lam, atten), VS(l->intensity)), VS(env->exposure));
-                ok = MAND(ok, MAND(VGT(e, VS(0.0f)), VLT(e, VS(INFINITY))));
-                for (int k = 0; k < 3; k++)
-                    light[k] = VSEL(ok, VADD(light[k], VMUL(VS(l->color[k]), e)), light[k]);
+                const V nl = dot3v(n, L);
+                const V e = VMUL(VMUL(atten, VS(l->intensity)), VS(env->exposure));
+                ok = MAND(ok, MAND(VGT(nl, VS(0.0f)), MAND(VGT(e, VS(0.0f)), VLT(e, VS(INFINITY)))));
+                const V col_e[3] = {VMUL(VS(l->color[0]), e), VMUL(VS(l->color[1]), e), VMUL(VS(l->color[2]), e)};
+                add_lightv(base, metal, a2, specw, n, vw, nv, L, nl, col_e, ok, out);
             }
         }
         for (int k = 0; k < 3; k++)
-            VST(rgb[k] + i, VMUL(VLD(p->base[k] + i), light[k]));
+            VST(rgb[k] + i, VADD(out[k], VLD(p->emit[k] + i)));
     }
     return degenerate;
 }

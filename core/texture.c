@@ -1,5 +1,5 @@
-/* fovea: scene textures: sRGB 8-bit RGBA stored as linear float RGBA with a box-filtered mip
- * chain, sampled trilinearly with REPEAT addressing. */
+/* fovea: scene textures: sRGB (or linear data) 8-bit RGBA stored as linear float RGBA with a box-filtered mip
+ * chain, sampled trilinearly with REPEAT, CLAMP or MIRROR addressing (glTF samplers). */
 #include "scene_impl.h"
 
 #include <math.h>
@@ -35,7 +35,7 @@ static void downsample(const float *src, int sw, int sh, float *dst, int dw, int
     }
 }
 
-int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h)
+static int add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h, int srgb)
 {
     if (!s || !rgba8 || w < 1 || h < 1 || w > FV_TEX_MAX_SIDE || h > FV_TEX_MAX_SIDE ||
         (size_t)w * (size_t)h > FV_TEX_MAX_TEXELS)
@@ -59,7 +59,7 @@ int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h)
     float lut[256]; /* sRGB -> linear */
     for (int i = 0; i < 256; i++) {
         float c = (float)i / 255.0f;
-        lut[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+        lut[i] = !srgb ? c : c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
     }
     const size_t n = (size_t)w * (size_t)h;
     for (size_t i = 0; i < n; i++) {
@@ -73,22 +73,52 @@ int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h)
     return s->texture_count++;
 }
 
-/* Bilinear, REPEAT addressing; uv (0,0) is the first texel of the first row (glTF). */
-/* A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. */
+int fv_scene_add_texture(fv_scene *s, const uint8_t *rgba8, int w, int h) { return add_texture(s, rgba8, w, h, 1); }
+int fv_scene_add_texture_linear(fv_scene *s, const uint8_t *rgba8, int w, int h)
+{
+    return add_texture(s, rgba8, w, h, 0);
+}
+
+int fv_scene_set_texture_wrap(fv_scene *s, int tex, fv_wrap wrap_s, fv_wrap wrap_t)
+{
+    if (!s || tex < 0 || tex >= s->texture_count) return -1;
+    s->textures[tex].wrap_s = wrap_s, s->textures[tex].wrap_t = wrap_t;
+    return 0;
+}
+
+/* A coordinate folded into [0, 1] by the wrap mode (glTF samplers; NaN and infinities give 0). */
+static float wrap_coord(float u, fv_wrap mode)
+{
+    if (!isfinite(u)) return 0.0f;
+    if (mode == FV_WRAP_CLAMP) return u < 0.0f ? 0.0f : u > 1.0f ? 1.0f : u;
+    if (mode == FV_WRAP_MIRROR) {
+        const float f = u - 2.0f * floorf(0.5f * u); /* [0, 2] */
+        return f > 1.0f ? 2.0f - f : f;
+    }
+    return u - floorf(u); /* [0,1] (1 only by rounding) */
+}
+
+/* A bilinear tap's neighbour index on one axis, i in [-1, side]: wrapped for REPEAT, the edge
+ * texel for CLAMP and MIRROR (a mirror repeats the edge texel across the edge). */
+static int wrap_index(int i, int side, fv_wrap mode)
+{
+    if (mode == FV_WRAP_REPEAT) return i < 0 ? i + side : i >= side ? i - side : i;
+    return i < 0 ? 0 : i >= side ? side - 1 : i;
+}
+
+/* Bilinear with the texture's wrap modes; uv (0,0) is the first texel of the first row (glTF).
+ * A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. */
 static void tex_tap(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp)
 {
     const int w = t->w[l], h = t->h[l];
     const float *px = t->level[l];
-    u = isfinite(u) ? u - floorf(u) : 0.0f; /* [0,1] (1 only by rounding) */
-    v = isfinite(v) ? v - floorf(v) : 0.0f;
+    u = wrap_coord(u, t->wrap_s);
+    v = wrap_coord(v, t->wrap_t);
     const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
     const float xf = floorf(x), yf = floorf(y);
     tp->fx = x - xf, tp->fy = y - yf;
-    int x0 = (int)xf, y0 = (int)yf, x1 = x0 + 1, y1 = y0 + 1; /* in [-1, side] */
-    if (x0 < 0) x0 += w;
-    if (y0 < 0) y0 += h;
-    if (x1 >= w) x1 -= w;
-    if (y1 >= h) y1 -= h;
+    const int x0 = wrap_index((int)xf, w, t->wrap_s), y0 = wrap_index((int)yf, h, t->wrap_t);
+    const int x1 = wrap_index((int)xf + 1, w, t->wrap_s), y1 = wrap_index((int)yf + 1, h, t->wrap_t);
     tp->p[0] = px + ((size_t)y0 * (size_t)w + (size_t)x0) * 4, tp->p[1] = px + ((size_t)y0 * (size_t)w + (size_t)x1) * 4;
     tp->p[2] = px + ((size_t)y1 * (size_t)w + (size_t)x0) * 4, tp->p[3] = px + ((size_t)y1 * (size_t)w + (size_t)x1) * 4;
 }

@@ -7,6 +7,8 @@
 #include "scene.h"
 #include "shade_dsp.h"
 
+#include <stb/stb_image_write.h>
+
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -693,7 +695,10 @@ static void test_gltf_hierarchy(void **state)
     assert_near(h.t, 5.0f, 1e-5f);
     assert_near(h.u, 0.25f, 1e-5f);
     assert_near(h.v, 0.25f, 1e-5f);
-    assert_rgb(rgb, 0.5f * 1.15f, 0.25f * 1.15f, 1.15f, 1e-5f, __LINE__);
+    /* The material gives only baseColorFactor, so metallic and roughness take the glTF
+     * defaults (1, 1): a rough metal. Head-on (n = l = v = h) with a2 = 1: D = 1/pi, V = 1/4,
+     * F = base, so the head light adds pi V D base = base/4 and the ambient 0.15 base. */
+    assert_rgb(rgb, 0.5f * 0.4f, 0.25f * 0.4f, 0.4f, 1e-5f, __LINE__);
     /* Without the rotation the triangle would be in the plane z = -5 at x in [0,1]. */
     const float o2[3] = {0.25f, 0.25f, 0}, d2[3] = {0, 0, -1};
     assert_false(cast(s, o2, d2, &h));
@@ -878,6 +883,360 @@ static void test_packet_shading_matches_scalar(void **state)
     s = commit_or_fail(s);
     check_packets(s, 3);
     fv_scene_free(s);
+}
+
+/* ---- glTF materials ------------------------------------------------------------------ */
+
+/* Four unit-normal quads [-1,1]^2 at z = 0 (nodes at x = 0, 3, 6, 9), each with its own
+ * material, seen head-on from z = 5 with the head light at the eye (n = l = v = h, Schlick
+ * weight 0). Expected values (tests/test_brdf.c works the BRDF out the same way):
+ *   0 dielectric base 0.5 roughness 0.5: pi V D = 4, 0.96 x 0.5 + 0.04 x 4 = 0.64; ambient
+ *     0.15 (0.96 x 0.5 + 0.04) = 0.078: 0.718
+ *   1 metal base 0.5 roughness 0.5: 4 x 0.5 = 2; ambient 0.15 x 0.5: 2.075
+ *   2 black rough dielectric, emissive (0.2, 0.4, 0.1) x KHR_materials_emissive_strength 5:
+ *     0.04 x 1/4 + 0.15 x 0.04 + emission = (1.016, 2.016, 0.516)
+ *   3 KHR_materials_specular specularFactor 0, base 0.5: matte, 0.5 + 0.075 = 0.575 */
+static void test_gltf_pbr_materials(void **state)
+{
+    (void)state;
+    unsigned char bin[60];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, idx, 12);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"extensionsUsed\":[\"KHR_materials_emissive_strength\",\"KHR_materials_specular\"],"
+        "\"materials\":["
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":0,\"roughnessFactor\":0.5}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":1,\"roughnessFactor\":0.5}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0},\"emissiveFactor\":[0.2,0.4,0.1],"
+        "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":5}}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":0},"
+        "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":1}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":2}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":3}]}],"
+        "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[3,0,0]},{\"mesh\":2,\"translation\":[6,0,0]},"
+        "{\"mesh\":3,\"translation\":[9,0,0]}],\"scenes\":[{\"nodes\":[0,1,2,3]}],\"scene\":0";
+    char *dir = tmpdir_make(), p[512], err[512];
+    path_join(p, sizeof p, dir, "pbr.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    static const float want[4][3] = {{0.718f, 0.718f, 0.718f}, {2.075f, 2.075f, 2.075f},
+                                     {1.016f, 2.016f, 0.516f}, {0.575f, 0.575f, 0.575f}};
+    for (int i = 0; i < 4; i++) {
+        const float o[3] = {3.0f * (float)i + 0.3f, -0.2f, 5}, d[3] = {0, 0, -1};
+        hit h;
+        float rgb[3];
+        cast_shade(s, o, d, 0, &h, rgb);
+        assert_int_equal(h.geom, (unsigned)i);
+        assert_rgb(rgb, want[i][0], want[i][1], want[i][2], 2e-6f * 4, __LINE__);
+    }
+    check_packets(s, 4); /* every ISA's kernel gives these bits from other directions too */
+    fv_scene_free(s);
+
+    /* out-of-range factors are refused, naming them */
+    char bad[4096];
+    snprintf(bad, sizeof bad, "%s", json);
+    char *m = strstr(bad, "\"metallicFactor\":1");
+    assert_non_null(m);
+    memcpy(m, "\"metallicFactor\":2", 18);
+    write_gltf(p, bin, sizeof bin, bad);
+    expect_load_fails(p, "metallicFactor");
+    const char *e5 = strstr(json, "\"emissiveStrength\":5");
+    assert_non_null(e5);
+    snprintf(bad, sizeof bad, "%.*s\"emissiveStrength\":-5%s", (int)(e5 - json), json, e5 + 20);
+    write_gltf(p, bin, sizeof bin, bad);
+    expect_load_fails(p, "negative emissiveStrength");
+    tmpdir_remove(dir);
+}
+
+/* A quad [-1,1]^2 (uv = ((x+1)/2, (y+1)/2)) with 2x1 maps, sampled at texel centres (u 0.25 and
+ * 0.75, v 0.5) head-on with the head light; base colour factor 0.5, roughness factor 0.5.
+ * metallicRoughnessTexture (linear; G roughness, B metallic) also the occlusionTexture (R):
+ *   left  (0, 255, 0): roughness 0.5, dielectric, occlusion 0 (no ambient): 0.64
+ *   right (255, 255, 255): roughness 0.5, metal, occlusion 1: 2 + 0.15 x 0.5 = 2.075
+ * emissiveTexture (sRGB) (255, 0, 0) left, black right, emissiveFactor 1: left gains (1, 0, 0).
+ * The head-on values are worked out in test_gltf_pbr_materials. */
+static void test_gltf_material_maps(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char mr[8] = {0, 255, 0, 255, 255, 255, 255, 255}, em[8] = {255, 0, 0, 255, 0, 0, 0, 255};
+    path_join(p, sizeof p, dir, "mr.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, mr, 8) != 0);
+    path_join(p, sizeof p, dir, "em.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, em, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+        "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+        "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"images\":[{\"uri\":\"mr.png\"},{\"uri\":\"em.png\"}],\"textures\":[{\"source\":0},{\"source\":1}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"roughnessFactor\":0.5,"
+        "\"metallicRoughnessTexture\":{\"index\":0}},\"occlusionTexture\":{\"index\":0},"
+        "\"emissiveTexture\":{\"index\":1},\"emissiveFactor\":[1,1,1]}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0";
+    path_join(p, sizeof p, dir, "maps.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    const float d[3] = {0, 0, -1}, left[3] = {-0.5f, 0, 5}, right[3] = {0.5f, 0, 5};
+    hit h;
+    float rgb[3];
+    cast_shade(s, left, d, 0, &h, rgb);
+    assert_rgb(rgb, 1.64f, 0.64f, 0.64f, 1e-5f, __LINE__);
+    cast_shade(s, right, d, 0, &h, rgb);
+    assert_rgb(rgb, 2.075f, 2.075f, 2.075f, 1e-5f, __LINE__);
+    check_packets(s, 5); /* the maps through the packet path: the same bits */
+    fv_scene_free(s);
+    tmpdir_remove(dir);
+}
+
+/* Alpha MASK (cutoff 0.6) in the ray query: a quad at z = 0 whose 2x1 base colour texture has
+ * alpha 0 on the left half and 1 on the right, in front of a wall at z = -2 (the same quad,
+ * opaque). From z = 5 straight down, a ray through the left half passes the cut-out and reaches
+ * the wall (t = 7), one through the right half stops at the quad (t = 5), through rtcIntersect1
+ * and rtcIntersect16 alike. A third, untextured quad at z = 2 (x + 3) with base alpha 0.5 <
+ * 0.6 lets every ray through; the same quad as BLEND (not composited yet) is opaque. */
+static void test_gltf_alpha_mask(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char px[8] = {255, 255, 255, 0, 255, 255, 255, 255};
+    path_join(p, sizeof p, dir, "a.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    char json[4096];
+    for (int blend = 0; blend < 2; blend++) {
+        snprintf(json, sizeof json,
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"images\":[{\"uri\":\"a.png\"}],\"textures\":[{\"source\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}},\"alphaMode\":\"MASK\","
+                 "\"alphaCutoff\":0.6},{},"
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,0.5]},\"alphaMode\":\"%s\",\"alphaCutoff\":0.6}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2,\"material\":1}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2,\"material\":2}]}],"
+                 "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[0,0,-2]},{\"mesh\":1,\"translation\":[3,0,-2]},"
+                 "{\"mesh\":2,\"translation\":[3,0,2]}],\"scenes\":[{\"nodes\":[0,1,2,3]}],\"scene\":0",
+                 blend ? "BLEND" : "MASK");
+        path_join(p, sizeof p, dir, "mask.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        const float d[3] = {0, 0, -1}, xs[4] = {-0.5f, 0.5f, 2.5f, 3.5f};
+        const float want_t[2][4] = {{7, 5, 7, 7}, {7, 5, 3, 3}};
+        hit h;
+        for (int i = 0; i < 4; i++) {
+            const float o[3] = {xs[i], 0.1f, 5};
+            assert_true(cast(s, o, d, &h));
+            assert_near(h.t, want_t[blend][i], 1e-5f);
+        }
+        /* the same rays as one packet of 16 (4 copies each) */
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        _Alignas(64) struct RTCRayHit16 rh;
+        memset(&rh, 0, sizeof rh);
+        _Alignas(64) int valid[16];
+        for (int q = 0; q < 16; q++) {
+            valid[q] = -1;
+            rh.ray.org_x[q] = xs[q % 4], rh.ray.org_y[q] = 0.1f, rh.ray.org_z[q] = 5;
+            rh.ray.dir_z[q] = -1, rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
+            rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+        for (int q = 0; q < 16; q++) assert_near(rh.ray.tfar[q], want_t[blend][q % 4], 1e-5f);
+        fv_scene_free(s);
+    }
+    /* a cutoff out of range is refused */
+    char *c = strstr(json, "\"alphaCutoff\":0.6");
+    memcpy(c, "\"alphaCutoff\":1.6", 17);
+    write_gltf(p, bin, sizeof bin, json);
+    expect_load_fails(p, "alphaCutoff");
+    tmpdir_remove(dir);
+}
+
+/* COLOR_0 multiplies the base colour, interpolated: corners red, green, blue, white (VEC4
+ * float; alpha dropped) on the quad [-1,1]^2, matte (specularFactor 0, metallic 0), head-on:
+ * base x (1 + 0.15). (0.5, -0.5) lies in triangle (0, 1, 2) at u = 0.5, v = 0.25, w = 0.25:
+ * colour (0.25, 0.5, 0.25) x 1.15. In triangle (0, 2, 3), (-0.5, 0.5) is at u = 0.25
+ * (corner 2, blue) and v = 0.5 (corner 3, white): (0.75, 0.5, 0.75) x 1.15. */
+static void test_gltf_vertex_colours(void **state)
+{
+    (void)state;
+    unsigned char bin[124];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const float col[16] = {1, 0, 0, 0.5f, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, col, 64);
+    memcpy(bin + 112, idx, 12);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":64},"
+        "{\"buffer\":0,\"byteOffset\":112,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"},"
+        "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0},"
+        "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"COLOR_0\":1},\"indices\":2,\"material\":0}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0";
+    char *dir = tmpdir_make(), p[512], err[512];
+    path_join(p, sizeof p, dir, "col.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    const float d[3] = {0, 0, -1}, a[3] = {0.5f, -0.5f, 5}, b[3] = {-0.5f, 0.5f, 5};
+    hit h;
+    float rgb[3];
+    cast_shade(s, a, d, 0, &h, rgb);
+    assert_rgb(rgb, 0.25f * 1.15f, 0.5f * 1.15f, 0.25f * 1.15f, 1e-5f, __LINE__);
+    cast_shade(s, b, d, 0, &h, rgb);
+    assert_rgb(rgb, 0.75f * 1.15f, 0.5f * 1.15f, 0.75f * 1.15f, 1e-5f, __LINE__);
+    check_packets(s, 6);
+    fv_scene_free(s);
+    tmpdir_remove(dir);
+}
+
+/* Sampler wrap modes: a quad [-1,1]^2 with u = 1.5 x + 0.5 (so u runs -1 .. 2) and a 2x1 base
+ * colour texture black | white, matte, head-on (rgb = 1.15 x texel), at lod 0. With
+ * x = -8/15 (u = -0.3) and x = 0.8 (u = 1.7), the bilinear tap x = u w - 0.5 gives:
+ *   REPEAT: u -> 0.7 (x 0.9: 0.1 black + 0.9 white = 0.9) both times
+ *   CLAMP_TO_EDGE: u -> 0 (x -0.5, both taps the black edge texel: 0) and 1 (white: 1)
+ *   MIRRORED_REPEAT: -0.3 -> 0.3 and 1.7 -> 0.3 (x 0.1: 0.9 black + 0.1 white = 0.1)
+ * The v coordinate (0.5) samples the only row. */
+static void test_gltf_sampler_wrap(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char px[8] = {0, 0, 0, 255, 255, 255, 255, 255};
+    path_join(p, sizeof p, dir, "bw.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {-1, 0.5f, 2, 0.5f, 2, 0.5f, -1, 0.5f};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    static const int gl[3] = {10497, 33071, 33648};
+    static const float want[3][2] = {{0.9f, 0.9f}, {0.0f, 1.0f}, {0.1f, 0.1f}};
+    for (int mode = 0; mode < 3; mode++) {
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"images\":[{\"uri\":\"bw.png\"}],\"samplers\":[{\"wrapS\":%d,\"wrapT\":%d}],"
+                 "\"textures\":[{\"source\":0,\"sampler\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+                 "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0",
+                 gl[mode], gl[(mode + 1) % 3]);
+        path_join(p, sizeof p, dir, "wrap.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        const float d[3] = {0, 0, -1}, xs[2] = {-8.0f / 15.0f, 0.8f};
+        for (int i = 0; i < 2; i++) {
+            const float o[3] = {xs[i], 0.3f, 5};
+            hit h;
+            float rgb[3];
+            cast_shade(s, o, d, 0, &h, rgb);
+            assert_near(rgb[1], 1.15f * want[mode][i], 1e-4f);
+        }
+        check_packets(s, 7 + (uint64_t)mode);
+        fv_scene_free(s);
+    }
+    tmpdir_remove(dir);
+}
+
+/* KHR_texture_transform on the base colour: a quad [-1,1]^2 with u = (x + 1)/2, v = 0.5 and the
+ * 2x1 black | white texture (REPEAT), matte, head-on (rgb = 1.15 x texel). At x = -0.5 and 0.5
+ * (u = 0.25 and 0.75, the texel centres):
+ *   none: 0, 1;   offset [0.5, 0]: u' = 0.75, 1.25 -> white, black: 1, 0
+ *   rotation pi: u' = -u, v' = -v: 0.75 and 0.25: 1, 0
+ *   scale [0.5, 1]: u' = 0.125 (tap x = -0.25: 0.25 of the wrapped white texel) and 0.375
+ *   (x = 0.25: 0.25 white): 0.25, 0.25 */
+static void test_gltf_texture_transform(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char px[8] = {0, 0, 0, 255, 255, 255, 255, 255};
+    path_join(p, sizeof p, dir, "bw.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
+    unsigned char bin[92];
+    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0.5f, 1, 0.5f, 1, 0.5f, 0, 0.5f};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+    static const char *const xf[4] = {"", ",\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0]}}",
+                                      ",\"extensions\":{\"KHR_texture_transform\":{\"rotation\":3.14159265}}",
+                                      ",\"extensions\":{\"KHR_texture_transform\":{\"scale\":[0.5,1]}}"};
+    static const float want[4][2] = {{0, 1}, {1, 0}, {1, 0}, {0.25f, 0.25f}};
+    for (int c = 0; c < 4; c++) {
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"extensionsUsed\":[\"KHR_texture_transform\"],\"extensionsRequired\":[\"KHR_texture_transform\"],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"images\":[{\"uri\":\"bw.png\"}],\"textures\":[{\"source\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0%s},\"metallicFactor\":0},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+                 "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0",
+                 xf[c]);
+        path_join(p, sizeof p, dir, "xf.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        const float d[3] = {0, 0, -1}, xs[2] = {-0.5f, 0.5f};
+        for (int i = 0; i < 2; i++) {
+            const float o[3] = {xs[i], 0.3f, 5};
+            hit h;
+            float rgb[3];
+            cast_shade(s, o, d, 0, &h, rgb);
+            assert_near(rgb[1], 1.15f * want[c][i], 1e-4f);
+        }
+        check_packets(s, 10 + (uint64_t)c);
+        fv_scene_free(s);
+    }
+    tmpdir_remove(dir);
 }
 
 /* ---- hostile files ------------------------------------------------------------------- */
@@ -1346,6 +1705,12 @@ int main(void)
         cmocka_unit_test(test_gltf_hierarchy),
         cmocka_unit_test(test_gltf_camera),
         cmocka_unit_test(test_gltf_sparse),
+        cmocka_unit_test(test_gltf_pbr_materials),
+        cmocka_unit_test(test_gltf_material_maps),
+        cmocka_unit_test(test_gltf_alpha_mask),
+        cmocka_unit_test(test_gltf_vertex_colours),
+        cmocka_unit_test(test_gltf_sampler_wrap),
+        cmocka_unit_test(test_gltf_texture_transform),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
         cmocka_unit_test(test_load_dof_glb_lights),

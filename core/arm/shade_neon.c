@@ -16,7 +16,6 @@ typedef uint32x4_t M;
 #define VDIV vdivq_f32
 #define VSQRT vsqrtq_f32
 #define VNEG vnegq_f32
-#define VMAX0(a) vmaxnmq_f32(a, vdupq_n_f32(0.0f))
 #define VGT vcgtq_f32
 #define VGE vcgeq_f32
 #define VLT vcltq_f32
@@ -28,7 +27,7 @@ static inline int mbits(uint32x4_t m)
     return (int)vaddvq_u32(vandq_u32(m, vld1q_u32(bit)));
 }
 #define MBITS mbits
-#define SHADE_FN lambert_neon
+#define SHADE_FN brdf_neon
 #include "shade_tmpl.h"
 
-void fv_shade_dsp_init_neon(fv_shade_dsp *d) { d->lambert = lambert_neon; }
+void fv_shade_dsp_init_neon(fv_shade_dsp *d) { d->brdf = brdf_neon; }

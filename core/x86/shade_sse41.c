@@ -4,4 +4,4 @@
 #define FV_X86_FN(name) name##_sse41
 #include "x86/shade_tmpl.h"
 
-void fv_shade_dsp_init_sse41(fv_shade_dsp *d) { d->lambert = lambert_sse41; }
+void fv_shade_dsp_init_sse41(fv_shade_dsp *d) { d->brdf = brdf_sse41; }

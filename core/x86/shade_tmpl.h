@@ -22,7 +22,6 @@ typedef __m256 V;
 #define VDIV _mm256_div_ps
 #define VSQRT _mm256_sqrt_ps
 #define VNEG(a) _mm256_xor_ps(a, _mm256_set1_ps(-0.0f))
-#define VMAX0(a) _mm256_max_ps(a, _mm256_setzero_ps())
 #define VGT(a, b) _mm256_cmp_ps(a, b, _CMP_GT_OQ)
 #define VGE(a, b) _mm256_cmp_ps(a, b, _CMP_GE_OQ)
 #define VLT(a, b) _mm256_cmp_ps(a, b, _CMP_LT_OQ)
@@ -40,7 +39,6 @@ typedef __m128 V;
 #define VDIV _mm_div_ps
 #define VSQRT _mm_sqrt_ps
 #define VNEG(a) _mm_xor_ps(a, _mm_set1_ps(-0.0f))
-#define VMAX0(a) _mm_max_ps(a, _mm_setzero_ps())
 #define VGT(a, b) _mm_cmpgt_ps(a, b)
 #define VGE(a, b) _mm_cmpge_ps(a, b)
 #define VLT(a, b) _mm_cmplt_ps(a, b)
@@ -49,5 +47,5 @@ typedef __m128 V;
 #define MBITS(m) _mm_movemask_ps(m)
 #endif
 typedef V M;
-#define SHADE_FN FV_X86_FN(lambert)
+#define SHADE_FN FV_X86_FN(brdf)
 #include "../shade_tmpl.h"

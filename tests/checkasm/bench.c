@@ -535,6 +535,8 @@ static void *shade_setup(void)
             for (int k = 0; k < 9; k++) p->nrm[k][q] = frand(&s, -1.0f, 1.0f);
             for (int k = 0; k < 3; k++)
                 p->dir[k][q] = k == 2 ? -1.0f : frand(&s, -1.0f, 1.0f), p->base[k][q] = frand(&s, 0.0f, 1.0f);
+            p->metal[q] = q & 1 ? 1.0f : 0.0f, p->a2[q] = frand(&s, 0.0f, 1.0f); /* glTF materials */
+            p->spec[q] = 1.0f, p->occl[q] = 1.0f;
         }
     t->lights[0].l = (fv_light){.type = FV_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .dir = {0, -1, 0}};
     t->lights[1].l = (fv_light){.type = FV_LIGHT_POINT, .color = {1, 0.8f, 0.6f}, .intensity = 50, .pos = {2, 5, 1},
@@ -548,7 +550,7 @@ static void shade_run_n(void *st, const checkasm_dsp *d, int row0, int rows, int
     const fv_shade_env env = {.lights = t->lights, .nlights = nlights, .exposure = 1.0f, .eye = {0, 1.6f, 3}};
     unsigned m = 0;
     for (int k = 0; k < rows; k++)
-        m += d->shade.lambert(&t->p[(row0 + k) % SH_SET], &env, t->rgb);
+        m += d->shade.brdf(&t->p[(row0 + k) % SH_SET], &env, t->rgb);
     shade_sink = t->rgb[0][0] + (float)m;
 }
 static void shade_head_run(void *st, const checkasm_dsp *d, int row0, int rows) { shade_run_n(st, d, row0, rows, 0); }
@@ -585,9 +587,9 @@ static void ray_run(void *st, const checkasm_dsp *d, int row0, int rows)
 const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"camera_rays", "1280x1440 rays, 115200 packets of 16", {F(ray.camera_rays), 0}, W * H / 16, ray_setup, NULL,
      ray_run, free},
-    {"lambert", "1280x1440 hits, 115200 packets of 16, head light", {F(shade.lambert), 0}, SH_PACKETS, shade_setup,
+    {"brdf", "1280x1440 hits, 115200 packets of 16, head light", {F(shade.brdf), 0}, SH_PACKETS, shade_setup,
      NULL, shade_head_run, free},
-    {"lambert_lights", "1280x1440 hits, 115200 packets of 16, 2 KHR lights", {F(shade.lambert), 0}, SH_PACKETS,
+    {"brdf_lights", "1280x1440 hits, 115200 packets of 16, 2 KHR lights", {F(shade.brdf), 0}, SH_PACKETS,
      shade_setup, NULL, shade_lights_run, free},
     {"pull_row", "1280x1440 -> 640x720, 720 rows", {F(pp.pull_row), 0}, H / 2, pull_setup, NULL, pull_run, pull_free},
     {"push_row", "1280x1440, 1440 rows", {F(pp.push_row), 0}, H, push_setup, NULL, push_run, push_free},

@@ -1,5 +1,6 @@
 /* fovea checkasm: the packet shading kernel (shade_dsp.h), every ISA version against the C
- * reference on random and edge-case packets, bit for bit (so -0 vs +0 counts): the head light
+ * reference on random and edge-case packets, bit for bit (so -0 vs +0 counts): matte, dielectric,
+ * metallic and mixed materials from mirror (the roughness floor) to rough, with emission; the head light
  * and every kind of KHR light (directional, point and spot, with and without range, a spot with
  * equal cones), hits at the eye (L = 0), normals facing away, opposite vertex normals
  * (degenerate), zero and huge distances. Outputs are canaried (checkasm.h). */
@@ -9,6 +10,7 @@
 
 #include "checkasm.h"
 
+#include "brdf.h"
 #include "shade_dsp.h"
 
 static float rnd(float lo, float hi) { return lo + (hi - lo) * checkasm_randf(); }
@@ -41,7 +43,16 @@ static void gen_packet(fv_shade_packet *p, int mode)
         for (int k = 0; k < 3; k++) {
             p->dir[k][q] = k == 2 ? -1.0f : rnd(-1.5f, 1.5f);
             p->base[k][q] = rnd(0.0f, 1.0f);
+            p->emit[k][q] = checkasm_rand() % 4 ? 0.0f : rnd(0.0f, 2.0f);
         }
+        /* materials: matte (specular 0), glTF dielectric, metal, in between; rough to mirror */
+        static const float metals[] = {0.0f, 1.0f, 0.5f};
+        p->metal[q] = checkasm_rand() % 2 ? metals[checkasm_rand() % 3] : rnd(0.0f, 1.0f);
+        p->spec[q] = checkasm_rand() % 3 ? 1.0f : checkasm_rand() % 2 ? 0.0f : rnd(0.0f, 1.0f);
+        static const float roughs[] = {0.0f, FV_MIN_ROUGHNESS, 1.0f, 0.5f};
+        const float r = mode == M_EDGE ? roughs[checkasm_rand() % 4] : rnd(0.0f, 1.0f);
+        p->a2[q] = fv_ggx_a2(r);
+        p->occl[q] = checkasm_rand() % 2 ? 1.0f : rnd(0.0f, 1.0f);
     }
 }
 
@@ -70,25 +81,25 @@ static void test_tables(void **state)
 {
     (void)state;
     checkasm_rng = 0x5eed05adeull;
-    static const char *const names[] = {"lambert"};
+    static const char *const names[] = {"brdf"};
     fv_shade_dsp ref;
     fv_shade_dsp_init(&ref, FV_ISA_C);
-    assert_true(ref.lambert == fv_shade_lambert_c);
+    assert_true(ref.brdf == fv_shade_brdf_c);
     CHECKASM_CHECK_ISA_TABLES("shade", fv_shade_dsp, &ref, names);
 }
 
-static void test_lambert(void **state)
+static void test_brdf(void **state)
 {
     (void)state;
     int tested = 0;
     for (int k = 0; checkasm_isas[k]; k++) {
         const unsigned isa = checkasm_isas[k];
-        if (!checkasm_cpu_runs(isa, "lambert"))
+        if (!checkasm_cpu_runs(isa, "brdf"))
             continue;
         fv_shade_dsp d;
         fv_shade_dsp_init(&d, isa);
-        if (!d.lambert || d.lambert == fv_shade_lambert_c)
-            fail_msg("lambert: %s has no version of its own", fv_isa_name(isa));
+        if (!d.brdf || d.brdf == fv_shade_brdf_c)
+            fail_msg("brdf: %s has no version of its own", fv_isa_name(isa));
         int runs = 0;
         for (int r = 0; r < 2000; r++) {
             const int mode = r % M_COUNT;
@@ -100,28 +111,28 @@ static void test_lambert(void **state)
                                       .eye = {rnd(-5, 5), rnd(-5, 5), rnd(-5, 5)}};
             float ref[3][FV_SHADE_LANES];
             buf got = checkasm_out_f32(3 * FV_SHADE_LANES, r & 3);
-            const unsigned dr = fv_shade_lambert_c(&p, &env, ref);
-            const unsigned dg = d.lambert(&p, &env, (float(*)[FV_SHADE_LANES])got.p);
-            checkasm_check_guards_f32(&got, 3 * FV_SHADE_LANES, fv_isa_name(isa), "lambert", r);
+            const unsigned dr = fv_shade_brdf_c(&p, &env, ref);
+            const unsigned dg = d.brdf(&p, &env, (float(*)[FV_SHADE_LANES])got.p);
+            checkasm_check_guards_f32(&got, 3 * FV_SHADE_LANES, fv_isa_name(isa), "brdf", r);
             if (dr != dg)
-                fail_msg("%s lambert run %d: degenerate lanes %#x, c %#x", fv_isa_name(isa), r, dg, dr);
+                fail_msg("%s brdf run %d: degenerate lanes %#x, c %#x", fv_isa_name(isa), r, dg, dr);
             /* the degenerate lanes' rgb is unspecified: compare the others */
             for (int q = 0; q < FV_SHADE_LANES; q++)
                 if (dr >> q & 1u)
                     for (int c = 0; c < 3; c++) ref[c][q] = got.p[c * FV_SHADE_LANES + q] = 0.0f;
             checkasm_compare(ref, got.p, 3 * FV_SHADE_LANES, CHECKASM_F32, 1, CHECKASM_EXACT,
-                             "%s lambert run %d lights %d mode %d", fv_isa_name(isa), r, nl, mode);
+                             "%s brdf run %d lights %d mode %d", fv_isa_name(isa), r, nl, mode);
             free(got.base);
             runs++;
         }
-        printf("[ checkasm ] lambert: %-7s == c on %d packets (bit-exact)\n", fv_isa_name(isa), runs);
+        printf("[ checkasm ] brdf: %-7s == c on %d packets (bit-exact)\n", fv_isa_name(isa), runs);
         tested++;
     }
-    printf("[ checkasm ] lambert: %d ISA version(s) tested\n", tested);
+    printf("[ checkasm ] brdf: %d ISA version(s) tested\n", tested);
 }
 
 const struct CMUnitTest checkasm_shade_tests[] = {
     cmocka_unit_test(test_tables),
-    cmocka_unit_test(test_lambert),
+    cmocka_unit_test(test_brdf),
     {0},
 };
