@@ -4,6 +4,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 
+#include "base/util.h"
 #include "raycast.h" /* FV_TILE, FV_DEPTH_MISS_M, fv_background_rgb */
 
 #define PI_F 3.14159265358979323846f
@@ -20,15 +21,6 @@ typedef struct {
     void *progress_ctx;
 } ref_job;
 
-static inline uint32_t hash32(uint32_t x) /* lowbias32 (C. Wellons): a good cheap integer mix */
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
 
 static inline float radical_inverse2(uint32_t i)
 {
@@ -64,9 +56,9 @@ static inline void concentric_disc(float u, float v, float *x, float *y)
 /* Lens sample s of pixel (x, y): offset in the lens plane (eye x, y) in metres. */
 static inline void lens_point(const ref_job *j, int x, int y, int s, float *lx, float *ly)
 {
-    const uint32_t h = hash32((uint32_t)x * 0x8da6b343u ^ (uint32_t)y * 0xd8163841u ^ j->prm->seed * 0xcb1ab31fu);
+    const uint32_t h = fv_hash32((uint32_t)x * 0x8da6b343u ^ (uint32_t)y * 0xd8163841u ^ j->prm->seed * 0xcb1ab31fu);
     const float sx = (float)(h >> 8) * (1.0f / 16777216.0f);
-    const float sy = (float)(hash32(h ^ 0x9e3779b9u) >> 8) * (1.0f / 16777216.0f);
+    const float sy = (float)(fv_hash32(h ^ 0x9e3779b9u) >> 8) * (1.0f / 16777216.0f);
     float u = ((float)s + 0.5f) / (float)j->prm->spp + sx, v = radical_inverse2((uint32_t)s) + sy;
     u -= u >= 1.0f ? 1.0f : 0.0f;
     v -= v >= 1.0f ? 1.0f : 0.0f;

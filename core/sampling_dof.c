@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/util.h"
 #include "tile.h"
 
 _Static_assert(FV_TILE == 16, "fv_dofsamp_tile works on 16x16 tiles");
@@ -57,20 +58,10 @@ float fv_dofsamp_keep(const fv_dofsamp_frame *f, float p, float c_px)
     return d < p ? d / p : 1.0f;
 }
 
-/* lowbias32 (C. Wellons): a full-avalanche 32-bit mix */
-static inline uint32_t mix32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
 
 uint32_t fv_dofsamp_hash(int x, int y, uint32_t seed)
 {
-    return mix32(mix32((uint32_t)x | (uint32_t)y << 16) ^ (seed * 0x9e3779b9u + 0x632be5abu));
+    return fv_hash32(fv_hash32((uint32_t)x | (uint32_t)y << 16) ^ (seed * 0x9e3779b9u + 0x632be5abu));
 }
 
 static inline int floor_shr(int v, int s) { return v >= 0 ? v >> s : -((-v + (1 << s) - 1) >> s); }
