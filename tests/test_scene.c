@@ -228,6 +228,17 @@ static void write_gltf(const char *path, const void *bin, size_t bin_len, const 
     free(b64);
 }
 
+/* The textured quad the material tests load: positions [-1,1]^2 at z = 0 (48 bytes), the given
+ * uv (32 bytes), two triangles as uint16 indices (12 bytes), in one 92-byte buffer. */
+static void quad_buffer(unsigned char bin[92], const float uv[8])
+{
+    static const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, uv, 32);
+    memcpy(bin + 80, idx, 12);
+}
+
 /* ---- builder: hits and shading ------------------------------------------------------- */
 
 /* Quad [-1,1]^2 at z=0, colour (0.8, 0.4, 0.2). A ray from (0.25, 0.25, 3) with dir
@@ -974,11 +985,8 @@ static void test_gltf_material_maps(void **state)
     path_join(p, sizeof p, dir, "em.png");
     assert_true(stbi_write_png(p, 2, 1, 4, em, 8) != 0);
     unsigned char bin[92];
-    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(bin, pos, 48);
-    memcpy(bin + 48, uv, 32);
-    memcpy(bin + 80, idx, 12);
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
     const char *json =
         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
         "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
@@ -1022,11 +1030,8 @@ static void test_gltf_alpha_mask(void **state)
     path_join(p, sizeof p, dir, "a.png");
     assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
     unsigned char bin[92];
-    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(bin, pos, 48);
-    memcpy(bin + 48, uv, 32);
-    memcpy(bin + 80, idx, 12);
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
     char json[4096];
     for (int blend = 0; blend < 2; blend++) {
         snprintf(json, sizeof json,
@@ -1140,11 +1145,8 @@ static void test_gltf_sampler_wrap(void **state)
     path_join(p, sizeof p, dir, "bw.png");
     assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
     unsigned char bin[92];
-    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {-1, 0.5f, 2, 0.5f, 2, 0.5f, -1, 0.5f};
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(bin, pos, 48);
-    memcpy(bin + 48, uv, 32);
-    memcpy(bin + 80, idx, 12);
+    static const float uv[8] = {-1, 0.5f, 2, 0.5f, 2, 0.5f, -1, 0.5f};
+    quad_buffer(bin, uv);
     static const int gl[3] = {10497, 33071, 33648};
     static const float want[3][2] = {{0.9f, 0.9f}, {0.0f, 1.0f}, {0.1f, 0.1f}};
     for (int mode = 0; mode < 3; mode++) {
@@ -1196,11 +1198,8 @@ static void test_gltf_texture_transform(void **state)
     path_join(p, sizeof p, dir, "bw.png");
     assert_true(stbi_write_png(p, 2, 1, 4, px, 8) != 0);
     unsigned char bin[92];
-    const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 0.5f, 1, 0.5f, 1, 0.5f, 0, 0.5f};
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(bin, pos, 48);
-    memcpy(bin + 48, uv, 32);
-    memcpy(bin + 80, idx, 12);
+    static const float uv[8] = {0, 0.5f, 1, 0.5f, 1, 0.5f, 0, 0.5f};
+    quad_buffer(bin, uv);
     static const char *const xf[4] = {"", ",\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0]}}",
                                       ",\"extensions\":{\"KHR_texture_transform\":{\"rotation\":3.14159265}}",
                                       ",\"extensions\":{\"KHR_texture_transform\":{\"scale\":[0.5,1]}}"};
