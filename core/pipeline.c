@@ -21,7 +21,8 @@ typedef struct {
     int hist_valid;    /* pyr[cur] and prev_cam may be reprojected */
     long frame;        /* frames rendered: the sampling pattern's phase */
     fv_focus focus;    /* depth of field: this eye's accommodation */
-    float *out;        /* depth of field: the final image (level 0's layout) */
+    float *out;        /* depth of field: the final image (level 0's layout); NULL where the
+                        * layered model converts its rows straight to the display format */
     int64_t last_t_ns; /* the time of its last frame (focus filter) */
     fv_lens_lca *lca;  /* lateral chromatic aberration tables (a lens with per-channel scales) */
     uint8_t *rgb8;     /* the last frame in the display format: sRGB 8-bit RGB, rows 3 w bytes */
@@ -130,10 +131,12 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
             fv_err(err, err_len, "out of memory for depth-of-field buffers");
             goto bad;
         }
+        /* the float image: asked for, or a model without the fused output (a lens's chromatic
+         * aberration, which reads other rows, adds it at the first frame with the lens) */
+        const int need_out = cfg->keep_image || dp->model != FV_DOF_MODEL_WEIER;
         for (int e = 0; e < 2; e++) {
             fv_focus_init(&p->eyes[e].focus, &dp->focus);
-            p->eyes[e].out = malloc((size_t)l0->stride * (size_t)l0->h * 4 * sizeof(float));
-            if (!p->eyes[e].out) {
+            if (need_out && !(p->eyes[e].out = malloc((size_t)l0->stride * (size_t)l0->h * 4 * sizeof(float)))) {
                 fv_err(err, err_len, "out of memory for depth-of-field buffers");
                 goto bad;
             }
@@ -255,6 +258,10 @@ static int render_dof(fv_pipeline *p, eye_state *es, fv_eye eye, const fv_pyrami
     st->focus_m = focus_m;
     const double focus_ms = (double)(fv_prof_stage_end(p->prof, FV_STAGE_COC, t0, (int)eye) - t0) * 1e-6;
     if (!(focus_m > 0.0f)) { /* no depth under the gaze yet: nothing to focus on, show it sharp */
+        if (!es->out) { /* the pipeline converts level 0 itself */
+            st->stage_ms[FV_STAGE_COC] = focus_ms;
+            return 0;
+        }
         for (int y = 0; y < l0->h; y++)
             memcpy(es->out + 4 * (ptrdiff_t)y * l0->stride, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride,
                    (size_t)l0->w * 4 * sizeof(float));
@@ -314,6 +321,11 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         return -1;
     if (es->cam.lens_on && !es->lca) /* built once: the lens does not change */
         es->lca = fv_output_lca_create(&es->cam);
+    if (p->dof && !es->out && es->lca && es->lca->on) { /* the output is a pass of its own */
+        const fv_pyr_level *l0 = &es->pyr[0].lv[0];
+        if (!(es->out = malloc((size_t)l0->stride * (size_t)l0->h * 4 * sizeof(float))))
+            return -1;
+    }
     for (int i = 0; i < FV_STAGE_COUNT; i++)
         st->stage_ms[i] = NAN;
     /* with reprojection, render into the other pyramid and read this one as history */
@@ -360,7 +372,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     if (!converted) {
         const int64_t to0 = fv_prof_stage_begin(p->prof, FV_STAGE_OUTPUT);
         const fv_pyr_level *l0 = &pyr->lv[0];
-        const float *img = p->dof ? es->out : l0->rgbd;
+        const float *img = p->dof && es->out ? es->out : l0->rgbd;
         fv_output_convert_pool(&p->conv, img, l0->stride, l0->w, l0->h, &es->cam, es->lca, es->rgb8,
                                (ptrdiff_t)l0->w * 3, p->pool);
         st->stage_ms[FV_STAGE_OUTPUT] =
@@ -437,6 +449,13 @@ const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stri
     const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
     *stride = l0->stride;
     return p->dof ? p->eyes[slot(eye)].out : l0->rgbd;
+}
+
+const float *fv_pipeline_depth(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride)
+{
+    const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];
+    *stride = l0->stride;
+    return l0->rgbd;
 }
 
 const uint8_t *fv_pipeline_rgb8(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride)

@@ -23,6 +23,10 @@ typedef struct fv_pipeline_config {
     fv_taa_params taa;       /* temporal reprojection (foveated only; full sampling needs none) */
     fv_dof_params dof;       /* depth of field (preset none: off) */
     fv_dofsamp_params dofsamp; /* DoF-driven sampling (with DoF and reprojection; default on) */
+    int keep_image;          /* keep the final float image for fv_pipeline_image (tests, tools).
+                              * 0 (default): with the layered DoF the combine's rows go straight to
+                              * the display format and never to memory as floats (29.5 MB a
+                              * 1280x1440 eye a frame saved) */
     int threads;             /* 0 = online CPUs */
     unsigned isa_mask;       /* kernels allowed (FV_ISA_* bits); ~0u = the best this CPU runs */
 } fv_pipeline_config;
@@ -83,8 +87,12 @@ void fv_pipeline_set_prof(fv_pipeline *p, struct fv_prof *prof);
 const fv_render_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 
 /* The eye's last image (after depth of field, if on): 4 floats a pixel (linear r, g, b,
- * depth_m), rows *stride pixels apart. */
+ * depth_m), rows *stride pixels apart. NULL when depth of field ran without a float image
+ * (fv_pipeline_config.keep_image 0: the display format only). */
 const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride);
+/* The eye's last depth: level 0 of its reconstruction, 4 floats a pixel with depth_m in the
+ * fourth (the final image's depth is the same), rows *stride pixels apart. Always there. */
+const float *fv_pipeline_depth(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride);
 /* The eye's last frame in the display format (the output stage: sRGB-encoded 8-bit RGB, the
  * lens's chromatic aberration resampled where set), rows *stride bytes apart; valid until the
  * eye's next render. */

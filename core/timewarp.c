@@ -83,7 +83,7 @@ void fv_tw_frame_capture(fv_tw_frame *f, const fv_pipeline *pl, int e)
     const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
     fv_pipeline_to_rgb8(pl, eye, f->rgb[e], (ptrdiff_t)f->w * 3);
     ptrdiff_t stride;
-    const float *img = fv_pipeline_image(pl, eye, &stride);
+    const float *img = fv_pipeline_depth(pl, eye, &stride); /* the final image's depth */
     fv_tw_pack_invd(f->invd[e], f->w, img, stride * 4, f->w, f->h);
     f->cam[e] = *fv_pipeline_camera(pl, eye);
 }

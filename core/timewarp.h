@@ -16,7 +16,7 @@
  * is linear; cameras of equal size). tol: the disocclusion tolerance (0.05 = 5 % in inverse depth). */
 void fv_tw_setup(fv_tw_map *m, const fv_camera *display, const fv_camera *source, float tol);
 
-/* The 16-bit inverse depth of an image of (r, g, b, depth_m) floats (fv_pipeline_image): round
+/* The 16-bit inverse depth of an image of (r, g, b, depth_m) floats (fv_pipeline_depth): round
  * (FV_TW_INVD_PER_M / depth_m), clamped to [0, 65535] (nearer than 6.25 cm: the nearest). */
 void fv_tw_pack_invd(uint16_t *dst, ptrdiff_t dst_stride, const float *rgbd, ptrdiff_t rgbd_stride, int w, int h);
 

@@ -80,6 +80,7 @@ static void test_fused_output_matches(void **state)
         cfg.cam.width = W, cfg.cam.height = H, cfg.threads = 3;
         cfg.dof.preset = FV_DOF_STRONG;
         cfg.dof.model = (fv_dof_model)model;
+        cfg.keep_image = 1;
         fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
         assert_non_null(pl);
         static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
@@ -95,6 +96,18 @@ static void test_fused_output_matches(void **state)
         const uint8_t *got = fv_pipeline_rgb8(pl, FV_EYE_LEFT, &bstride);
         assert_int_equal(bstride, W * 3);
         assert_memory_equal(got, want, sizeof want);
+        fv_pipeline_destroy(pl);
+        /* the default keeps no float image: the layered model's rows go straight to the
+         * display format, the same bytes */
+        cfg.keep_image = 0;
+        pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
+        assert_non_null(pl);
+        for (int f = 0; f < 2; f++)
+            assert_int_equal(fv_pipeline_render(pl, FV_EYE_LEFT, &origin, 0.5f, 0.5f, &st), 0);
+        assert_false(isnan(st.stage_ms[FV_STAGE_OUTPUT]));
+        if (model == FV_DOF_MODEL_WEIER)
+            assert_null(fv_pipeline_image(pl, FV_EYE_LEFT, &fstride));
+        assert_memory_equal(fv_pipeline_rgb8(pl, FV_EYE_LEFT, &bstride), want, sizeof want);
         fv_pipeline_destroy(pl);
     }
     fv_scene_free(scene);

@@ -414,6 +414,7 @@ static void dof_config(fv_pipeline_config *cfg, int dofsamp, int threads)
     cfg->dofsamp.enabled = dofsamp;
     cfg->dofsamp.kappa = 2.0f; /* the wall (c 6 px) is thinned too, not only the near card */
     cfg->threads = threads;
+    cfg->keep_image = 1; /* the float image is compared */
 }
 
 /* With history (frame 2 on) the strong blur of the wall and the near card removes rays; the

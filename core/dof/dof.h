@@ -104,7 +104,9 @@ typedef struct fv_dof_times {
     double output_ms; /* the fused output stage (view conv set); NAN: not done here */
 } fv_dof_times;
 
-/* A model's whole DoF: out (4 floats a pixel, rows out_stride pixels) gets the blurred image. */
+/* A model's whole DoF: out (4 floats a pixel, rows out_stride pixels) gets the blurred image.
+ * The layered model (weier) takes out NULL with v->conv set: each finished row then goes only to
+ * the display format (no float image in memory). */
 typedef void (*fv_dof_model_fn)(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride,
                                 fv_pool *pool, const fv_dof_dsp *dsp, fv_dof_times *t);
 void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,

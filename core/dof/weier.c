@@ -169,7 +169,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->v = v, x->wk = wk, x->dsp = dsp, x->out = out, x->out_stride = out_stride, x->tab = wk->gauss;
     x->w = v->pyr->lv[0].w, x->h = v->pyr->lv[0].h;
     x->tw = (x->w + TILE - 1) / TILE, x->th = (x->h + TILE - 1) / TILE;
-    if (x->w != wk->w || x->h != wk->h || ensure_aux(wk, fv_pool_threads(pool)))
+    if (x->w != wk->w || x->h != wk->h || (!out && !v->conv) || ensure_aux(wk, fv_pool_threads(pool)))
         goto fail;
     x->K = v->prm->pupil_mm * 1e-3f * v->focal_px * v->blur_scale;
     x->dn = fmaxf(v->focus_m - v->prm->tolerance_m, FV_COC_MIN_DEPTH_M), x->df = v->focus_m + v->prm->tolerance_m;
@@ -224,8 +224,9 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     }
     return;
 fail:
-    /* no memory for the scratch: show the image sharp rather than nothing */
-    for (int y = 0; y < v->pyr->lv[0].h; y++)
+    /* no memory for the scratch: show the image sharp rather than nothing (without a float
+     * image the pipeline converts level 0 itself) */
+    for (int y = 0; out && y < v->pyr->lv[0].h; y++)
         memcpy(out + 4 * (ptrdiff_t)y * out_stride, v->pyr->lv[0].rgbd + 4 * (ptrdiff_t)y * v->pyr->lv[0].stride,
                (size_t)v->pyr->lv[0].w * 4 * sizeof(float));
     if (t)

@@ -271,7 +271,7 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
     /* slots: 0 far, 1 near, 2..7 the far periphery's temporary and up-sampled levels, reused
      * afterwards by the near layer's up-sampling (3, 4) and the enhancement's levels (5..7);
      * 8 t; the half-resolution blur up-sampled (9), then the enhancement's CoC-like width (9),
-     * result (10), temporary (11), ones (12) */
+     * result (10), temporary (11), ones (12); the output row without a float image (13) */
     float *far = fvw_slot(x, tid, 0), *near = fvw_slot(x, tid, 1), *trow = fvw_slot(x, tid, 8);
     float *enh = x->enh_on ? fvw_slot(x, tid, 10) : NULL;
     uint8_t sig[TILE * 8];
@@ -356,11 +356,13 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         if (enh)
             fvw_enhance_row(x, tid, y, sharp, trow, enh);
         const int64_t tb = fv_time_ns();
-        fvw_combine_row(x, y, sharp, coc, far, nfull, lup, trow, enh);
+        /* without a float image the row lives in slot 13 only, converted while in cache */
+        float *orow = x->out ? x->out + 4 * (ptrdiff_t)y * x->out_stride : fvw_slot(x, tid, 13);
+        fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh);
         const int64_t tc = fv_time_ns();
         if (v->conv) /* the output stage on the row just written, while it is in cache */
-            fv_output_convert(v->conv, x->out + 4 * (ptrdiff_t)y * x->out_stride, x->out_stride, x->w, 1, NULL, NULL,
-                              v->rgb8 + (ptrdiff_t)y * v->rgb8_stride, v->rgb8_stride);
+            fv_output_convert(v->conv, orow, x->out_stride, x->w, 1, NULL, NULL, v->rgb8 + (ptrdiff_t)y * v->rgb8_stride,
+                              v->rgb8_stride);
         const int64_t td = v->conv ? fv_time_ns() : tc;
         for (int i = tx0; i < tx1; i++)
             trow[i] = 1.0f;

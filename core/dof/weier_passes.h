@@ -13,7 +13,7 @@
 
 #define TILE 16
 #define LOW 4          /* the near layer's reduced resolution in the periphery: 4x4 blocks */
-#define NSLOT 13       /* per-thread row buffers of the fused vertical + combine pass */
+#define NSLOT 14       /* per-thread row buffers of the fused vertical + combine pass */
 #define ENH_LEVELS 3   /* contrast enhancement: levels 1..3 (footprints up to ~8 px) */
 #define MAX_UP_LEVEL 5 /* periphery far blur: levels 1..5 (CoC up to 64 px) */
 #define LAMBDA_STEPS 8 /* the level LUT's steps per pixel of CoC */
@@ -101,7 +101,7 @@ void fvw_hblur_band(void *ctx, int band, int tid);
 void fvw_vcombine_band(void *ctx, int band, int tid);
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
-void fvw_combine_row(const fvw_ctx *x, int y, const float *sharp, const float *coc, const float *far, const float *near,
+void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
                      const float *lnear, const float *trow, const float *enh);
 
 #endif
