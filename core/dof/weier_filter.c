@@ -78,8 +78,14 @@ void fvw_hpass_band(void *ctx, int band, int tid)
         const float *rgbd = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
         const float *coc = x->wk->p1[0] + y * st;
         float *fh = x->wk->p4[1] + 4 * y * st;
-        for (int xs = x->cx0; xs < x->cx1; xs += TILE * 8) {
-            const int n = fv_mini(x->cx1 - xs, TILE * 8);
+        /* the far Gaussian is read only by pixels inside the transition disc (t < 1), from rows
+         * up to FV_DOF_RMAX away: this row is needed over the widest disc span within that
+         * reach, the one nearest the gaze's row */
+        int fa, fb;
+        fvw_disc_span(x, fv_clampf(x->v->gaze_y, (float)y + 0.5f - FV_DOF_RMAX, (float)y + 0.5f + FV_DOF_RMAX), &fa, &fb);
+        fa = fa > x->cx0 ? fa : x->cx0, fb = fb < x->cx1 ? fb : x->cx1;
+        for (int xs = fa; xs < fb; xs += TILE * 8) {
+            const int n = fv_mini(fb - xs, TILE * 8);
             for (int i = 0; i < n; i++) {
                 const float c = coc[xs + i];
                 sig[i] = fvw_sig_index(c > 0.0f ? c * 0.25f : x->t_fsig[band * x->tw + (xs + i) / TILE]);
@@ -284,25 +290,23 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         const int64_t ta = fv_time_ns();
         const float fy = (float)y + 0.5f;
         const float *coc = x->wk->p1[0] + y * st, *sharp = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
-        const float dyr = fy - v->gaze_y, r1 = v->r1_px;
-        int tx0 = x->w, tx1 = x->w;
-        if (dyr * dyr < r1 * r1) {
-            const float half = sqrtf(r1 * r1 - dyr * dyr);
-            tx0 = fv_clampi((int)floorf(v->gaze_x - half) - 1, 0, x->w);
-            tx1 = fv_clampi((int)ceilf(v->gaze_x + half) + 1, 0, x->w);
-        }
+        int tx0, tx1;
+        fvw_disc_span(x, fy, &tx0, &tx1);
         for (int i = tx0; i < tx1; i++)
             trow[i] = fvw_t_of(x, (float)i + 0.5f, fy);
-        /* far: the centre's Gaussian (normalised), then the periphery's pyramid blended in */
+        /* far: the centre's Gaussian (normalised), then the periphery's pyramid blended in. Only
+         * pixels with t < 1 (inside the disc's span) read the Gaussian: the periphery's blur
+         * replaces it wherever t is 1, and the combine reads no far colour where c is 0 */
         const int centre_row = y >= x->cy0 && y < x->cy1;
         if (centre_row) {
-            for (int xs = x->cx0; xs < x->cx1; xs += TILE * 8) {
-                const int n = fv_mini(x->cx1 - xs, TILE * 8);
+            const int ga = tx0 > x->cx0 ? tx0 : x->cx0, gb = tx1 < x->cx1 ? tx1 : x->cx1;
+            for (int xs = ga; xs < gb; xs += TILE * 8) {
+                const int n = fv_mini(gb - xs, TILE * 8);
                 for (int i = 0; i < n; i++)
                     sig[i] = fvw_sig_index(coc[xs + i] > 0.0f ? coc[xs + i] * 0.25f : 0.0f);
                 x->dsp->dof_vgauss_row(far, x->wk->p4[1], st, y, x->cy0, x->cy1, xs, n, sig, x->tab);
             }
-            for (int i = x->cx0; i < x->cx1; i++)
+            for (int i = ga; i < gb; i++)
                 if (coc[i] > 0.0f && trow[i] < 1.0f && far[4 * i + 3] > 0.0f)
                     for (int k = 0; k < 3; k++)
                         far[4 * i + k] /= far[4 * i + 3];

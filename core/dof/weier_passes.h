@@ -75,6 +75,20 @@ static inline float fvw_t_of(const fvw_ctx *x, float fx, float fy)
 }
 
 
+/* The columns [*a, *b) of a row at height fy (pixel centre) that the transition disc (radius r1
+ * around the gaze) covers, with a pixel to spare each side; empty (*a = *b = w) off the disc.
+ * Pixels outside it have t = 1. */
+static inline void fvw_disc_span(const fvw_ctx *x, float fy, int *a, int *b)
+{
+    const float dyr = fy - x->v->gaze_y, r1 = x->v->r1_px;
+    *a = *b = x->w;
+    if (dyr * dyr < r1 * r1) {
+        const float half = sqrtf(r1 * r1 - dyr * dyr);
+        *a = fv_clampi((int)floorf(x->v->gaze_x - half) - 1, 0, x->w);
+        *b = fv_clampi((int)ceilf(x->v->gaze_x + half) + 1, 0, x->w);
+    }
+}
+
 /* sigma (pixels) -> table index */
 static inline uint8_t fvw_sig_index(float sigma)
 {
