@@ -142,10 +142,48 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
 {
     (void)tid;
     fvw_ctx *x = ctx;
-    for (int by = band * (TILE / LOW); by < fv_mini((band + 1) * (TILE / LOW), x->lh); by++)
-        for (int i = 0; i < x->lw; i++)
-            near_box_col(x->l_v + 4 * ((ptrdiff_t)by * x->lw + i), x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw, x->l_hr + i,
-                         x->l_hw + i, x->lw, by, x->lh, x->l_reach);
+    for (int by = band * (TILE / LOW); by < fv_mini((band + 1) * (TILE / LOW), x->lh); by++) {
+        int lo = x->lw, hi = 0;
+        for (int i = 0; i < x->lw; i++) {
+            float *o = x->l_v + 4 * ((ptrdiff_t)by * x->lw + i);
+            near_box_col(o, x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw, x->l_hr + i, x->l_hw + i, x->lw, by, x->lh,
+                         x->l_reach);
+            if (o[0] != 0.0f || o[1] != 0.0f || o[2] != 0.0f || o[3] != 0.0f)
+                lo = lo < i ? lo : i, hi = i + 1;
+        }
+        x->l_span[2 * by] = lo < hi ? lo : 0;
+        x->l_span[2 * by + 1] = lo < hi ? hi : 0;
+    }
+}
+
+/* Row y of the quarter-resolution near layer up-sampled into lup (slot 14, all 0 at the band's
+ * start): only over the columns whose texels are not all 0 (most of the image has no near
+ * field), the rest of the row kept at 0 from the last row's dirty span [*da, *db). The same
+ * values as up-sampling the whole row (0 + a (0 - 0) is 0). */
+static void near_upsample_row(const fvw_ctx *x, int tid, int y, float *restrict lup, int *da, int *db)
+{
+    const float v = ((float)y + 0.5f) * (1.0f / LOW) - 0.5f, fv = floorf(v);
+    const int r0 = fv_clampi((int)fv, 0, x->lh - 1), r1 = fv_clampi((int)fv + 1, 0, x->lh - 1);
+    const int lo = fv_mini(x->l_span[2 * r0] < x->l_span[2 * r0 + 1] ? x->l_span[2 * r0] : x->lw,
+                           x->l_span[2 * r1] < x->l_span[2 * r1 + 1] ? x->l_span[2 * r1] : x->lw);
+    const int hi = x->l_span[2 * r0 + 1] > x->l_span[2 * r1 + 1] ? x->l_span[2 * r0 + 1] : x->l_span[2 * r1 + 1];
+    int xa = x->w, xb = x->w;
+    if (lo < hi) { /* pixel x reads texels floor((x + 0.5) / 4 - 0.5) and the next: a pixel to spare */
+        xa = fv_clampi(LOW * lo - LOW, 0, x->w);
+        xb = fv_clampi(LOW * hi + LOW, 0, x->w);
+    }
+    /* zero what the last row left outside [xa, xb) */
+    if (*da < *db) {
+        const int za = *da, zb = fv_mini(*db, xa);
+        if (za < zb)
+            memset(lup + 4 * za, 0, (size_t)(zb - za) * 4 * sizeof(float));
+        const int wa = *da > xb ? *da : xb, wb = *db;
+        if (wa < wb)
+            memset(lup + 4 * wa, 0, (size_t)(wb - wa) * 4 * sizeof(float));
+    }
+    const img4 im = {x->l_v, x->lw, x->lh, x->lw};
+    fvw_upsample_row(x->dsp, &im, 2, &x->xt[2], y, xa, xb, fvw_slot(x, tid, 4), lup); /* LOW = 2^2 */
+    *da = xa, *db = xb;
 }
 
 /* The deepest pyramid level the pixels of [xa, xb) with t > 0 read: lambda grows with |c|, so
@@ -277,7 +315,8 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
     /* slots: 0 far, 1 near, 2..7 the far periphery's temporary and up-sampled levels, reused
      * afterwards by the near layer's up-sampling (3, 4) and the enhancement's levels (5..7);
      * 8 t; the half-resolution blur up-sampled (9), then the enhancement's CoC-like width (9),
-     * result (10), temporary (11), ones (12); the output row without a float image (13) */
+     * result (10), temporary (11), ones (12); the output row without a float image (13); the
+     * quarter-resolution near layer up-sampled (14) */
     float *far = fvw_slot(x, tid, 0), *near = fvw_slot(x, tid, 1), *trow = fvw_slot(x, tid, 8);
     float *enh = x->enh_on ? fvw_slot(x, tid, 10) : NULL;
     uint8_t sig[TILE * 8];
@@ -286,6 +325,9 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
      * each row writes and puts back */
     for (int i = 0; i < x->w; i++)
         trow[i] = 1.0f;
+    int lup_da = 0, lup_db = 0; /* the up-sampled near row's span that is not 0 */
+    if (x->l_reach >= 0)
+        memset(fvw_slot(x, tid, 14), 0, (size_t)x->w * 4 * sizeof(float));
     for (int y = y0; y < y1; y++) {
         const int64_t ta = fv_time_ns();
         const float fy = (float)y + 0.5f;
@@ -353,9 +395,8 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         }
         float *lup = NULL;
         if (x->l_reach >= 0) {
-            lup = fvw_slot(x, tid, 3);
-            const img4 im = {x->l_v, x->lw, x->lh, x->lw};
-            fvw_upsample_row(x->dsp, &im, 2, &x->xt[2], y, 0, x->w, fvw_slot(x, tid, 4), lup); /* LOW = 2^2 */
+            lup = fvw_slot(x, tid, 14);
+            near_upsample_row(x, tid, y, lup, &lup_da, &lup_db);
         }
         if (enh)
             fvw_enhance_row(x, tid, y, sharp, trow, enh);

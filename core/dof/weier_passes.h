@@ -13,7 +13,7 @@
 
 #define TILE 16
 #define LOW 4          /* the near layer's reduced resolution in the periphery: 4x4 blocks */
-#define NSLOT 14       /* per-thread row buffers of the fused vertical + combine pass */
+#define NSLOT 15       /* per-thread row buffers of the fused vertical + combine pass */
 #define ENH_LEVELS 3   /* contrast enhancement: levels 1..3 (footprints up to ~8 px) */
 #define MAX_UP_LEVEL 5 /* periphery far blur: levels 1..5 (CoC up to 64 px) */
 #define LAMBDA_STEPS 8 /* the level LUT's steps per pixel of CoC */
@@ -53,6 +53,7 @@ typedef struct {
     float *l_src, *l_r, *l_w;  /* source: premultiplied (rgb, coverage) / radius / box weight */
     float *l_h, *l_hr, *l_hw;  /* after the horizontal pass */
     float *l_v;                /* after the vertical pass */
+    int32_t *l_span;           /* per row of l_v: its texels [l_span[2 by], l_span[2 by + 1]) that are not all 0 */
     int l_reach;               /* the largest radius there */
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
     const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
