@@ -30,6 +30,7 @@ typedef struct fv_bench_run {
     int counters;                      /* hardware counters were read */
     char counters_why[160];            /* else why not */
     double ctr[FV_PROF_STAGES][FV_BENCH_MAX_CTRS]; /* per frame, per profiled stage */
+    fv_pipeline_memory mem;            /* the bytes the pipeline keeps (fv_pipeline_memory_bytes) */
 } fv_bench_run;
 
 /* Stage statistics over `frames` timed frames into r (means as sums of value / frames, so a

@@ -451,6 +451,33 @@ const float *fv_pipeline_image(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stri
     return p->dof ? p->eyes[slot(eye)].out : l0->rgbd;
 }
 
+static size_t pyramid_bytes(const fv_pyramid *p)
+{
+    size_t n = 0;
+    for (int l = 0; p->mem && l < p->levels; l++)
+        n += (size_t)p->lv[l].stride * (size_t)p->lv[l].h * 5 * sizeof(float); /* rgbd + weight */
+    return n;
+}
+
+void fv_pipeline_memory_bytes(const fv_pipeline *p, fv_eye eye, fv_pipeline_memory *m)
+{
+    const eye_state *es = &p->eyes[slot(eye)];
+    const fv_pyr_level *l0 = &es->pyr[0].lv[0];
+    const size_t px = (size_t)l0->stride * (size_t)l0->h, tiles = (size_t)((p->cfg.cam.width + FV_TILE - 1) / FV_TILE) *
+                                                                    (size_t)((p->cfg.cam.height + FV_TILE - 1) / FV_TILE);
+    memset(m, 0, sizeof *m);
+    m->pyramids = pyramid_bytes(&es->pyr[0]) + pyramid_bytes(&es->pyr[1]);
+    m->image = es->out ? px * 4 * sizeof(float) : 0;
+    m->display = (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height * 3;
+    m->other = es->rows ? tiles * FV_TILE * sizeof(uint32_t) : 0;
+    if (p->dof) {
+        const fv_dof_work *wk = &p->dof_work;
+        m->shared = (size_t)wk->stride * (size_t)wk->h * (4 * FV_DOF_PLANES4 + FV_DOF_PLANES1) * sizeof(float) +
+                    (wk->aux_len + wk->rows_len) * sizeof(float) +
+                    (p->dofsamp_map ? fv_dofsamp_map_len(&es->pyr[0]) * sizeof(float) : 0);
+    }
+}
+
 const float *fv_pipeline_depth(const fv_pipeline *p, fv_eye eye, ptrdiff_t *stride)
 {
     const fv_pyr_level *l0 = &fv_pipeline_pyramid(p, eye)->lv[0];

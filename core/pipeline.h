@@ -86,6 +86,20 @@ struct fv_prof;
 void fv_pipeline_set_prof(fv_pipeline *p, struct fv_prof *prof);
 const fv_render_dsp *fv_pipeline_dsp(const fv_pipeline *p);
 
+/* The bytes the pipeline keeps between frames (allocated; large planes the frame touches only in
+ * part, such as the DoF centre's, become resident only there). */
+typedef struct fv_pipeline_memory {
+    size_t pyramids; /* per eye: the reconstruction pyramid and, with reprojection, its history
+                      * (r, g, b, depth and a weight a texel, every level) */
+    size_t image;    /* per eye: the final float image (fv_pipeline_config.keep_image; 0 without) */
+    size_t display;  /* per eye: the display-format image */
+    size_t other;    /* per eye: the last frame's sample bits (DoF-driven sampling) */
+    size_t shared;   /* both eyes together: DoF scratch planes, tables and row buffers, the
+                      * DoF-driven sampling map */
+} fv_pipeline_memory;
+/* For the eye (its buffers exist from fv_pipeline_create or its first frame on). */
+void fv_pipeline_memory_bytes(const fv_pipeline *p, fv_eye eye, fv_pipeline_memory *m);
+
 /* The eye's last image (after depth of field, if on): 4 floats a pixel (linear r, g, b,
  * depth_m), rows *stride pixels apart. NULL when depth of field ran without a float image
  * (fv_pipeline_config.keep_image 0: the display format only). */

@@ -103,8 +103,21 @@ int fv_bench_run_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, c
         fv_perfctr_close(pc);
     }
     fv_bench_acc_finish(&acc);
+    fv_pipeline_memory_bytes(pl, FV_EYE_CENTER, &r->mem);
     fv_pipeline_destroy(pl);
     return rc;
+}
+
+static void print_memory(FILE *f, const fv_bench_run *res, int nres)
+{
+    const double mb = 1.0 / (1024.0 * 1024.0);
+    for (int i = 0; i < nres; i++) {
+        const fv_pipeline_memory *m = &res[i].mem;
+        fprintf(f, "memory (%s): per eye %.1f MiB (pyramids %.1f, final float image %.1f, display image %.1f, other "
+                   "%.2f); DoF scratch for both eyes %.1f MiB\n",
+                res[i].mode, (double)(m->pyramids + m->image + m->display + m->other) * mb, (double)m->pyramids * mb,
+                (double)m->image * mb, (double)m->display * mb, (double)m->other * mb, (double)m->shared * mb);
+    }
 }
 
 /* ---- printing ---- */
@@ -245,6 +258,7 @@ void fv_bench_print_results(FILE *f, const fv_bench_report *rep)
                 (double)res[0].samples / res[1].samples, res[0].total_mean / res[1].total_mean);
     fv_bench_print_ceiling(f, res, rep->nruns);
     print_roofline(f, res, rep->nruns, rep->width, rep->height, rep->copy_gbps);
+    print_memory(f, res, rep->nruns);
     if (rep->nruns > 0)
         print_counters(f, &res[0]);
 }
@@ -290,6 +304,9 @@ static void json_run(FILE *f, const fv_bench_run *r, int w, int h, double gbps)
     json_num(f, r->mrays);
     fprintf(f, ", \"sampler\": \"%s\", \"ceiling_ms\": ", r->sampler);
     json_num(f, r->ceiling_ms);
+    fprintf(f, ",\n   \"memory_bytes\": {\"pyramids\": %zu, \"image\": %zu, \"display\": %zu, \"other\": %zu, "
+               "\"shared\": %zu}",
+            r->mem.pyramids, r->mem.image, r->mem.display, r->mem.other, r->mem.shared);
     fprintf(f, ",\n   \"roofline\": {");
     for (int k = 0; k < FV_BENCH_NROOF; k++) {
         const int s = fv_bench_roof_stages[k];
