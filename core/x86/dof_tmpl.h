@@ -400,3 +400,104 @@ static void FV_X86_FN(vgauss_row)(float *restrict dst, const float *src, ptrdiff
     dof_offsets_v(off, R, stride, y, ylo, yhi);
     DOF_GAUSS(dst + 4 * (ptrdiff_t)x0, src + 4 * (ptrdiff_t)x0, off, n, sig, tab, 0);
 }
+
+/* ---- periph_row (dof_dsp.h): 4 pixels from an even x whose texels x/2 - 1 .. x/2 + 2 lie inside
+ * the half row, channels as vectors across the pixels (SoA), each step the reference's operation
+ * per lane; the pyramid level, the combine's branches and the table index become selects ---- */
+#include "output_dsp.h"
+
+typedef struct {
+    __m128 zero, one, sign, steps, lut_n, half;
+    __m128i lmax, lut_top;
+} dof_pr_k;
+
+static inline dof_pr_k dof_pr_setup(const fv_dof_periph_args *a)
+{
+    dof_pr_k k;
+    k.zero = _mm_setzero_ps(), k.one = _mm_set1_ps(1.0f), k.sign = _mm_set1_ps(-0.0f);
+    k.steps = _mm_set1_ps((float)a->lambda_steps), k.lut_n = _mm_set1_ps((float)FV_SRGB_LUT), k.half = _mm_set1_ps(0.5f);
+    k.lmax = _mm_set1_epi32(a->lambda_max), k.lut_top = _mm_set1_epi32(FV_SRGB_LUT);
+    return k;
+}
+
+/* fv_srgb_index of 4 values */
+static inline __m128i dof_srgb_idx4(__m128 v, const dof_pr_k *k)
+{
+    const __m128i r = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(v, k->lut_n), k->half));
+    const __m128i in = _mm_blendv_epi8(k->lut_top, r, _mm_castps_si128(_mm_cmplt_ps(v, k->one)));
+    return _mm_and_si128(in, _mm_castps_si128(_mm_cmpgt_ps(v, k->zero)));
+}
+
+/* the steps after the up-sampled level 1 (up[3]) and the sharp pixels (s[3]) of 4 pixels: the
+ * level blend, the combine at t = 1, the near layer, the display bytes (12) into dst */
+static inline void dof_periph_tail4(uint8_t *dst, const fv_dof_periph_args *a, int x, const __m128 s[3],
+                                    const __m128 up[3], const dof_pr_k *k)
+{
+    const __m128 c = _mm_loadu_ps(a->coc + x), m = _mm_andnot_ps(k->sign, c);
+    const __m128 act = _mm_cmpgt_ps(m, k->zero);
+    const __m128i li = _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(m, k->steps)), k->lmax);
+    _Alignas(16) int32_t lv[4];
+    _mm_store_si128((__m128i *)lv, _mm_and_si128(li, _mm_castps_si128(act)));
+    const __m128 lt = _mm_setr_ps(a->lambda[lv[0]], a->lambda[lv[1]], a->lambda[lv[2]], a->lambda[lv[3]]);
+    const __m128 l = _mm_and_ps(_mm_min_ps(lt, k->one), act); /* l < 1 ? l : 1; 0 where |c| is 0 */
+    const __m128 top = _mm_cmpge_ps(l, k->one);                /* (int) l = 1 */
+    const __m128 f = _mm_sub_ps(l, _mm_and_ps(top, k->one));
+    const __m128 cpos = _mm_cmpgt_ps(c, k->zero), cneg = _mm_cmplt_ps(c, k->zero);
+    const __m128 abn = _mm_and_ps(_mm_mul_ps(k->one, _mm_min_ps(_mm_xor_ps(c, k->sign), k->one)), cneg);
+    const __m128 ab = _mm_blendv_ps(abn, _mm_min_ps(c, k->one), cpos);
+    const __m128 blend = _mm_cmpgt_ps(ab, k->zero);
+    __m128 o[3];
+    for (int ch = 0; ch < 3; ch++) {
+        const __m128 u0 = _mm_blendv_ps(s[ch], up[ch], top);
+        const __m128 far = _mm_add_ps(u0, _mm_mul_ps(f, _mm_sub_ps(up[ch], u0)));
+        o[ch] = _mm_blendv_ps(s[ch], _mm_add_ps(s[ch], _mm_mul_ps(ab, _mm_sub_ps(far, s[ch]))), blend);
+    }
+    if (a->lnear) {
+        __m128 q0 = _mm_loadu_ps(a->lnear + 4 * x), q1 = _mm_loadu_ps(a->lnear + 4 * x + 4);
+        __m128 q2 = _mm_loadu_ps(a->lnear + 4 * x + 8), q3 = _mm_loadu_ps(a->lnear + 4 * x + 12);
+        _MM_TRANSPOSE4_PS(q0, q1, q2, q3);
+        const __m128 sc = _mm_blendv_ps(k->one, k->zero, cneg);
+        const __m128 q[4] = {q0, q1, q2, q3};
+        __m128 nv[4];
+        for (int ch = 0; ch < 4; ch++)
+            nv[ch] = _mm_add_ps(k->zero, _mm_mul_ps(k->one, _mm_sub_ps(_mm_mul_ps(sc, q[ch]), k->zero)));
+        const __m128 pos = _mm_cmpgt_ps(nv[3], k->zero), cov = _mm_min_ps(nv[3], k->one);
+        for (int ch = 0; ch < 3; ch++)
+            o[ch] = _mm_blendv_ps(o[ch], _mm_add_ps(o[ch], _mm_mul_ps(cov, _mm_sub_ps(_mm_div_ps(nv[ch], nv[3]), o[ch]))),
+                                  pos);
+    }
+    _Alignas(16) int32_t id[3][4];
+    for (int ch = 0; ch < 3; ch++)
+        _mm_store_si128((__m128i *)id[ch], dof_srgb_idx4(o[ch], k));
+    for (int i = 0; i < 4; i++)
+        for (int ch = 0; ch < 3; ch++)
+            dst[3 * (x + i) + ch] = a->lut[id[ch][i]];
+}
+
+/* 4 pixels (AoS) -> r, g, b vectors */
+static inline void dof_soa3(const float *p, __m128 v[3])
+{
+    __m128 p0 = _mm_loadu_ps(p), p1 = _mm_loadu_ps(p + 4), p2 = _mm_loadu_ps(p + 8), p3 = _mm_loadu_ps(p + 12);
+    _MM_TRANSPOSE4_PS(p0, p1, p2, p3);
+    v[0] = p0, v[1] = p1, v[2] = p2;
+}
+
+static inline void dof_periph4(uint8_t *dst, const fv_dof_periph_args *a, int x, const dof_pr_k *k)
+{
+    const int t = x / 2 - 1; /* texels t .. t + 3 */
+    const __m128 ay = _mm_set1_ps(a->ay), ax = _mm_setr_ps(0.75f, 0.25f, 0.75f, 0.25f);
+    __m128 tx[4];
+    for (int j = 0; j < 4; j++) { /* the two half rows blended: the reference's texel */
+        const __m128 pa = _mm_loadu_ps(a->ha + 4 * (t + j)), pb = _mm_loadu_ps(a->hb + 4 * (t + j));
+        tx[j] = _mm_add_ps(pa, _mm_mul_ps(ay, _mm_sub_ps(pb, pa)));
+    }
+    _MM_TRANSPOSE4_PS(tx[0], tx[1], tx[2], tx[3]);
+    __m128 s[3], up[3];
+    dof_soa3(a->sharp + 4 * x, s);
+    for (int ch = 0; ch < 3; ch++) { /* pixel 2i reads texels (i - 1, i) at 3/4, 2i + 1 (i, i + 1) at 1/4 */
+        const __m128 p0 = _mm_shuffle_ps(tx[ch], tx[ch], _MM_SHUFFLE(2, 1, 1, 0));
+        const __m128 p1 = _mm_shuffle_ps(tx[ch], tx[ch], _MM_SHUFFLE(3, 2, 2, 1));
+        up[ch] = _mm_add_ps(p0, _mm_mul_ps(ax, _mm_sub_ps(p1, p0)));
+    }
+    dof_periph_tail4(dst, a, x, s, up, k);
+}
