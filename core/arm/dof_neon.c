@@ -18,7 +18,6 @@
 #include "dof/weier_impl.h"
 #include "base/util.h"
 #include "dof/dof_dsp.h"
-#include "output_dsp.h"
 
 #define CH 128 /* output pixels per chunk of the horizontal pass's masked row (TILE * 8) */
 
@@ -360,90 +359,8 @@ static void nearbox_row_neon(float *restrict out, float *restrict out_r, float *
     }
 }
 
-/* ---- periph_row: 4 pixels a step from an even x whose texels x/2 - 1 .. x/2 + 2 lie inside the
- * half row, channels as vectors (LD4 deinterleaves pixels and texels); C's a < b ? a : b by a
- * compare and select (FMIN would differ on NaN), the reference's operations per lane ---- */
-static inline float32x4_t minc(float32x4_t a, float32x4_t b) { return vbslq_f32(vcltq_f32(a, b), a, b); }
-
-static inline uint32x4_t srgb_idx4(float32x4_t v)
-{
-    const float32x4_t one = vdupq_n_f32(1.0f);
-    const uint32x4_t r = vreinterpretq_u32_s32(
-        vcvtq_s32_f32(vaddq_f32(vmulq_f32(v, vdupq_n_f32((float)FV_SRGB_LUT)), vdupq_n_f32(0.5f))));
-    const uint32x4_t in = vbslq_u32(vcltq_f32(v, one), r, vdupq_n_u32(FV_SRGB_LUT));
-    return vandq_u32(in, vcgtq_f32(v, vdupq_n_f32(0.0f)));
-}
-
-static inline void periph4_neon(uint8_t *dst, const fv_dof_periph_args *a, int x)
-{
-    const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f), ay = vdupq_n_f32(a->ay);
-    const float32x4_t ax = {0.75f, 0.25f, 0.75f, 0.25f};
-    const int t = x / 2 - 1; /* texels t .. t + 3 */
-    const float32x4x4_t ta = vld4q_f32(a->ha + 4 * t), tb = vld4q_f32(a->hb + 4 * t), s = vld4q_f32(a->sharp + 4 * x);
-    float32x4_t up[3];
-    for (int ch = 0; ch < 3; ch++) {
-        const float32x4_t tx = vaddq_f32(ta.val[ch], vmulq_f32(ay, vsubq_f32(tb.val[ch], ta.val[ch])));
-        /* pixel 2i reads texels (i - 1, i) at 3/4, 2i + 1 (i, i + 1) at 1/4: (0 1) (1 2) (1 2) (2 3) */
-        const float32x4_t e1 = vextq_f32(tx, tx, 1), e2 = vextq_f32(tx, tx, 2);
-        const float32x4_t p0 = vzip1q_f32(tx, e1), p1 = vzip1q_f32(e1, e2);
-        up[ch] = vaddq_f32(p0, vmulq_f32(ax, vsubq_f32(p1, p0)));
-    }
-    const float32x4_t c = vld1q_f32(a->coc + x), m = vabsq_f32(c);
-    const uint32x4_t act = vcgtq_f32(m, zero);
-    const int32x4_t li = vminq_s32(vcvtq_s32_f32(vmulq_f32(m, vdupq_n_f32((float)a->lambda_steps))),
-                                   vdupq_n_s32(a->lambda_max));
-    int32_t lv[4];
-    vst1q_s32(lv, vreinterpretq_s32_u32(vandq_u32(vreinterpretq_u32_s32(li), act)));
-    const float32x4_t lt = {a->lambda[lv[0]], a->lambda[lv[1]], a->lambda[lv[2]], a->lambda[lv[3]]};
-    const float32x4_t l = vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(minc(lt, one)), act));
-    const uint32x4_t top = vcgeq_f32(l, one);
-    const float32x4_t f = vsubq_f32(l, vreinterpretq_f32_u32(vandq_u32(top, vreinterpretq_u32_f32(one))));
-    const uint32x4_t cpos = vcgtq_f32(c, zero), cneg = vcltq_f32(c, zero);
-    const float32x4_t abn = vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(vmulq_f32(one, minc(vnegq_f32(c), one))), cneg));
-    const float32x4_t ab = vbslq_f32(cpos, minc(c, one), abn);
-    const uint32x4_t blend = vcgtq_f32(ab, zero);
-    float32x4_t o[3];
-    for (int ch = 0; ch < 3; ch++) {
-        const float32x4_t u0 = vbslq_f32(top, up[ch], s.val[ch]);
-        const float32x4_t far = vaddq_f32(u0, vmulq_f32(f, vsubq_f32(up[ch], u0)));
-        o[ch] = vbslq_f32(blend, vaddq_f32(s.val[ch], vmulq_f32(ab, vsubq_f32(far, s.val[ch]))), s.val[ch]);
-    }
-    if (a->lnear) {
-        const float32x4x4_t q = vld4q_f32(a->lnear + 4 * x);
-        const float32x4_t sc = vbslq_f32(cneg, zero, one);
-        float32x4_t nv[4];
-        for (int ch = 0; ch < 4; ch++)
-            nv[ch] = vaddq_f32(zero, vmulq_f32(one, vsubq_f32(vmulq_f32(sc, q.val[ch]), zero)));
-        const uint32x4_t pos = vcgtq_f32(nv[3], zero);
-        const float32x4_t cov = minc(nv[3], one);
-        for (int ch = 0; ch < 3; ch++)
-            o[ch] = vbslq_f32(pos, vaddq_f32(o[ch], vmulq_f32(cov, vsubq_f32(vdivq_f32(nv[ch], nv[3]), o[ch]))), o[ch]);
-    }
-    uint32_t id[3][4];
-    for (int ch = 0; ch < 3; ch++)
-        vst1q_u32(id[ch], srgb_idx4(o[ch]));
-    for (int i = 0; i < 4; i++)
-        for (int ch = 0; ch < 3; ch++)
-            dst[3 * (x + i) + ch] = a->lut[id[ch][i]];
-}
-
-static void periph_row_neon(uint8_t *restrict dst, const fv_dof_periph_args *a, int x0, int n)
-{
-    int x = x0;
-    const int lo = x0 > 2 ? x0 + (x0 & 1) : 2, hi = x0 + n; /* x >= 2: texel x/2 - 1 >= 0 */
-    if (lo > x) {
-        fv_dof_periph_row_c(dst, a, x, (lo < hi ? lo : hi) - x);
-        x = lo < hi ? lo : hi;
-    }
-    for (; x + 4 <= hi && x / 2 + 2 <= a->hw - 1; x += 4)
-        periph4_neon(dst, a, x);
-    if (x < hi)
-        fv_dof_periph_row_c(dst, a, x, hi - x);
-}
-
 void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
-    d->dof_periph_row = periph_row_neon;
     d->dof_nearbox_row = nearbox_row_neon;
     d->dof_nearblk_row = nearblk_row_neon;
     d->dof_upsample_row = upsample_row_neon;

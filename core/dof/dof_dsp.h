@@ -67,14 +67,6 @@ typedef void (*fv_dof_hgauss_row_fn)(float *restrict dst, const float *rgbd, con
 typedef void (*fv_dof_vgauss_row_fn)(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
                                      int x0, int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
 typedef void (*fv_dof_combine_row_fn)(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
-/* dof_periph_row: the periphery's pixels x in [x0, x0+n) of a row beyond the transition disc
- *   (t = 1) straight to display bytes dst[3x .. 3x+2], the same bytes as the chain it replaces
- *   (dof_upsample_row by 2 of the vertically interpolated half-resolution row, dof_pyrblur_row
- *   with need 1, dof_combine_row with t = 1 and no full-resolution near layer, rgb8_row); the
- *   order of operations is fv_dof_periph_row_c's. Texels are clamped to [0, hw); the ISA
- *   versions read whole runs of texels and pixels of [x0, x0+n) they then select away. */
-struct fv_dof_periph_args;
-typedef void (*fv_dof_periph_row_fn)(uint8_t *restrict dst, const struct fv_dof_periph_args *a, int x0, int n);
 
 typedef struct fv_dof_dsp {
     fv_dof_coc_row_fn dof_coc_row;
@@ -85,7 +77,6 @@ typedef struct fv_dof_dsp {
     fv_dof_pyrblur_row_fn dof_pyrblur_row;
     fv_dof_nearblk_row_fn dof_nearblk_row;
     fv_dof_nearbox_row_fn dof_nearbox_row;
-    fv_dof_periph_row_fn dof_periph_row;
 } fv_dof_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -102,7 +93,6 @@ void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args 
 void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
                            const float *ax, int n);
 void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
-void fv_dof_periph_row_c(uint8_t *restrict dst, const struct fv_dof_periph_args *a, int x0, int n);
 void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n);
 void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
                           const float *r, const float *wgt, int w, int x0, int n, int reach);

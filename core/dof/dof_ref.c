@@ -7,7 +7,6 @@
 #include "dof/weier_impl.h"
 #include "base/util.h"
 #include "dof/dof_dsp.h"
-#include "output_dsp.h"
 
 
 void fv_dof_coc_row_c(float *restrict coc, const float *rgbd, int n, float K, float dn, float df)
@@ -153,55 +152,6 @@ void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args
     }
 }
 
-/* The half-resolution row's texel k, channel ch, interpolated between its two rows. */
-static inline float periph_tex(const fv_dof_periph_args *a, int k, int ch)
-{
-    const float p = a->ha[4 * k + ch];
-    return p + a->ay * (a->hb[4 * k + ch] - p);
-}
-
-void fv_dof_periph_row_c(uint8_t *restrict dst, const struct fv_dof_periph_args *a, int x0, int n)
-{
-    for (int x = x0; x < x0 + n; x++) {
-        /* level 1 at the pixel: the by-2 bilinear tap of fvw_xtaps_init */
-        const float u = ((float)x + 0.5f) * 0.5f - 0.5f, fu = floorf(u), ax = u - fu;
-        const int i0 = fv_clampi((int)fu, 0, a->hw - 1), i1 = fv_clampi((int)fu + 1, 0, a->hw - 1);
-        const float *s = a->sharp + 4 * x, c = a->coc[x], m = c < 0.0f ? -c : c;
-        float o[3], far[3] = {0.0f, 0.0f, 0.0f};
-        /* the pyramid blur (need 1: level 0 is the sharp row) */
-        float l = 0.0f;
-        if (m > 0.0f) {
-            const int li = (int)(m * (float)a->lambda_steps);
-            l = a->lambda[li < a->lambda_max ? li : a->lambda_max];
-            l = l < 1.0f ? l : 1.0f;
-        }
-        const int L0 = (int)l;
-        const float f = l - (float)L0;
-        for (int k = 0; k < 3; k++) {
-            const float t0 = periph_tex(a, i0, k), up1 = t0 + ax * (periph_tex(a, i1, k) - t0);
-            const float u0 = L0 ? up1 : s[k];
-            far[k] = u0 + f * (up1 - u0);
-        }
-        /* the combine with t = 1 */
-        const float ab = c > 0.0f ? (c < 1.0f ? c : 1.0f) : c < 0.0f ? 1.0f * (-c < 1.0f ? -c : 1.0f) : 0.0f;
-        for (int k = 0; k < 3; k++)
-            o[k] = ab > 0.0f ? s[k] + ab * (far[k] - s[k]) : s[k];
-        if (a->lnear) {
-            const float sc = c < 0.0f ? 0.0f : 1.0f, *q = a->lnear + 4 * x;
-            float nv[4];
-            for (int k = 0; k < 4; k++)
-                nv[k] = 0.0f + 1.0f * (sc * q[k] - 0.0f);
-            if (nv[3] > 0.0f) {
-                const float cov = nv[3] < 1.0f ? nv[3] : 1.0f;
-                for (int k = 0; k < 3; k++)
-                    o[k] = o[k] + cov * (nv[k] / nv[3] - o[k]);
-            }
-        }
-        for (int k = 0; k < 3; k++)
-            dst[3 * x + k] = a->lut[fv_srgb_index(o[k])];
-    }
-}
-
 void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
 {
     for (int b = 0; 4 * b < n; b++) {
@@ -253,7 +203,6 @@ void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
     d->dof_combine_row = fv_dof_combine_row_c;
     d->dof_nearblk_row = fv_dof_nearblk_row_c;
     d->dof_nearbox_row = fv_dof_nearbox_row_c;
-    d->dof_periph_row = fv_dof_periph_row_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_dof_dsp_init_sse41(d);

@@ -199,7 +199,6 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->up_levels = fv_mini(MAX_UP_LEVEL, v->pyr->levels - 1);
     x->half_on = !v->prm->full_res_periphery && x->up_levels >= 1 && v->pyr->lv[1].w == x->hw && v->pyr->lv[1].h == x->hh;
     x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
-    x->periph_fused = x->half_on && !out && v->conv && !x->enh_on;
     const int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, x->th, fvw_coc_band, x);
     fvw_dilate_tiles(x);

@@ -3,7 +3,6 @@
  * fused vertical pass, which hands each finished row to the combine (combine.c). */
 #include "dof/weier_passes.h"
 #include "output_convert.h"
-#include "output_dsp.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -354,9 +353,7 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
                     for (int k = 0; k < 3; k++)
                         far[4 * i + k] /= far[4 * i + 3];
         }
-        if (x->periph_fused) { /* beyond the disc: the fused kernel below, after the near layer */
-            blur_periphery(x, tid, y, coc, trow, sharp, far, tx0, tx1);
-        } else if (x->half_on) {
+        if (x->half_on) {
             periphery_row(x, tid, y, coc, trow, sharp, far, 0, tx0);
             periphery_row(x, tid, y, coc, trow, sharp, far, tx1, x->w);
             blur_periphery(x, tid, y, coc, trow, sharp, far, tx0, tx1);
@@ -406,27 +403,10 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         const int64_t tb = fv_time_ns();
         /* without a float image the row lives in slot 13 only, converted while in cache */
         float *orow = x->out ? x->out + 4 * (ptrdiff_t)y * x->out_stride : fvw_slot(x, tid, 13);
-        uint8_t *drow = v->conv ? v->rgb8 + (ptrdiff_t)y * v->rgb8_stride : NULL;
-        /* the columns the chain of kernels does: the whole row, or with the fused periphery the
-         * disc's span (the periphery's blur, combine and conversion in one kernel, timed with
-         * the combine) */
-        const int ca = x->periph_fused ? tx0 : 0, cb = x->periph_fused ? tx1 : x->w;
-        if (x->periph_fused) {
-            const float hv = ((float)y + 0.5f) * 0.5f - 0.5f, hf = floorf(hv);
-            const float *hb = x->hblur;
-            const fv_dof_periph_args pa = {
-                .sharp = sharp, .coc = coc, .ay = hv - hf, .hw = x->hw, .lnear = lup, .lambda = x->lambda,
-                .ha = hb + 4 * (ptrdiff_t)fv_clampi((int)hf, 0, x->hh - 1) * x->hw,
-                .hb = hb + 4 * (ptrdiff_t)fv_clampi((int)hf + 1, 0, x->hh - 1) * x->hw,
-                .lambda_steps = LAMBDA_STEPS, .lambda_max = LAMBDA_N - 1, .lut = v->conv->srgb};
-            x->dsp->dof_periph_row(drow, &pa, 0, tx0);
-            x->dsp->dof_periph_row(drow, &pa, tx1, x->w - tx1);
-        }
-        if (ca < cb)
-            fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh, ca, cb - ca);
+        fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh);
         const int64_t tc = fv_time_ns();
-        if (v->conv && ca < cb) /* the output stage on the row just written, while it is in cache */
-            fv_output_convert(v->conv, orow + 4 * ca, x->out_stride, cb - ca, 1, NULL, NULL, drow + 3 * ca,
+        if (v->conv) /* the output stage on the row just written, while it is in cache */
+            fv_output_convert(v->conv, orow, x->out_stride, x->w, 1, NULL, NULL, v->rgb8 + (ptrdiff_t)y * v->rgb8_stride,
                               v->rgb8_stride);
         const int64_t td = v->conv ? fv_time_ns() : tc;
         for (int i = tx0; i < tx1; i++)

@@ -44,19 +44,4 @@ typedef struct fv_dof_pyrblur_args {
     int lambda_steps, lambda_max;
 } fv_dof_pyrblur_args;
 
-/* One row's periphery beyond the transition disc (dsp dof_periph_row): t = 1 there, so the
- * layered filter's steps for it reduce to the pyramid blur between the sharp row and the
- * half-resolution blur, the quarter-resolution near layer and the display format, fused. */
-typedef struct fv_dof_periph_args {
-    const float *sharp;        /* level 0 row (r, g, b, depth_m) */
-    const float *coc;          /* signed CoC row, px */
-    const float *ha, *hb;      /* the half-resolution blur's rows above and below (hw texels of 4 floats) */
-    float ay;                  /* their vertical weight: the row's level 1 is ha + ay (hb - ha) */
-    int hw;                    /* texels a half row */
-    const float *lnear;        /* the quarter-resolution near layer up-sampled to the row; NULL = none */
-    const float *lambda;       /* |c| * lambda_steps (clamped to lambda_max) -> continuous level */
-    int lambda_steps, lambda_max;
-    const uint8_t *lut;        /* linear -> sRGB bytes (core/output_dsp.h: FV_SRGB_LUT + 1 entries, padded) */
-} fv_dof_periph_args;
-
 #endif

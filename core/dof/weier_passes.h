@@ -62,8 +62,6 @@ typedef struct {
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
     /* the periphery's far blur at half resolution (the level 1 grid), up-sampled once per row */
     int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
-    int periph_fused;          /* beyond the disc the periphery goes straight to display bytes
-                                * (dof_periph_row): half_on, no float image, no enhancement */
     int hw, hh;                /* level 1's size */
     float *hblur;              /* hw x hh x 4: level 1 blurred by the half-resolution CoC */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
@@ -119,6 +117,6 @@ void fvw_vcombine_band(void *ctx, int band, int tid);
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
 void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
-                     const float *lnear, const float *trow, const float *enh, int xa, int n);
+                     const float *lnear, const float *trow, const float *enh);
 
 #endif

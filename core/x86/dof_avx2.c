@@ -5,7 +5,6 @@
  * references'. The combine takes 8 pixels at a time without branches (see there); the
  * up-sampling and the periphery's level blend 8 at a time as 4 pixel pairs. */
 #include <immintrin.h>
-#include <string.h>
 
 #define FV_X86_W 8
 #define FV_X86_FN(name) name##_avx2
@@ -446,127 +445,8 @@ static void nearbox_row_avx2(float *restrict out, float *restrict out_r, float *
     }
 }
 
-/* ---- periph_row: 8 pixels a step from an even x whose texels x/2 - 1 .. x/2 + 4 lie inside the
- * half row; channels as vectors across the 8 pixels. 4 pixels of AoS in two registers are put
- * in SoA by the 128-bit-lane unpacks, which leave the lanes in the order 0 2 4 6 1 3 5 7. */
-static inline void soa8(__m256 a, __m256 b, __m256 c, __m256 d, __m256 v[4])
-{
-    const __m256 t0 = _mm256_unpacklo_ps(a, b), t1 = _mm256_unpackhi_ps(a, b);
-    const __m256 t2 = _mm256_unpacklo_ps(c, d), t3 = _mm256_unpackhi_ps(c, d);
-    v[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
-    v[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
-    v[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
-    v[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
-}
-
-/* 8 pixels of AoS at p, channels in pixel order */
-static inline void soa8_px(const float *p, __m256 v[4])
-{
-    const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-    soa8(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), _mm256_loadu_ps(p + 16), _mm256_loadu_ps(p + 24), v);
-    for (int ch = 0; ch < 4; ch++)
-        v[ch] = _mm256_permutevar8x32_ps(v[ch], order);
-}
-
-static inline __m256i srgb_idx8(__m256 v, __m256 zero, __m256 one)
-{
-    const __m256i r = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(v, _mm256_set1_ps((float)FV_SRGB_LUT)),
-                                                        _mm256_set1_ps(0.5f)));
-    const __m256i in = _mm256_blendv_epi8(_mm256_set1_epi32(FV_SRGB_LUT), r,
-                                          _mm256_castps_si256(_mm256_cmp_ps(v, one, _CMP_LT_OQ)));
-    return _mm256_and_si256(in, _mm256_castps_si256(_mm256_cmp_ps(v, zero, _CMP_GT_OQ)));
-}
-
-static inline void periph8(uint8_t *dst, const fv_dof_periph_args *a, int x)
-{
-    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), sign = _mm256_set1_ps(-0.0f);
-    const int t = x / 2 - 1; /* texels t .. t + 5 (the last pair loaded twice) */
-    const __m256 ay = _mm256_set1_ps(a->ay);
-    __m256 tp[3];
-    for (int j = 0; j < 3; j++) {
-        const __m256 pa = _mm256_loadu_ps(a->ha + 4 * (t + 2 * j)), pb = _mm256_loadu_ps(a->hb + 4 * (t + 2 * j));
-        tp[j] = _mm256_add_ps(pa, _mm256_mul_ps(ay, _mm256_sub_ps(pb, pa)));
-    }
-    __m256 tx[4];
-    soa8(tp[0], tp[1], tp[2], tp[2], tx); /* texel j at lane j / 2 (even j), 4 + j / 2 (odd) */
-    /* pixel 2i reads texels (i - 1, i) at 3/4, pixel 2i + 1 (i, i + 1) at 1/4 (relative to t: the
-     * pairs (0 1) (1 2) (1 2) (2 3) (2 3) (3 4) (3 4) (4 5)) */
-    const __m256i i0 = _mm256_setr_epi32(0, 4, 4, 1, 1, 5, 5, 2), i1 = _mm256_setr_epi32(4, 1, 1, 5, 5, 2, 2, 6);
-    const __m256 ax = _mm256_setr_ps(0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f);
-    __m256 up[3], s[4];
-    for (int ch = 0; ch < 3; ch++) {
-        const __m256 p0 = _mm256_permutevar8x32_ps(tx[ch], i0), p1 = _mm256_permutevar8x32_ps(tx[ch], i1);
-        up[ch] = _mm256_add_ps(p0, _mm256_mul_ps(ax, _mm256_sub_ps(p1, p0)));
-    }
-    soa8_px(a->sharp + 4 * x, s);
-    const __m256 c = _mm256_loadu_ps(a->coc + x), m = _mm256_andnot_ps(sign, c);
-    const __m256 act = _mm256_cmp_ps(m, zero, _CMP_GT_OQ);
-    const __m256i li = _mm256_and_si256(_mm256_min_epi32(_mm256_cvttps_epi32(_mm256_mul_ps(m, _mm256_set1_ps((float)a->lambda_steps))),
-                                                         _mm256_set1_epi32(a->lambda_max)),
-                                        _mm256_castps_si256(act));
-    const __m256 l = _mm256_and_ps(_mm256_min_ps(_mm256_i32gather_ps(a->lambda, li, 4), one), act);
-    const __m256 top = _mm256_cmp_ps(l, one, _CMP_GE_OQ);
-    const __m256 f = _mm256_sub_ps(l, _mm256_and_ps(top, one));
-    const __m256 cneg = _mm256_cmp_ps(c, zero, _CMP_LT_OQ);
-    const __m256 abn = _mm256_and_ps(_mm256_mul_ps(one, _mm256_min_ps(_mm256_xor_ps(c, sign), one)), cneg);
-    const __m256 ab = _mm256_blendv_ps(abn, _mm256_min_ps(c, one), _mm256_cmp_ps(c, zero, _CMP_GT_OQ));
-    const __m256 blend = _mm256_cmp_ps(ab, zero, _CMP_GT_OQ);
-    __m256 o[3];
-    for (int ch = 0; ch < 3; ch++) {
-        const __m256 u0 = _mm256_blendv_ps(s[ch], up[ch], top);
-        const __m256 far = _mm256_add_ps(u0, _mm256_mul_ps(f, _mm256_sub_ps(up[ch], u0)));
-        o[ch] = _mm256_blendv_ps(s[ch], _mm256_add_ps(s[ch], _mm256_mul_ps(ab, _mm256_sub_ps(far, s[ch]))), blend);
-    }
-    if (a->lnear) {
-        __m256 q[4], nv[4];
-        soa8_px(a->lnear + 4 * x, q);
-        const __m256 sc = _mm256_blendv_ps(one, zero, cneg);
-        for (int ch = 0; ch < 4; ch++)
-            nv[ch] = _mm256_add_ps(zero, _mm256_mul_ps(one, _mm256_sub_ps(_mm256_mul_ps(sc, q[ch]), zero)));
-        const __m256 pos = _mm256_cmp_ps(nv[3], zero, _CMP_GT_OQ), cov = _mm256_min_ps(nv[3], one);
-        for (int ch = 0; ch < 3; ch++)
-            o[ch] = _mm256_blendv_ps(
-                o[ch], _mm256_add_ps(o[ch], _mm256_mul_ps(cov, _mm256_sub_ps(_mm256_div_ps(nv[ch], nv[3]), o[ch]))), pos);
-    }
-    /* the table's bytes (whole words read: the table is padded), r | g << 8 | b << 16 a pixel,
-     * then 3 bytes of each */
-    const __m256i mask = _mm256_set1_epi32(0xff);
-    const int *lut = (const int *)(const void *)a->lut;
-    const __m256i r = _mm256_and_si256(_mm256_i32gather_epi32(lut, srgb_idx8(o[0], zero, one), 1), mask);
-    const __m256i g = _mm256_and_si256(_mm256_i32gather_epi32(lut, srgb_idx8(o[1], zero, one), 1), mask);
-    const __m256i b = _mm256_and_si256(_mm256_i32gather_epi32(lut, srgb_idx8(o[2], zero, one), 1), mask);
-    const __m256i px = _mm256_or_si256(r, _mm256_or_si256(_mm256_slli_epi32(g, 8), _mm256_slli_epi32(b, 16)));
-    const __m128i keep = _mm_setr_epi8(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1);
-    const __m128i k0 = _mm_shuffle_epi8(_mm256_castsi256_si128(px), keep);
-    const __m128i k1 = _mm_shuffle_epi8(_mm256_extracti128_si256(px, 1), keep);
-    const int32_t w0 = _mm_extract_epi32(k0, 2), w1 = _mm_extract_epi32(k1, 2);
-    uint8_t *o8 = dst + 3 * x;
-    _mm_storel_epi64((__m128i *)(void *)o8, k0);
-    memcpy(o8 + 8, &w0, 4);
-    _mm_storel_epi64((__m128i *)(void *)(o8 + 12), k1);
-    memcpy(o8 + 20, &w1, 4);
-}
-
-static void periph_row_avx2(uint8_t *restrict dst, const fv_dof_periph_args *a, int x0, int n)
-{
-    const dof_pr_k k = dof_pr_setup(a);
-    int x = x0;
-    const int lo = x0 > 2 ? x0 + (x0 & 1) : 2, hi = x0 + n; /* x >= 2: texel x/2 - 1 >= 0 */
-    if (lo > x) {
-        fv_dof_periph_row_c(dst, a, x, (lo < hi ? lo : hi) - x);
-        x = lo < hi ? lo : hi;
-    }
-    for (; x + 8 <= hi && x / 2 + 4 <= a->hw - 1; x += 8)
-        periph8(dst, a, x);
-    for (; x + 4 <= hi && x / 2 + 2 <= a->hw - 1; x += 4)
-        dof_periph4(dst, a, x, &k);
-    if (x < hi)
-        fv_dof_periph_row_c(dst, a, x, hi - x);
-}
-
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d)
 {
-    d->dof_periph_row = periph_row_avx2;
     d->dof_nearbox_row = nearbox_row_avx2;
     d->dof_nearblk_row = nearblk_row_avx2;
     d->dof_upsample_row = upsample_row_avx2;

@@ -52,25 +52,8 @@ static void nearbox_row_sse41(float *restrict out, float *restrict out_r, float 
             fv_dof_nearbox_row_c(out, out_r, out_w, src, r, wgt, w, i, 1, reach), i++;
 }
 
-/* 4 pixels a step from an even pixel whose texels are inside the row; the ends by the reference */
-static void periph_row_sse41(uint8_t *restrict dst, const fv_dof_periph_args *a, int x0, int n)
-{
-    const dof_pr_k k = dof_pr_setup(a);
-    int x = x0;
-    const int lo = x0 > 2 ? x0 + (x0 & 1) : 2, hi = x0 + n; /* x >= 2: texel x/2 - 1 >= 0 */
-    if (lo > x) {
-        fv_dof_periph_row_c(dst, a, x, (lo < hi ? lo : hi) - x);
-        x = lo < hi ? lo : hi;
-    }
-    for (; x + 4 <= hi && x / 2 + 2 <= a->hw - 1; x += 4)
-        dof_periph4(dst, a, x, &k);
-    if (x < hi)
-        fv_dof_periph_row_c(dst, a, x, hi - x);
-}
-
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d)
 {
-    d->dof_periph_row = periph_row_sse41;
     d->dof_nearbox_row = nearbox_row_sse41;
     d->dof_nearblk_row = nearblk_row_sse41;
     d->dof_upsample_row = upsample_row_sse41;

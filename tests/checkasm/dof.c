@@ -11,10 +11,6 @@
 
 #include "dof/dof_dsp.h"
 #include "dof/weier_impl.h"
-#include "output_dsp.h"
-
-#define PR_STEPS 8                  /* the layered filter's LAMBDA_STEPS */
-#define PR_N (64 * PR_STEPS + 1)     /* and LAMBDA_N (CoCs 0 .. 64 px) */
 
 static float rnd(void) { return fv_test_randf(&checkasm_rng); }
 static int rndi(int n) { return (int)(fv_test_rand(&checkasm_rng) % (uint64_t)n); }
@@ -75,7 +71,7 @@ static void run_all(const char *kernel, runner fn, size_t member)
 /* ------------------------------------------------------------------ tables */
 
 static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row",
-                                     "dof_nearblk_row", "dof_nearbox_row", "dof_periph_row"};
+                                     "dof_nearblk_row", "dof_nearbox_row"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -94,7 +90,6 @@ static void test_tables(void **state)
     assert_true(ref.dof_pyrblur_row == fv_dof_pyrblur_row_c);
     assert_true(ref.dof_nearblk_row == fv_dof_nearblk_row_c);
     assert_true(ref.dof_nearbox_row == fv_dof_nearbox_row_c);
-    assert_true(ref.dof_periph_row == fv_dof_periph_row_c);
     CHECKASM_CHECK_ISA_TABLES("dof", fv_dof_dsp, &ref, names);
 }
 
@@ -621,81 +616,6 @@ static void test_nearbox_row(void **state)
     run_all("dof_nearbox_row", run_nearbox, offsetof(fv_dof_dsp, dof_nearbox_row));
 }
 
-/* ------------------------------------------------------------------ periph_row */
-
-static long periph_far, periph_near; /* pixels the reference blurred / covered with the near layer */
-
-/* A row of w pixels, the span [x0, x0 + n); the half rows of (w + 1) / 2 texels, exact size (a
- * read past a row's end shows under ASan); lambda a monotone table of levels 0 .. 1.5 (the
- * clamp to 1 runs), the output table distinct per index. Colours may leave [0, 1] (the table
- * index clamps); CoCs are 0, -0, small, near (< 0) or far, up to 64 px. */
-static void run_periph1(const fv_dof_dsp *d, const char *isa, int w, int x0, int n, int off, const float *lambda,
-                        const uint8_t *lut)
-{
-    const int hw = (w + 1) / 2;
-    buf sharp = buf_new(4 * (size_t)w, off), coc = buf_new((size_t)w, off), lnear = buf_new(4 * (size_t)w, off);
-    buf ha = buf_new(4 * (size_t)hw, off), hb = buf_new(4 * (size_t)hw, off);
-    const int cmode = rndi(4);
-    for (int i = 0; i < w; i++) {
-        const float u = rnd();
-        coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? 64.0f * rnd() : cmode == 2 ? -64.0f * rnd() :
-                   u < 0.15f ? 0.0f : u < 0.2f ? -0.0f : u < 0.3f ? rnd() - 0.5f : u < 0.6f ? -30.0f * rnd() : 40.0f * rnd();
-        const float lw = rndi(3) ? 0.05f + 1.5f * rnd() : 0.0f;
-        for (int c = 0; c < 4; c++) {
-            sharp.p[4 * i + c] = colour();
-            lnear.p[4 * i + c] = c < 3 ? lw * colour() : lw;
-        }
-    }
-    for (int i = 0; i < 4 * hw; i++)
-        ha.p[i] = colour(), hb.p[i] = colour();
-    const fv_dof_periph_args a = {
-        .sharp = sharp.p, .coc = coc.p, .ha = ha.p, .hb = rndi(5) ? hb.p : ha.p,
-        .ay = rndi(4) ? rnd() : rndi(2) ? 0.25f : 0.75f, .hw = hw, .lnear = rndi(3) ? lnear.p : NULL,
-        .lambda = lambda, .lambda_steps = PR_STEPS, .lambda_max = PR_N - 1, .lut = lut};
-    uint8_t *rb, *tb;
-    uint8_t *r = checkasm_out_u8(3 * (size_t)w, off, &rb), *t = checkasm_out_u8(3 * (size_t)w, off, &tb);
-    fv_dof_periph_row_c(r, &a, x0, n);
-    d->dof_periph_row(t, &a, x0, n);
-    checkasm_check_guards(t, 3 * (size_t)w, isa, "periph_row", n);
-    checkasm_compare(r, t, 3 * (size_t)w, CHECKASM_U8, 3, CHECKASM_EXACT, "%s periph_row w=%d x0=%d n=%d", isa, w, x0,
-                     n);
-    compared += 3 * (size_t)w;
-    for (int x = x0; x < x0 + n; x++) {
-        periph_far += coc.p[x] != 0.0f;
-        periph_near += a.lnear && coc.p[x] >= 0.0f && lnear.p[4 * x + 3] > 0.0f;
-    }
-    free(sharp.base), free(coc.base), free(lnear.base), free(ha.base), free(hb.base), free(rb), free(tb);
-}
-
-static float periph_lambda[PR_N];
-static uint8_t periph_lut[FV_SRGB_LUT + 1 + FV_SRGB_LUT_PAD];
-
-static void run_periph(const fv_dof_dsp *d, const char *isa)
-{
-    for (int n = 1; n <= 40; n++)
-        for (int rep = 0; rep < 6; rep++) {
-            const int w = n + (rndi(3) == 0 ? 0 : rndi(30));
-            run_periph1(d, isa, w, rndi(w - n + 1), n, rndi(4), periph_lambda, periph_lut);
-        }
-    for (int k = 0; k < 8; k++) { /* production rows: the spans either side of the disc */
-        const int w = 1200 + rndi(200), a = rndi(w / 2), b = a + rndi(w - a);
-        run_periph1(d, isa, w, 0, a, rndi(4), periph_lambda, periph_lut);
-        run_periph1(d, isa, w, b, w - b, rndi(4), periph_lambda, periph_lut);
-    }
-}
-
-static void test_periph_row(void **state)
-{
-    (void)state;
-    for (int i = 0; i < PR_N; i++) /* monotone, 0 at 0, past 1 (clamped) at the end */
-        periph_lambda[i] = 1.5f * (float)i / (float)(PR_N - 1) * (i % 7 ? 1.0f : 0.999f);
-    for (int i = 0; i < (int)sizeof periph_lut; i++)
-        periph_lut[i] = (uint8_t)(i * 7 + (i >> 8));
-    run_all("dof_periph_row", run_periph, offsetof(fv_dof_dsp, dof_periph_row));
-    printf("[ checkasm ] periph steps run (all ISAs): blurred %ld, near layer %ld\n", periph_far, periph_near);
-    assert_true(periph_far > 0 && periph_near > 0);
-}
-
 const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_gauss_tab),
@@ -707,6 +627,5 @@ const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_pyrblur_row),
     cmocka_unit_test(test_nearblk_row),
     cmocka_unit_test(test_nearbox_row),
-    cmocka_unit_test(test_periph_row),
     {0},
 };
