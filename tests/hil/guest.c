@@ -1988,13 +1988,26 @@ static int cmd_calibrate(int argc, char **argv)
     const char *line = strstr(cr.out, "calibration: ");
     if (line)
         sscanf(line, "calibration: %d points, validation mean %lf deg, max %lf deg", &points, &vmean, &vmax);
+    /* the fewest usable frames a point's slot had (the table's frames column): how much margin
+     * the guest's tracking rate leaves (a fixation needs 3 in its window) */
+    int min_frames = -1;
+    for (const char *q = strstr(cr.out, "\n    1  "); q; q = strchr(q + 1, '\n')) {
+        int idx, fr;
+        char kind[16], fix[16];
+        float ty, tp;
+        if (sscanf(q + 1, "%d %15s %f %f %15s %d", &idx, kind, &ty, &tp, fix, &fr) != 6)
+            break;
+        if (min_frames < 0 || fr < min_frames)
+            min_frames = fr;
+    }
     const int file_ok = access(cal_path, R_OK) == 0;
     const int run_ok = exit_code(cr.status) == 0 && points == 9 && vmean <= CAL_MEAN_MAX_DEG &&
                        vmax <= CAL_MAX_MAX_DEG && file_ok;
     result("calib-run", run_ok,
            "exit=%d points=%d valid_mean_deg=%.2f valid_max_deg=%.2f file=%d run_s=%.2f open_after_exec_ms=%.0f "
-           "video_frames=%ld output_bufs=%ld",
-           exit_code(cr.status), points, vmean, vmax, file_ok, cr.secs, cr.start_wait_ms, f.cur + 1, f.n_out);
+           "video_frames=%ld output_bufs=%ld min_slot_frames=%d",
+           exit_code(cr.status), points, vmean, vmax, file_ok, cr.secs, cr.start_wait_ms, f.cur + 1, f.n_out,
+           min_frames);
 
     /* the read-back: the last frame held (the wearer on the last target) */
     while (!f.ended)
@@ -2037,6 +2050,6 @@ int main(int argc, char **argv)
         return cmd_headset_compare(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "kms-compare"))
         return cmd_kms_compare(argc, argv);
-    fprintf(stderr, "usage: fovea-hil v4l2|gpio|kms|kms-compare ... (see tests/hil/guest.c)\n");
+    fprintf(stderr, "usage: fovea-hil v4l2|gpio|headset|calibrate|kms|kms-compare ... (see tests/hil/guest.c)\n");
     return 2;
 }
