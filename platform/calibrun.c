@@ -124,7 +124,8 @@ int fv_calibrate_run(const fv_calibrate_opts *o, char *err, size_t err_len)
     char why[400];
     const int bad = fv_calproc_finish(c, &cal, &rep, why, sizeof why);
     FILE *out = o->out ? o->out : stdout;
-    fprintf(out, "point  kind        target (deg)     fixation  spread (deg)  error (deg)\n");
+    /* frames: usable tracked frames in the point's slot (how fast the camera and tracker ran) */
+    fprintf(out, "point  kind        target (deg)     fixation  frames  spread (deg)  error (deg)\n");
     for (int k = 0; k < rep.n_points; k++) {
         const fv_calproc_point *pt = &rep.points[k];
         char spread[16] = "-", error[16] = "";
@@ -132,9 +133,9 @@ int fv_calibrate_run(const fv_calibrate_opts *o, char *err, size_t err_len)
             snprintf(spread, sizeof spread, "%.2f", (double)(pt->disp_px / rep.px_per_deg));
         if (pt->kind == FV_CALPROC_VALID && pt->ok && isfinite(pt->err_deg))
             snprintf(error, sizeof error, "%.2f", (double)pt->err_deg);
-        fprintf(out, "%5d  %-10s  %6.1f %6.1f    %-8s  %12s  %11s\n", k + 1,
+        fprintf(out, "%5d  %-10s  %6.1f %6.1f    %-8s  %6d  %12s  %11s\n", k + 1,
                 pt->kind == FV_CALPROC_GRID ? "grid" : "validation", (double)pt->yaw_deg, (double)pt->pitch_deg,
-                pt->ok ? "yes" : "NONE", spread, error);
+                pt->ok ? "yes" : "NONE", pt->frames, spread, error);
     }
     if (bad) {
         fv_err(err, err_len, "calibration failed: %s", why);

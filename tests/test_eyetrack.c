@@ -289,6 +289,91 @@ static void test_spectacles(void **state)
     free(img);
 }
 
+/* An MRL-like crop through spectacles (crop mode): bright skin above a dark brow, the frame's
+ * bright rim under it, and below the rim the eye behind a tinted lens: a pupil only 5-9 grey
+ * levels darker than its iris. The brow's box has a far brighter ring than the pupil's (the
+ * forehead and the rim); before the crop mode clipped bright pixels and refused bands it won
+ * every crop here. Pupil, brow height, rim brightness and noise vary over 12 crops; the
+ * reported centre must be within 3 px of the pupil's (the crop mode reports a box centre put on
+ * a pixel centre and moved 5 % toward the crop's centre: 1-2 px by construction). */
+static void crop_specs_image(uint8_t *img, int w, int h, float px, float py, int brow_y, int rim, int pupil_dark,
+                             uint64_t *seed)
+{
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float v;
+            if (y < brow_y)
+                v = 88.0f; /* forehead */
+            else if (y < brow_y + 12)
+                v = 46.0f; /* brow, across the whole crop */
+            else if (y < brow_y + 16)
+                v = 70.0f;
+            else if (y < brow_y + 19)
+                v = (float)rim; /* the frame's rim */
+            else {          /* behind the lens */
+                const float d = hypotf((float)x + 0.5f - px, (float)y + 0.5f - py);
+                v = d < 5.0f ? 52.0f - (float)pupil_dark : d < 11.0f ? 52.0f : 58.0f;
+            }
+            v += 2.0f * (fv_test_randf(seed) + fv_test_randf(seed) - 1.0f);
+            img[(size_t)y * w + x] = (uint8_t)lrintf(v);
+        }
+}
+
+static void test_crop_spectacles(void **state)
+{
+    (void)state;
+    enum { CW = 90, CH = 96 };
+    uint8_t img[CW * CH];
+    uint64_t seed = 77;
+    fv_eye_tracker *t = fv_eye_create(NULL, FV_EYE_MODE_CROP);
+    int ok = 0;
+    float worst = 0.0f;
+    for (int i = 0; i < 12; i++) {
+        const float px = 38.0f + 2.0f * (float)(i % 6), py = 62.0f + (float)(i % 4);
+        const int brow_y = 10 + i % 5, rim = 110 + 10 * (i % 3), dark = 5 + i % 5;
+        crop_specs_image(img, CW, CH, px, py, brow_y, rim, dark, &seed);
+        fv_eye_result r;
+        assert_int_equal(fv_track_image(t, img, CW, CH, CW, &r), 0);
+        const float e = r.found ? hypotf(r.pupil_x - px, r.pupil_y - py) : INFINITY;
+        worst = fmaxf(worst, e);
+        ok += e <= 3.0f;
+    }
+    printf("[ eyetrack ] crops through spectacles: %d of 12 within 3 px of the pupil, worst %.1f px\n", ok, worst);
+    assert_int_equal(ok, 12);
+    fv_eye_destroy(t);
+}
+
+/* A tinted lens scales the pupil's contrast by its transmission (~0.7): a pupil 2.5 grey levels
+ * darker than its surround (pixels alternately 2 and 3 darker) is reported in crop mode
+ * (threshold 2) and lost in headset mode (3); 1.5 is lost in both, 3.5 found in both. */
+static void test_low_contrast_lost(void **state)
+{
+    (void)state;
+    enum { CW = 80, CH = 80 };
+    uint8_t img[CW * CH];
+    const int lo[3] = { 1, 2, 3 };              /* the pupil's pixels: lo or lo + 1 darker */
+    const int want_crop[3] = { 0, 1, 1 }, want_headset[3] = { 0, 0, 1 };
+    for (int k = 0; k < 3; k++) {
+        for (int y = 0; y < CH; y++)
+            for (int x = 0; x < CW; x++)
+                img[y * CW + x] = hypotf((float)x + 0.5f - 40.0f, (float)y + 0.5f - 40.0f) < 7.0f
+                                      ? (uint8_t)(60 - lo[k] - ((x + y) & 1))
+                                      : 60;
+        fv_eye_result rc, rh;
+        fv_eye_tracker *tc = fv_eye_create(NULL, FV_EYE_MODE_CROP), *th = fv_eye_create(NULL, FV_EYE_MODE_HEADSET);
+        assert_int_equal(fv_track_image(tc, img, CW, CH, CW, &rc), 0);
+        assert_int_equal(fv_track_image(th, img, CW, CH, CW, &rh), 0);
+        printf("[ eyetrack ] pupil %d.5 grey levels dark: crop found %d (contrast %.2f), headset found %d (contrast %.2f)\n",
+               lo[k], rc.found, (double)rc.contrast, rh.found, (double)rh.contrast);
+        assert_int_equal(rc.found, want_crop[k]);
+        assert_int_equal(rh.found, want_headset[k]);
+        if (rc.found)
+            assert_true(hypotf(rc.pupil_x - 40.0f, rc.pupil_y - 40.0f) <= 2.0f);
+        fv_eye_destroy(tc);
+        fv_eye_destroy(th);
+    }
+}
+
 static void test_blinks(void **state)
 {
     (void)state;
@@ -483,6 +568,10 @@ static void test_mode_settings(void **state)
     assert_int_equal(c->centroid_iters, 2);
     assert_true(c->min_aspect == 0.3);
     assert_int_equal(c->ransac_iters, 0);
+    assert_int_equal(c->search_sides, 1); /* spectacles: the relaxed sides test, clipping, tint */
+    assert_true(c->sides_frac == 0.3f && c->sides_min_grey == 3.0f);
+    assert_int_equal(c->search_clip_grey, 20);
+    assert_true(c->lost_contrast == 2.0f);
     const fv_eye_mode_settings *hs = fv_eye_mode_get_settings(FV_EYE_MODE_HEADSET);
     assert_ptr_equal(hs, &fv_eye_headset_settings);
     assert_int_equal(hs->mode, FV_EYE_MODE_HEADSET);
@@ -491,6 +580,10 @@ static void test_mode_settings(void **state)
     assert_int_equal(hs->refine_max_side, 320);
     assert_int_equal(hs->ransac_iters, 64);
     assert_true(hs->min_aspect == 0.6);
+    assert_int_equal(hs->search_sides, 1);
+    assert_true(hs->sides_frac == 0.5f && hs->sides_min_grey == 10.0f);
+    assert_int_equal(hs->search_clip_grey, 0);
+    assert_true(hs->lost_contrast == 3.0f);
     assert_null(fv_eye_mode_get_settings(FV_EYE_MODE_AUTO));
     static const char *names[] = { "auto", "headset", "crop" };
     for (int m = 0; m < 3; m++) {
@@ -910,6 +1003,8 @@ int main(void)
         cmocka_unit_test(test_synthetic_noisy),
         cmocka_unit_test(test_partial_occlusion),
         cmocka_unit_test(test_spectacles),
+        cmocka_unit_test(test_crop_spectacles),
+        cmocka_unit_test(test_low_contrast_lost),
         cmocka_unit_test(test_blinks),
         cmocka_unit_test(test_calib_recovers_polynomial),
         cmocka_unit_test(test_calib_file),

@@ -4,14 +4,14 @@
 #include "base/util.h"
 #include "eyetrack/track_impl.h"
 
-void fv_et_judge(fv_et_history *ref, const fv_et_pupil *p, int history, fv_eye_result *r)
+void fv_et_judge(fv_et_history *ref, const fv_et_pupil *p, int history, float lost_contrast, fv_eye_result *r)
 {
     /* confidence: contrast (grey levels) and how much of the outline the fit explains */
     const float cc = fv_clampf((r->contrast - 4.0f) / 24.0f, 0.0f, 1.0f);
     const float fit = p->fit ? fv_clampf(p->inliers / 0.6f, 0.0f, 1.0f) : 0.5f;
     r->confidence = cc * (0.4f + 0.6f * fit);
 
-    if (r->contrast < 3.0f) {
+    if (r->contrast < lost_contrast) {
         r->status = FV_EYE_LOST;
         r->found = 0;
     }

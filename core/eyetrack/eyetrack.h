@@ -38,7 +38,14 @@ typedef struct fv_eye_mode_settings {
     fv_eye_mode mode;
     /* search */
     int search_sides;           /* the pupil box must contrast with its ring on 3 of 4 sides (a
-                                   spectacle frame's rim, a dark band, does not): headset frames */
+                                   spectacle frame's rim, a dark band, does not) */
+    float sides_frac;           /* a side contrasts when brighter than the box by this fraction
+                                   of the ring's contrast, */
+    float sides_min_grey;       /* and by at least this many grey levels */
+    int search_clip_grey;       /* the search image is clipped at its median + this before the
+                                   box search (a frame's rim, a lens reflection's halo or bright
+                                   skin do not make a ring look bright); 0 = off */
+    float lost_contrast;        /* below this contrast (grey levels) no pupil is reported */
     /* refinement */
     int refine_on_search_image; /* refine on the (inpainted) search image, not the frame */
     int refine_max_side;        /* else on the frame halved while its min side exceeds this

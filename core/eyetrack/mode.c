@@ -7,6 +7,9 @@
 const fv_eye_mode_settings fv_eye_headset_settings = {
     .mode = FV_EYE_MODE_HEADSET,
     .search_sides = 1,
+    .sides_frac = 0.5f,
+    .sides_min_grey = 10.0f,
+    .lost_contrast = 3.0f,
     .refine_on_search_image = 0,
     .refine_max_side = 320, /* the edge points keep sub-pixel precision, noise halves, work quarters */
     .window_side_div = 4,   /* the search box can be only the darkest part of a big pupil */
@@ -28,6 +31,15 @@ const fv_eye_mode_settings fv_eye_headset_settings = {
  * refinement tried, which here only gives the levels, size, fit quality and glints. */
 const fv_eye_mode_settings fv_eye_crop_settings = {
     .mode = FV_EYE_MODE_CROP,
+    /* spectacles (docs/eyetrack.md, "Spectacles"): the brow above a frame's bright rim is a
+     * dark box with a bright ring; clipped, the rim counts no more than skin, and the sides
+     * test with a lower bar (a tinted lens leaves 6-15 grey levels of contrast, and the lid or
+     * rim often takes one side) refuses the brow, a band as dark as the box along itself */
+    .search_sides = 1,
+    .sides_frac = 0.3f,
+    .sides_min_grey = 3.0f,
+    .search_clip_grey = 20,
+    .lost_contrast = 2.0f, /* 3 behind a lens passing ~70 % */
     .refine_on_search_image = 1,
     .centroid_iters = 2,
     .min_aspect = 0.3,

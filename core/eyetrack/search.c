@@ -5,7 +5,9 @@
  * bright; F is halved again to <= 64 (C). Over integral images (dsp->et_integral_row) every
  * centre and box size of C is scored by contrast with its ring, darkness and a weak centre prior
  * (box_search); the best is refined in position and size on F. Contrast, not darkness alone,
- * rejects brows, lashes and shadows (as dark around as inside). */
+ * rejects brows, lashes and shadows (as dark around as inside). In crop mode the search image
+ * is first clipped at its median + search_clip_grey: a spectacle frame's bright rim under a dark
+ * brow would otherwise give the brow the brightest ring in the crop. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,9 +52,10 @@ typedef struct {
     int iw, sw, sh;
     float dark, prior, cxm, cym;
     int sides; /* only boxes that pass sides_ok */
+    float sides_frac, sides_min_grey;
 } box_ctx;
 
-static int sides_ok(const uint32_t *ii, int sw, int sh, int x, int y, int k, float inner, float ring);
+static int sides_ok(const box_ctx *b, int x, int y, int k, float inner, float ring);
 
 static inline void box_offer(const box_ctx *b, box_hit *best, float score, float mi, float mo, int x, int y, int k)
 {
@@ -62,7 +65,7 @@ static inline void box_offer(const box_ctx *b, box_hit *best, float score, float
         const float ddx = (float)x - b->cxm, ddy = (float)y - b->cym;
         score -= b->prior * sqrtf(ddx * ddx + ddy * ddy);
     }
-    if (score > best->score && (!b->sides || sides_ok(b->ii, b->sw, b->sh, x, y, k, mi, mo)))
+    if (score > best->score && (!b->sides || sides_ok(b, x, y, k, mi, mo)))
         *best = (box_hit){ score, mi, mo, x, y, k };
 }
 
@@ -89,10 +92,11 @@ static void box_clipped(const box_ctx *b, box_hit *best, int k, int ko, int y, i
 }
 
 static void box_search(const fv_eyetrack_dsp *d, const uint32_t *ii, int sw, int sh, int kmin, int kmax, int step1, int x0,
-                       int x1, int y0, int y1, float dark, float mu, int sides, box_hit *best)
+                       int x1, int y0, int y1, float dark, float mu, const fv_eye_mode_settings *sides, box_hit *best)
 {
     const float rf = 1.5f;
-    const box_ctx b = { ii, sw + 1, sw, sh, dark, mu / (float)(sw < sh ? sw : sh), 0.5f * (sw - 1), 0.5f * (sh - 1), sides };
+    const box_ctx b = { ii, sw + 1, sw, sh, dark, mu / (float)(sw < sh ? sw : sh), 0.5f * (sw - 1), 0.5f * (sh - 1),
+                        sides != NULL, sides ? sides->sides_frac : 0.0f, sides ? sides->sides_min_grey : 0.0f };
     const int iw = sw + 1, xs = fv_maxi(0, x0), xe = fv_mini(sw, x1);
     enum { CHUNK = 256 };
     float sc[CHUNK];
@@ -131,16 +135,19 @@ static void box_search(const fv_eyetrack_dsp *d, const uint32_t *ii, int sw, int
 }
 
 /* A pupil is surrounded by brighter iris on every side; a band (a spectacle frame's rim, a lid
- * margin) is as dark as the box along itself. Each of the ring's four side strips must be
- * brighter than the box by half the ring's contrast (and 10 grey levels), but one side may fail (a pupil under
- * the lashes of a lowered lid). */
-static int sides_ok(const uint32_t *ii, int sw, int sh, int x, int y, int k, float inner, float ring)
+ * margin, a brow) is as dark as the box along itself. Each of the ring's four side strips must be
+ * brighter than the box by sides_frac of the ring's contrast and sides_min_grey grey levels
+ * (headset 0.5 and 10; crop 0.3 and 3, a tinted lens leaving crops 6-15 levels of contrast), but
+ * one side may fail (a pupil under the lashes of a lowered lid, a crop's rim). */
+static int sides_ok(const box_ctx *b, int x, int y, int k, float inner, float ring)
 {
-    const int iw = sw + 1, ko = (int)lrintf(1.5f * k);
+    const uint32_t *ii = b->ii;
+    const int sw = b->sw, sh = b->sh, iw = sw + 1, ko = (int)lrintf(1.5f * k);
     const int ox0 = fv_maxi(0, x - ko), ox1 = fv_mini(sw, x + ko + 1), oy0 = fv_maxi(0, y - ko), oy1 = fv_mini(sh, y + ko + 1);
     const int bx0 = x - k, bx1 = x + k + 1, by0 = y - k, by1 = y + k + 1;
     const int side[4][4] = {{ox0, oy0, ox1, by0}, {ox0, by1, ox1, oy1}, {ox0, by0, bx0, by1}, {bx1, by0, ox1, by1}};
-    const float need = fmaxf((ring - inner) * 0.5f, 10.0f); /* grey levels: a box inside a uniform band has no contrast at all */
+    /* grey levels: a box inside a uniform band has no contrast at all */
+    const float need = fmaxf((ring - inner) * b->sides_frac, b->sides_min_grey);
     int fails = 0;
     for (int i = 0; i < 4; i++) {
         const int a = (side[i][2] - side[i][0]) * (side[i][3] - side[i][1]);
@@ -156,7 +163,7 @@ static int sides_ok(const uint32_t *ii, int sw, int sh, int x, int y, int k, flo
  * (F halved again until min side <= SEARCH_C_SIDE). The exhaustive search runs on C;
  * F only refines position and size around C's answer, which costs ~25x less than searching F. */
 fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
-                             ptrdiff_t stride, const fv_et_scratch *s, int sides_test)
+                             ptrdiff_t stride, const fv_et_scratch *s, const fv_eye_mode_settings *set)
 {
     fv_et_candidate c = { 0 };
     uint8_t *work = s->work, *mask = s->mask, *small = s->lowres;
@@ -194,15 +201,22 @@ fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, c
     const int kmin = fv_maxi(1, (int)lrintf(p->min_radius_frac * side));
     const int kmax = fv_maxi(kmin, (int)lrintf(p->max_radius_frac * side));
     box_hit b = { -1e30f, 0, 0, 0, 0, 0 };
+    if (set->search_clip_grey > 0) { /* bright rims, halos and skin count as the median + clip */
+        uint8_t *dst = cs == small ? mask : small;
+        const int cap = fv_mini(255, lv.median + set->search_clip_grey);
+        for (int i = 0; i < cw * ch; i++)
+            dst[i] = cs[i] > cap ? (uint8_t)cap : cs[i];
+        cs = dst;
+    }
     integral(d, cs, cw, ch, ii);
     /* centres no nearer the border than border_frac of the side: vignetted corners and image
      * edges are dark, and a pupil there is cut anyway */
     const int mx = (int)lrintf(p->border_frac * side);
     /* the best box whose four sides all (but one) contrast with it (a band-shaped box is
      * refused); only if there is none, the best box */
-    for (int sides = sides_test; sides >= 0; sides--) {
+    for (int sides = set->search_sides; sides >= 0; sides--) {
         b = (box_hit){ -1e30f, 0, 0, 0, 0, 0 };
-        box_search(d, ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, p->centre_prior, sides, &b);
+        box_search(d, ii, cw, ch, kmin, kmax, 0, mx, cw - mx, mx, ch - mx, dark, p->centre_prior, sides ? set : NULL, &b);
         if (b.score > -1e30f)
             break;
     }
@@ -213,7 +227,7 @@ fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, c
         box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };
         integral(d, work, sw, sh, ii);
         box_search(d, ii, sw, sh, fv_maxi(1, fk - f), fk + f, 1, fx - f - 1, fx + f + 2, fy - f - 1, fy + f + 2, dark, 0.0f,
-                   0, &bf); /* no prior: it would bias the position */
+                   NULL, &bf); /* no prior: it would bias the position */
         if (bf.score > -1e30f)
             b = bf;
         else

@@ -144,7 +144,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
     r->mode = fv_eye_resolve_mode(t->mode, w, h);
     const fv_eye_mode_settings *set = fv_eye_mode_get_settings(r->mode);
 
-    const fv_et_candidate c = fv_et_search(&t->dsp, &t->p, luma, w, h, stride, &s, set->search_sides);
+    const fv_et_candidate c = fv_et_search(&t->dsp, &t->p, luma, w, h, stride, &s, set);
     if (!c.ok)
         return 0;
     fv_et_pupil p;
@@ -181,7 +181,7 @@ static int track(fv_eye_tracker *t, const uint8_t *luma, int w, int h, ptrdiff_t
         r->pg_x = r->pupil_x - gx / r->n_glints;
         r->pg_y = r->pupil_y - gy / r->n_glints;
     }
-    fv_et_judge(&t->ref, &p, history, r);
+    fv_et_judge(&t->ref, &p, history, set->lost_contrast, r);
     return 0;
 }
 

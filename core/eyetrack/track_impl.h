@@ -51,7 +51,7 @@ typedef struct fv_et_candidate {
 } fv_et_candidate;
 
 fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, const uint8_t *luma, int w, int h,
-                             ptrdiff_t stride, const fv_et_scratch *s, int sides);
+                             ptrdiff_t stride, const fv_et_scratch *s, const fv_eye_mode_settings *set);
 
 /* ---- glints.c */
 
@@ -106,6 +106,6 @@ int fv_et_refine(const fv_et_refine_args *a, fv_et_pupil *out);
 
 /* Confidence, then loss (too little contrast) and, with history, blinks against the running
  * reference, which a good frame updates. r: position, contrast and glints filled in. */
-void fv_et_judge(fv_et_history *ref, const fv_et_pupil *p, int history, fv_eye_result *r);
+void fv_et_judge(fv_et_history *ref, const fv_et_pupil *p, int history, float lost_contrast, fv_eye_result *r);
 
 #endif

@@ -22,6 +22,14 @@ HS_SECONDS=${HIL_HS_SECONDS:-4}
 # the headset's vsync source, default the gpio-sim line; HIL_HS_VSYNC=timer:90 is the negative
 # control of the vsync check (photons on a timer, not on the line's edges: it must fail)
 HS_VSYNC=${HIL_HS_VSYNC:+HIL_HS_VSYNC=$HIL_HS_VSYNC }
+# the calibration check: the scripted wearer's target time and video frame rate, and how long
+# fovea-headset renders with the calibration it wrote
+CAL_DWELL_MS=${HIL_CAL_DWELL_MS:-1000}
+CAL_FPS=${HIL_CAL_FPS:-30}
+CAL_READBACK_SECONDS=${HIL_CAL_READBACK_SECONDS:-4}
+# the rate the video is played at, default CAL_FPS; another one is the negative control of
+# calib-run (the wearer drifts off the procedure's schedule: it must fail)
+CAL_PLAY=${HIL_CAL_PLAY_FPS:+HIL_CAL_PLAY_FPS=$HIL_CAL_PLAY_FPS }
 # extra QEMU options, e.g. HIL_QEMU_EXTRA="-icount shift=auto"
 QEMU_EXTRA=${HIL_QEMU_EXTRA:-}
 guest_bin=$BUILD/hil/fovea-hil
@@ -82,6 +90,19 @@ head -n1 assets/eye_synth.y4m | grep -q '^YUV4MPEG2 W320 H240 .*Cmono' ||
 hdr=$(head -n1 assets/eye_synth.y4m | wc -c)
 head -c $((hdr + FRAMES * (6 + 320 * 240))) assets/eye_synth.y4m > "$run/initrd/data/eye_synth.y4m"
 head -n $((FRAMES + 1)) assets/eye_synth.csv > "$run/initrd/data/eye_synth.csv"
+# the calibration check's scripted wearer (gen_eye --calibration: the procedure's own schedule),
+# made once per gen_eye binary and settings (5 s, 32 MB at the defaults)
+gen_eye=$BUILD/tools/gen_eye
+[ -x "$gen_eye" ] || die "$gen_eye missing (make builds it)"
+cal_key=$( (md5sum < "$gen_eye"; echo "$CAL_DWELL_MS $CAL_FPS") | md5sum | cut -c1-16)
+cal_video=$HIL_DIR/calib-$cal_key.y4m
+if [ ! -s "$cal_video" ] || [ ! -s "${cal_video%.y4m}.csv" ]; then
+    rm -f "$HIL_DIR"/calib-*.y4m "$HIL_DIR"/calib-*.csv
+    "$gen_eye" --calibration "$CAL_DWELL_MS" --fps "$CAL_FPS" --out "$cal_video" --truth "${cal_video%.y4m}.csv" ||
+        die "gen_eye --calibration failed"
+fi
+cp "$cal_video" "$run/initrd/data/calib.y4m"
+cp "${cal_video%.y4m}.csv" "$run/initrd/data/calib.csv"
 : > "$run/initrd/modules.list"
 mods=$(for m in vivid bochs gpio-sim; do
     modprobe -d "$HIL_ROOT" -S "$HIL_KVER" --show-depends "$m" || die "modprobe --show-depends $m failed"
@@ -118,7 +139,7 @@ qemu_args=(-accel tcg -cpu max -m 512 -smp "$SMP" $QEMU_EXTRA -nodefaults -no-re
     -chardev "pipe,id=ctl,path=$run/ctl" -serial chardev:ctl
     -chardev "pipe,id=mon,path=$run/mon" -mon chardev=mon,mode=readline
     -kernel "$HIL_VMLINUX" -initrd "$run/initrd.gz"
-    -append "console=ttyS0 quiet panic=-1 rdinit=/init $HS_VSYNC""HIL_HS_SIZE=$HS_SIZE HIL_HS_SECONDS=$HS_SECONDS HIL_FRAMES=$FRAMES HIL_GPIO_SECONDS=$GPIO_SECONDS")
+    -append "console=ttyS0 quiet panic=-1 rdinit=/init $HS_VSYNC$CAL_PLAY""HIL_HS_SIZE=$HS_SIZE HIL_HS_SECONDS=$HS_SECONDS HIL_FRAMES=$FRAMES HIL_GPIO_SECONDS=$GPIO_SECONDS HIL_CAL_DWELL_MS=$CAL_DWELL_MS HIL_CAL_FPS=$CAL_FPS HIL_CAL_READBACK_SECONDS=$CAL_READBACK_SECONDS")
 say "booting: qemu-system-x86_64 ${qemu_args[*]}"
 t_boot=$(date +%s.%N)
 timeout --kill-after=5 "$TIMEOUT" qemu-system-x86_64 "${qemu_args[@]}" > "$run/qemu.log" 2>&1 &
@@ -188,7 +209,7 @@ if [ $hs_shot_done = 1 ]; then
     fi
 fi
 checks="boot modules v4l2-loop v4l2-track v4l2-buf-error v4l2-reopen gpio-lock gpio-dropped headset-selftest
-    headset-run headset-vsync headset-flip headset-readback kms-flip kms-readback"
+    headset-run headset-vsync headset-flip headset-readback calib-run calib-readback kms-flip kms-readback"
 pass=0 fail=0
 for c in $checks; do
     line=$(grep -m1 "^HIL $c " "$run/console.txt" || true)
