@@ -91,7 +91,7 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
      * pinhole by the ray kernel; a lens lane by lane. */                                                    \
     static void trace_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,             \
                           const fv_raygen_cam *rc, struct RTCIntersectContext *ictx, struct RTCRayHit##N *rh,  \
-                          int *valid, const fv_pyr_level *l0, const uint8_t *px, int k, int x0, int y0)       \
+                          int *valid, const uint8_t *px, int k, int x0, int y0)                               \
     {                                                                                                         \
         if (!cam->lens_on) {                                                                                  \
             dsp->ray.camera_rays(rc, px, x0, y0, rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z, N);             \
@@ -114,9 +114,6 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
         memcpy(valid, lane_valid(16 - k), sizeof(int) * N);                                                      \
         rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
         fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                                    \
-        /* and the image lines the packet will write: cold, and each store would wait for its line */        \
-        for (int q = 0; q < k; q++)                                                                           \
-            __builtin_prefetch(l0->rgbd + 4 * ((y0 + (px[q] >> 4)) * l0->stride + x0 + (px[q] & 15)), 1);     \
     }                                                                                                         \
     /* Writes lanes 0 .. k-1 (shaded into rgb) to level 0. */                                               \
     static void write_##N(const fv_pyr_level *l0, const struct RTCRayHit##N *rh, const float rgb[3][16],      \
@@ -161,7 +158,7 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
         }                                                                                                     \
         const int np = (n + N - 1) / N;                                                                       \
         for (int b = 0; b < np; b++)                                                                          \
-            trace_##N(scene, cam, dsp, &rc, &ictx, &rh[b], valid, l0, px + b * N, n - b * N < N ? n - b * N : N, \
+            trace_##N(scene, cam, dsp, &rc, &ictx, &rh[b], valid, px + b * N, n - b * N < N ? n - b * N : N,     \
                       x0, y0);                                                                                \
         const int64_t t0 = fv_time_ns();                                                                      \
         for (int b = 0; b < np; b++) {                                                                        \
@@ -196,6 +193,12 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_rende
     const int n = fv_raycast_pixels(rows, tw, th, px);
     if (n == 0)
         return 0;
+    /* the image lines the samples will be written to (cold: each store would wait for its line),
+     * asked for before the rays are traced; a line holds 4 pixels, one nibble of a row */
+    for (int y = 0; y < th; y++)
+        for (int x = 0; x < tw; x += 4)
+            if (rows[y] >> x & 15u)
+                __builtin_prefetch(l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0 + x), 1);
     for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
         px[q] = px[n - 1];
     if (fv_raycast_packet_width() == 16)

@@ -133,6 +133,31 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     static _Thread_local _Alignas(64) fv_shade_packet pk;
     fv_tex_taps taps[4][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
+    /* the hit lanes' ray data straight across (a miss lane's values are finite and unused) */
+    for (int q = 0; q < n; q++) {
+        pk.u[q] = h->u[q], pk.v[q] = h->v[q], pk.t[q] = h->t[q];
+        pk.dir[0][q] = h->dir[0][q], pk.dir[1][q] = h->dir[1][q], pk.dir[2][q] = h->dir[2][q];
+    }
+    /* A packet usually hits one mesh: an untextured mesh without vertex colours then has one
+     * material for every lane, broadcast to all 16 (material_at's values, computed once). */
+    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0;
+    for (int q = 0; q < n; q++) {
+        const unsigned g = h->geom[q];
+        if (g == RTC_INVALID_GEOMETRY_ID) continue;
+        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
+        g0 = g;
+    }
+    const fv_mesh_rec *um = !mixed && g0 < s->mesh_count ? &s->meshes[g0] : NULL;
+    if (um && (um->tex_ref >= 0 || um->col)) um = NULL;
+    if (um) {
+        fv_brdf_mat mat;
+        float occ, emit[3];
+        material_at(um, 0, 0.0f, 0.0f, 1.0f, NULL, NULL, NULL, NULL, &mat, &occ, emit);
+        for (int q = 0; q < FV_SHADE_LANES; q++) {
+            for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
+            pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
+        }
+    }
     for (int q = 0; q < n; q++) {
         const unsigned g = h->geom[q], prim = h->prim[q];
         const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
@@ -145,11 +170,10 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const fv_tri_attr *at = &m->attr[prim];
         for (int k = 0; k < 9; k++)
             pk.nrm[k][q] = at->n[k];
+        if (um) continue;
         const float u = h->u[q], v = h->v[q], t = h->t[q];
-        const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
-        pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
-        for (int k = 0; k < 3; k++) pk.dir[k][q] = dir[k];
         if (m->tex_ref >= 0) { /* the texel fetches of all lanes are asked for before any is used */
+            const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
             const float fp = px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
