@@ -5,6 +5,7 @@
 #include "base/util.h"
 
 #include <math.h>
+#include <string.h>
 
 _Static_assert(FV_SHADE_LANES == 16, "fv_hit_packet (scene.h) holds 16 lanes");
 
@@ -133,16 +134,25 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     static _Thread_local _Alignas(64) fv_shade_packet pk;
     fv_tex_taps taps[4][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
-    /* the hit lanes' ray data straight across (a miss lane's values are finite and unused) */
-    for (int q = 0; q < n; q++) {
-        pk.u[q] = h->u[q], pk.v[q] = h->v[q], pk.t[q] = h->t[q];
-        pk.dir[0][q] = h->dir[0][q], pk.dir[1][q] = h->dir[1][q], pk.dir[2][q] = h->dir[2][q];
+    /* the lanes' ray data straight across (a miss lane's values are finite and unused); whole
+     * 64-byte rows for a full packet. Locals: the stores to pk would make the compiler reload h. */
+    const unsigned *geom = h->geom, *primv = h->prim;
+    if (n == FV_SHADE_LANES) {
+        memcpy(pk.u, h->u, sizeof pk.u), memcpy(pk.v, h->v, sizeof pk.v), memcpy(pk.t, h->t, sizeof pk.t);
+        for (int k = 0; k < 3; k++) memcpy(pk.dir[k], h->dir[k], sizeof pk.dir[k]);
+    } else {
+        const float *hu = h->u, *hv = h->v, *ht = h->t, *d0 = h->dir[0], *d1 = h->dir[1], *d2 = h->dir[2];
+        for (int q = 0; q < n; q++) {
+            pk.u[q] = hu[q], pk.v[q] = hv[q], pk.t[q] = ht[q];
+            pk.dir[0][q] = d0[q], pk.dir[1][q] = d1[q], pk.dir[2][q] = d2[q];
+        }
     }
     /* A packet usually hits one mesh: an untextured mesh without vertex colours then has one
-     * material for every lane, broadcast to all 16 (material_at's values, computed once). */
+     * material for every lane, broadcast to all 16 (material_at's values, computed once), and
+     * each lane only needs its corner normals. */
     unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0;
     for (int q = 0; q < n; q++) {
-        const unsigned g = h->geom[q];
+        const unsigned g = geom[q];
         if (g == RTC_INVALID_GEOMETRY_ID) continue;
         mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
         g0 = g;
@@ -157,9 +167,25 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
             pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
         }
+        const fv_tri_attr *attr = um->attr;
+        const size_t tris = um->tri_count;
+        for (int q = 0; q < n; q++) {
+            const unsigned prim = primv[q];
+            if (geom[q] == RTC_INVALID_GEOMETRY_ID)
+                continue;
+            if (prim >= tris) { /* no such triangle: black */
+                black |= 1u << q;
+                continue;
+            }
+            hits |= 1u << q;
+            const float *a = attr[prim].n;
+            pk.nrm[0][q] = a[0], pk.nrm[1][q] = a[1], pk.nrm[2][q] = a[2];
+            pk.nrm[3][q] = a[3], pk.nrm[4][q] = a[4], pk.nrm[5][q] = a[5];
+            pk.nrm[6][q] = a[6], pk.nrm[7][q] = a[7], pk.nrm[8][q] = a[8];
+        }
     }
-    for (int q = 0; q < n; q++) {
-        const unsigned g = h->geom[q], prim = h->prim[q];
+    for (int q = 0; q < n && !um; q++) {
+        const unsigned g = geom[q], prim = primv[q];
         const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
         if (!m || prim >= m->tri_count) { /* a miss, or no such triangle (black) */
             if (g != RTC_INVALID_GEOMETRY_ID)
@@ -170,7 +196,6 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const fv_tri_attr *at = &m->attr[prim];
         for (int k = 0; k < 9; k++)
             pk.nrm[k][q] = at->n[k];
-        if (um) continue;
         const float u = h->u[q], v = h->v[q], t = h->t[q];
         if (m->tex_ref >= 0) { /* the texel fetches of all lanes are asked for before any is used */
             const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
