@@ -204,7 +204,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
             for (int j = 0; j < 4; j++) {
                 const int id = slot_texture(m, j);
-                if (id < 0) continue;
+                if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
                 float su, sv;
                 slot_uv(m, j, tu, tv, &su, &sv);
                 fv_texture_taps(&s->textures[id], su, sv, lod + m->lod_bias[j], &taps[j][q]);
@@ -226,8 +226,9 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const float *tx[4] = {NULL, NULL, NULL, NULL};
         for (int j = 0; j < 4; j++)
             if (slot_texture(m, j) >= 0) {
-                fv_texture_blend(&taps[j][q], texel[j]);
-                tx[j] = texel[j];
+                if (m->slot_src[j] == j)
+                    fv_texture_blend(&taps[j][q], texel[j]);
+                tx[j] = texel[m->slot_src[j]];
             }
         fv_brdf_mat mat;
         float occ, emit[3];
