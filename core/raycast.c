@@ -194,10 +194,11 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_rende
     if (n == 0)
         return 0;
     /* the image lines the samples will be written to (cold: each store would wait for its line),
-     * asked for before the rays are traced; a line holds 4 pixels, one nibble of a row */
+     * asked for before the rays are traced: every line (4 pixels) of a row with a sample; a test
+     * per line mispredicted in the sparse periphery */
     for (int y = 0; y < th; y++)
-        for (int x = 0; x < tw; x += 4)
-            if (rows[y] >> x & 15u)
+        if (rows[y])
+            for (int x = 0; x < tw; x += 4)
                 __builtin_prefetch(l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0 + x), 1);
     for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
         px[q] = px[n - 1];

@@ -184,6 +184,9 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             pk.nrm[6][q] = a[6], pk.nrm[7][q] = a[7], pk.nrm[8][q] = a[8];
         }
     }
+    const fv_mesh_rec *plain_m = NULL; /* the mesh whose material plain holds */
+    fv_brdf_mat plain = {{0, 0, 0}, 0, 0, 0};
+    float plain_occ = 1.0f, plain_emit[3] = {0, 0, 0};
     for (int q = 0; q < n && !um; q++) {
         const unsigned g = geom[q], prim = primv[q];
         const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
@@ -212,11 +215,14 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             }
             textured |= 1u << q;
         } else {
-            fv_brdf_mat mat;
-            float occ, emit[3];
-            material_at(m, prim, u, v, 1.0f - u - v, NULL, NULL, NULL, NULL, &mat, &occ, emit);
-            for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
-            pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
+            /* without vertex colours the material is the mesh's: computed once per run of lanes
+             * on one mesh */
+            if (m != plain_m || m->col) {
+                material_at(m, prim, u, v, 1.0f - u - v, NULL, NULL, NULL, NULL, &plain, &plain_occ, plain_emit);
+                plain_m = m;
+            }
+            for (int k = 0; k < 3; k++) pk.base[k][q] = plain.base[k], pk.emit[k][q] = plain_emit[k];
+            pk.metal[q] = plain.metallic, pk.a2[q] = plain.a2, pk.spec[q] = plain.specular, pk.occl[q] = plain_occ;
         }
     }
     for (unsigned r = textured; r; r &= r - 1) {
