@@ -32,7 +32,7 @@ int fv_bench_acc_init(fv_bench_acc *a, fv_bench_run *r, const char *mode, int fr
     memset(r, 0, sizeof *r);
     r->mode = mode;
     r->sampler = "weier";
-    r->ceiling_ms = r->ceiling_mrays = NAN;
+    r->ceiling_ms = r->ceiling_mrays = r->shade_ms = NAN;
     a->r = r;
     a->frames = frames;
     a->total = calloc((size_t)(frames > 0 ? frames : 1), sizeof *a->total);
@@ -60,6 +60,8 @@ void fv_bench_acc_finish(fv_bench_acc *a)
         r->ceiling_ms = a->ceil_sum / a->ceil_n;
         r->ceiling_mrays = (double)r->samples / (r->ceiling_ms * 1e3);
     }
+    if (a->shade_n > 0)
+        r->shade_ms = a->shade_sum / a->shade_n;
     free(a->total);
     a->total = NULL;
 }
@@ -70,6 +72,20 @@ void fv_bench_acc_add_ceiling(fv_bench_acc *a, double ms)
         return;
     a->ceil_sum += ms;
     a->ceil_n++;
+}
+
+void fv_bench_acc_add_shade(fv_bench_acc *a, double ms)
+{
+    if (a->shade_n >= a->frames)
+        return;
+    a->shade_sum += ms;
+    a->shade_n++;
+}
+
+double fv_bench_shade_share(const fv_bench_run *r)
+{
+    const double t = r->stage_mean[FV_STAGE_TRACE];
+    return t > 0.0 && r->shade_ms >= 0.0 ? r->shade_ms / t : NAN;
 }
 
 double fv_bench_ceiling_ratio(const fv_bench_run *r)

@@ -27,6 +27,8 @@ typedef struct fv_bench_run {
     const char *sampler;               /* the sampling pattern, fv_sampler_names: "weier" | "liu" */
     double ceiling_ms;                 /* mean bare-Embree time of the same rays (core/ceiling.h); NAN: not run */
     double ceiling_mrays;              /* samples over ceiling_ms */
+    double shade_ms;                   /* mean time shading hits inside the ray stage (all threads' time over
+                                          the thread count, as the stage is wall time); NAN: not measured */
     int counters;                      /* hardware counters were read */
     char counters_why[160];            /* else why not */
     double ctr[FV_PROF_STAGES][FV_BENCH_MAX_CTRS]; /* per frame, per profiled stage */
@@ -42,12 +44,19 @@ typedef struct fv_bench_acc {
     double *total; /* each frame's total_ms */
     double ceil_sum;
     int ceil_n;
+    double shade_sum;
+    int shade_n;
 } fv_bench_acc;
 int fv_bench_acc_init(fv_bench_acc *a, fv_bench_run *r, const char *mode, int frames);
 void fv_bench_acc_add(fv_bench_acc *a, const fv_frame_stats *st);
 void fv_bench_acc_finish(fv_bench_acc *a);
 /* One timed frame's ceiling time (--ceiling): finish sets ceiling_ms to their mean. */
 void fv_bench_acc_add_ceiling(fv_bench_acc *a, double ms);
+/* One timed frame's shading time in ms (fv_raycast_shade_ns's increase over the frame, over the
+ * pool's threads): finish sets shade_ms to their mean. */
+void fv_bench_acc_add_shade(fv_bench_acc *a, double ms);
+/* shade_ms as a fraction of the ray stage's time (NAN when either is missing). */
+double fv_bench_shade_share(const fv_bench_run *r);
 /* The ray stage against its ceiling: trace / ceiling time of one run (NAN without a ceiling),
  * and a foveated ray's cost in units of a full-frame bare-Embree ray (fov's trace time per ray
  * over full's ceiling time per ray; NAN when either is missing). */

@@ -82,6 +82,25 @@ static inline void fv_brdf_cos(const fv_brdf_mat *m, float nl, float nv, float n
     }
 }
 
+/* fv_brdf_cos for the head light, which sits at the eye: l = v, so h = v, n.l = n.h = n.v and
+ * v.h = 1 (Schlick's weight is 0). The same bits as fv_brdf_cos(m, nv, nv, nv, 1) for nv in
+ * (0, 1] (tests/test_brdf.c), with one square root for Smith's two equal terms and no half
+ * vector: 3 of the 6 square roots and 2 of the 6 divisions of a lane lit by the head light. */
+static inline void fv_brdf_cos_head(const fv_brdf_mat *m, float nv, float out[3])
+{
+    nv = fv_clamp01(nv);
+    const float g = nv * sqrtf(nv * nv * (1.0f - m->a2) + m->a2);
+    const float s = g + g;
+    const float vis = s > 0.0f ? 0.5f / s : 0.0f;
+    const float spec = FV_PI_F * (vis * fv_ggx_d(m->a2, nv)); /* pi V D */
+    const float fd = m->specular * FV_DIELECTRIC_F0;
+    for (int k = 0; k < 3; k++) {
+        const float diel = (1.0f - fd) * m->base[k] + fd * spec;
+        const float metal = spec * m->base[k];
+        out[k] = ((1.0f - m->metallic) * diel + m->metallic * metal) * nv;
+    }
+}
+
 /* The environment term: a uniform white surround of radiance `ambient`, reflected with the
  * BRDF's normal-incidence mix (Fresnel f0, the specular lobe's albedo taken as 1, roughness
  * ignored): dielectric (1 - s f0) base + s f0, metal base. Keeps unlit sides from going black. */

@@ -5,6 +5,7 @@
 #include <stdatomic.h>
 #include <string.h>
 
+#include "base/clock.h"
 #include "render_dsp.h"
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
@@ -75,16 +76,22 @@ static const float lane_inf[16] = {INFINITY, INFINITY, INFINITY, INFINITY, INFIN
 static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
 #define lane_valid(j) (lane_valid_all + (j))
 
-/* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths), double-buffered: packet
- * b + 1 is traced before packet b is shaded, so the triangle records of b's hits, prefetched
- * when b was traced, arrive while Embree works (they were the shading's main cost). */
+/* Shading time of every tile since the start, summed over threads (fv_raycast_shade_ns). */
+static atomic_llong shade_ns_total;
+long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_total, memory_order_relaxed); }
+
+/* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths). A tile's packets are all
+ * traced first, then all shaded, then written: the triangle records and image lines of every hit,
+ * prefetched right after its packet was traced, have the rest of the tile's tracing to arrive
+ * (they were the shading's main cost), and shading is timed with two clock reads per tile. */
+#define FV_TILE_PACKETS(N) (FV_TILE * FV_TILE / (N))
 #define DEF_PACKETS(N)                                                                                            \
     /* Camera rays through the pixel centres px[0 .. N) (as fv_camera_ray computes them) straight into      \
      * the SoA packet, lanes from k on invalid; px holds N copies of its last pixel past the end. The        \
      * pinhole by the ray kernel; a lens lane by lane. */                                                    \
     static void trace_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,             \
                           const fv_raygen_cam *rc, struct RTCIntersectContext *ictx, struct RTCRayHit##N *rh,  \
-                          int *valid, const fv_pyr_level *l0, const uint8_t *px, int k, int x0, int y0)       \
+                          int *valid, const uint8_t *px, int k, int x0, int y0)                               \
     {                                                                                                         \
         if (!cam->lens_on) {                                                                                  \
             dsp->ray.camera_rays(rc, px, x0, y0, rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z, N);             \
@@ -107,19 +114,11 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
         memcpy(valid, lane_valid(16 - k), sizeof(int) * N);                                                      \
         rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
         fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                                    \
-        /* and the image lines the packet will write: cold, and each store would wait for its line */        \
-        for (int q = 0; q < k; q++)                                                                           \
-            __builtin_prefetch(l0->rgbd + 4 * ((y0 + (px[q] >> 4)) * l0->stride + x0 + (px[q] & 15)), 1);     \
     }                                                                                                         \
-    /* Shades lanes 0 .. k-1 and writes them to level 0. */                                                 \
-    static void finish_##N(const fv_scene *scene, const fv_camera *cam, const fv_shade_dsp *dsp,               \
-                           const fv_pyr_level *l0, const struct RTCRayHit##N *rh, const uint8_t *px, int k,    \
-                           int x0, int y0)                                                                    \
+    /* Writes lanes 0 .. k-1 (shaded into rgb) to level 0. */                                               \
+    static void write_##N(const fv_pyr_level *l0, const struct RTCRayHit##N *rh, const float rgb[3][16],      \
+                          const uint8_t *px, int k, int x0, int y0)                                           \
     {                                                                                                         \
-        _Alignas(64) float rgb[3][16];                                                                        \
-        const fv_hit_packet hp = {rh->hit.geomID, rh->hit.primID, rh->hit.u, rh->hit.v, rh->ray.tfar,         \
-                                  {rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z}};                             \
-        fv_scene_shade_packet(scene, dsp, &hp, k, cam->px_tan, cam->eye_pos, rgb);                            \
         for (int q = 0; q < k; q++) {                                                                         \
             const int p = px[q];                                                                              \
             float *dst = l0->rgbd + 4 * ((y0 + (p >> 4)) * l0->stride + x0 + (p & 15));                       \
@@ -133,33 +132,45 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
             }                                                                                                 \
         }                                                                                                     \
     }                                                                                                         \
+    /* Per thread: a whole tile's packets (20 KiB) and their colours. */                                     \
+    static _Thread_local _Alignas(64) struct RTCRayHit##N tile_rh_##N[FV_TILE_PACKETS(N)];                   \
+    static _Thread_local _Alignas(64) float tile_rgb_##N[FV_TILE_PACKETS(N)][3][16];                         \
+    static _Thread_local float tile_org_##N[3] = {NAN, NAN, NAN};                                            \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
                             const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                  \
     {                                                                                                         \
         struct RTCIntersectContext ictx;                                                                      \
         rtcInitIntersectContext(&ictx);                                                                       \
         ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                                     \
-        _Alignas(64) struct RTCRayHit##N rh[2];                                                               \
-        _Alignas(64) int valid[2][N];                                                                         \
+        struct RTCRayHit##N *rh = tile_rh_##N;                                                                \
+        _Alignas(64) int valid[N];                                                                            \
         const fv_raygen_cam rc = {cam->tan_left, cam->tan_top, cam->px_tan, {cam->right[0], cam->right[1],    \
                                   cam->right[2]}, {cam->up[0], cam->up[1], cam->up[2]},                       \
                                   {cam->back[0], cam->back[1], cam->back[2]}};                                \
-        for (int b = 0; b < 2; b++)                                                                           \
-            for (int q = 0; q < N; q++) { /* what no lane changes */                                         \
-                rh[b].ray.org_x[q] = cam->eye_pos[0], rh[b].ray.org_y[q] = cam->eye_pos[1];                   \
-                rh[b].ray.org_z[q] = cam->eye_pos[2], rh[b].ray.tnear[q] = 0.0f, rh[b].ray.time[q] = 0.0f;    \
-                rh[b].ray.mask[q] = ~0u, rh[b].ray.flags[q] = 0, rh[b].ray.id[q] = (unsigned)q;               \
-            }                                                                                                 \
-        const int np = (n + N - 1) / N;                                                                       \
-        trace_##N(scene, cam, dsp, &rc, &ictx, &rh[0], valid[0], l0, px, n < N ? n : N, x0, y0);             \
-        for (int b = 0; b < np; b++) {                                                                        \
-            const int i = (b + 1) * N;                                                                        \
-            if (b + 1 < np)                                                                                   \
-                trace_##N(scene, cam, dsp, &rc, &ictx, &rh[(b + 1) & 1], valid[(b + 1) & 1], l0, px + i,       \
-                          n - i < N ? n - i : N, x0, y0);                                                     \
-            const int k = n - b * N < N ? n - b * N : N;                                                      \
-            finish_##N(scene, cam, &dsp->shade, l0, &rh[b & 1], px + b * N, k, x0, y0);                       \
+        if (memcmp(tile_org_##N, cam->eye_pos, sizeof tile_org_##N)) { /* what no lane changes: once per eye */ \
+            for (int b = 0; b < FV_TILE_PACKETS(N); b++)                                                      \
+                for (int q = 0; q < N; q++) {                                                                 \
+                    rh[b].ray.org_x[q] = cam->eye_pos[0], rh[b].ray.org_y[q] = cam->eye_pos[1];               \
+                    rh[b].ray.org_z[q] = cam->eye_pos[2], rh[b].ray.tnear[q] = 0.0f, rh[b].ray.time[q] = 0.0f; \
+                    rh[b].ray.mask[q] = ~0u, rh[b].ray.flags[q] = 0, rh[b].ray.id[q] = (unsigned)q;           \
+                }                                                                                             \
+            memcpy(tile_org_##N, cam->eye_pos, sizeof tile_org_##N);                                          \
         }                                                                                                     \
+        const int np = (n + N - 1) / N;                                                                       \
+        for (int b = 0; b < np; b++)                                                                          \
+            trace_##N(scene, cam, dsp, &rc, &ictx, &rh[b], valid, px + b * N, n - b * N < N ? n - b * N : N,     \
+                      x0, y0);                                                                                \
+        const int64_t t0 = fv_time_ns();                                                                      \
+        for (int b = 0; b < np; b++) {                                                                        \
+            const fv_hit_packet hp = {rh[b].hit.geomID, rh[b].hit.primID, rh[b].hit.u, rh[b].hit.v,           \
+                                      rh[b].ray.tfar, {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z}};   \
+            fv_scene_shade_packet(scene, &dsp->shade, &hp, n - b * N < N ? n - b * N : N, cam->px_tan,        \
+                                  cam->eye_pos, tile_rgb_##N[b]);                                             \
+        }                                                                                                     \
+        atomic_fetch_add_explicit(&shade_ns_total, fv_time_ns() - t0, memory_order_relaxed);                  \
+        for (int b = 0; b < np; b++)                                                                          \
+            write_##N(l0, &rh[b], (const float(*)[16])tile_rgb_##N[b], px + b * N,                             \
+                      n - b * N < N ? n - b * N : N, x0, y0);                                                 \
     }
 DEF_PACKETS(8)
 DEF_PACKETS(16)
@@ -182,6 +193,13 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_rende
     const int n = fv_raycast_pixels(rows, tw, th, px);
     if (n == 0)
         return 0;
+    /* the image lines the samples will be written to (cold: each store would wait for its line),
+     * asked for before the rays are traced: every line (4 pixels) of a row with a sample; a test
+     * per line mispredicted in the sparse periphery */
+    for (int y = 0; y < th; y++)
+        if (rows[y])
+            for (int x = 0; x < tw; x += 4)
+                __builtin_prefetch(l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0 + x), 1);
     for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
         px[q] = px[n - 1];
     if (fv_raycast_packet_width() == 16)

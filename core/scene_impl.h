@@ -54,6 +54,8 @@ typedef struct fv_mesh_rec {
     float occlusion_strength;
     int tex_ref;                  /* the texture texel_density counts (first of texture, map[]), or -1 */
     float lod_bias[4];            /* base colour, map[0..2]: log2 of the texel ratio to tex_ref */
+    signed char slot_src[4];      /* per slot: the first slot sampled the same way (same texture and
+                                     uv transform: glTF's packed occlusion-roughness-metallic), or itself */
     int has_uvx;                  /* uvx is used */
     float uvx[4][6];              /* per slot (base colour, map[]): fv_material_maps.uv_transform */
     float *col;                   /* per triangle 9 floats, its corners' vertex colours, or NULL */

@@ -133,6 +133,15 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     /* maps that cannot change the result are not sampled */
     if (r.occlusion_strength == 0.0f) r.map[FV_MAP_OCC] = -1;
     if (m->emissive[0] == 0.0f && m->emissive[1] == 0.0f && m->emissive[2] == 0.0f) r.map[FV_MAP_EMIS] = -1;
+    for (int j = 0; j < 4; j++) { /* slots that would fetch the same texels: the packet path fetches them once */
+        const int tj = j == 0 ? r.texture : r.map[j - 1];
+        r.slot_src[j] = (signed char)j;
+        for (int i = 0; i < j && tj >= 0; i++)
+            if ((i == 0 ? r.texture : r.map[i - 1]) == tj && (!r.has_uvx || !memcmp(r.uvx[i], r.uvx[j], sizeof r.uvx[i]))) {
+                r.slot_src[j] = (signed char)i;
+                break;
+            }
+    }
     memcpy(r.emissive, m->emissive, sizeof r.emissive);
     float *pos = malloc(nv * 3 * sizeof(float));
     uint32_t *tri = malloc(nt * 3 * sizeof(uint32_t));

@@ -5,6 +5,7 @@
 #include "base/util.h"
 
 #include <math.h>
+#include <string.h>
 
 _Static_assert(FV_SHADE_LANES == 16, "fv_hit_packet (scene.h) holds 16 lanes");
 
@@ -133,8 +134,61 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     static _Thread_local _Alignas(64) fv_shade_packet pk;
     fv_tex_taps taps[4][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
+    /* the lanes' ray data straight across (a miss lane's values are finite and unused); whole
+     * 64-byte rows for a full packet. Locals: the stores to pk would make the compiler reload h. */
+    const unsigned *geom = h->geom, *primv = h->prim;
+    if (n == FV_SHADE_LANES) {
+        memcpy(pk.u, h->u, sizeof pk.u), memcpy(pk.v, h->v, sizeof pk.v), memcpy(pk.t, h->t, sizeof pk.t);
+        for (int k = 0; k < 3; k++) memcpy(pk.dir[k], h->dir[k], sizeof pk.dir[k]);
+    } else {
+        const float *hu = h->u, *hv = h->v, *ht = h->t, *d0 = h->dir[0], *d1 = h->dir[1], *d2 = h->dir[2];
+        for (int q = 0; q < n; q++) {
+            pk.u[q] = hu[q], pk.v[q] = hv[q], pk.t[q] = ht[q];
+            pk.dir[0][q] = d0[q], pk.dir[1][q] = d1[q], pk.dir[2][q] = d2[q];
+        }
+    }
+    /* A packet usually hits one mesh: an untextured mesh without vertex colours then has one
+     * material for every lane, broadcast to all 16 (material_at's values, computed once), and
+     * each lane only needs its corner normals. */
+    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0;
     for (int q = 0; q < n; q++) {
-        const unsigned g = h->geom[q], prim = h->prim[q];
+        const unsigned g = geom[q];
+        if (g == RTC_INVALID_GEOMETRY_ID) continue;
+        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
+        g0 = g;
+    }
+    const fv_mesh_rec *um = !mixed && g0 < s->mesh_count ? &s->meshes[g0] : NULL;
+    if (um && (um->tex_ref >= 0 || um->col)) um = NULL;
+    if (um) {
+        fv_brdf_mat mat;
+        float occ, emit[3];
+        material_at(um, 0, 0.0f, 0.0f, 1.0f, NULL, NULL, NULL, NULL, &mat, &occ, emit);
+        for (int q = 0; q < FV_SHADE_LANES; q++) {
+            for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
+            pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
+        }
+        const fv_tri_attr *attr = um->attr;
+        const size_t tris = um->tri_count;
+        for (int q = 0; q < n; q++) {
+            const unsigned prim = primv[q];
+            if (geom[q] == RTC_INVALID_GEOMETRY_ID)
+                continue;
+            if (prim >= tris) { /* no such triangle: black */
+                black |= 1u << q;
+                continue;
+            }
+            hits |= 1u << q;
+            const float *a = attr[prim].n;
+            pk.nrm[0][q] = a[0], pk.nrm[1][q] = a[1], pk.nrm[2][q] = a[2];
+            pk.nrm[3][q] = a[3], pk.nrm[4][q] = a[4], pk.nrm[5][q] = a[5];
+            pk.nrm[6][q] = a[6], pk.nrm[7][q] = a[7], pk.nrm[8][q] = a[8];
+        }
+    }
+    const fv_mesh_rec *plain_m = NULL; /* the mesh whose material plain holds */
+    fv_brdf_mat plain = {{0, 0, 0}, 0, 0, 0};
+    float plain_occ = 1.0f, plain_emit[3] = {0, 0, 0};
+    for (int q = 0; q < n && !um; q++) {
+        const unsigned g = geom[q], prim = primv[q];
         const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
         if (!m || prim >= m->tri_count) { /* a miss, or no such triangle (black) */
             if (g != RTC_INVALID_GEOMETRY_ID)
@@ -146,16 +200,14 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         for (int k = 0; k < 9; k++)
             pk.nrm[k][q] = at->n[k];
         const float u = h->u[q], v = h->v[q], t = h->t[q];
-        const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
-        pk.u[q] = u, pk.v[q] = v, pk.t[q] = t;
-        for (int k = 0; k < 3; k++) pk.dir[k][q] = dir[k];
         if (m->tex_ref >= 0) { /* the texel fetches of all lanes are asked for before any is used */
+            const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
             const float fp = px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
             for (int j = 0; j < 4; j++) {
                 const int id = slot_texture(m, j);
-                if (id < 0) continue;
+                if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
                 float su, sv;
                 slot_uv(m, j, tu, tv, &su, &sv);
                 fv_texture_taps(&s->textures[id], su, sv, lod + m->lod_bias[j], &taps[j][q]);
@@ -163,11 +215,14 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             }
             textured |= 1u << q;
         } else {
-            fv_brdf_mat mat;
-            float occ, emit[3];
-            material_at(m, prim, u, v, 1.0f - u - v, NULL, NULL, NULL, NULL, &mat, &occ, emit);
-            for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
-            pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
+            /* without vertex colours the material is the mesh's: computed once per run of lanes
+             * on one mesh */
+            if (m != plain_m || m->col) {
+                material_at(m, prim, u, v, 1.0f - u - v, NULL, NULL, NULL, NULL, &plain, &plain_occ, plain_emit);
+                plain_m = m;
+            }
+            for (int k = 0; k < 3; k++) pk.base[k][q] = plain.base[k], pk.emit[k][q] = plain_emit[k];
+            pk.metal[q] = plain.metallic, pk.a2[q] = plain.a2, pk.spec[q] = plain.specular, pk.occl[q] = plain_occ;
         }
     }
     for (unsigned r = textured; r; r &= r - 1) {
@@ -177,8 +232,9 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const float *tx[4] = {NULL, NULL, NULL, NULL};
         for (int j = 0; j < 4; j++)
             if (slot_texture(m, j) >= 0) {
-                fv_texture_blend(&taps[j][q], texel[j]);
-                tx[j] = texel[j];
+                if (m->slot_src[j] == j)
+                    fv_texture_blend(&taps[j][q], texel[j]);
+                tx[j] = texel[m->slot_src[j]];
             }
         fv_brdf_mat mat;
         float occ, emit[3];

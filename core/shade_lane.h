@@ -61,7 +61,15 @@ static inline void fv_shade_lane(const fv_brdf_mat *m, float occlusion, const fl
     const float nv = fv_lane_dot3(n, v);
     const float hit[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
     fv_brdf_ambient(m, FV_SCENE_AMBIENT * occlusion, rgb); /* occlusion darkens the surround only */
-    if (nlights == 0) { /* head light: irradiance 1, white, no falloff */
+    if (nlights == 0 && org[0] == eye[0] && org[1] == eye[1] && org[2] == eye[2]) {
+        /* head light (irradiance 1, white, no falloff) at the ray's origin: the hit at
+         * eye + t dir (t > 0) sees it along l = v (fv_brdf_cos_head); the packet kernels' case */
+        if (t > 0.0f && nv > 0.0f) {
+            float f[3];
+            fv_brdf_cos_head(m, nv, f);
+            for (int k = 0; k < 3; k++) rgb[k] += f[k];
+        }
+    } else if (nlights == 0) { /* head light elsewhere (a lens point's ray, core/reference.c) */
         float L[3] = {eye[0] - hit[0], eye[1] - hit[1], eye[2] - hit[2]};
         const float ll = fv_lane_dot3(L, L);
         if (ll > 0.0f) {

@@ -53,6 +53,25 @@ static inline void brdf_cosv(const V base[3], V metal, V a2, V specw, V nl, V nv
     }
 }
 
+/* fv_brdf_cos_head (core/brdf.h) */
+static inline void brdf_cos_headv(const V base[3], V metal, V a2, V specw, V nv, V out[3])
+{
+    nv = clamp01v(nv);
+    const V one = VS(1.0f);
+    const V g = VMUL(nv, VSQRT(VADD(VMUL(VMUL(nv, nv), VSUB(one, a2)), a2)));
+    const V s = VADD(g, g);
+    const V vis = VSEL(VGT(s, VS(0.0f)), VDIV(VS(0.5f), s), VS(0.0f));
+    const V dd = VADD(VMUL(VSUB(one, nv), VADD(one, nv)), VMUL(VMUL(nv, nv), a2));
+    const V dist = VDIV(a2, VMUL(VS(FV_PI_F), VMUL(dd, dd)));
+    const V spec = VMUL(VS(FV_PI_F), VMUL(vis, dist));
+    const V fd = VMUL(specw, VS(FV_DIELECTRIC_F0));
+    for (int k = 0; k < 3; k++) {
+        const V diel = VADD(VMUL(VSUB(one, fd), base[k]), VMUL(fd, spec));
+        const V met = VMUL(spec, base[k]);
+        out[k] = VMUL(VADD(VMUL(VSUB(one, metal), diel), VMUL(metal, met)), nv);
+    }
+}
+
 /* fv_lane_add_light (core/shade_lane.h), on the lanes of ok only */
 static inline void add_lightv(const V base[3], V metal, V a2, V specw, const V n[3], const V v[3], V nv,
                               const V L[3], V nl, const V col_e[3], M ok, V rgb[3])
@@ -105,17 +124,12 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
                 out[k] = VMUL(amb, VADD(VMUL(VSUB(one, metal), diel), VMUL(metal, base[k])));
             }
         }
-        if (env->nlights == 0) { /* head light: irradiance 1, white, no falloff */
-            V L[3] = {VSUB(VS(env->eye[0]), hit[0]), VSUB(VS(env->eye[1]), hit[1]), VSUB(VS(env->eye[2]), hit[2])};
-            const V ll = dot3v(L, L);
-            const V il = VDIV(one, VSQRT(ll));
+        if (env->nlights == 0) { /* head light at the eye: l = v (fv_brdf_cos_head) */
+            V f[3];
+            brdf_cos_headv(base, metal, a2, specw, nv, f);
+            const M ok = MAND(VGT(t, VS(0.0f)), VGT(nv, VS(0.0f)));
             for (int k = 0; k < 3; k++)
-                L[k] = VMUL(L[k], il);
-            const V nl = dot3v(n, L);
-            const V ce = VMUL(one, one); /* colour x e, as the scalar code multiplies it */
-            const V col_e[3] = {ce, ce, ce};
-            add_lightv(base, metal, a2, specw, n, vw, nv, L, nl, col_e, MAND(VGT(ll, VS(0.0f)), VGT(nl, VS(0.0f))),
-                       out);
+                out[k] = VSEL(ok, VADD(out[k], f[k]), out[k]);
         } else {
             for (int j = 0; j < env->nlights; j++) {
                 const fv_light_rec *lr = &env->lights[j];

@@ -291,6 +291,10 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
         grep -q "$k" "$T/b.json" && ok || bad "bench JSON lacks $k"
     done
     grep -q 'Ray Tracing' "$T/out" && ok || bad "bench table header missing"
+    # the shading share of the ray stage per mode (issue 17): a time in the JSON, a line in the output
+    [ "$(grep -c '"shade_ms": [0-9]' "$T/b.json")" = 2 ] && ok || bad "bench JSON shade_ms: $(cat "$T/b.json")"
+    grep -q 'shading inside the ray stage.*foveated [0-9.]* ms ([0-9]* %), full [0-9.]* ms' "$T/out" && ok ||
+        bad "bench shading line: $(cat "$T/out")"
     # a turning head: the reprojection column is measured, and the JSON says the rate
     if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --mode foveated --yaw-rate 30 \
         --json "$T/t.json" >/dev/null 2>"$T/err"; then

@@ -62,6 +62,30 @@ static void test_stage_means(void **state)
     assert_null(a.total);
 }
 
+/* The shading share: the mean of the timed frames' shading times over the stage's mean time;
+ * NAN until a frame's shading is added. */
+static void test_shade_share(void **state)
+{
+    (void)state;
+    fv_bench_run r;
+    fv_bench_acc a;
+    assert_int_equal(fv_bench_acc_init(&a, &r, "full", 3), 0);
+    const fv_frame_stats f = frame(10, 1, 20, 100);
+    for (int i = 0; i < 3; i++)
+        fv_bench_acc_add(&a, &f);
+    fv_bench_acc_finish(&a);
+    assert_true(isnan(r.shade_ms) && isnan(fv_bench_shade_share(&r)));
+    assert_int_equal(fv_bench_acc_init(&a, &r, "full", 3), 0);
+    static const double shade[4] = {2, 3, 7, 50}; /* the 4th is past `frames` */
+    for (int i = 0; i < 4; i++) {
+        fv_bench_acc_add(&a, &f);
+        fv_bench_acc_add_shade(&a, shade[i]);
+    }
+    fv_bench_acc_finish(&a);
+    assert_near(r.shade_ms, 4.0, 1e-12);                     /* (2 + 3 + 7) / 3 */
+    assert_near(fv_bench_shade_share(&r), 0.4, 1e-12);       /* of the 10 ms stage */
+}
+
 static void test_stats_sum(void **state)
 {
     (void)state;
@@ -429,6 +453,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_median),       cmocka_unit_test(test_stage_means), cmocka_unit_test(test_stats_sum),
+        cmocka_unit_test(test_shade_share),
         cmocka_unit_test(test_counter_hook), cmocka_unit_test(test_roofline),    cmocka_unit_test(test_sweep_parse),
         cmocka_unit_test(test_head_at),      cmocka_unit_test(test_copy_gbps),   cmocka_unit_test(test_mean_acc),
         cmocka_unit_test(test_quality),      cmocka_unit_test(test_report_lines), cmocka_unit_test(test_latency_csv),

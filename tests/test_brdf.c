@@ -7,6 +7,7 @@
 #include "brdf.h"
 
 #include <math.h>
+#include <string.h>
 
 #define PI 3.14159265358979323846
 
@@ -164,12 +165,41 @@ static void test_clamps(void **state)
     assert_true(isfinite(f[0]) && f[0] > 0.0f);
 }
 
+/* The head light's shortcut (l = v) is the general BRDF at n.l = n.h = n.v, v.h = 1, bit for
+ * bit, for every material and n.v in (0, 1]; and the hand-worked head-on value above. */
+static void test_head_light(void **state)
+{
+    (void)state;
+    uint64_t seed = 0x4ead11647ull;
+    for (int it = 0; it < 20000; it++) {
+        const float nv = it == 0 ? 1.0f : it == 1 ? 1e-20f : 1e-6f + (1.0f - 1e-6f) * (float)fv_test_randf(&seed);
+        const float roughness = it % 7 == 0 ? 0.0f : (float)fv_test_randf(&seed);
+        const float metallic = it % 3 == 0 ? 0.0f : it % 3 == 1 ? 1.0f : (float)fv_test_randf(&seed);
+        const float specular = it % 5 == 0 ? 0.0f : 1.0f;
+        fv_brdf_mat m = mat((float)fv_test_randf(&seed), metallic, roughness, specular);
+        m.base[1] = (float)fv_test_randf(&seed), m.base[2] = (float)fv_test_randf(&seed);
+        float want[3], got[3];
+        fv_brdf_cos(&m, nv, nv, nv, 1.0f, want);
+        fv_brdf_cos_head(&m, nv, got);
+        for (int k = 0; k < 3; k++)
+            if (memcmp(&want[k], &got[k], sizeof(float))) {
+                print_error("it %d nv %.9g channel %d: head %.9g, general %.9g\n", it, (double)nv, k, (double)got[k],
+                            (double)want[k]);
+                fail();
+            }
+    }
+    const fv_brdf_mat half = mat(0.5f, 0.5f, 0.5f, 1.0f);
+    float f[3];
+    fv_brdf_cos_head(&half, 1.0f, f);
+    ASSERT_REL(f[0], 1.32, 1e-6); /* test_head_on_values */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_head_on_values),  cmocka_unit_test(test_grazing_fresnel),
         cmocka_unit_test(test_ambient),         cmocka_unit_test(test_sweep_against_appendix),
-        cmocka_unit_test(test_clamps),
+        cmocka_unit_test(test_clamps),          cmocka_unit_test(test_head_light),
     };
     return cmocka_run_group_tests_name("brdf", tests, NULL, NULL);
 }

@@ -121,12 +121,64 @@ static void test_sampled(void **state)
     fv_sampler_free(&smp);
 }
 
+/* One tile cast on this thread from two eye positions in turn (the packets' fixed lanes, the
+ * origin among them, are kept per thread between tiles): each time the depths are the bare
+ * rays' from that eye; a tile without rays shades nothing, a tile with hits adds shading time. */
+static void test_tile_moves_eye(void **state)
+{
+    (void)state;
+    fv_scene *s = scene_make();
+    fv_pool *pool = fv_pool_create(1);
+    assert_non_null(pool);
+    fv_render_dsp dsp;
+    fv_render_dsp_init(&dsp, FV_ISA_C);
+    fv_pyramid pyr;
+    assert_int_equal(fv_pyramid_init(&pyr, W, H), 0);
+    float *depth = malloc(sizeof(float) * W * H);
+    assert_non_null(depth);
+    uint32_t rows[FV_TILE], none[FV_TILE] = {0};
+    for (int y = 0; y < FV_TILE; y++)
+        rows[y] = ~0u;
+    fv_camera cam0;
+    camera_make(&cam0);
+    const long long idle0 = fv_raycast_shade_ns();
+    assert_int_equal(fv_raycast_tile(s, &cam0, &dsp, &pyr.lv[0], 16, 16, 16, 16, none), 0);
+    assert_true(fv_raycast_shade_ns() == idle0);
+    for (int it = 0; it < 4; it++) {
+        fv_camera_desc d;
+        fv_camera_desc_default(&d);
+        d.width = W, d.height = H;
+        const fv_pose eye = {{it & 1 ? 0.7f : -0.2f, it & 1 ? 0.3f : 0.0f, it & 1 ? 0.5f : 0.0f}, {0, 0, 0, 1}};
+        fv_camera cam;
+        assert_int_equal(fv_camera_setup(&cam, &d, &eye), 0);
+        const long long t0 = fv_raycast_shade_ns();
+        assert_int_equal(fv_raycast_tile(s, &cam, &dsp, &pyr.lv[0], 16, 16, 16, 16, rows), 256);
+        assert_true(fv_raycast_shade_ns() > t0);
+        const fv_ceiling_opts o = {.packet = 16};
+        assert_int_equal(fv_ceiling_trace(s, &cam, pool, &o, depth), W * H);
+        int hits = 0;
+        for (int y = 16; y < 32; y++)
+            for (int x = 16; x < 32; x++) {
+                const fv_pyr_level *l0 = &pyr.lv[0];
+                const float z = l0->rgbd[4 * (y * l0->stride + x) + 3], c = depth[y * W + x];
+                assert_float_equal(z, isinf(c) ? FV_DEPTH_MISS_M : c, 0.0f);
+                hits += !isinf(c);
+            }
+        assert_true(hits > 0);
+    }
+    free(depth);
+    fv_pyramid_free(&pyr);
+    fv_pool_destroy(pool);
+    fv_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_full_frame_16),
         cmocka_unit_test(test_full_frame_8),
         cmocka_unit_test(test_sampled),
+        cmocka_unit_test(test_tile_moves_eye),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

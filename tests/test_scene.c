@@ -1013,6 +1013,23 @@ static void test_gltf_material_maps(void **state)
     assert_rgb(rgb, 2.075f, 2.075f, 2.075f, 1e-5f, __LINE__);
     check_packets(s, 5); /* the maps through the packet path: the same bits */
     fv_scene_free(s);
+    /* The occlusion read from the same texture as metallic-roughness (the packet path fetches
+     * those texels once) but through its own uv transform, half a texture to the side: its own
+     * texels, as the scalar path fetches them (left half: occlusion from the right texel). */
+    char json2[4096];
+    snprintf(json2, sizeof json2, "\"extensionsUsed\":[\"KHR_texture_transform\"],%s", json);
+    char *occ = strstr(json2, "\"occlusionTexture\":{\"index\":0}");
+    assert_non_null(occ);
+    const char *xf = "\"occlusionTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0]}}}";
+    char tail[4096];
+    snprintf(tail, sizeof tail, "%s", occ + strlen("\"occlusionTexture\":{\"index\":0}"));
+    snprintf(occ, sizeof json2 - (size_t)(occ - json2), "%s%s", xf, tail);
+    write_gltf(p, bin, sizeof bin, json2);
+    s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    check_packets(s, 15);
+    fv_scene_free(s);
     tmpdir_remove(dir);
 }
 
