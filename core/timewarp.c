@@ -71,6 +71,18 @@ void fv_tw_tiles_build(const fv_timewarp_dsp *d, fv_tw_tiles *t, const fv_tw_src
             t->lohi[2 * ((size_t)ty * t->tw + tx)] = (uint16_t)mm[0];
             t->lohi[2 * ((size_t)ty * t->tw + tx) + 1] = (uint16_t)mm[1];
         }
+    t->tw4 = (t->tw + 3) / 4, t->th4 = (t->th + 3) / 4;
+    for (int ty = 0; ty < t->th4; ty++)
+        for (int tx = 0; tx < t->tw4; tx++) {
+            unsigned lo = 65535, hi = 0;
+            for (int j = 4 * ty; j < 4 * ty + 4 && j < t->th; j++)
+                for (int i = 4 * tx; i < 4 * tx + 4 && i < t->tw; i++) {
+                    const uint16_t *e = t->lohi + 2 * ((size_t)j * t->tw + i);
+                    lo = e[0] < lo ? e[0] : lo, hi = e[1] > hi ? e[1] : hi;
+                }
+            t->lohi4[2 * ((size_t)ty * t->tw4 + tx)] = (uint16_t)lo;
+            t->lohi4[2 * ((size_t)ty * t->tw4 + tx) + 1] = (uint16_t)hi;
+        }
 }
 
 /* the least and greatest depth code over source pixels [ix0, ix1] x [iy0, iy1] (or a superset) */
@@ -81,10 +93,14 @@ static void depth_range(const fv_timewarp_dsp *d, const fv_tw_src *s, const fv_t
         d->tw_minmax(s->invd + (ptrdiff_t)iy0 * s->invd_stride + ix0, s->invd_stride, ix1 - ix0 + 1, iy1 - iy0 + 1, mm);
         return;
     }
+    /* a footprint wider than 6 tiles reads the coarse level (a superset: fewer reads) */
+    const int T = ix1 - ix0 > 6 * FV_TW_TILE || iy1 - iy0 > 6 * FV_TW_TILE ? 4 * FV_TW_TILE : FV_TW_TILE;
+    const uint16_t *l = T == FV_TW_TILE ? tiles->lohi : tiles->lohi4;
+    const int tw = T == FV_TW_TILE ? tiles->tw : tiles->tw4;
     unsigned lo = 65535, hi = 0;
-    for (int ty = iy0 / FV_TW_TILE; ty <= iy1 / FV_TW_TILE; ty++) {
-        const uint16_t *r = tiles->lohi + 2 * (size_t)ty * tiles->tw;
-        for (int tx = ix0 / FV_TW_TILE; tx <= ix1 / FV_TW_TILE; tx++) {
+    for (int ty = iy0 / T; ty <= iy1 / T; ty++) {
+        const uint16_t *r = l + 2 * (size_t)ty * tw;
+        for (int tx = ix0 / T; tx <= ix1 / T; tx++) {
             lo = r[2 * tx] < lo ? r[2 * tx] : lo;
             hi = r[2 * tx + 1] > hi ? r[2 * tx + 1] : hi;
         }
@@ -97,7 +113,7 @@ static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *b)
 {
     memset(b, 0, sizeof *b);
-    b->x0 = X0, b->x1 = X1;
+    b->x0 = X0, b->x1 = X1, b->y0 = Y0, b->y1 = Y1;
     const float cx[4] = {(float)X0 + 0.5f, (float)X1 - 0.5f, (float)X0 + 0.5f, (float)X1 - 0.5f};
     const float cy[4] = {(float)Y0 + 0.5f, (float)Y0 + 0.5f, (float)Y1 - 0.5f, (float)Y1 - 0.5f};
     float A[3][4];
@@ -173,7 +189,6 @@ static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
     b->u1 = (fu[1][0] + fu[1][1]) * 0.5f, b->v1 = (fv[1][0] + fv[1][1]) * 0.5f;
     if (!(fabsf(b->u0) < 1e6f && fabsf(b->v0) < 1e6f && fabsf(b->u1) < 1e6f && fabsf(b->v1) < 1e6f))
         return 0;
-    b->y0 = Y0, b->y1 = Y1;
     /* the rows' translations in 1/64 px with 16 more bits, stepped per row (no float per row) */
     const double rows = Y1 - Y0 > 1 ? (double)(Y1 - Y0 - 1) : 1.0, k = 64.0 * 65536.0;
     b->qu = (int64_t)((double)b->u0 * k + (b->u0 < 0 ? -0.5 : 0.5));
@@ -200,15 +215,24 @@ void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int
     row_offsets(b->qu + (int64_t)(y - b->y0) * b->dqu, b->qv + (int64_t)(y - b->y0) * b->dqv, ox, oy, fx, fy);
 }
 
-/* a block, else its halves (down to FV_TW_BLOCK_MIN columns); returns the entries written */
+/* a block, else its quarters (halves where a side is down to FV_TW_BLOCK_MIN), depth first:
+ * the entries that cover a row come in column order; returns the entries written */
 static int plan_split(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out)
 {
-    if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || X1 - X0 <= FV_TW_BLOCK_MIN)
+    const int MIN = FV_TW_BLOCK_MIN;
+    if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || (X1 - X0 <= MIN && Y1 - Y0 <= MIN))
         return 1;
-    const int Xm = X0 + (X1 - X0 + 1) / 2;
-    const int n = plan_split(d, m, src, tiles, X0, Xm, Y0, Y1, guess, out);
-    return n + plan_split(d, m, src, tiles, Xm, X1, Y0, Y1, guess, out + n);
+    const int Xm = X1 - X0 > MIN ? X0 + (X1 - X0 + 1) / 2 : X1, Ym = Y1 - Y0 > MIN ? Y0 + (Y1 - Y0 + 1) / 2 : Y1;
+    int n = plan_split(d, m, src, tiles, X0, Xm, Y0, Ym, guess, out);
+    if (Xm < X1)
+        n += plan_split(d, m, src, tiles, Xm, X1, Y0, Ym, guess, out + n);
+    if (Ym < Y1) {
+        n += plan_split(d, m, src, tiles, X0, Xm, Ym, Y1, guess, out + n);
+        if (Xm < X1)
+            n += plan_split(d, m, src, tiles, Xm, X1, Ym, Y1, guess, out + n);
+    }
+    return n;
 }
 
 int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
@@ -228,8 +252,9 @@ int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
 #define FV_TW_PREFETCH_ROWS 3
 
 /* one row of a translated block: its clamped columns written here, the rest as a piece for
- * tw_spans; the source position is clamped to the source as the reference's. 1 when a piece. */
-static inline int block_row(fv_tw_piece *pc, uint8_t *o, int y, const fv_tw_block *b, const int64_t q[2],
+ * tw_spans; the source position is clamped to the source as the reference's. o holds columns
+ * from xo on. 1 when a piece. */
+static inline int block_row(fv_tw_piece *pc, uint8_t *o, int xo, int y, const fv_tw_block *b, const int64_t q[2],
                             const fv_tw_src *s)
 {
     int ox, oy, fx, fy;
@@ -251,14 +276,14 @@ static inline int block_row(fv_tw_piece *pc, uint8_t *o, int y, const fv_tw_bloc
             e1[c] = fv_tw_span_px(r0[l], r0[l], r1[l], r1[l], 0, fy);
         }
         for (int x = b->x0; x < xa; x++)
-            memcpy(o + 3 * x, e0, 3);
+            memcpy(o + 3 * (x - xo), e0, 3);
         for (int x = xb; x < b->x1; x++)
-            memcpy(o + 3 * x, e1, 3);
+            memcpy(o + 3 * (x - xo), e1, 3);
     }
     if (xa >= xb)
         return 0;
     pc->s0 = r0 + 3 * (ptrdiff_t)(xa + ox), pc->s1 = r1 + 3 * (ptrdiff_t)(xa + ox);
-    pc->dst = 3 * xa, pc->n = 3 * (xb - xa), pc->fx = fx, pc->fy = fy;
+    pc->dst = 3 * (xa - xo), pc->n = 3 * (xb - xa), pc->fx = fx, pc->fy = fy;
     /* a display row reads pieces of ten or so source rows (the homography's tilt), too many
      * short streams for the hardware prefetcher: fetch this piece's source a few rows ahead */
     if (sy + FV_TW_PREFETCH_ROWS + 1 < s->h)
@@ -270,40 +295,48 @@ static inline int block_row(fv_tw_piece *pc, uint8_t *o, int y, const fv_tw_bloc
 long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1, const fv_tw_map *m,
                      const fv_tw_src *src, const fv_tw_tiles *tiles)
 {
-    enum { CHUNK = 32 }; /* blocks planned at a time */
+    enum { CHUNK = 8, MAXE = FV_TW_BLOCK_SPLIT * CHUNK }; /* blocks planned at a time, their entries */
     const int BW = FV_TW_BLOCK_W, BH = FV_TW_BLOCK_H, nbx = (src->w + BW - 1) / BW;
-    fv_tw_block plan[FV_TW_BLOCK_SPLIT * CHUNK];
-    fv_tw_piece pc[FV_TW_BLOCK_SPLIT * CHUNK];
-    int64_t q[FV_TW_BLOCK_SPLIT * CHUNK][2]; /* the blocks' row translations, stepped row by row */
+    fv_tw_block plan[MAXE];
+    fv_tw_piece pc[MAXE];
+    int on[MAXE];                  /* the entries covering the row */
+    uint8_t row[3 * CHUNK * FV_TW_BLOCK_W]; /* a row's columns composed in cache, then streamed (tw_stream) */
     long holes = 0;
     for (int by = y0 / BH; by * BH < y1; by++) {
         const int ya = by * BH > y0 ? by * BH : y0, yb = mini(by * BH + BH, y1);
         float guess = 0.0f;
         for (int bx0 = 0; bx0 < nbx; bx0 += CHUNK) {
             const int n = fv_tw_plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess);
-            for (int i = 0; i < n; i++)
-                q[i][0] = plan[i].qu + (int64_t)(ya - plan[i].y0) * plan[i].dqu,
-                q[i][1] = plan[i].qv + (int64_t)(ya - plan[i].y0) * plan[i].dqv;
+            const int x0 = bx0 * BW, x1 = mini((bx0 + CHUNK) * BW, src->w);
+            int no = 0;
             for (int y = ya; y < yb; y++) {
-                uint8_t *o = dst + (ptrdiff_t)y * dst_stride;
                 int np = 0;
-                for (int i = 0; i < n;) {
-                    if (plan[i].fast) {
-                        np += block_row(&pc[np], o, y, &plan[i], q[i], src);
-                        q[i][0] += plan[i].dqu, q[i][1] += plan[i].dqv;
-                        i++;
-                    } else { /* a run of per-pixel blocks in one call: the kernel interleaves 64 pixels */
-                        int j = i + 1;
-                        while (j < n && !plan[j].fast)
+                if (y == ya || (y - by * BH) % FV_TW_BLOCK_MIN == 0) { /* entries start on these rows */
+                    no = 0;
+                    for (int i = 0; i < n; i++)
+                        if (plan[i].y0 <= y && y < plan[i].y1)
+                            on[no++] = i;
+                }
+                for (int k = 0; k < no;) {
+                    const fv_tw_block *b = &plan[on[k]];
+                    if (b->fast) {
+                        const int64_t q[2] = {b->qu + (int64_t)(y - b->y0) * b->dqu, b->qv + (int64_t)(y - b->y0) * b->dqv};
+                        np += block_row(&pc[np], row, x0, y, b, q, src);
+                        k++;
+                    } else { /* a run of per-pixel entries in one call: the kernel interleaves 64 pixels */
+                        int j = k + 1;
+                        while (j < no && !plan[on[j]].fast)
                             j++;
-                        holes += d->tw_row(o + 3 * plan[i].x0, plan[i].x0, y, plan[j - 1].x1 - plan[i].x0, m, src);
-                        i = j;
+                        holes += d->tw_row(row + 3 * (b->x0 - x0), b->x0, y, plan[on[j - 1]].x1 - b->x0, m, src);
+                        k = j;
                     }
                 }
-                d->tw_spans(o, pc, np);
+                d->tw_spans(row, pc, np);
+                d->tw_stream(dst + (ptrdiff_t)y * dst_stride + 3 * x0, row, 3 * (x1 - x0));
             }
         }
     }
+    d->tw_stream(NULL, NULL, 0); /* the fence: the rows are visible to the thread that shows them */
     return holes;
 }
 
@@ -314,9 +347,10 @@ int fv_tw_frame_alloc(fv_tw_frame *f, int w, int h)
     for (int e = 0; e < 2; e++) {
         f->rgb[e] = calloc((size_t)w * h * 3 + FV_TW_RGB_PAD, 1);
         f->invd[e] = calloc((size_t)w * h * 2 + FV_TW_INVD_PAD, 1);
-        const size_t tiles = (size_t)((w + FV_TW_TILE - 1) / FV_TW_TILE) * ((h + FV_TW_TILE - 1) / FV_TW_TILE);
-        f->tiles[e].lohi = calloc(2 * tiles, sizeof(uint16_t));
-        if (!f->rgb[e] || !f->invd[e] || !f->tiles[e].lohi) {
+        const int tw = (w + FV_TW_TILE - 1) / FV_TW_TILE, th = (h + FV_TW_TILE - 1) / FV_TW_TILE;
+        f->tiles[e].lohi = calloc(2 * (size_t)tw * th, sizeof(uint16_t));
+        f->tiles[e].lohi4 = calloc(2 * (size_t)((tw + 3) / 4) * ((th + 3) / 4), sizeof(uint16_t));
+        if (!f->rgb[e] || !f->invd[e] || !f->tiles[e].lohi || !f->tiles[e].lohi4) {
             fv_tw_frame_free(f);
             return -1;
         }
@@ -330,9 +364,10 @@ void fv_tw_frame_free(fv_tw_frame *f)
         free(f->rgb[e]);
         free(f->invd[e]);
         free(f->tiles[e].lohi);
+        free(f->tiles[e].lohi4);
         f->rgb[e] = NULL;
         f->invd[e] = NULL;
-        f->tiles[e].lohi = NULL;
+        f->tiles[e].lohi = f->tiles[e].lohi4 = NULL;
     }
 }
 

@@ -25,8 +25,8 @@ void fv_tw_pack_invd(uint16_t *dst, ptrdiff_t dst_stride, const float *rgbd, ptr
 
 /* ---- the block warp ----
  * Display block rows of FV_TW_BLOCK_H rows are cut into blocks of FV_TW_BLOCK_W columns; a block
- * that cannot be translated is cut into halves, down to FV_TW_BLOCK_MIN columns, and one that
- * still cannot runs the per-pixel kernel. A block is translated when the planner proves that, for each of its pixels, the
+ * that cannot be translated is cut into quarters, down to FV_TW_BLOCK_MIN pixels a side, and a
+ * part that still cannot runs the per-pixel kernel. A block is translated when the planner proves that, for each of its pixels, the
  * reference's bilinear tap position (before its 7-bit weight truncation, after its clamp to the
  * source) lies within FV_TW_BLOCK_POS_PX, per axis, of the block's tap: each row is translated
  * (fv_tw_block_row), the source position clamped to the source the same way.
@@ -48,16 +48,15 @@ void fv_tw_pack_invd(uint16_t *dst, ptrdiff_t dst_stride, const float *rgbd, ptr
  * of the others, so a disocclusion there is narrower than half a pixel; they are not counted
  * (the count is the per-pixel kernel's over the other blocks). */
 #define FV_TW_BLOCK_W 64
-#define FV_TW_BLOCK_H 32
-#define FV_TW_BLOCK_MIN 16  /* the narrowest half */
-#define FV_TW_BLOCK_SPLIT 4 /* entries a block may become (FV_TW_BLOCK_W / FV_TW_BLOCK_MIN) */
+#define FV_TW_BLOCK_H 64
+#define FV_TW_BLOCK_MIN 8    /* the smallest side of a part */
+#define FV_TW_BLOCK_SPLIT 64 /* entries a block may become ((FV_TW_BLOCK_W / FV_TW_BLOCK_MIN)^2) */
 #define FV_TW_BLOCK_POS_PX 0.25f
-#define FV_TW_TILE 8 /* the side of a tile of fv_tw_tiles */
+#define FV_TW_TILE 8 /* the side of a tile of fv_tw_tiles; its coarse level: 4 x 4 tiles */
 
 typedef struct fv_tw_block {
-    int x0, x1;         /* display columns [x0, x1) of the block row */
+    int x0, x1, y0, y1; /* display pixels [x0, x1) x [y0, y1) */
     int fast;           /* 1: translated; 0: the per-pixel kernel */
-    int y0, y1;         /* its rows (translated blocks) */
     float u0, v0, u1, v1; /* the translation (source minus display position) of its first and last row */
     int64_t qu, qv, dqu, dqv; /* the first row's in 1/2^22 px and the step a row (fv_tw_block_row) */
     float err_px;       /* the planner's bound on the position error (translated blocks) */
@@ -67,17 +66,21 @@ typedef struct fv_tw_block {
 void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int *fy);
 
 /* The least and greatest inverse depth of each FV_TW_TILE square of a source (lohi[2 (ty tw + tx)]
- * and the next), built once per rendered frame so the display path need not read the depth. */
+ * and the next), and of each 4 x 4 of those (lohi4, for large footprints), built once per
+ * rendered frame so the display path need not read the depth. */
 typedef struct fv_tw_tiles {
-    uint16_t *lohi;
-    int tw, th; /* tiles a row, rows of tiles */
+    uint16_t *lohi, *lohi4;
+    int tw, th;   /* tiles a row, rows of tiles */
+    int tw4, th4; /* the coarse level's */
 } fv_tw_tiles;
-/* lohi must hold 2 tw th elements, tw = ceil(w / FV_TW_TILE), th = ceil(h / FV_TW_TILE) */
+/* lohi must hold 2 tw th elements, tw = ceil(w / FV_TW_TILE), th = ceil(h / FV_TW_TILE); lohi4
+ * 2 ceil(tw / 4) ceil(th / 4) */
 void fv_tw_tiles_build(const fv_timewarp_dsp *d, fv_tw_tiles *t, const fv_tw_src *src);
 
 /* Plans display block row by (rows [by FV_TW_BLOCK_H, + FV_TW_BLOCK_H) clipped to the source):
  * its blocks from column bx0 FV_TW_BLOCK_W on, nb of FV_TW_BLOCK_W (the last one clipped), into
- * out (at most FV_TW_BLOCK_SPLIT nb entries, in column order, covering the columns). Returns the entries.
+ * out (at most FV_TW_BLOCK_SPLIT nb entries; they tile the blocks, and those covering a row come
+ * in column order). Returns the entries.
  * tiles: NULL reads the depth plane itself. *guess carries the depth guess G from block to block
  * (0 at the row's start): a row planned in pieces plans as it does whole. */
 int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,

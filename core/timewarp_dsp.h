@@ -33,6 +33,12 @@
  *   vqrdmulh steps). Reads s0[0, n + 3), s1[0, n + 3), nothing more. Every ISA version gives the
  *   reference's bytes.
  *
+ * tw_stream: copies n bytes from src (a row just composed in cache) to dst (the display image),
+ *   exact; the x86 versions store around the cache (non-temporal stores): the display image is
+ *   not read back by this thread, and a store that misses the cache would otherwise read the
+ *   line first (a third of the warp's memory traffic). n = 0 (dst, src unused): the fence after
+ *   a frame's rows (x86 sfence), so other threads see the stores.
+ *
  * tw_minmax: the least and greatest element of a w x h rectangle of 16-bit values (rows of
  *   stride elements), w, h >= 1, into out[0], out[1]. Reads the rectangle only. Exact. */
 #ifndef FOVEA_TIMEWARP_DSP_H
@@ -71,11 +77,13 @@ typedef struct fv_tw_piece {
 } fv_tw_piece;
 typedef void (*fv_tw_spans_fn)(uint8_t *restrict dst, const fv_tw_piece *pieces, int count);
 typedef void (*fv_tw_minmax_fn)(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2]);
+typedef void (*fv_tw_stream_fn)(uint8_t *restrict dst, const uint8_t *restrict src, int n);
 
 typedef struct fv_timewarp_dsp {
     fv_tw_row_fn tw_row;
     fv_tw_spans_fn tw_spans;
     fv_tw_minmax_fn tw_minmax;
+    fv_tw_stream_fn tw_stream;
 } fv_timewarp_dsp;
 
 void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask);
@@ -84,6 +92,7 @@ void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask);
 int fv_tw_row_c(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s);
 void fv_tw_spans_c(uint8_t *restrict dst, const fv_tw_piece *pieces, int count);
 void fv_tw_minmax_c(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2]);
+void fv_tw_stream_c(uint8_t *restrict dst, const uint8_t *restrict src, int n);
 
 /* tw_spans' step for one byte (the ISA versions' tails) */
 static inline uint8_t fv_tw_span_px(int a, int b, int c, int d, int fx, int fy)

@@ -1,6 +1,8 @@
 /* fovea: the timewarp kernel's C reference (contract: timewarp_dsp.h). */
 #include "timewarp_dsp.h"
 
+#include <string.h>
+
 int fv_tw_row_c(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s)
 {
     const float py = (float)y + 0.5f;
@@ -36,11 +38,18 @@ void fv_tw_minmax_c(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned 
     out[0] = lo, out[1] = hi;
 }
 
+void fv_tw_stream_c(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    if (n)
+        memcpy(dst, src, (size_t)n);
+}
+
 void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask)
 {
     d->tw_row = fv_tw_row_c;
     d->tw_spans = fv_tw_spans_c;
     d->tw_minmax = fv_tw_minmax_c;
+    d->tw_stream = fv_tw_stream_c;
     const unsigned avail = isa_mask & fv_cpu_isas();
     (void)avail;
 #if defined(__x86_64__)

@@ -72,9 +72,8 @@ static double translated_share(const fv_timewarp_dsp *d, const fv_tw_map *m, con
     for (int by = 0; by < nby; by++) {
         float g = 0.0f;
         const int n = fv_tw_plan_blocks(d, m, s, tiles, by, 0, nbx, b, &g);
-        const int rows = (by + 1) * FV_TW_BLOCK_H < s->h ? FV_TW_BLOCK_H : s->h - by * FV_TW_BLOCK_H;
         for (int i = 0; i < n; i++)
-            px += b[i].fast ? (double)(b[i].x1 - b[i].x0) * rows : 0.0;
+            px += b[i].fast ? (double)(b[i].x1 - b[i].x0) * (b[i].y1 - b[i].y0) : 0.0;
     }
     free(b);
     return px / ((double)s->w * s->h);

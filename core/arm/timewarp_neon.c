@@ -199,8 +199,18 @@ static void tw_minmax_neon(const uint16_t *p, ptrdiff_t stride, int w, int h, un
     out[0] = vminvq_u16(lo), out[1] = vmaxvq_u16(hi);
 }
 
+/* plain stores: the intrinsics have no non-temporal store (STNP would need assembly) */
+static void tw_stream_neon(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    int k = 0;
+    for (; k + 16 <= n; k += 16)
+        vst1q_u8(dst + k, vld1q_u8(src + k));
+    memcpy(dst + k, src + k, (size_t)(n - k));
+}
+
 void fv_timewarp_dsp_init_neon(fv_timewarp_dsp *d)
 {
+    d->tw_stream = tw_stream_neon;
     d->tw_row = tw_row_neon;
     d->tw_spans = tw_spans_neon;
     d->tw_minmax = tw_minmax_neon;

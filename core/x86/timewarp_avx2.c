@@ -259,8 +259,23 @@ static void tw_minmax_avx2(const uint16_t *p, ptrdiff_t stride, int w, int h, un
     out[1] = 65535u - ((unsigned)_mm_cvtsi128_si32(_mm_minpos_epu16(_mm_xor_si128(g, _mm_set1_epi16(-1)))) & 0xffff);
 }
 
+static void tw_stream_avx2(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    if (!n) {
+        _mm_sfence();
+        return;
+    }
+    int k = (int)((32 - ((uintptr_t)dst & 31)) & 31);
+    k = k < n ? k : n;
+    memcpy(dst, src, (size_t)k);
+    for (; k + 32 <= n; k += 32)
+        _mm256_stream_si256((__m256i *)(void *)(dst + k), _mm256_loadu_si256((const __m256i *)(const void *)(src + k)));
+    memcpy(dst + k, src + k, (size_t)(n - k));
+}
+
 void fv_timewarp_dsp_init_avx2(fv_timewarp_dsp *d)
 {
+    d->tw_stream = tw_stream_avx2;
     d->tw_row = tw_row_avx2;
     d->tw_spans = tw_spans_avx2;
     d->tw_minmax = tw_minmax_avx2;

@@ -197,8 +197,23 @@ static void tw_minmax_sse41(const uint16_t *p, ptrdiff_t stride, int w, int h, u
     out[1] = 65535u - ((unsigned)_mm_cvtsi128_si32(_mm_minpos_epu16(_mm_xor_si128(hi, _mm_set1_epi16(-1)))) & 0xffff);
 }
 
+static void tw_stream_sse41(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    if (!n) {
+        _mm_sfence();
+        return;
+    }
+    int k = (int)((16 - ((uintptr_t)dst & 15)) & 15);
+    k = k < n ? k : n;
+    memcpy(dst, src, (size_t)k);
+    for (; k + 16 <= n; k += 16)
+        _mm_stream_si128((__m128i *)(void *)(dst + k), _mm_loadu_si128((const __m128i *)(const void *)(src + k)));
+    memcpy(dst + k, src + k, (size_t)(n - k));
+}
+
 void fv_timewarp_dsp_init_sse41(fv_timewarp_dsp *d)
 {
+    d->tw_stream = tw_stream_sse41;
     d->tw_row = tw_row_sse41;
     d->tw_spans = tw_spans_sse41;
     d->tw_minmax = tw_minmax_sse41;

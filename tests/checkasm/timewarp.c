@@ -260,10 +260,12 @@ static void test_block_warp(void **state)
     uint16_t *invd = malloc((npx + FV_TW_INVD_PAD / 2) * sizeof *invd);
     uint8_t *refhole = malloc(npx), *fastpx = malloc(npx);
     const int tw = (BW_W + FV_TW_TILE - 1) / FV_TW_TILE, th = (BW_H + FV_TW_TILE - 1) / FV_TW_TILE;
+    const int tw4 = (tw + 3) / 4, th4 = (th + 3) / 4;
     uint16_t *lohi = malloc(2 * (size_t)tw * th * sizeof *lohi), *want_tiles = malloc(2 * (size_t)tw * th * sizeof *lohi);
+    uint16_t *lohi4 = malloc(2 * (size_t)tw4 * th4 * sizeof *lohi), *want4 = malloc(2 * (size_t)tw4 * th4 * sizeof *lohi);
     const int nbx = (BW_W + FV_TW_BLOCK_W - 1) / FV_TW_BLOCK_W;
     fv_tw_block *plan = malloc(FV_TW_BLOCK_SPLIT * (size_t)nbx * sizeof *plan);
-    assert_true(rgb && ref && blk && invd && refhole && fastpx && lohi && want_tiles && plan);
+    assert_true(rgb && ref && blk && invd && refhole && fastpx && lohi && want_tiles && lohi4 && want4 && plan);
     fv_camera_desc cd;
     fv_camera_desc_default(&cd);
     cd.width = BW_W, cd.height = BW_H;
@@ -317,7 +319,16 @@ static void test_block_warp(void **state)
                         lo = invd[y * BW_W + x] < lo ? invd[y * BW_W + x] : lo, hi = invd[y * BW_W + x] > hi ? invd[y * BW_W + x] : hi;
                 want_tiles[2 * (ty * tw + tx)] = (uint16_t)lo, want_tiles[2 * (ty * tw + tx) + 1] = (uint16_t)hi;
             }
-        fv_tw_tiles tiles = {lohi, 0, 0};
+        const int T4 = 4 * FV_TW_TILE;
+        for (int ty = 0; ty < th4; ty++)
+            for (int tx = 0; tx < tw4; tx++) {
+                unsigned lo = 65535, hi = 0;
+                for (int y = ty * T4; y < (ty + 1) * T4 && y < BW_H; y++)
+                    for (int x = tx * T4; x < (tx + 1) * T4 && x < BW_W; x++)
+                        lo = invd[y * BW_W + x] < lo ? invd[y * BW_W + x] : lo, hi = invd[y * BW_W + x] > hi ? invd[y * BW_W + x] : hi;
+                want4[2 * (ty * tw4 + tx)] = (uint16_t)lo, want4[2 * (ty * tw4 + tx) + 1] = (uint16_t)hi;
+            }
+        fv_tw_tiles tiles = {lohi, lohi4, 0, 0, 0, 0};
         const fv_tw_tiles *tp = trial & 2 ? &tiles : NULL;
         for (int k = -1; k < 0 || checkasm_isas[k]; k++) { /* C first, then this build's ISAs */
             const unsigned isa = k < 0 ? FV_ISA_C : checkasm_isas[k];
@@ -329,7 +340,9 @@ static void test_block_warp(void **state)
             fv_tw_tiles_build(&d, &tiles, &s);
             assert_int_equal(tiles.tw, tw);
             assert_int_equal(tiles.th, th);
-            if (memcmp(lohi, want_tiles, 2 * (size_t)tw * th * sizeof *lohi))
+            assert_int_equal(tiles.tw4, tw4);
+            assert_int_equal(tiles.th4, th4);
+            if (memcmp(lohi, want_tiles, 2 * (size_t)tw * th * sizeof *lohi) || memcmp(lohi4, want4, 2 * (size_t)tw4 * th4 * sizeof *lohi))
                 fail_msg("%s: fv_tw_tiles_build differs from the tiles' least and greatest", fv_isa_name(isa));
             uint8_t *ob;
             uint8_t *o = checkasm_out_u8(npx * 3, 1, &ob);
@@ -349,12 +362,18 @@ static void test_block_warp(void **state)
             for (int by = 0; by * FV_TW_BLOCK_H < BW_H; by++) {
                 float g = 0.0f;
                 const int n = fv_tw_plan_blocks(&c, &m, &s, tp, by, 0, nbx, plan, &g);
-                assert_int_equal(plan[0].x0, 0);
-                assert_int_equal(plan[n - 1].x1, BW_W);
+                /* the entries tile the block row, those of a row in column order */
+                for (int y = by * FV_TW_BLOCK_H; y < (by + 1) * FV_TW_BLOCK_H && y < BW_H; y++) {
+                    int x = 0;
+                    for (int i = 0; i < n; i++)
+                        if (plan[i].y0 <= y && y < plan[i].y1) {
+                            assert_int_equal(plan[i].x0, x);
+                            x = plan[i].x1;
+                        }
+                    assert_int_equal(x, BW_W);
+                }
                 for (int i = 0; i < n; i++) {
-                    if (i)
-                        assert_int_equal(plan[i].x0, plan[i - 1].x1);
-                    for (int y = by * FV_TW_BLOCK_H; y < (by + 1) * FV_TW_BLOCK_H && y < BW_H; y++)
+                    for (int y = plan[i].y0; y < plan[i].y1; y++)
                         for (int x = plan[i].x0; x < plan[i].x1; x++) {
                             const size_t j = (size_t)y * BW_W + x;
                             checked++;
@@ -410,7 +429,7 @@ static void test_block_warp(void **state)
     /* both paths were exercised */
     assert_true(fast_total > checked / 4);
     assert_true(slow_total > 0);
-    free(rgb), free(ref), free(blk), free(invd), free(refhole), free(fastpx), free(lohi), free(want_tiles), free(plan);
+    free(rgb), free(ref), free(blk), free(invd), free(refhole), free(fastpx), free(lohi), free(want_tiles), free(lohi4), free(want4), free(plan);
 }
 
 const struct CMUnitTest checkasm_timewarp_tests[] = {
