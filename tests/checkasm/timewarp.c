@@ -18,7 +18,7 @@
 #include "camera.h"
 #include "timewarp.h"
 
-static const char *const names[] = {"tw_row", "tw_spans", "tw_minmax"};
+static const char *const names[] = {"tw_row", "tw_spans", "tw_minmax", "tw_stream"};
 
 static void test_tables(void **state)
 {
@@ -225,6 +225,32 @@ static void test_tw_minmax(void **state)
         }
     }
     free(p);
+}
+
+static void test_tw_stream(void **state)
+{
+    (void)state;
+    uint8_t src[700];
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "tw_stream"))
+            continue;
+        fv_timewarp_dsp d;
+        fv_timewarp_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+        for (int n = 0; n <= 600; n += n < 80 ? 1 : 37) /* every head and tail around the alignment */
+            for (int off = 0; off < 33; off += 7) {
+                for (int i = 0; i < n; i++)
+                    src[i] = (uint8_t)checkasm_rand();
+                uint8_t *b;
+                uint8_t *t = checkasm_out_u8((size_t)n, off, &b);
+                d.tw_stream(t, src, n);
+                d.tw_stream(NULL, NULL, 0); /* the fence */
+                checkasm_check_guards(t, (size_t)n, fv_isa_name(isa), "tw_stream", n);
+                checkasm_compare(src, t, (size_t)n, CHECKASM_U8, 1, CHECKASM_EXACT, "%s tw_stream n=%d off=%d",
+                                 fv_isa_name(isa), n, off);
+                free(b);
+            }
+    }
 }
 
 /* ---- the block warp against the per-pixel reference (timewarp.h's contract) ---- */
@@ -438,6 +464,7 @@ const struct CMUnitTest checkasm_timewarp_tests[] = {
     cmocka_unit_test(test_tw_spans),
     cmocka_unit_test(test_tw_spans_formula),
     cmocka_unit_test(test_tw_minmax),
+    cmocka_unit_test(test_tw_stream),
     cmocka_unit_test(test_block_warp),
     {0},
 };
