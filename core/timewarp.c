@@ -183,7 +183,8 @@ static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
     const float eu = maxf(fu[0][1] - fu[0][0], fu[1][1] - fu[1][0]) * 0.5f + cu;
     const float ev = maxf(fv[0][1] - fv[0][0], fv[1][1] - fv[1][0]) * 0.5f + cv;
     const float err = maxf(eu, ev) + 1.0f / 128.0f; /* + a row's rounding to 1/64 */
-    if (!(err + 1e-3f <= FV_TW_BLOCK_POS_PX))         /* 1e-3: this computation's own rounding */
+    b->err_px = err;
+    if (!(err + 1e-3f <= FV_TW_BLOCK_POS_PX)) /* 1e-3: this computation's own rounding */
         return 0;
     b->u0 = (fu[0][0] + fu[0][1]) * 0.5f, b->v0 = (fv[0][0] + fv[0][1]) * 0.5f;
     b->u1 = (fu[1][0] + fu[1][1]) * 0.5f, b->v1 = (fv[1][0] + fv[1][1]) * 0.5f;
@@ -195,7 +196,6 @@ static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
     b->qv = (int64_t)((double)b->v0 * k + (b->v0 < 0 ? -0.5 : 0.5));
     const double su = ((double)b->u1 - b->u0) / rows * k, sv = ((double)b->v1 - b->v0) / rows * k;
     b->dqu = (int64_t)(su + (su < 0 ? -0.5 : 0.5)), b->dqv = (int64_t)(sv + (sv < 0 ? -0.5 : 0.5));
-    b->err_px = err;
     b->fast = 1;
     return 1;
 }
@@ -216,12 +216,16 @@ void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int
 }
 
 /* a block, else its quarters (halves where a side is down to FV_TW_BLOCK_MIN), depth first:
- * the entries that cover a row come in column order; returns the entries written */
+ * the entries that cover a row come in column order; returns the entries written. A block
+ * whose bound is more than its side / FV_TW_BLOCK_MIN times too large is not cut: halving the
+ * side halves the spread of a smooth mapping, so even its smallest parts would fail (a frame
+ * warped far: planning 85 parts a block would cost more than the per-pixel warp saves). */
 static int plan_split(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out)
 {
-    const int MIN = FV_TW_BLOCK_MIN;
-    if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || (X1 - X0 <= MIN && Y1 - Y0 <= MIN))
+    const int MIN = FV_TW_BLOCK_MIN, side = X1 - X0 > Y1 - Y0 ? X1 - X0 : Y1 - Y0;
+    if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || side <= MIN ||
+        out->err_px > FV_TW_BLOCK_POS_PX * (float)side / (float)MIN)
         return 1;
     const int Xm = X1 - X0 > MIN ? X0 + (X1 - X0 + 1) / 2 : X1, Ym = Y1 - Y0 > MIN ? Y0 + (Y1 - Y0 + 1) / 2 : Y1;
     int n = plan_split(d, m, src, tiles, X0, Xm, Y0, Ym, guess, out);
