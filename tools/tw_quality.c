@@ -113,7 +113,15 @@ int main(int argc, char **argv)
             png_dir = argv[++i];
         else if (!strcmp(argv[i], "--eye") && i + 1 < argc)
             right = !strcmp(argv[++i], "right");
-        else
+        else if (!strcmp(argv[i], "--help")) {
+            printf("usage: tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] [--step MM]\n"
+                   "                  [--eye left|right] [--png DIR] [--bench N]\n"
+                   "  --step MM   a sideways head step of MM a refresh besides the turn (default 0)\n"
+                   "  --png DIR   DIR/warped_K.png, direct_K.png, error_K.png (the luma error x8)\n"
+                   "  --bench N   time the stereo pair one refresh old on this thread, block warp,\n"
+                   "              per-pixel warp and a copy of the pair's bytes, N times each\n");
+            return 0;
+        } else
             fv_usage_error(prog, "usage: tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] "
                                  "[--step MM] [--eye left|right] [--png DIR] [--bench N]");
     }
