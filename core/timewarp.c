@@ -312,14 +312,17 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
         for (int bx0 = 0; bx0 < nbx; bx0 += CHUNK) {
             const int n = fv_tw_plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess);
             const int x0 = bx0 * BW, x1 = mini((bx0 + CHUNK) * BW, src->w);
-            int no = 0;
+            int no = 0, next = ya; /* the entries covering the row change on row next */
             for (int y = ya; y < yb; y++) {
                 int np = 0;
-                if (y == ya || (y - by * BH) % FV_TW_BLOCK_MIN == 0) { /* entries start on these rows */
-                    no = 0;
-                    for (int i = 0; i < n; i++)
+                if (y == next) {
+                    no = 0, next = yb;
+                    for (int i = 0; i < n; i++) {
                         if (plan[i].y0 <= y && y < plan[i].y1)
                             on[no++] = i;
+                        const int c = plan[i].y0 > y ? plan[i].y0 : plan[i].y1;
+                        next = c > y && c < next ? c : next;
+                    }
                 }
                 for (int k = 0; k < no;) {
                     const fv_tw_block *b = &plan[on[k]];
