@@ -199,9 +199,12 @@ static void tw_minmax_neon(const uint16_t *p, ptrdiff_t stride, int w, int h, un
     out[0] = vminvq_u16(lo), out[1] = vmaxvq_u16(hi);
 }
 
-/* plain stores: the intrinsics have no non-temporal store (STNP would need assembly) */
+/* plain stores: the intrinsics have no non-temporal store (STNP would need assembly); n = 0
+ * (the fence call) has nothing to order */
 static void tw_stream_neon(uint8_t *restrict dst, const uint8_t *restrict src, int n)
 {
+    if (!n)
+        return;
     int k = 0;
     for (; k + 16 <= n; k += 16)
         vst1q_u8(dst + k, vld1q_u8(src + k));
