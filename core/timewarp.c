@@ -44,12 +44,306 @@ void fv_tw_pack_invd(uint16_t *dst, ptrdiff_t dst_stride, const float *rgbd, ptr
     }
 }
 
-long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1, const fv_tw_map *m,
-                     const fv_tw_src *src)
+long fv_tw_warp_rows_pixel(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1,
+                           const fv_tw_map *m, const fv_tw_src *src)
 {
     long holes = 0;
     for (int y = y0; y < y1; y++)
         holes += d->tw_row(dst + (ptrdiff_t)y * dst_stride, 0, y, src->w, m, src);
+    return holes;
+}
+
+static inline float minf(float a, float b) { return a < b ? a : b; }
+static inline float maxf(float a, float b) { return a > b ? a : b; }
+static inline int mini(int a, int b) { return a < b ? a : b; }
+/* the reference's nearest-pixel index of a coordinate (fv_tw_fetch_w) */
+static inline int tw_index(float u, int n) { return (int)fv_tw_clampf(u, (float)(n - 1)); }
+
+void fv_tw_tiles_build(const fv_timewarp_dsp *d, fv_tw_tiles *t, const fv_tw_src *src)
+{
+    const int T = FV_TW_TILE;
+    t->tw = (src->w + T - 1) / T, t->th = (src->h + T - 1) / T;
+    for (int ty = 0; ty < t->th; ty++)
+        for (int tx = 0; tx < t->tw; tx++) {
+            unsigned mm[2];
+            d->tw_minmax(src->invd + (ptrdiff_t)ty * T * src->invd_stride + tx * T, src->invd_stride,
+                         mini(T, src->w - tx * T), mini(T, src->h - ty * T), mm);
+            t->lohi[2 * ((size_t)ty * t->tw + tx)] = (uint16_t)mm[0];
+            t->lohi[2 * ((size_t)ty * t->tw + tx) + 1] = (uint16_t)mm[1];
+        }
+    t->tw4 = (t->tw + 3) / 4, t->th4 = (t->th + 3) / 4;
+    for (int ty = 0; ty < t->th4; ty++)
+        for (int tx = 0; tx < t->tw4; tx++) {
+            unsigned lo = 65535, hi = 0;
+            for (int j = 4 * ty; j < 4 * ty + 4 && j < t->th; j++)
+                for (int i = 4 * tx; i < 4 * tx + 4 && i < t->tw; i++) {
+                    const uint16_t *e = t->lohi + 2 * ((size_t)j * t->tw + i);
+                    lo = e[0] < lo ? e[0] : lo, hi = e[1] > hi ? e[1] : hi;
+                }
+            t->lohi4[2 * ((size_t)ty * t->tw4 + tx)] = (uint16_t)lo;
+            t->lohi4[2 * ((size_t)ty * t->tw4 + tx) + 1] = (uint16_t)hi;
+        }
+}
+
+/* the least and greatest depth code over source pixels [ix0, ix1] x [iy0, iy1] (or a superset) */
+static void depth_range(const fv_timewarp_dsp *d, const fv_tw_src *s, const fv_tw_tiles *tiles, int ix0, int ix1,
+                        int iy0, int iy1, unsigned mm[2])
+{
+    if (!tiles) {
+        d->tw_minmax(s->invd + (ptrdiff_t)iy0 * s->invd_stride + ix0, s->invd_stride, ix1 - ix0 + 1, iy1 - iy0 + 1, mm);
+        return;
+    }
+    /* a footprint wider than 6 tiles reads the coarse level (a superset: fewer reads) */
+    const int T = ix1 - ix0 > 6 * FV_TW_TILE || iy1 - iy0 > 6 * FV_TW_TILE ? 4 * FV_TW_TILE : FV_TW_TILE;
+    const uint16_t *l = T == FV_TW_TILE ? tiles->lohi : tiles->lohi4;
+    const int tw = T == FV_TW_TILE ? tiles->tw : tiles->tw4;
+    unsigned lo = 65535, hi = 0;
+    for (int ty = iy0 / T; ty <= iy1 / T; ty++) {
+        const uint16_t *r = l + 2 * (size_t)ty * tw;
+        for (int tx = ix0 / T; tx <= ix1 / T; tx++) {
+            lo = r[2 * tx] < lo ? r[2 * tx] : lo;
+            hi = r[2 * tx + 1] > hi ? r[2 * tx + 1] : hi;
+        }
+    }
+    mm[0] = lo, mm[1] = hi;
+}
+
+/* one block (the proof: timewarp.h); 1 when translated */
+static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *s, const fv_tw_tiles *tiles,
+                      int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *b)
+{
+    memset(b, 0, sizeof *b);
+    b->x0 = X0, b->x1 = X1, b->y0 = Y0, b->y1 = Y1;
+    const float cx[4] = {(float)X0 + 0.5f, (float)X1 - 0.5f, (float)X0 + 0.5f, (float)X1 - 0.5f};
+    const float cy[4] = {(float)Y0 + 0.5f, (float)Y0 + 0.5f, (float)Y1 - 0.5f, (float)Y1 - 0.5f};
+    float A[3][4];
+    for (int j = 0; j < 3; j++)
+        for (int k = 0; k < 4; k++)
+            A[j][k] = (m->a0[j] + cy[k] * m->ay[j]) + cx[k] * m->ax[j]; /* the reference's order */
+    const float *t = m->t, eps = 1.0f / 64.0f; /* eps: float rounding of a projection, px */
+    float G = *guess, lo = 0.0f, hi = 0.0f;
+    for (int it = 0;; it++) {
+        if (it == 3)
+            return 0;
+        float umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY, zmin = INFINITY;
+        for (int e = 0; e < 2; e++) {
+            const float w = e ? G : 0.0f;
+            for (int k = 0; k < 4; k++) {
+                const float nz = A[2][k] + t[2] * w, r = 1.0f / nz;
+                const float u = (A[0][k] + t[0] * w) * r, v = (A[1][k] + t[1] * w) * r;
+                umin = minf(umin, u), umax = maxf(umax, u), vmin = minf(vmin, v), vmax = maxf(vmax, v);
+                zmin = minf(zmin, nz);
+            }
+        }
+        if (!(zmin > 2.0f * FV_TW_ZMIN)) /* behind the eye (or NaN): no clamp-free proof */
+            return 0;
+        if (!(umax - umin < 4096.0f && vmax - vmin < 4096.0f))
+            return 0;
+        unsigned mm[2];
+        depth_range(d, s, tiles, tw_index(umin - eps, s->w), tw_index(umax + eps, s->w), tw_index(vmin - eps, s->h),
+                    tw_index(vmax + eps, s->h), mm);
+        const float wl = (float)mm[0] * m->w_scale, wh = (float)mm[1] * m->w_scale;
+        const float dl = 1.0f - t[2] * wl, dh = 1.0f - t[2] * wh;
+        if (!(dl > FV_TW_DEN_MIN && dh > FV_TW_DEN_MIN)) /* the conversion's floor: not monotonic there */
+            return 0;
+        const float azmin = minf(minf(A[2][0], A[2][1]), minf(A[2][2], A[2][3]));
+        const float azmax = maxf(maxf(A[2][0], A[2][1]), maxf(A[2][2], A[2][3]));
+        /* w_d = A_z w_s / den: increasing in w_s, linear in A_z > 0 */
+        lo = (azmin * wl) / dl * (1.0f - 1e-5f), hi = (azmax * wh) / dh * (1.0f + 1e-5f); /* + the interior's rounding */
+        if (hi <= G)
+            break;
+        G = hi * 1.0625f;
+    }
+    *guess = hi * 1.0625f;
+    /* the offsets q(c, w) - c at the corners for w = lo, hi: ranges along the top edge (k = 0, 1)
+     * and the bottom edge (k = 2, 3) */
+    float fu[2][2] = {{INFINITY, -INFINITY}, {INFINITY, -INFINITY}}, fv[2][2] = {{INFINITY, -INFINITY}, {INFINITY, -INFINITY}};
+    float qu = 0, qv = 0, dmin = INFINITY;
+    for (int e = 0; e < 2; e++) {
+        const float w = e ? hi : lo;
+        for (int k = 0; k < 4; k++) {
+            const float nz = A[2][k] + t[2] * w, r = 1.0f / nz; /* > 0: w in [0, G] */
+            const float u = (A[0][k] + t[0] * w) * r, v = (A[1][k] + t[1] * w) * r;
+            const int edge = k >> 1;
+            fu[edge][0] = minf(fu[edge][0], u - cx[k]), fu[edge][1] = maxf(fu[edge][1], u - cx[k]);
+            fv[edge][0] = minf(fv[edge][0], v - cy[k]), fv[edge][1] = maxf(fv[edge][1], v - cy[k]);
+            qu = maxf(qu, fabsf(u)), qv = maxf(qv, fabsf(v)), dmin = minf(dmin, nz);
+        }
+    }
+    /* the homography's curvature: bilinear interpolation of the corners is off by at most
+     * hx^2 / 8 |q_xx| + hy^2 / 8 |q_yy| */
+    const float hx = (float)(X1 - X0 - 1), hy = (float)(Y1 - Y0 - 1), d2 = dmin * dmin;
+    const float ax2 = fabsf(m->ax[2]), ay2 = fabsf(m->ay[2]);
+    const float cu = hx * hx / 8.0f * 2.0f * ax2 * (fabsf(m->ax[0]) + qu * ax2) / d2 +
+                     hy * hy / 8.0f * 2.0f * ay2 * (fabsf(m->ay[0]) + qu * ay2) / d2;
+    const float cv = hx * hx / 8.0f * 2.0f * ax2 * (fabsf(m->ax[1]) + qv * ax2) / d2 +
+                     hy * hy / 8.0f * 2.0f * ay2 * (fabsf(m->ay[1]) + qv * ay2) / d2;
+    /* a row's translation interpolates the edges' middles, so a pixel is off by at most the
+     * larger half spread of the two edges (in between: their blend) */
+    const float eu = maxf(fu[0][1] - fu[0][0], fu[1][1] - fu[1][0]) * 0.5f + cu;
+    const float ev = maxf(fv[0][1] - fv[0][0], fv[1][1] - fv[1][0]) * 0.5f + cv;
+    const float err = maxf(eu, ev) + 1.0f / 128.0f; /* + a row's rounding to 1/64 */
+    b->err_px = err;
+    if (!(err + 1e-3f <= FV_TW_BLOCK_POS_PX)) /* 1e-3: this computation's own rounding */
+        return 0;
+    b->u0 = (fu[0][0] + fu[0][1]) * 0.5f, b->v0 = (fv[0][0] + fv[0][1]) * 0.5f;
+    b->u1 = (fu[1][0] + fu[1][1]) * 0.5f, b->v1 = (fv[1][0] + fv[1][1]) * 0.5f;
+    if (!(fabsf(b->u0) < 1e6f && fabsf(b->v0) < 1e6f && fabsf(b->u1) < 1e6f && fabsf(b->v1) < 1e6f))
+        return 0;
+    /* the rows' translations in 1/64 px with 16 more bits, stepped per row (no float per row) */
+    const double rows = Y1 - Y0 > 1 ? (double)(Y1 - Y0 - 1) : 1.0, k = 64.0 * 65536.0;
+    b->qu = (int64_t)((double)b->u0 * k + (b->u0 < 0 ? -0.5 : 0.5));
+    b->qv = (int64_t)((double)b->v0 * k + (b->v0 < 0 ? -0.5 : 0.5));
+    const double su = ((double)b->u1 - b->u0) / rows * k, sv = ((double)b->v1 - b->v0) / rows * k;
+    b->dqu = (int64_t)(su + (su < 0 ? -0.5 : 0.5)), b->dqv = (int64_t)(sv + (sv < 0 ? -0.5 : 0.5));
+    b->fast = 1;
+    return 1;
+}
+
+/* Row translations in fixed point: 1/64 px with 16 more bits, offset by a multiple of 2^22 that
+ * keeps them positive (shifts of negatives are the compiler's choice in C) */
+#define TW_QBIAS ((int64_t)1 << 52)
+static inline void row_offsets(int64_t qu, int64_t qv, int *ox, int *oy, int *fx, int *fy)
+{
+    const int64_t u = (qu + TW_QBIAS + 32768) >> 16, v = (qv + TW_QBIAS + 32768) >> 16; /* 1/64 px, rounded */
+    *ox = (int)(u >> 6) - (int)(TW_QBIAS >> 22), *oy = (int)(v >> 6) - (int)(TW_QBIAS >> 22);
+    *fx = (int)(u & 63), *fy = (int)(v & 63);
+}
+
+void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int *fy)
+{
+    row_offsets(b->qu + (int64_t)(y - b->y0) * b->dqu, b->qv + (int64_t)(y - b->y0) * b->dqv, ox, oy, fx, fy);
+}
+
+/* a block, else its quarters (halves where a side is down to FV_TW_BLOCK_MIN), depth first:
+ * the entries that cover a row come in column order; returns the entries written. A block
+ * whose bound is more than its side / FV_TW_BLOCK_MIN times too large is not cut: halving the
+ * side halves the spread of a smooth mapping, so even its smallest parts would fail (a frame
+ * warped far: planning 85 parts a block would cost more than the per-pixel warp saves). */
+static int plan_split(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
+                      int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out)
+{
+    const int MIN = FV_TW_BLOCK_MIN, side = X1 - X0 > Y1 - Y0 ? X1 - X0 : Y1 - Y0;
+    if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || side <= MIN ||
+        out->err_px > FV_TW_BLOCK_POS_PX * (float)side / (float)MIN)
+        return 1;
+    const int Xm = X1 - X0 > MIN ? X0 + (X1 - X0 + 1) / 2 : X1, Ym = Y1 - Y0 > MIN ? Y0 + (Y1 - Y0 + 1) / 2 : Y1;
+    int n = plan_split(d, m, src, tiles, X0, Xm, Y0, Ym, guess, out);
+    if (Xm < X1)
+        n += plan_split(d, m, src, tiles, Xm, X1, Y0, Ym, guess, out + n);
+    if (Ym < Y1) {
+        n += plan_split(d, m, src, tiles, X0, Xm, Ym, Y1, guess, out + n);
+        if (Xm < X1)
+            n += plan_split(d, m, src, tiles, Xm, X1, Ym, Y1, guess, out + n);
+    }
+    return n;
+}
+
+int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
+                      int by, int bx0, int nb, fv_tw_block *out, float *guess)
+{
+    const int BW = FV_TW_BLOCK_W, Y0 = by * FV_TW_BLOCK_H, Y1 = mini(Y0 + FV_TW_BLOCK_H, src->h);
+    int n = 0;
+    for (int i = 0; i < nb; i++) {
+        const int X0 = (bx0 + i) * BW, X1 = mini(X0 + BW, src->w);
+        if (X0 >= X1)
+            break;
+        n += plan_split(d, m, src, tiles, X0, X1, Y0, Y1, guess, out + n);
+    }
+    return n;
+}
+
+#define FV_TW_PREFETCH_ROWS 3
+
+/* one row of a translated block: its clamped columns written here, the rest as a piece for
+ * tw_spans; the source position is clamped to the source as the reference's. o holds columns
+ * from xo on. 1 when a piece. */
+static inline int block_row(fv_tw_piece *pc, uint8_t *o, int xo, int y, const fv_tw_block *b, const int64_t q[2],
+                            const fv_tw_src *s)
+{
+    int ox, oy, fx, fy;
+    row_offsets(q[0], q[1], &ox, &oy, &fx, &fy);
+    int sy = y + oy;
+    if (sy < 0) /* above the first row: it, with no vertical weight */
+        sy = 0, fy = 0;
+    else if (sy >= s->h - 1)
+        sy = s->h - 1, fy = 0;
+    const uint8_t *r0 = s->rgb + (ptrdiff_t)sy * s->rgb_stride, *r1 = fy ? r0 + s->rgb_stride : r0;
+    /* columns whose tap is left of the first column or right of the last take that column */
+    const int xa = b->x0 + ox < 0 ? mini(-ox, b->x1) : b->x0;
+    const int xb = b->x1 + ox > s->w - 1 ? (s->w - 1 - ox > xa ? s->w - 1 - ox : xa) : b->x1;
+    if (xa > b->x0 || xb < b->x1) {
+        uint8_t e0[3], e1[3];
+        for (int c = 0; c < 3; c++) {
+            e0[c] = fv_tw_span_px(r0[c], r0[c], r1[c], r1[c], 0, fy);
+            const int l = 3 * (s->w - 1) + c;
+            e1[c] = fv_tw_span_px(r0[l], r0[l], r1[l], r1[l], 0, fy);
+        }
+        for (int x = b->x0; x < xa; x++)
+            memcpy(o + 3 * (x - xo), e0, 3);
+        for (int x = xb; x < b->x1; x++)
+            memcpy(o + 3 * (x - xo), e1, 3);
+    }
+    if (xa >= xb)
+        return 0;
+    pc->s0 = r0 + 3 * (ptrdiff_t)(xa + ox), pc->s1 = r1 + 3 * (ptrdiff_t)(xa + ox);
+    pc->dst = 3 * (xa - xo), pc->n = 3 * (xb - xa), pc->fx = fx, pc->fy = fy;
+    /* a display row reads pieces of ten or so source rows (the homography's tilt), too many
+     * short streams for the hardware prefetcher: fetch this piece's source a few rows ahead */
+    if (sy + FV_TW_PREFETCH_ROWS + 1 < s->h)
+        for (int k = 0; k < pc->n + 3; k += 64)
+            __builtin_prefetch(pc->s0 + FV_TW_PREFETCH_ROWS * s->rgb_stride + k);
+    return 1;
+}
+
+long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1, const fv_tw_map *m,
+                     const fv_tw_src *src, const fv_tw_tiles *tiles)
+{
+    enum { CHUNK = 8, MAXE = FV_TW_BLOCK_SPLIT * CHUNK }; /* blocks planned at a time, their entries */
+    const int BW = FV_TW_BLOCK_W, BH = FV_TW_BLOCK_H, nbx = (src->w + BW - 1) / BW;
+    fv_tw_block plan[MAXE];
+    fv_tw_piece pc[MAXE];
+    int on[MAXE];                  /* the entries covering the row */
+    uint8_t row[3 * CHUNK * FV_TW_BLOCK_W]; /* a row's columns composed in cache, then streamed (tw_stream) */
+    long holes = 0;
+    for (int by = y0 / BH; by * BH < y1; by++) {
+        const int ya = by * BH > y0 ? by * BH : y0, yb = mini(by * BH + BH, y1);
+        float guess = 0.0f;
+        for (int bx0 = 0; bx0 < nbx; bx0 += CHUNK) {
+            const int n = fv_tw_plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess);
+            const int x0 = bx0 * BW, x1 = mini((bx0 + CHUNK) * BW, src->w);
+            int no = 0, next = ya; /* the entries covering the row change on row next */
+            for (int y = ya; y < yb; y++) {
+                int np = 0;
+                if (y == next) {
+                    no = 0, next = yb;
+                    for (int i = 0; i < n; i++) {
+                        if (plan[i].y0 <= y && y < plan[i].y1)
+                            on[no++] = i;
+                        const int c = plan[i].y0 > y ? plan[i].y0 : plan[i].y1;
+                        next = c > y && c < next ? c : next;
+                    }
+                }
+                for (int k = 0; k < no;) {
+                    const fv_tw_block *b = &plan[on[k]];
+                    if (b->fast) {
+                        const int64_t q[2] = {b->qu + (int64_t)(y - b->y0) * b->dqu, b->qv + (int64_t)(y - b->y0) * b->dqv};
+                        np += block_row(&pc[np], row, x0, y, b, q, src);
+                        k++;
+                    } else { /* a run of per-pixel entries in one call: the kernel interleaves 64 pixels */
+                        int j = k + 1;
+                        while (j < no && !plan[on[j]].fast)
+                            j++;
+                        holes += d->tw_row(row + 3 * (b->x0 - x0), b->x0, y, plan[on[j - 1]].x1 - b->x0, m, src);
+                        k = j;
+                    }
+                }
+                d->tw_spans(row, pc, np);
+                d->tw_stream(dst + (ptrdiff_t)y * dst_stride + 3 * x0, row, 3 * (x1 - x0));
+            }
+        }
+    }
+    d->tw_stream(NULL, NULL, 0); /* the fence: the rows are visible to the thread that shows them */
     return holes;
 }
 
@@ -60,7 +354,10 @@ int fv_tw_frame_alloc(fv_tw_frame *f, int w, int h)
     for (int e = 0; e < 2; e++) {
         f->rgb[e] = calloc((size_t)w * h * 3 + FV_TW_RGB_PAD, 1);
         f->invd[e] = calloc((size_t)w * h * 2 + FV_TW_INVD_PAD, 1);
-        if (!f->rgb[e] || !f->invd[e]) {
+        const int tw = (w + FV_TW_TILE - 1) / FV_TW_TILE, th = (h + FV_TW_TILE - 1) / FV_TW_TILE;
+        f->tiles[e].lohi = calloc(2 * (size_t)tw * th, sizeof(uint16_t));
+        f->tiles[e].lohi4 = calloc(2 * (size_t)((tw + 3) / 4) * ((th + 3) / 4), sizeof(uint16_t));
+        if (!f->rgb[e] || !f->invd[e] || !f->tiles[e].lohi || !f->tiles[e].lohi4) {
             fv_tw_frame_free(f);
             return -1;
         }
@@ -73,8 +370,11 @@ void fv_tw_frame_free(fv_tw_frame *f)
     for (int e = 0; e < 2; e++) {
         free(f->rgb[e]);
         free(f->invd[e]);
+        free(f->tiles[e].lohi);
+        free(f->tiles[e].lohi4);
         f->rgb[e] = NULL;
         f->invd[e] = NULL;
+        f->tiles[e].lohi = f->tiles[e].lohi4 = NULL;
     }
 }
 
@@ -85,6 +385,11 @@ void fv_tw_frame_capture(fv_tw_frame *f, const fv_pipeline *pl, int e)
     ptrdiff_t stride;
     const float *img = fv_pipeline_depth(pl, eye, &stride); /* the final image's depth */
     fv_tw_pack_invd(f->invd[e], f->w, img, stride * 4, f->w, f->h);
+    /* the depth's tiles, here on the renderer's thread, not on the display's; exact on any ISA */
+    fv_timewarp_dsp d;
+    fv_timewarp_dsp_init(&d, ~0u);
+    const fv_tw_src s = {f->rgb[e], (ptrdiff_t)f->w * 3, f->invd[e], f->w, f->w, f->h};
+    fv_tw_tiles_build(&d, &f->tiles[e], &s);
     f->cam[e] = *fv_pipeline_camera(pl, eye);
 }
 
@@ -94,7 +399,7 @@ long fv_tw_frame_warp(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, con
     fv_tw_map m;
     fv_tw_setup(&m, display, &f->cam[e], tol);
     const fv_tw_src s = {f->rgb[e], (ptrdiff_t)f->w * 3, f->invd[e], f->w, f->w, f->h};
-    return fv_tw_warp_rows(d, dst, dst_stride, 0, f->h, &m, &s);
+    return fv_tw_warp_rows(d, dst, dst_stride, 0, f->h, &m, &s, &f->tiles[e]);
 }
 
 double fv_tw_psnr_outside_holes(const uint8_t *warped, const uint8_t *ref, const fv_tw_map *m, const fv_tw_src *src,

@@ -1,8 +1,11 @@
 /* fovea: timewarp, the display path's late correction. A rendered frame (8-bit RGB and a 16-bit
  * inverse depth plane, from a source camera) is warped to the camera of the newest head pose
- * right before a refresh: a backward warp per display pixel (fixed-point iteration on the
- * source's depth; the kernel and its contract: timewarp_dsp.h). Disocclusions are filled from
- * the farther surface beside the hole. OS-free. */
+ * right before a refresh. The reference is a backward warp per display pixel (fixed-point
+ * iteration on the source's depth; the kernel and its contract: timewarp_dsp.h), disocclusions
+ * filled from the farther surface beside the hole. The warp used (fv_tw_warp_rows) is a block
+ * warp over it: 16x16 display blocks whose every pixel's reference tap is provably within
+ * FV_TW_BLOCK_POS_PX of one translation per row are resampled at it (tw_spans); the other
+ * blocks run the per-pixel kernel. OS-free. */
 #ifndef FOVEA_TIMEWARP_H
 #define FOVEA_TIMEWARP_H
 
@@ -20,10 +23,76 @@ void fv_tw_setup(fv_tw_map *m, const fv_camera *display, const fv_camera *source
  * (FV_TW_INVD_PER_M / depth_m), clamped to [0, 65535] (nearer than 6.25 cm: the nearest). */
 void fv_tw_pack_invd(uint16_t *dst, ptrdiff_t dst_stride, const float *rgbd, ptrdiff_t rgbd_stride, int w, int h);
 
-/* Warps rows [y0, y1) of the display image (rows of dst_stride bytes, src->w pixels each).
- * Returns the disoccluded pixels. */
+/* ---- the block warp ----
+ * Display block rows of FV_TW_BLOCK_H rows are cut into blocks of FV_TW_BLOCK_W columns; a block
+ * that cannot be translated is cut into quarters, down to FV_TW_BLOCK_MIN pixels a side, and a
+ * part that still cannot runs the per-pixel kernel. A block is translated when the planner proves that, for each of its pixels, the
+ * reference's bilinear tap position (before its 7-bit weight truncation, after its clamp to the
+ * source) lies within FV_TW_BLOCK_POS_PX, per axis, of the block's tap: each row is translated
+ * (fv_tw_block_row), the source position clamped to the source the same way.
+ * The proof: the source's inverse depth over the rectangle R that the display depths [0, G] can
+ * reach from the block (R from the 8 projections of the corners at w = 0 and G: a projective map
+ * of a box with positive Z lies in the hull of its vertices' images) gives a display depth range
+ * [lo, hi]; hi <= G means every fetch of the reference's iteration (w1 at q(0), w2 at q(w1))
+ * lands in R, so its tap is at q(p, w) for some w in [lo, hi]; q(p, w) for those w lies on the
+ * segment between q(p, lo) and q(p, hi); q(p, w) - p is the bilinear blend of the corners'
+ * offsets up to the homography's curvature term (h^2 / 8 |q''|, |q''| <= 2 |D'| (|N'| + |q| |D'|)
+ * / D^2 for q = N / D); a row's translation blends the middles of the top and bottom edges'
+ * offset ranges (both corners, w = lo and hi), so the larger half spread of an edge, the
+ * curvature term and the rounding to 1/64 bound the rest; clamping to the source shrinks
+ * distances. A superset of R (the tiles of fv_tw_tiles) keeps the proof.
+ * Values: a translated pixel differs from the reference's by at most
+ * 2 (FV_TW_BLOCK_POS_PX + 1/128) x (the largest minus the least of the source channel over the
+ * 4x4 pixels around the reference's tap) + 1 level (tests/checkasm/timewarp.c checks it).
+ * Disocclusions: within a translated block every reference tap lies within 2 FV_TW_BLOCK_POS_PX
+ * of the others, so a disocclusion there is narrower than half a pixel; they are not counted
+ * (the count is the per-pixel kernel's over the other blocks). */
+#define FV_TW_BLOCK_W 64
+#define FV_TW_BLOCK_H 64
+#define FV_TW_BLOCK_MIN 8    /* the smallest side of a part */
+#define FV_TW_BLOCK_SPLIT 64 /* entries a block may become ((FV_TW_BLOCK_W / FV_TW_BLOCK_MIN)^2) */
+#define FV_TW_BLOCK_POS_PX 0.25f
+#define FV_TW_TILE 8 /* the side of a tile of fv_tw_tiles; its coarse level: 4 x 4 tiles */
+
+typedef struct fv_tw_block {
+    int x0, x1, y0, y1; /* display pixels [x0, x1) x [y0, y1) */
+    int fast;           /* 1: translated; 0: the per-pixel kernel */
+    float u0, v0, u1, v1; /* the translation (source minus display position) of its first and last row */
+    int64_t qu, qv, dqu, dqv; /* the first row's in 1/2^22 px and the step a row (fv_tw_block_row) */
+    float err_px;       /* the planner's bound on the position error (translated blocks) */
+} fv_tw_block;
+/* Row y's translation of a translated block, its rows' linear blend of the first's and the last's
+ * (in fixed point, within 2^-16 px) rounded to 1/64: display pixel (x, y) resamples the source at (x + ox + fx / 64, y + oy + fy / 64). */
+void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int *fy);
+
+/* The least and greatest inverse depth of each FV_TW_TILE square of a source (lohi[2 (ty tw + tx)]
+ * and the next), and of each 4 x 4 of those (lohi4, for large footprints), built once per
+ * rendered frame so the display path need not read the depth. */
+typedef struct fv_tw_tiles {
+    uint16_t *lohi, *lohi4;
+    int tw, th;   /* tiles a row, rows of tiles */
+    int tw4, th4; /* the coarse level's */
+} fv_tw_tiles;
+/* lohi must hold 2 tw th elements, tw = ceil(w / FV_TW_TILE), th = ceil(h / FV_TW_TILE); lohi4
+ * 2 ceil(tw / 4) ceil(th / 4) */
+void fv_tw_tiles_build(const fv_timewarp_dsp *d, fv_tw_tiles *t, const fv_tw_src *src);
+
+/* Plans display block row by (rows [by FV_TW_BLOCK_H, + FV_TW_BLOCK_H) clipped to the source):
+ * its blocks from column bx0 FV_TW_BLOCK_W on, nb of FV_TW_BLOCK_W (the last one clipped), into
+ * out (at most FV_TW_BLOCK_SPLIT nb entries; they tile the blocks, and those covering a row come
+ * in column order). Returns the entries.
+ * tiles: NULL reads the depth plane itself. *guess carries the depth guess G from block to block
+ * (0 at the row's start): a row planned in pieces plans as it does whole. */
+int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
+                      int by, int bx0, int nb, fv_tw_block *out, float *guess);
+
+/* Warps rows [y0, y1) of the display image (rows of dst_stride bytes, src->w pixels each) with
+ * the block warp (tiles: NULL, or src's). Returns the disoccluded pixels (of the per-pixel blocks). */
 long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1, const fv_tw_map *m,
-                     const fv_tw_src *src);
+                     const fv_tw_src *src, const fv_tw_tiles *tiles);
+/* The same rows with the per-pixel kernel everywhere (the reference the block warp is held to). */
+long fv_tw_warp_rows_pixel(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1,
+                           const fv_tw_map *m, const fv_tw_src *src);
 
 /* Bytes a plane must have past its last pixel / element for the kernels' word reads. */
 #define FV_TW_RGB_PAD 16
@@ -38,12 +107,13 @@ typedef struct fv_tw_frame {
     uint8_t *rgb[2];        /* left, right: display bytes, w * 3 a row, FV_TW_RGB_PAD past the end */
     uint16_t *invd[2];      /* w a row, FV_TW_INVD_PAD bytes past the end */
     fv_camera cam[2];       /* the cameras they were rendered from */
+    fv_tw_tiles tiles[2];   /* of invd, built at capture */
 } fv_tw_frame;
 
 int fv_tw_frame_alloc(fv_tw_frame *f, int w, int h); /* 0, or -1 out of memory */
 void fv_tw_frame_free(fv_tw_frame *f);
-/* After fv_pipeline_render of eye e (0 left, 1 right): keep its display bytes, inverse depth and
- * camera. */
+/* After fv_pipeline_render of eye e (0 left, 1 right): keep its display bytes, inverse depth (and
+ * its tiles) and camera. */
 void fv_tw_frame_capture(fv_tw_frame *f, const struct fv_pipeline *pl, int e);
 /* Warps eye e of f to camera `display` (same size, no lens) into dst (rows of dst_stride bytes).
  * Returns the disoccluded pixels. */

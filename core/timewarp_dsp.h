@@ -21,7 +21,26 @@
  *   last element, FV_TW_INVD_PAD); h * stride must stay below 2^31 (bytes for rgb, elements for
  *   invd).
  *   Every ISA version gives the reference's bytes and count (the float steps are the same IEEE
- *   operations in the same order, true division, no FMA; the colour is integer). */
+ *   operations in the same order, true division, no FMA; the colour is integer).
+ *
+ * tw_spans: the block warp's resample (core/timewarp.c), the pieces of one display row: for each
+ *   piece p of pieces[0, count), p->n bytes of packed RGB at one bilinear phase, fx, fy in
+ *   [0, 63] (6-bit weights), from rows s0 = p->s0 and s1 = p->s1 into dst + p->dst. For k in [0, n):
+ *     h0 = s0[k] (64 - fx) + s0[k + 3] fx, h1 likewise from s1 (s1 is the source row below s0),
+ *     v = h0 + ((h1 - h0) fy 512 + 16384) >> 15   (arithmetic shift),
+ *     dst[k] = (v 512 + 16384) >> 15 = (v + 32) >> 6.
+ *   That is the exact bilinear value at the phase, rounded, within 1 level (pmulhrsw /
+ *   vqrdmulh steps). Reads s0[0, n + 3), s1[0, n + 3), nothing more. Every ISA version gives the
+ *   reference's bytes.
+ *
+ * tw_stream: copies n bytes from src (a row just composed in cache) to dst (the display image),
+ *   exact; the x86 versions store around the cache (non-temporal stores): the display image is
+ *   not read back by this thread, and a store that misses the cache would otherwise read the
+ *   line first (a third of the warp's memory traffic). n = 0 (dst, src unused): the fence after
+ *   a frame's rows (x86 sfence), so other threads see the stores.
+ *
+ * tw_minmax: the least and greatest element of a w x h rectangle of 16-bit values (rows of
+ *   stride elements), w, h >= 1, into out[0], out[1]. Reads the rectangle only. Exact. */
 #ifndef FOVEA_TIMEWARP_DSP_H
 #define FOVEA_TIMEWARP_DSP_H
 
@@ -51,14 +70,38 @@ typedef struct fv_tw_src {
 
 typedef int (*fv_tw_row_fn)(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s);
 
+typedef struct fv_tw_piece {
+    const uint8_t *s0, *s1; /* source bytes of the first display byte's top and bottom taps */
+    int dst, n;             /* display bytes [dst, dst + n) of the row */
+    int fx, fy;             /* 0..63 */
+} fv_tw_piece;
+typedef void (*fv_tw_spans_fn)(uint8_t *restrict dst, const fv_tw_piece *pieces, int count);
+typedef void (*fv_tw_minmax_fn)(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2]);
+typedef void (*fv_tw_stream_fn)(uint8_t *restrict dst, const uint8_t *restrict src, int n);
+
 typedef struct fv_timewarp_dsp {
     fv_tw_row_fn tw_row;
+    fv_tw_spans_fn tw_spans;
+    fv_tw_minmax_fn tw_minmax;
+    fv_tw_stream_fn tw_stream;
 } fv_timewarp_dsp;
 
 void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask);
 
 /* ---- internal: reference, shared per-pixel steps and per-ISA fillers ---- */
 int fv_tw_row_c(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s);
+void fv_tw_spans_c(uint8_t *restrict dst, const fv_tw_piece *pieces, int count);
+void fv_tw_minmax_c(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2]);
+void fv_tw_stream_c(uint8_t *restrict dst, const uint8_t *restrict src, int n);
+
+/* tw_spans' step for one byte (the ISA versions' tails) */
+static inline uint8_t fv_tw_span_px(int a, int b, int c, int d, int fx, int fy)
+{
+    const int h0 = a * (64 - fx) + b * fx, h1 = c * (64 - fx) + d * fx; /* a, c at x; b, d at x + 3 bytes */
+    const int p = (h1 - h0) * (fy << 9) + 16384; /* |p| < 2^30 */
+    const int v = h0 + (p >= 0 ? p >> 15 : -((-p + 32767) >> 15)); /* floor, as psraw */
+    return (uint8_t)((v * 512 + 16384) >> 15);
+}
 
 static inline float fv_tw_clampf(float v, float hi)
 {

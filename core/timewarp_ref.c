@@ -1,6 +1,8 @@
 /* fovea: the timewarp kernel's C reference (contract: timewarp_dsp.h). */
 #include "timewarp_dsp.h"
 
+#include <string.h>
+
 int fv_tw_row_c(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s)
 {
     const float py = (float)y + 0.5f;
@@ -14,9 +16,40 @@ int fv_tw_row_c(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m,
     return holes;
 }
 
+void fv_tw_spans_c(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+{
+    for (int i = 0; i < count; i++) {
+        const fv_tw_piece *p = &pieces[i];
+        uint8_t *o = dst + p->dst;
+        for (int k = 0; k < p->n; k++)
+            o[k] = fv_tw_span_px(p->s0[k], p->s0[k + 3], p->s1[k], p->s1[k + 3], p->fx, p->fy);
+    }
+}
+
+void fv_tw_minmax_c(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2])
+{
+    unsigned lo = 65535, hi = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const unsigned v = p[(ptrdiff_t)y * stride + x];
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+    out[0] = lo, out[1] = hi;
+}
+
+void fv_tw_stream_c(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    if (n)
+        memcpy(dst, src, (size_t)n);
+}
+
 void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask)
 {
     d->tw_row = fv_tw_row_c;
+    d->tw_spans = fv_tw_spans_c;
+    d->tw_minmax = fv_tw_minmax_c;
+    d->tw_stream = fv_tw_stream_c;
     const unsigned avail = isa_mask & fv_cpu_isas();
     (void)avail;
 #if defined(__x86_64__)

@@ -1,14 +1,22 @@
-/* tw_quality: the timewarp's image quality on a scene. Renders a frame (full sampling, no
- * reprojection, no depth of field: the only difference left is the warp's), warps it to the head
- * turned by RATE deg/s for one and two refreshes (yaw about the head's centre, so the eyes also
- * move), renders directly at that pose and prints the luma PSNR outside disocclusions, the
- * disoccluded share, and the PSNR of showing the old frame unwarped.
- *   tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] [--eye left|right] [--png DIR]
- * (--png: DIR/warped_K.png, DIR/direct_K.png and DIR/error_K.png, the luma error x8 around grey) */
+/* tw_quality: the timewarp's image quality and cost on a scene. Renders a frame (full sampling,
+ * no reprojection, no depth of field: the only difference left is the warp's), warps it to the
+ * head turned by RATE deg/s for one and two refreshes (yaw about the head's centre, so the eyes
+ * also move; --step adds a sideways head step of MM per refresh), renders directly at that pose
+ * and prints the luma PSNR outside disocclusions of the block warp (fv_tw_warp_rows) and of the
+ * per-pixel reference, the disoccluded share, the share of translated blocks, and the PSNR of
+ * showing the old frame unwarped.
+ *   tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] [--step MM] [--eye left|right]
+ *              [--png DIR] [--bench N]
+ * --png: DIR/warped_K.png, DIR/direct_K.png and DIR/error_K.png (the luma error x8 around grey).
+ * --bench N: times the stereo pair (both eyes of the frame, one refresh old) warped on this one
+ * thread, block warp and per-pixel, against a copy of the same bytes (memcpy of both eyes), each
+ * N times alternately; prints medians of thread CPU time and of wall time and the ratios. */
+#define _DEFAULT_SOURCE /* getloadavg */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "cli.h"
 #include "metrics.h"
@@ -18,6 +26,58 @@
 #include "timewarp.h"
 
 static const char *prog = "tw_quality";
+
+static double now_ms(clockid_t c)
+{
+    struct timespec ts;
+    clock_gettime(c, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_d);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* the head after k refreshes: turned about world +Y by rate k / hz, stepped along its right by
+ * step_mm k */
+static void moved(const fv_pose *p0, double rate, double hz, double step_mm, int k, fv_pose *p1)
+{
+    const double a = rate * k / hz * 3.14159265358979 / 180.0;
+    const float q[4] = {0, (float)sin(a / 2), 0, (float)cos(a / 2)};
+    *p1 = *p0;
+    fv_quat_mul(q, p0->quat, p1->quat);
+    float right[3];
+    const float x[3] = {1, 0, 0};
+    fv_quat_rotate(p0->quat, x, right);
+    for (int j = 0; j < 3; j++)
+        p1->pos[j] += right[j] * (float)(step_mm * 1e-3 * k);
+}
+
+/* the share of the display's pixels in translated blocks */
+static double translated_share(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *s, const fv_tw_tiles *tiles)
+{
+    const int nbx = (s->w + FV_TW_BLOCK_W - 1) / FV_TW_BLOCK_W, nby = (s->h + FV_TW_BLOCK_H - 1) / FV_TW_BLOCK_H;
+    fv_tw_block *b = malloc(FV_TW_BLOCK_SPLIT * (size_t)nbx * sizeof *b);
+    if (!b)
+        return NAN;
+    double px = 0;
+    for (int by = 0; by < nby; by++) {
+        float g = 0.0f;
+        const int n = fv_tw_plan_blocks(d, m, s, tiles, by, 0, nbx, b, &g);
+        for (int i = 0; i < n; i++)
+            px += b[i].fast ? (double)(b[i].x1 - b[i].x0) * (b[i].y1 - b[i].y0) : 0.0;
+    }
+    free(b);
+    return px / ((double)s->w * s->h);
+}
 
 static int render(fv_pipeline *pl, fv_eye eye, const fv_pose *head, fv_tw_frame *f, int e)
 {
@@ -33,7 +93,8 @@ int main(int argc, char **argv)
     const char *scene_path = "assets/range.glb";
     int w = 1280, h = 1440, right = 0;
     const char *png_dir = NULL;
-    double rate = 30.0, hz = 90.0;
+    double rate = 30.0, hz = 90.0, step_mm = 0.0;
+    int bench = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--scene") && i + 1 < argc)
             scene_path = argv[++i];
@@ -44,13 +105,25 @@ int main(int argc, char **argv)
             rate = fv_arg_float(prog, "--rate", argv[++i], 0.0f, 1000.0f);
         else if (!strcmp(argv[i], "--hz") && i + 1 < argc)
             hz = fv_arg_float(prog, "--hz", argv[++i], 1.0f, 1000.0f);
+        else if (!strcmp(argv[i], "--step") && i + 1 < argc)
+            step_mm = fv_arg_float(prog, "--step", argv[++i], -100.0f, 100.0f);
+        else if (!strcmp(argv[i], "--bench") && i + 1 < argc)
+            bench = (int)fv_arg_long(prog, "--bench", argv[++i], 1, 1000);
         else if (!strcmp(argv[i], "--png") && i + 1 < argc)
             png_dir = argv[++i];
         else if (!strcmp(argv[i], "--eye") && i + 1 < argc)
             right = !strcmp(argv[++i], "right");
-        else
+        else if (!strcmp(argv[i], "--help")) {
+            printf("usage: tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] [--step MM]\n"
+                   "                  [--eye left|right] [--png DIR] [--bench N]\n"
+                   "  --step MM   a sideways head step of MM a refresh besides the turn (default 0)\n"
+                   "  --png DIR   DIR/warped_K.png, direct_K.png, error_K.png (the luma error x8)\n"
+                   "  --bench N   time the stereo pair one refresh old on this thread, block warp,\n"
+                   "              per-pixel warp and a copy of the pair's bytes, N times each\n");
+            return 0;
+        } else
             fv_usage_error(prog, "usage: tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] "
-                                 "[--eye left|right]");
+                                 "[--step MM] [--eye left|right] [--png DIR] [--bench N]");
     }
     char err[512];
     fv_scene *scene = fv_scene_load(scene_path, err, sizeof err);
@@ -68,27 +141,29 @@ int main(int argc, char **argv)
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)w / (float)h, p0.pos, p0.quat);
     const fv_eye eye = right ? FV_EYE_RIGHT : FV_EYE_LEFT;
     fv_tw_frame f0, f1;
-    uint8_t *out = malloc((size_t)w * h * 3);
-    if (!out || fv_tw_frame_alloc(&f0, w, h) || fv_tw_frame_alloc(&f1, w, h) || render(pl, eye, &p0, &f0, right))
+    uint8_t *out = malloc((size_t)w * h * 3), *outp = malloc((size_t)w * h * 3);
+    if (!out || !outp || fv_tw_frame_alloc(&f0, w, h) || fv_tw_frame_alloc(&f1, w, h) ||
+        render(pl, eye, &p0, &f0, right))
         fv_fail(prog, FV_EXIT_FAIL, "out of memory or render failed");
     fv_timewarp_dsp d;
     fv_timewarp_dsp_init(&d, ~0u);
-    printf("%s %dx%d %s eye, head turning %.1f deg/s at %.1f Hz (full sampling, no TAA, no DoF)\n", scene_path, w, h,
-           right ? "right" : "left", rate, hz);
+    printf("%s %dx%d %s eye, head turning %.1f deg/s, stepping %.2f mm a refresh, at %.1f Hz (full sampling, no TAA, "
+           "no DoF)\n", scene_path, w, h, right ? "right" : "left", rate, step_mm, hz);
     for (int k = 1; k <= 2; k++) {
-        const double a = rate * k / hz * 3.14159265358979 / 180.0; /* yaw about world +Y */
-        const float q[4] = {0, (float)sin(a / 2), 0, (float)cos(a / 2)};
-        fv_pose p1 = p0;
-        fv_quat_mul(q, p0.quat, p1.quat);
+        fv_pose p1;
+        moved(&p0, rate, hz, step_mm, k, &p1);
         if (render(pl, eye, &p1, &f1, right))
             fv_fail(prog, FV_EXIT_FAIL, "render failed");
         fv_tw_map m;
         fv_tw_setup(&m, &f1.cam[right], &f0.cam[right], 0.05f);
         const fv_tw_src s = {f0.rgb[right], (ptrdiff_t)w * 3, f0.invd[right], w, w, h};
-        fv_tw_warp_rows(&d, out, (ptrdiff_t)w * 3, 0, h, &m, &s);
+        fv_tw_warp_rows(&d, out, (ptrdiff_t)w * 3, 0, h, &m, &s, &f0.tiles[right]);
+        fv_tw_warp_rows_pixel(&d, outp, (ptrdiff_t)w * 3, 0, h, &m, &s);
         double holes;
         const double psnr = fv_tw_psnr_outside_holes(out, f1.rgb[right], &m, &s, &holes);
+        const double psnr_px = fv_tw_psnr_outside_holes(outp, f1.rgb[right], &m, &s, &holes);
         const double stale = fv_luma_psnr(f0.rgb[right], f1.rgb[right], w, h, (ptrdiff_t)w * 3, NULL);
+        const double fast = translated_share(&d, &m, &s, &f0.tiles[right]);
         if (png_dir) {
             char path[1024];
             float *e = malloc((size_t)w * h * sizeof *e);
@@ -111,13 +186,78 @@ int main(int argc, char **argv)
             free(e);
             free(vis);
         }
-        printf("  %d refresh%s old (%.3f deg): warped %.2f dB luma PSNR outside disocclusions, disoccluded %.4f %% "
-               "of pixels; unwarped %.2f dB\n",
-               k, k > 1 ? "es" : "", rate * k / hz, psnr, 100.0 * holes, stale);
+        printf("  %d refresh%s old (%.3f deg): block warp %.2f dB luma PSNR outside disocclusions (%.1f %% of pixels "
+               "translated), per-pixel %.2f dB; disoccluded %.4f %% of pixels; unwarped %.2f dB\n",
+               k, k > 1 ? "es" : "", rate * k / hz, psnr, 100.0 * fast, psnr_px, 100.0 * holes, stale);
+    }
+    if (bench) {
+        /* the pair: the other eye's frame too, both warped one refresh */
+        const int other = !right;
+        if (render(pl, other ? FV_EYE_RIGHT : FV_EYE_LEFT, &p0, &f0, other))
+            fv_fail(prog, FV_EXIT_FAIL, "render failed");
+        fv_pose p1;
+        moved(&p0, rate, hz, step_mm, 1, &p1);
+        fv_camera_desc cd = cfg.cam;
+        fv_tw_map m[2];
+        fv_tw_src s[2];
+        for (int e = 0; e < 2; e++) {
+            fv_camera c;
+            cd.eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
+            if (fv_camera_setup(&c, &cd, &p1))
+                fv_fail(prog, FV_EXIT_FAIL, "camera set-up failed");
+            fv_tw_setup(&m[e], &c, &f0.cam[e], 0.05f);
+            s[e] = (fv_tw_src){f0.rgb[e], (ptrdiff_t)w * 3, f0.invd[e], w, w, h};
+        }
+        uint8_t *pair = malloc((size_t)w * h * 6);
+        double *t[7];
+        for (int j = 0; j < 7; j++)
+            t[j] = malloc((size_t)bench * sizeof(double));
+        if (!pair || !t[0] || !t[1] || !t[2] || !t[3] || !t[4] || !t[5] || !t[6])
+            fv_fail(prog, FV_EXIT_FAIL, "out of memory");
+        long hb = 0, hp = 0;
+        for (int r = 0; r < bench; r++)
+            for (int v = 0; v < 3; v++) { /* 0 copy, 1 block warp, 2 per-pixel: alternately */
+                const double c0 = now_ms(CLOCK_THREAD_CPUTIME_ID), w0 = now_ms(CLOCK_MONOTONIC);
+                for (int e = 0; e < 2; e++) {
+                    uint8_t *o = pair + (size_t)e * w * h * 3;
+                    if (v == 0)
+                        memcpy(o, f0.rgb[e], (size_t)w * h * 3);
+                    else if (v == 1)
+                        hb = fv_tw_warp_rows(&d, o, (ptrdiff_t)w * 3, 0, h, &m[e], &s[e], &f0.tiles[e]);
+                    else
+                        hp = fv_tw_warp_rows_pixel(&d, o, (ptrdiff_t)w * 3, 0, h, &m[e], &s[e]);
+                }
+                t[v][r] = now_ms(CLOCK_THREAD_CPUTIME_ID) - c0, t[3 + v][r] = now_ms(CLOCK_MONOTONIC) - w0;
+                if (v == 2) { /* the block warp's planning alone */
+                    const double p0c = now_ms(CLOCK_THREAD_CPUTIME_ID);
+                    translated_share(&d, &m[0], &s[0], &f0.tiles[0]), translated_share(&d, &m[1], &s[1], &f0.tiles[1]);
+                    t[6][r] = now_ms(CLOCK_THREAD_CPUTIME_ID) - p0c;
+                }
+            }
+        double med[7];
+        for (int j = 0; j < 7; j++)
+            med[j] = median(t[j], bench);
+        const double fast = 0.5 * (translated_share(&d, &m[0], &s[0], &f0.tiles[0]) +
+                                   translated_share(&d, &m[1], &s[1], &f0.tiles[1]));
+        double la[3] = {0, 0, 0};
+        if (getloadavg(la, 3) != 3)
+            la[0] = -1;
+        printf("  pair (2 x %dx%d, one refresh), one thread, %s, median of %d, load %.2f: thread CPU ms / wall ms\n",
+               w, h, fv_isa_name(fv_cpu_best_isa(~0u)), bench, la[0]);
+        printf("    copy of the pair's bytes (2 x %.1f MB): %.3f / %.3f ms\n", (double)w * h * 3 / 1e6, med[0], med[3]);
+        printf("    block warp: %.3f / %.3f ms (%.2fx the copy; planning %.3f ms of it; %.1f %% of pixels translated; "
+               "%ld disoccluded)\n",
+               med[1], med[4], med[1] / med[0], med[6], 100.0 * fast, hb);
+        printf("    per-pixel warp: %.3f / %.3f ms (%.1fx the copy; %ld disoccluded)\n", med[2], med[5],
+               med[2] / med[0], hp);
+        for (int j = 0; j < 7; j++)
+            free(t[j]);
+        free(pair);
     }
     fv_tw_frame_free(&f0);
     fv_tw_frame_free(&f1);
     free(out);
+    free(outp);
     fv_pipeline_destroy(pl);
     fv_scene_free(scene);
     return 0;

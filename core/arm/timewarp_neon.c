@@ -144,4 +144,77 @@ static int tw_row_neon(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_
     return holes;
 }
 
-void fv_timewarp_dsp_init_neon(fv_timewarp_dsp *d) { d->tw_row = tw_row_neon; }
+/* the block warp's resample: 16 bytes a step; vqrdmulh is pmulhrsw's rounding (it saturates
+ * only -32768 x -32768, which the operands never reach), the last step overlapping */
+static inline uint8x16_t span16(const uint8_t *s0, const uint8_t *s1, uint8x8_t w0, uint8x8_t w1, int16x8_t wy)
+{
+    const uint8x16_t a = vld1q_u8(s0), b = vld1q_u8(s0 + 3), c = vld1q_u8(s1), d = vld1q_u8(s1 + 3);
+    const int16x8_t h0l = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_low_u8(a), w0), vget_low_u8(b), w1));
+    const int16x8_t h0h = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_high_u8(a), w0), vget_high_u8(b), w1));
+    const int16x8_t h1l = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_low_u8(c), w0), vget_low_u8(d), w1));
+    const int16x8_t h1h = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_high_u8(c), w0), vget_high_u8(d), w1));
+    const int16x8_t vl = vaddq_s16(h0l, vqrdmulhq_s16(vsubq_s16(h1l, h0l), wy));
+    const int16x8_t vh = vaddq_s16(h0h, vqrdmulhq_s16(vsubq_s16(h1h, h0h), wy));
+    /* (v + 32) >> 6, v in [0, 16320] */
+    return vcombine_u8(vqrshrun_n_s16(vl, 6), vqrshrun_n_s16(vh, 6));
+}
+
+static void tw_spans_neon(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+{
+    for (int i = 0; i < count; i++) {
+        const fv_tw_piece *p = &pieces[i];
+        const int n = p->n, fx = p->fx, fy = p->fy;
+        const uint8x8_t w0 = vdup_n_u8((uint8_t)(64 - fx)), w1 = vdup_n_u8((uint8_t)fx);
+        const int16x8_t wy = vdupq_n_s16((int16_t)(fy << 9));
+        uint8_t *o = dst + p->dst;
+        int k = 0;
+        for (; k + 16 <= n; k += 16)
+            vst1q_u8(o + k, span16(p->s0 + k, p->s1 + k, w0, w1, wy));
+        if (k < n && n >= 16) {
+            vst1q_u8(o + n - 16, span16(p->s0 + n - 16, p->s1 + n - 16, w0, w1, wy));
+            k = n;
+        }
+        for (; k < n; k++)
+            o[k] = fv_tw_span_px(p->s0[k], p->s0[k + 3], p->s1[k], p->s1[k + 3], fx, fy);
+    }
+}
+
+static void tw_minmax_neon(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2])
+{
+    if (w < 8) {
+        fv_tw_minmax_c(p, stride, w, h, out);
+        return;
+    }
+    uint16x8_t lo = vdupq_n_u16(65535), hi = vdupq_n_u16(0);
+    for (int y = 0; y < h; y++) {
+        const uint16_t *r = p + (ptrdiff_t)y * stride;
+        for (int x = 0;; x += 8) {
+            x = x + 8 <= w ? x : w - 8; /* the last 8 overlap: min and max do not mind */
+            const uint16x8_t v = vld1q_u16(r + x);
+            lo = vminq_u16(lo, v), hi = vmaxq_u16(hi, v);
+            if (x + 8 >= w)
+                break;
+        }
+    }
+    out[0] = vminvq_u16(lo), out[1] = vmaxvq_u16(hi);
+}
+
+/* plain stores: the intrinsics have no non-temporal store (STNP would need assembly); n = 0
+ * (the fence call) has nothing to order */
+static void tw_stream_neon(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    if (!n)
+        return;
+    int k = 0;
+    for (; k + 16 <= n; k += 16)
+        vst1q_u8(dst + k, vld1q_u8(src + k));
+    memcpy(dst + k, src + k, (size_t)(n - k));
+}
+
+void fv_timewarp_dsp_init_neon(fv_timewarp_dsp *d)
+{
+    d->tw_stream = tw_stream_neon;
+    d->tw_row = tw_row_neon;
+    d->tw_spans = tw_spans_neon;
+    d->tw_minmax = tw_minmax_neon;
+}

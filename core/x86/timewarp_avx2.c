@@ -184,4 +184,99 @@ static int tw_row_avx2(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_
     return holes;
 }
 
-void fv_timewarp_dsp_init_avx2(fv_timewarp_dsp *d) { d->tw_row = tw_row_avx2; }
+/* the block warp's resample: 32 bytes a step (the in-lane unpacks and packs keep the order),
+ * bytes of x and x + 3 interleaved so pmaddubsw applies the horizontal weights, pmulhrsw the
+ * vertical phase and the final rounding; the rest in 16-byte steps, the last one overlapping */
+static inline __m128i span16(const uint8_t *s0, const uint8_t *s1, __m128i wx, __m128i wy, __m128i k512)
+{
+    const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)s0);
+    const __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(s0 + 3));
+    const __m128i c = _mm_loadu_si128((const __m128i *)(const void *)s1);
+    const __m128i d = _mm_loadu_si128((const __m128i *)(const void *)(s1 + 3));
+    const __m128i h0l = _mm_maddubs_epi16(_mm_unpacklo_epi8(a, b), wx), h0h = _mm_maddubs_epi16(_mm_unpackhi_epi8(a, b), wx);
+    const __m128i h1l = _mm_maddubs_epi16(_mm_unpacklo_epi8(c, d), wx), h1h = _mm_maddubs_epi16(_mm_unpackhi_epi8(c, d), wx);
+    const __m128i vl = _mm_add_epi16(h0l, _mm_mulhrs_epi16(_mm_sub_epi16(h1l, h0l), wy));
+    const __m128i vh = _mm_add_epi16(h0h, _mm_mulhrs_epi16(_mm_sub_epi16(h1h, h0h), wy));
+    return _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512));
+}
+
+static void tw_spans_avx2(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+{
+    const __m256i k512 = _mm256_set1_epi16(512);
+    for (int i = 0; i < count; i++) {
+        const fv_tw_piece *p = &pieces[i];
+        const uint8_t *s0 = p->s0, *s1 = p->s1;
+        uint8_t *o = dst + p->dst;
+        const int n = p->n, fx = p->fx, fy = p->fy;
+        const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
+        int k = 0;
+        for (; k + 32 <= n; k += 32) {
+            const __m256i a = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k));
+            const __m256i b = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k + 3));
+            const __m256i c = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k));
+            const __m256i e = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k + 3));
+            const __m256i h0l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(a, b), wx);
+            const __m256i h0h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(a, b), wx);
+            const __m256i h1l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(c, e), wx);
+            const __m256i h1h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(c, e), wx);
+            const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
+            const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
+            _mm256_storeu_si256((__m256i *)(void *)(o + k),
+                                _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512)));
+        }
+        const __m128i wx4 = _mm256_castsi256_si128(wx), wy4 = _mm256_castsi256_si128(wy), k5 = _mm256_castsi256_si128(k512);
+        for (; k + 16 <= n; k += 16)
+            _mm_storeu_si128((__m128i *)(void *)(o + k), span16(s0 + k, s1 + k, wx4, wy4, k5));
+        if (k < n && n >= 16) { /* the last 16 again, overlapping: the same bytes */
+            _mm_storeu_si128((__m128i *)(void *)(o + n - 16), span16(s0 + n - 16, s1 + n - 16, wx4, wy4, k5));
+            k = n;
+        }
+        for (; k < n; k++)
+            o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+    }
+}
+
+static void tw_minmax_avx2(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2])
+{
+    if (w < 16) {
+        fv_tw_minmax_c(p, stride, w, h, out);
+        return;
+    }
+    __m256i lo = _mm256_set1_epi16(-1), hi = _mm256_setzero_si256();
+    for (int y = 0; y < h; y++) {
+        const uint16_t *r = p + (ptrdiff_t)y * stride;
+        for (int x = 0;; x += 16) {
+            x = x + 16 <= w ? x : w - 16; /* the last 16 overlap: min and max do not mind */
+            const __m256i v = _mm256_loadu_si256((const __m256i *)(const void *)(r + x));
+            lo = _mm256_min_epu16(lo, v), hi = _mm256_max_epu16(hi, v);
+            if (x + 16 >= w)
+                break;
+        }
+    }
+    const __m128i l = _mm_min_epu16(_mm256_castsi256_si128(lo), _mm256_extracti128_si256(lo, 1));
+    const __m128i g = _mm_max_epu16(_mm256_castsi256_si128(hi), _mm256_extracti128_si256(hi, 1));
+    out[0] = (unsigned)_mm_cvtsi128_si32(_mm_minpos_epu16(l)) & 0xffff;
+    out[1] = 65535u - ((unsigned)_mm_cvtsi128_si32(_mm_minpos_epu16(_mm_xor_si128(g, _mm_set1_epi16(-1)))) & 0xffff);
+}
+
+static void tw_stream_avx2(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    if (!n) {
+        _mm_sfence();
+        return;
+    }
+    int k = (int)((32 - ((uintptr_t)dst & 31)) & 31);
+    k = k < n ? k : n;
+    memcpy(dst, src, (size_t)k);
+    for (; k + 32 <= n; k += 32)
+        _mm256_stream_si256((__m256i *)(void *)(dst + k), _mm256_loadu_si256((const __m256i *)(const void *)(src + k)));
+    memcpy(dst + k, src + k, (size_t)(n - k));
+}
+
+void fv_timewarp_dsp_init_avx2(fv_timewarp_dsp *d)
+{
+    d->tw_stream = tw_stream_avx2;
+    d->tw_row = tw_row_avx2;
+    d->tw_spans = tw_spans_avx2;
+    d->tw_minmax = tw_minmax_avx2;
+}

@@ -139,4 +139,82 @@ static int tw_row_sse41(uint8_t *restrict dst, int x0, int y, int n, const fv_tw
     return holes;
 }
 
-void fv_timewarp_dsp_init_sse41(fv_timewarp_dsp *d) { d->tw_row = tw_row_sse41; }
+/* the block warp's resample: 16 bytes a step, bytes of x and x + 3 interleaved so pmaddubsw
+ * applies the horizontal weights, pmulhrsw the vertical phase and the final rounding */
+static inline __m128i span16(const uint8_t *s0, const uint8_t *s1, __m128i wx, __m128i wy, __m128i k512)
+{
+    const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)s0);
+    const __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(s0 + 3));
+    const __m128i c = _mm_loadu_si128((const __m128i *)(const void *)s1);
+    const __m128i d = _mm_loadu_si128((const __m128i *)(const void *)(s1 + 3));
+    const __m128i h0l = _mm_maddubs_epi16(_mm_unpacklo_epi8(a, b), wx), h0h = _mm_maddubs_epi16(_mm_unpackhi_epi8(a, b), wx);
+    const __m128i h1l = _mm_maddubs_epi16(_mm_unpacklo_epi8(c, d), wx), h1h = _mm_maddubs_epi16(_mm_unpackhi_epi8(c, d), wx);
+    const __m128i vl = _mm_add_epi16(h0l, _mm_mulhrs_epi16(_mm_sub_epi16(h1l, h0l), wy));
+    const __m128i vh = _mm_add_epi16(h0h, _mm_mulhrs_epi16(_mm_sub_epi16(h1h, h0h), wy));
+    return _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512));
+}
+
+static void tw_spans_sse41(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+{
+    const __m128i k512 = _mm_set1_epi16(512);
+    for (int i = 0; i < count; i++) {
+        const fv_tw_piece *p = &pieces[i];
+        const int n = p->n, fx = p->fx, fy = p->fy;
+        const __m128i wx = _mm_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm_set1_epi16((short)(fy << 9));
+        uint8_t *o = dst + p->dst;
+        int k = 0;
+        for (; k + 16 <= n; k += 16)
+            _mm_storeu_si128((__m128i *)(void *)(o + k), span16(p->s0 + k, p->s1 + k, wx, wy, k512));
+        if (n >= 16 && k < n) { /* the last 16 again, overlapping: the bytes are the same */
+            k = n - 16;
+            _mm_storeu_si128((__m128i *)(void *)(o + k), span16(p->s0 + k, p->s1 + k, wx, wy, k512));
+            k = n;
+        }
+        for (; k < n; k++)
+            o[k] = fv_tw_span_px(p->s0[k], p->s0[k + 3], p->s1[k], p->s1[k + 3], fx, fy);
+    }
+}
+
+static void tw_minmax_sse41(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2])
+{
+    if (w < 8) {
+        fv_tw_minmax_c(p, stride, w, h, out);
+        return;
+    }
+    __m128i lo = _mm_set1_epi16(-1), hi = _mm_setzero_si128();
+    for (int y = 0; y < h; y++) {
+        const uint16_t *r = p + (ptrdiff_t)y * stride;
+        for (int x = 0;; x += 8) {
+            x = x + 8 <= w ? x : w - 8; /* the last 8 overlap: min and max do not mind */
+            const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)(r + x));
+            lo = _mm_min_epu16(lo, v), hi = _mm_max_epu16(hi, v);
+            if (x + 8 >= w)
+                break;
+        }
+    }
+    /* minpos gives the least of 8 u16; the greatest is the least of the complements */
+    out[0] = (unsigned)_mm_cvtsi128_si32(_mm_minpos_epu16(lo)) & 0xffff;
+    out[1] = 65535u - ((unsigned)_mm_cvtsi128_si32(_mm_minpos_epu16(_mm_xor_si128(hi, _mm_set1_epi16(-1)))) & 0xffff);
+}
+
+static void tw_stream_sse41(uint8_t *restrict dst, const uint8_t *restrict src, int n)
+{
+    if (!n) {
+        _mm_sfence();
+        return;
+    }
+    int k = (int)((16 - ((uintptr_t)dst & 15)) & 15);
+    k = k < n ? k : n;
+    memcpy(dst, src, (size_t)k);
+    for (; k + 16 <= n; k += 16)
+        _mm_stream_si128((__m128i *)(void *)(dst + k), _mm_loadu_si128((const __m128i *)(const void *)(src + k)));
+    memcpy(dst + k, src + k, (size_t)(n - k));
+}
+
+void fv_timewarp_dsp_init_sse41(fv_timewarp_dsp *d)
+{
+    d->tw_stream = tw_stream_sse41;
+    d->tw_row = tw_row_sse41;
+    d->tw_spans = tw_spans_sse41;
+    d->tw_minmax = tw_minmax_sse41;
+}

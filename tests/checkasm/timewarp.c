@@ -1,9 +1,14 @@
-/* fovea checkasm: the timewarp kernel (timewarp_dsp.h), every ISA version against the C
- * reference, bit for bit (bytes and disocclusion count): maps from random head motions (small
- * turns and steps, a turn past 90 degrees that puts source points behind the eye, steps that
- * hit the depth conversion's floor), sources with depth edges, flat depth, the nearest and the
- * farthest depth codes; every row length from 1 up with tails, offsets into the row, the first
- * and last rows. Outputs canaried; source planes exact-size plus the contract's padding. */
+/* fovea checkasm: the timewarp kernels (timewarp_dsp.h), every ISA version against the C
+ * reference, bit for bit: tw_row (bytes and disocclusion count) on maps from random head motions
+ * (small turns and steps, a turn past 90 degrees that puts source points behind the eye, steps
+ * that hit the depth conversion's floor), sources with depth edges, flat depth, the nearest and
+ * the farthest depth codes; every row length from 1 up with tails, offsets into the row, the
+ * first and last rows; tw_spans on random pieces (lengths 1 up, phases 0 and 63, exact-size
+ * source rows); tw_minmax on random rectangles. Then the block warp (core/timewarp.c) on every
+ * ISA against the per-pixel C reference within its contract (timewarp.h): translated pixels
+ * within FV_TW_BLOCK_POS_PX of the reference's tap and within the value bound, the others and
+ * the disocclusion count exact. Outputs canaried; source planes exact-size plus the contract's
+ * padding. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -13,7 +18,7 @@
 #include "camera.h"
 #include "timewarp.h"
 
-static const char *const names[] = {"tw_row"};
+static const char *const names[] = {"tw_row", "tw_spans", "tw_minmax", "tw_stream"};
 
 static void test_tables(void **state)
 {
@@ -124,8 +129,342 @@ static void test_tw_row(void **state)
         assert_true(holes_seen > 0);
 }
 
+static void test_tw_spans(void **state)
+{
+    (void)state;
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "tw_spans"))
+            continue;
+        fv_timewarp_dsp d;
+        fv_timewarp_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+        for (int trial = 0; trial < 300; trial++) {
+            enum { MAXP = 6 };
+            fv_tw_piece pc[MAXP];
+            uint8_t *src[MAXP][2];
+            const int np = 1 + (int)(checkasm_rand() % MAXP);
+            int len = 0;
+            for (int i = 0; i < np; i++) {
+                /* lengths 1..200 bytes (every tail), phases with their extremes */
+                const int n = trial < 100 ? 1 + (trial + 37 * i) % 100 : 1 + (int)(checkasm_rand() % 200);
+                const uint64_t r = checkasm_rand();
+                pc[i].fx = r % 5 == 0 ? 0 : r % 5 == 1 ? 63 : (int)((r >> 8) % 64);
+                pc[i].fy = r % 7 == 0 ? 0 : r % 7 == 1 ? 63 : (int)((r >> 16) % 64);
+                for (int j = 0; j < 2; j++) { /* exactly the n + 3 bytes the contract reads */
+                    src[i][j] = malloc((size_t)n + 3);
+                    assert_non_null(src[i][j]);
+                    for (int b = 0; b < n + 3; b++) {
+                        const uint64_t v = checkasm_rand();
+                        src[i][j][b] = (uint8_t)(trial % 4 == 0 ? (v & 1) * 255 : v);
+                    }
+                }
+                pc[i].s0 = src[i][0], pc[i].s1 = src[i][1];
+                len += (int)(checkasm_rand() % 9); /* gaps the kernel must leave alone */
+                pc[i].dst = len, pc[i].n = n;
+                len += n;
+            }
+            uint8_t *rb, *tb;
+            uint8_t *r = checkasm_out_u8((size_t)len, trial % 3, &rb), *t = checkasm_out_u8((size_t)len, trial % 3, &tb);
+            fv_tw_spans_c(r, pc, np);
+            d.tw_spans(t, pc, np);
+            checkasm_check_guards(t, (size_t)len, fv_isa_name(isa), "tw_spans", len);
+            checkasm_compare(r, t, (size_t)len, CHECKASM_U8, 1, CHECKASM_EXACT, "%s tw_spans trial=%d pieces=%d",
+                             fv_isa_name(isa), trial, np);
+            free(rb), free(tb);
+            for (int i = 0; i < np; i++)
+                free(src[i][0]), free(src[i][1]);
+        }
+    }
+}
+
+/* tw_spans' C reference against the bilinear value it rounds: within 1 level of
+ * sum c w / 4096 over the 4 taps, w the 6-bit weights' products (the contract's accuracy) */
+static void test_tw_spans_formula(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 20000; i++) {
+        const uint64_t r = checkasm_rand();
+        const uint8_t s0[4] = {(uint8_t)r, 0, 0, (uint8_t)(r >> 8)}, s1[4] = {(uint8_t)(r >> 16), 0, 0, (uint8_t)(r >> 24)};
+        const fv_tw_piece p = {s0, s1, 0, 1, (int)((r >> 32) % 64), (int)((r >> 40) % 64)};
+        uint8_t o;
+        fv_tw_spans_c(&o, &p, 1);
+        const double fx = p.fx / 64.0, fy = p.fy / 64.0;
+        const double want = (1 - fy) * ((1 - fx) * s0[0] + fx * s0[3]) + fy * ((1 - fx) * s1[0] + fx * s1[3]);
+        if (fabs(o - want) > 0.51)
+            fail_msg("tw_spans: %d, the bilinear value %.3f (fx %d fy %d)", o, want, p.fx, p.fy);
+    }
+}
+
+static void test_tw_minmax(void **state)
+{
+    (void)state;
+    enum { MW = 53, MH = 11 };
+    uint16_t *p = malloc(MW * MH * sizeof *p);
+    assert_non_null(p);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "tw_minmax"))
+            continue;
+        fv_timewarp_dsp d;
+        fv_timewarp_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+        for (int trial = 0; trial < 400; trial++) {
+            for (int i = 0; i < MW * MH; i++) {
+                const uint64_t v = checkasm_rand();
+                p[i] = (uint16_t)(trial % 5 == 0 ? (v & 1) * 65535 : trial % 5 == 1 ? 30000 + v % 3 : v);
+            }
+            const int w = 1 + (int)(checkasm_rand() % MW), h = 1 + (int)(checkasm_rand() % MH);
+            const int x = (int)(checkasm_rand() % (uint64_t)(MW - w + 1)), y = (int)(checkasm_rand() % (uint64_t)(MH - h + 1));
+            unsigned want[2] = {65535, 0}, got[2];
+            for (int j = y; j < y + h; j++) /* the definition, not fv_tw_minmax_c */
+                for (int i = x; i < x + w; i++)
+                    want[0] = p[j * MW + i] < want[0] ? p[j * MW + i] : want[0], want[1] = p[j * MW + i] > want[1] ? p[j * MW + i] : want[1];
+            d.tw_minmax(p + y * MW + x, MW, w, h, got);
+            if (got[0] != want[0] || got[1] != want[1])
+                fail_msg("%s tw_minmax %dx%d at (%d, %d): %u..%u, want %u..%u", fv_isa_name(isa), w, h, x, y, got[0], got[1],
+                         want[0], want[1]);
+        }
+    }
+    free(p);
+}
+
+static void test_tw_stream(void **state)
+{
+    (void)state;
+    uint8_t src[700];
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "tw_stream"))
+            continue;
+        fv_timewarp_dsp d;
+        fv_timewarp_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+        for (int n = 0; n <= 600; n += n < 80 ? 1 : 37) /* every head and tail around the alignment */
+            for (int off = 0; off < 33; off += 7) {
+                for (int i = 0; i < n; i++)
+                    src[i] = (uint8_t)checkasm_rand();
+                uint8_t *b;
+                uint8_t *t = checkasm_out_u8((size_t)n, off, &b);
+                d.tw_stream(t, src, n);
+                d.tw_stream(NULL, NULL, 0); /* the fence */
+                checkasm_check_guards(t, (size_t)n, fv_isa_name(isa), "tw_stream", n);
+                checkasm_compare(src, t, (size_t)n, CHECKASM_U8, 1, CHECKASM_EXACT, "%s tw_stream n=%d off=%d",
+                                 fv_isa_name(isa), n, off);
+                free(b);
+            }
+    }
+}
+
+/* ---- the block warp against the per-pixel reference (timewarp.h's contract) ---- */
+#define BW_W 331 /* odd: several blocks, clipped last ones */
+#define BW_H 181 /* the last block row 53 rows: parts start off the 8-row grid */
+
+/* the reference's tap position for display pixel (x, y) before its weight truncation: the
+ * iteration of fv_tw_pixel with the same helpers, clamped as fv_tw_tap clamps */
+static void ref_tap(const fv_tw_map *m, const fv_tw_src *s, int x, int y, float *bu, float *bv)
+{
+    const float py = (float)y + 0.5f, px = (float)x + 0.5f;
+    const float r[3] = {m->a0[0] + py * m->ay[0], m->a0[1] + py * m->ay[1], m->a0[2] + py * m->ay[2]};
+    const float A[3] = {r[0] + px * m->ax[0], r[1] + px * m->ax[1], r[2] + px * m->ax[2]};
+    float u0, v0, u1, v1, u2, v2;
+    fv_tw_proj(A, m->t, 0.0f, &u0, &v0);
+    const float w1 = fv_tw_fetch_w(m, s, A[2], u0, v0);
+    fv_tw_proj(A, m->t, w1, &u1, &v1);
+    const float w2 = fv_tw_fetch_w(m, s, A[2], u1, v1);
+    fv_tw_proj(A, m->t, w2, &u2, &v2);
+    const float w3 = fv_tw_fetch_w(m, s, A[2], u2, v2);
+    const float d = w3 > w2 ? w3 - w2 : w2 - w3, mx = w3 > w2 ? w3 : w2;
+    const int first = d > m->tol * mx && w2 < w3;
+    *bu = fv_tw_clampf((first ? u1 : u2) - 0.5f, (float)(s->w - 1));
+    *bv = fv_tw_clampf((first ? v1 : v2) - 0.5f, (float)(s->h - 1));
+}
+
+static void test_block_warp(void **state)
+{
+    (void)state;
+    checkasm_rng = 0x5eed0b10ull;
+    const size_t npx = (size_t)BW_W * BW_H;
+    uint8_t *rgb = malloc(npx * 3 + FV_TW_RGB_PAD), *ref = malloc(npx * 3), *blk = malloc(npx * 3);
+    uint16_t *invd = malloc((npx + FV_TW_INVD_PAD / 2) * sizeof *invd);
+    uint8_t *refhole = malloc(npx), *fastpx = malloc(npx);
+    const int tw = (BW_W + FV_TW_TILE - 1) / FV_TW_TILE, th = (BW_H + FV_TW_TILE - 1) / FV_TW_TILE;
+    const int tw4 = (tw + 3) / 4, th4 = (th + 3) / 4;
+    uint16_t *lohi = malloc(2 * (size_t)tw * th * sizeof *lohi), *want_tiles = malloc(2 * (size_t)tw * th * sizeof *lohi);
+    uint16_t *lohi4 = malloc(2 * (size_t)tw4 * th4 * sizeof *lohi), *want4 = malloc(2 * (size_t)tw4 * th4 * sizeof *lohi);
+    const int nbx = (BW_W + FV_TW_BLOCK_W - 1) / FV_TW_BLOCK_W;
+    fv_tw_block *plan = malloc(FV_TW_BLOCK_SPLIT * (size_t)nbx * sizeof *plan);
+    assert_true(rgb && ref && blk && invd && refhole && fastpx && lohi && want_tiles && lohi4 && want4 && plan);
+    fv_camera_desc cd;
+    fv_camera_desc_default(&cd);
+    cd.width = BW_W, cd.height = BW_H;
+    fv_timewarp_dsp c;
+    fv_timewarp_dsp_init(&c, FV_ISA_C);
+    long fast_total = 0, slow_total = 0, checked = 0;
+    float worst_pos = 0.0f;
+    for (int trial = 0; trial < 40; trial++) {
+        /* sources: depth blocks with edges (random colours, and smooth colours so the value bound
+         * is tight), flat, near objects, random codes, a wall at 1 m with poles at 0.3 m one
+         * column wide (a pole just outside a block's footprint at w = 0 is hit once the parallax
+         * counts) */
+        const int mode = trial % 5 == 4 ? 2 : trial % 5 == 3 ? 3 : trial % 5 == 2 ? 1 : trial % 5 == 1 ? 4 : 0;
+        for (size_t i = 0; i < npx * 3 + FV_TW_RGB_PAD; i++)
+            rgb[i] = (uint8_t)(trial & 1 ? (i / 3 % BW_W) * 255 / BW_W + (i % 3) * 20 : checkasm_rand());
+        const float zb[4] = {0.3f, 1.0f, 4.0f, 30.0f};
+        for (int y = 0; y < BW_H; y++)
+            for (int x = 0; x < BW_W; x++) {
+                const uint64_t r = checkasm_rand();
+                invd[y * BW_W + x] = (uint16_t)(mode == 0   ? FV_TW_INVD_PER_M / zb[((x / 45) + (y / 29)) & 3] + 0.5f
+                                                : mode == 1 ? FV_TW_INVD_PER_M / 2.0f
+                                                : mode == 2 ? (r & 3) == 0 ? 0 : (r & 3) == 1 ? 65535 : r >> 16
+                                                : mode == 4 ? FV_TW_INVD_PER_M / (x % 40 == 17 ? 0.3f : 1.0f)
+                                                            : 60000 + r % 5536);
+            }
+        /* small motions (a refresh or a few of head turn, eye steps up to 5 mm), and a larger one */
+        const float turn = trial % 8 == 7 ? 8.0f : 0.2f + 0.3f * (float)(trial % 4);
+        const float step = trial % 3 == 0 ? 0.0f : trial % 3 == 1 ? 0.001f : 0.005f;
+        fv_pose pa, pb;
+        random_pose(&pa, turn, step);
+        random_pose(&pb, turn, step);
+        cd.eye = trial & 1 ? FV_EYE_RIGHT : FV_EYE_LEFT;
+        fv_camera ca, cb;
+        assert_int_equal(fv_camera_setup(&ca, &cd, &pa), 0);
+        assert_int_equal(fv_camera_setup(&cb, &cd, &pb), 0);
+        fv_tw_map m;
+        fv_tw_setup(&m, &cb, &ca, 0.05f);
+        const fv_tw_src s = {rgb, (ptrdiff_t)BW_W * 3, invd, BW_W, BW_W, BW_H};
+        fv_tw_warp_rows_pixel(&c, ref, (ptrdiff_t)BW_W * 3, 0, BW_H, &m, &s);
+        for (int y = 0; y < BW_H; y++)
+            for (int x = 0; x < BW_W; x++) {
+                uint8_t px[3];
+                refhole[y * BW_W + x] = (uint8_t)fv_tw_row_c(px, x, y, 1, &m, &s);
+            }
+        /* the tiles, against their definition */
+        for (int ty = 0; ty < th; ty++)
+            for (int tx = 0; tx < tw; tx++) {
+                unsigned lo = 65535, hi = 0;
+                for (int y = ty * FV_TW_TILE; y < (ty + 1) * FV_TW_TILE && y < BW_H; y++)
+                    for (int x = tx * FV_TW_TILE; x < (tx + 1) * FV_TW_TILE && x < BW_W; x++)
+                        lo = invd[y * BW_W + x] < lo ? invd[y * BW_W + x] : lo, hi = invd[y * BW_W + x] > hi ? invd[y * BW_W + x] : hi;
+                want_tiles[2 * (ty * tw + tx)] = (uint16_t)lo, want_tiles[2 * (ty * tw + tx) + 1] = (uint16_t)hi;
+            }
+        const int T4 = 4 * FV_TW_TILE;
+        for (int ty = 0; ty < th4; ty++)
+            for (int tx = 0; tx < tw4; tx++) {
+                unsigned lo = 65535, hi = 0;
+                for (int y = ty * T4; y < (ty + 1) * T4 && y < BW_H; y++)
+                    for (int x = tx * T4; x < (tx + 1) * T4 && x < BW_W; x++)
+                        lo = invd[y * BW_W + x] < lo ? invd[y * BW_W + x] : lo, hi = invd[y * BW_W + x] > hi ? invd[y * BW_W + x] : hi;
+                want4[2 * (ty * tw4 + tx)] = (uint16_t)lo, want4[2 * (ty * tw4 + tx) + 1] = (uint16_t)hi;
+            }
+        fv_tw_tiles tiles = {lohi, lohi4, 0, 0, 0, 0};
+        const fv_tw_tiles *tp = trial & 2 ? &tiles : NULL;
+        for (int k = -1; k < 0 || checkasm_isas[k]; k++) { /* C first, then this build's ISAs */
+            const unsigned isa = k < 0 ? FV_ISA_C : checkasm_isas[k];
+            if (isa != FV_ISA_C && !checkasm_cpu_runs(isa, "block warp"))
+                continue;
+            fv_timewarp_dsp d;
+            fv_timewarp_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+            memset(lohi, 0, 2 * (size_t)tw * th * sizeof *lohi);
+            fv_tw_tiles_build(&d, &tiles, &s);
+            assert_int_equal(tiles.tw, tw);
+            assert_int_equal(tiles.th, th);
+            assert_int_equal(tiles.tw4, tw4);
+            assert_int_equal(tiles.th4, th4);
+            if (memcmp(lohi, want_tiles, 2 * (size_t)tw * th * sizeof *lohi) || memcmp(lohi4, want4, 2 * (size_t)tw4 * th4 * sizeof *lohi))
+                fail_msg("%s: fv_tw_tiles_build differs from the tiles' least and greatest", fv_isa_name(isa));
+            uint8_t *ob;
+            uint8_t *o = checkasm_out_u8(npx * 3, 1, &ob);
+            const long holes = fv_tw_warp_rows(&d, o, (ptrdiff_t)BW_W * 3, 0, BW_H, &m, &s, tp);
+            checkasm_check_guards(o, npx * 3, fv_isa_name(isa), "block warp", trial);
+            if (k >= 0) { /* the kernels are exact: the same bytes as the C block warp */
+                checkasm_compare(blk, o, npx * 3, CHECKASM_U8, 3, CHECKASM_EXACT, "%s block warp trial=%d",
+                                 fv_isa_name(isa), trial);
+                free(ob);
+                continue;
+            }
+            memcpy(blk, o, npx * 3);
+            free(ob);
+            /* C: each pixel against the reference, by its block's plan */
+            long want_holes = 0;
+            memset(fastpx, 0, npx);
+            for (int by = 0; by * FV_TW_BLOCK_H < BW_H; by++) {
+                float g = 0.0f;
+                const int n = fv_tw_plan_blocks(&c, &m, &s, tp, by, 0, nbx, plan, &g);
+                /* the entries tile the block row, those of a row in column order */
+                for (int y = by * FV_TW_BLOCK_H; y < (by + 1) * FV_TW_BLOCK_H && y < BW_H; y++) {
+                    int x = 0;
+                    for (int i = 0; i < n; i++)
+                        if (plan[i].y0 <= y && y < plan[i].y1) {
+                            assert_int_equal(plan[i].x0, x);
+                            x = plan[i].x1;
+                        }
+                    assert_int_equal(x, BW_W);
+                }
+                for (int i = 0; i < n; i++) {
+                    for (int y = plan[i].y0; y < plan[i].y1; y++)
+                        for (int x = plan[i].x0; x < plan[i].x1; x++) {
+                            const size_t j = (size_t)y * BW_W + x;
+                            checked++;
+                            if (!plan[i].fast) {
+                                want_holes += refhole[j];
+                                slow_total++;
+                                if (memcmp(blk + 3 * j, ref + 3 * j, 3))
+                                    fail_msg("trial %d: per-pixel block pixel (%d, %d) differs from the reference", trial, x, y);
+                                continue;
+                            }
+                            fast_total++;
+                            fastpx[j] = 1;
+                            int ox, oy, fx, fy;
+                            fv_tw_block_row(&plan[i], y, &ox, &oy, &fx, &fy);
+                            const float tu = fv_tw_clampf((float)(x + ox) + (float)fx / 64.0f, (float)(BW_W - 1));
+                            const float tv = fv_tw_clampf((float)(y + oy) + (float)fy / 64.0f, (float)(BW_H - 1));
+                            float bu, bv;
+                            ref_tap(&m, &s, x, y, &bu, &bv);
+                            const float e = fmaxf(fabsf(tu - bu), fabsf(tv - bv));
+                            worst_pos = e > worst_pos ? e : worst_pos;
+                            if (e > FV_TW_BLOCK_POS_PX)
+                                fail_msg("trial %d: pixel (%d, %d) taps (%.4f, %.4f), the reference (%.4f, %.4f): %.4f px "
+                                         "apart, bound %.2f (block [%d, %d) bound %.4f)", trial, x, y, tu, tv, bu, bv, e,
+                                         FV_TW_BLOCK_POS_PX, plan[i].x0, plan[i].x1, plan[i].err_px);
+                            /* the value bound: 2 (bound + 1/128) x the channel's range over the 4x4
+                             * pixels around the reference's tap, + 1 */
+                            const int x0 = (int)bu, y0 = (int)bv;
+                            for (int ch = 0; ch < 3; ch++) {
+                                int lo = 255, hi = 0;
+                                for (int yy = y0 - 1; yy <= y0 + 2; yy++)
+                                    for (int xx = x0 - 1; xx <= x0 + 2; xx++) {
+                                        const int cx = xx < 0 ? 0 : xx >= BW_W ? BW_W - 1 : xx;
+                                        const int cy = yy < 0 ? 0 : yy >= BW_H ? BW_H - 1 : yy;
+                                        const int v = rgb[((size_t)cy * BW_W + cx) * 3 + ch];
+                                        lo = v < lo ? v : lo, hi = v > hi ? v : hi;
+                                    }
+                                const int bound = (int)(2.0f * (FV_TW_BLOCK_POS_PX + 1.0f / 128.0f) * (float)(hi - lo) + 1.01f);
+                                const int diff = abs((int)blk[3 * j + ch] - (int)ref[3 * j + ch]);
+                                if (diff > bound)
+                                    fail_msg("trial %d: pixel (%d, %d) channel %d: %d, the reference %d, bound %d", trial, x,
+                                             y, ch, blk[3 * j + ch], ref[3 * j + ch], bound);
+                            }
+                        }
+                }
+            }
+            if (holes != want_holes)
+                fail_msg("trial %d: %ld disoccluded pixels, the reference's over the per-pixel blocks %ld", trial, holes,
+                         want_holes);
+        }
+    }
+    printf("    block warp: %ld pixels checked, %.1f %% translated, worst tap distance %.4f px\n", checked,
+           100.0 * (double)fast_total / (double)(checked ? checked : 1), worst_pos);
+    /* both paths were exercised */
+    assert_true(fast_total > checked / 4);
+    assert_true(slow_total > 0);
+    free(rgb), free(ref), free(blk), free(invd), free(refhole), free(fastpx), free(lohi), free(want_tiles), free(lohi4), free(want4), free(plan);
+}
+
 const struct CMUnitTest checkasm_timewarp_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_tw_row),
+    cmocka_unit_test(test_tw_spans),
+    cmocka_unit_test(test_tw_spans_formula),
+    cmocka_unit_test(test_tw_minmax),
+    cmocka_unit_test(test_tw_stream),
+    cmocka_unit_test(test_block_warp),
     {0},
 };
