@@ -326,15 +326,23 @@ static void taa_blend_avx2(const struct fv_taa_frame *f, const struct fv_taa_til
     flow->n = fn;
 }
 
-static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1); }
-
-/* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). */
+/* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). The
+ * history pixels stay as loaded, two per 256-bit register; their depths are taken out in the
+ * lane order 0, 2, 4, 6, 1, 3, 5, 7 (two shuffles), checked in that order, and only the depth
+ * lanes of the stored pixels are replaced. */
 static inline int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                              const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
+                                const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
 {
     const int sx0 = x0 + t->flow_x;
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), mhalf = _mm256_set1_ps(-0.5f);
-    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);       /* lane -> pixel of the depth order */
+    const __m256i to_linear = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);   /* depth order -> pixel order */
+    const __m256i pair_mask0 = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), pair_mask1 = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
+    const __m256i pair_mask2 = _mm256_setr_epi32(4, 4, 4, 4, 5, 5, 5, 5), pair_mask3 = _mm256_setr_epi32(6, 6, 6, 6, 7, 7, 7, 7);
+    __m256 T2[3], Bk[3], NX[3];
+    for (int k = 0; k < 3; k++)
+        T2[k] = _mm256_set1_ps(f->T2[k]), Bk[k] = _mm256_set1_ps(B[k]), NX[k] = _mm256_set1_ps(f->NX[k]);
+    const __m256 pyv = _mm256_set1_ps(py), zmin = _mm256_set1_ps(1e-4f), one = _mm256_set1_ps(1.0f);
     int i = ilo;
     for (; i + 8 <= ihi; i += 8) {
         const __m256 w = _mm256_loadu_ps(wgt + i);
@@ -344,43 +352,46 @@ static inline int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_ta
         if (!_mm256_movemask_ps(m))
             continue;
         const float *src = hrow + 4 * sx;
-        __m128 r0 = _mm_loadu_ps(src), g0 = _mm_loadu_ps(src + 4), b0 = _mm_loadu_ps(src + 8), z0 = _mm_loadu_ps(src + 12);
-        __m128 r1 = _mm_loadu_ps(src + 16), g1 = _mm_loadu_ps(src + 20), b1 = _mm_loadu_ps(src + 24),
-               z1 = _mm_loadu_ps(src + 28);
-        _MM_TRANSPOSE4_PS(r0, g0, b0, z0);
-        _MM_TRANSPOSE4_PS(r1, g1, b1, z1);
-        __m256 z = pair(z0, z1);
+        /* pixels 0|1, 2|3, 4|5, 6|7 (named, not an array: GCC copied an array through the stack in
+         * 16-byte halves, and the 32-byte reloads then missed store forwarding) */
+        __m256 p0 = _mm256_loadu_ps(src), p1 = _mm256_loadu_ps(src + 8), p2 = _mm256_loadu_ps(src + 16),
+               p3 = _mm256_loadu_ps(src + 24);
         if (!f->identity) {
-            const __m256 D = z;
+            const __m256 a = _mm256_unpackhi_ps(p0, p1), b = _mm256_unpackhi_ps(p2, p3);
+            const __m256 D = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 2, 3, 2)); /* depths 0, 2, 4, 6 | 1, 3, 5, 7 */
+            const __m256i lane = order;
             const __m256 uc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(sx), lane)), half);
             const __m256 pxc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x0 + i), lane)), half);
             __m256 c[3];
             for (int k = 0; k < 3; k++)
-                c[k] = _mm256_add_ps(_mm256_set1_ps(f->T2[k]),
-                                     _mm256_mul_ps(D, _mm256_add_ps(_mm256_set1_ps(B[k]),
-                                                                    _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[k])))));
-            z = c[2];
-            const __m256 rz = _mm256_div_ps(_mm256_set1_ps(1.0f), z);
+                c[k] = _mm256_add_ps(T2[k], _mm256_mul_ps(D, _mm256_add_ps(Bk[k], _mm256_mul_ps(uc, NX[k]))));
+            const __m256 z = c[2];
+            const __m256 rz = _mm256_div_ps(one, z);
             const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(c[0], rz), pxc);
-            const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(c[1], rz), _mm256_set1_ps(py));
-            const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
-                                            _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ)));
-            m = _mm256_and_ps(m, _mm256_and_ps(_mm256_cmp_ps(z, _mm256_set1_ps(1e-4f), _CMP_GT_OQ), ok));
+            const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(c[1], rz), pyv);
+            const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
+                                                          _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ))),
+                                            _mm256_cmp_ps(z, zmin, _CMP_GT_OQ));
+            m = _mm256_and_ps(m, _mm256_permutevar8x32_ps(ok, to_linear));
             if (!_mm256_movemask_ps(m))
                 continue;
-            z0 = _mm256_castps256_ps128(z);
-            z1 = _mm256_extractf128_ps(z, 1);
+            /* this view's depth into lanes 3 and 7 of each pixel pair (z's element k of each half) */
+            p0 = _mm256_blend_ps(p0, _mm256_permute_ps(z, 0x00), 0x88);
+            p1 = _mm256_blend_ps(p1, _mm256_permute_ps(z, 0x55), 0x88);
+            p2 = _mm256_blend_ps(p2, _mm256_permute_ps(z, 0xaa), 0x88);
+            p3 = _mm256_blend_ps(p3, _mm256_permute_ps(z, 0xff), 0x88);
         }
-        _MM_TRANSPOSE4_PS(r0, g0, b0, z0); /* back to pixels (r, g, b, depth) */
-        _MM_TRANSPOSE4_PS(r1, g1, b1, z1);
         float *o = rgbd + 4 * i;
-        const __m256 p[4] = {pair(r0, g0), pair(b0, z0), pair(r1, g1), pair(b1, z1)}; /* pixels 0|1, 2|3, ... */
-        for (int k = 0; k < 4; k++) {
-            const __m256 mk = _mm256_permutevar8x32_ps(
-                m, _mm256_setr_epi32(2 * k, 2 * k, 2 * k, 2 * k, 2 * k + 1, 2 * k + 1, 2 * k + 1, 2 * k + 1));
-            _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), p[k], mk));
+        if (_mm256_movemask_ps(m) == 0xff) {
+            _mm256_storeu_ps(o, p0), _mm256_storeu_ps(o + 8, p1);
+            _mm256_storeu_ps(o + 16, p2), _mm256_storeu_ps(o + 24, p3);
+            _mm256_storeu_ps(wgt + i, ws);
+        } else {
+#define ST(k, pk) _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), pk, _mm256_permutevar8x32_ps(m, pair_mask##k)))
+            ST(0, p0), ST(1, p1), ST(2, p2), ST(3, p3);
+#undef ST
+            _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
         }
-        _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
     }
     return i;
 }
