@@ -264,6 +264,7 @@ static void taa_blend_neon(const struct fv_taa_frame *f, const struct fv_taa_til
                 xs[n] = x0 + i;
                 ys[n] = y;
                 n++;
+                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
             }
         }
         for (int k = n; k < ((n + 3) & ~3); k++) /* idle lanes of the last group repeat its first sample */

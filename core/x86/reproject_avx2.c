@@ -310,6 +310,7 @@ static void taa_blend_avx2(const struct fv_taa_frame *f, const struct fv_taa_til
                 xs[n] = x0 + i;
                 ys[n] = y;
                 n++;
+                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
             }
         }
         for (int k = n; k < ((n + 7) & ~7); k++) /* idle lanes of the last group repeat its first sample */

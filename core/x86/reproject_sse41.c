@@ -225,6 +225,7 @@ static void taa_blend_sse41(const struct fv_taa_frame *f, const struct fv_taa_ti
                 xs[n] = x0 + i;
                 ys[n] = y;
                 n++;
+                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
             }
         }
         for (int k = n; k < ((n + 3) & ~3); k++) /* idle lanes of the last group repeat its first sample */
