@@ -335,7 +335,7 @@ static void taa_blend_avx2(const struct fv_taa_frame *f, const struct fv_taa_til
  * history pixels stay as loaded, two per 256-bit register; their depths are taken out in the
  * lane order 0, 2, 4, 6, 1, 3, 5, 7 (two shuffles), checked in that order, and only the depth
  * lanes of the stored pixels are replaced. */
-static inline int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+static inline __attribute__((always_inline)) int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                                 const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
 {
     const int sx0 = x0 + t->flow_x;
