@@ -79,8 +79,8 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 static inline __attribute__((always_inline)) void soa8_pairs(const float *p, const int32_t o[8], __m256 *first,
                                                              __m256 *second)
 {
-#define PAIR(k) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_castpd_ps(_mm_load_sd((const double *)(p + o[k])))), \
-                                     _mm_castpd_ps(_mm_load_sd((const double *)(p + o[k + 4]))), 1)
+#define PAIR(k) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + o[k])))), \
+                                     _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + o[k + 4]))), 1)
     const __m256 q0 = PAIR(0), q1 = PAIR(1), q2 = PAIR(2), q3 = PAIR(3);
 #undef PAIR
     const __m256 a = _mm256_unpacklo_ps(q0, q1), b = _mm256_unpacklo_ps(q2, q3);

@@ -164,8 +164,8 @@ static inline void group_taps(const struct fv_taa_frame *f, const struct fv_taa_
     transpose4(T(h1, 0, 4), T(h1, 1, 4), T(h1, 2, 4), T(h1, 3, 4), &c11[0], &c11[1], &c11[2], &c11[3]);
 #undef T
     const float *w0 = L->wgt, *w1 = L->wgt + L->stride;
-#define PR(p, a, b) _mm_movelh_ps(_mm_castpd_ps(_mm_load_sd((const double *)(p + oi[a]))), \
-                                  _mm_castpd_ps(_mm_load_sd((const double *)(p + oi[b]))))
+#define PR(p, a, b) _mm_movelh_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + oi[a]))), \
+                                  _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + oi[b]))))
     const __m128 q0 = PR(w0, 0, 1), q1 = PR(w0, 2, 3), q2 = PR(w1, 0, 1), q3 = PR(w1, 2, 3);
 #undef PR
     const __m128 W00 = _mm_shuffle_ps(q0, q1, _MM_SHUFFLE(2, 0, 2, 0)), W10 = _mm_shuffle_ps(q0, q1, _MM_SHUFFLE(3, 1, 3, 1));
