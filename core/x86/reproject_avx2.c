@@ -5,9 +5,9 @@
  * transposes); wider footprints go through the shared scalar taps. The fill takes eight pixels
  * at a time. Same operations in the same order per lane as the reference (built with -mfma but
  * -ffp-contract=off, no FMA intrinsics): bit-identical.
- * (An earlier 8-lane blend was slower than the per-sample loop: its taps waited on history
- * misses one group at a time and its per-lane loops spilled; here groups are prefetched two
- * ahead and the per-lane code is straight-line.) */
+ * (A first version was no faster than the per-sample loop: its taps waited on history misses
+ * one group at a time and its per-lane loops over arrays of vectors went through the stack;
+ * here groups are prefetched two ahead and the per-lane code is straight-line; docs/reproject.md.) */
 #include <immintrin.h>
 
 #include <stdint.h>
