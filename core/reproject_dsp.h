@@ -17,8 +17,11 @@
  * taa_fill: every pixel with weight 0 (a hole) takes valid history, if any: colour, depth in
  *   this frame's view, weight = the history's confidence in (0, 1]. Others untouched.
  * Both read the history pyramid only at texels [-1, w] x [-1, h] of a level (its border).
- * All arithmetic outside the 4-channel texel accumulation is scalar and shared
- * (core/reproject_tmpl.h), so every ISA version gives the reference's bits. */
+ * Every ISA version gives the reference's bits: the SIMD blends (eight samples a step with AVX2,
+ * four with SSE4.1 and NEON) do each lane's operations in the reference's order (no FMA, no
+ * reciprocal estimates; selects where vmax would treat NaN differently), add the flow sums in
+ * sample order, and hand footprints wider than one texel to the shared scalar taps
+ * (core/reproject_tmpl.h). Bound: 0 ulp, checked by tests/checkasm/reproject.c. */
 struct fv_taa_frame;
 struct fv_taa_tile;
 struct fv_taa_flow;

@@ -14,7 +14,8 @@
  *                    accw = accw + ((wt00 + wt01) + (wt10 + wt11))
  *   out_blend(px, acc, accw, alpha)   h = acc / accw; px.rgb = h + alpha (px.rgb - h)
  *   sample_mask(wgt, n)               bit i set where wgt[i] == 1 (n <= 64)
- * (an ISA that defines TAA_OWN_BLEND needs none of these and writes its own blend).
+ * (an ISA that defines TAA_OWN_BLEND writes its own blend and may hand samples its vector path
+ * does not take to taa_taps, which needs tap, acc4 and out_blend).
  * The blend's per-sample arithmetic is scalar IEEE code here, identical for all ISAs; the fill
  * has a scalar form here (the reference, and the ISAs' row edges) that the ISA files vectorise
  * across pixels with the same operations per lane. */
@@ -41,8 +42,8 @@ static inline int taa_level(float f, int max_level)
 static const float taa_pow2[8] = {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f, 128.0f};
 static const float taa_inv_pow2[8] = {1.0f, 0.5f, 0.25f, 0.125f, 0.0625f, 0.03125f, 0.015625f, 0.0078125f};
 
-#ifndef TAA_OWN_BLEND /* an ISA may vectorise the blend across samples instead */
-/* A sample between its projection and its taps (the blend's two halves, below). */
+/* A sample between its projection and its taps (the blend's two halves, below; an ISA that
+ * blends several samples per step sends the samples its vector path does not take here). */
 typedef struct {
     float *px;          /* the sample (r, g, b, depth) */
     float u, v, z;      /* its previous pixel and view depth */
@@ -83,6 +84,17 @@ static inline __attribute__((always_inline)) void taa_taps(const struct fv_taa_f
     out_blend(q->px, acc, accw, a1 > t->alpha ? a1 : t->alpha);
 }
 
+/* The blend's per-sample footprint: pyramid level and quincunx half extent (taps when >= 1/8). */
+static inline int taa_footprint(const struct fv_taa_frame *f, float fp, float *o_out)
+{
+    const int l = taa_level(fp, f->max_level);
+    const float ts = taa_pow2[l];
+    float o = (fp - ts) * 0.5f;
+    *o_out = o < 0.5f * ts ? o : 0.5f * ts;
+    return l;
+}
+
+#ifndef TAA_OWN_BLEND /* an ISA may vectorise the blend across samples instead */
 static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
                               const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
                               struct fv_taa_flow *flow)
@@ -132,10 +144,9 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
             if (keep_sample)
                 continue; /* history has no weight here: the sample stays exactly as traced */
             const float fp = (d * rz) * t->widen;
-            const int l = taa_level(fp, f->max_level);
-            const float ts = taa_pow2[l], inv_ts = taa_inv_pow2[l];
-            float o = (fp - ts) * 0.5f;
-            o = o < 0.5f * ts ? o : 0.5f * ts;
+            float o;
+            const int l = taa_footprint(f, fp, &o);
+            const float inv_ts = taa_inv_pow2[l];
             taa_pending *q = &ring[head++ % TAA_RING];
             q->px = px;
             q->u = u;

@@ -1,4 +1,6 @@
-/* fovea: temporal reprojection kernels, NEON: one texel = one float32x4_t (r, g, b, depth).
+/* fovea: temporal reprojection kernels, NEON. The blend takes four samples a step (the design
+ * of core/x86/reproject_avx2.c at four lanes: single level-0 taps in SoA form, wider footprints
+ * through the shared scalar taps, where one texel = one float32x4_t (r, g, b, depth)).
  * Same operations in the same order as the reference (no fused multiply-add intrinsics; the
  * tree is built with -ffp-contract=off): bit-identical. Row loops and scalar arithmetic:
  * core/reproject_tmpl.h. */
@@ -63,7 +65,225 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 }
 
 #define TAA_FN(name) name##_neon
+#define TAA_OWN_BLEND /* four samples a step, below */
 #include "reproject_tmpl.h"
+
+/* four pixel vectors <-> four channel vectors (a 4x4 transpose) */
+static inline void transpose4(float32x4_t p0, float32x4_t p1, float32x4_t p2, float32x4_t p3, float32x4_t *c0,
+                              float32x4_t *c1, float32x4_t *c2, float32x4_t *c3)
+{
+    const float32x4_t a0 = vtrn1q_f32(p0, p1), a1 = vtrn2q_f32(p0, p1);
+    const float32x4_t a2 = vtrn1q_f32(p2, p3), a3 = vtrn2q_f32(p2, p3);
+    *c0 = vreinterpretq_f32_f64(vtrn1q_f64(vreinterpretq_f64_f32(a0), vreinterpretq_f64_f32(a2)));
+    *c1 = vreinterpretq_f32_f64(vtrn1q_f64(vreinterpretq_f64_f32(a1), vreinterpretq_f64_f32(a3)));
+    *c2 = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(a0), vreinterpretq_f64_f32(a2)));
+    *c3 = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(a1), vreinterpretq_f64_f32(a3)));
+}
+
+static inline unsigned lane_bits(uint32x4_t m)
+{
+    static const uint32_t bits[4] = {1, 2, 4, 8};
+    return vaddvq_u32(vandq_u32(m, vld1q_u32(bits)));
+}
+
+/* x > y ? x : y, NaN-exact like the reference's ternaries (vmaxq would propagate a NaN) */
+static inline float32x4_t sel_gt(float32x4_t x, float32x4_t y) { return vbslq_f32(vcgtq_f32(x, y), x, y); }
+
+typedef struct {
+    float32x4_t R, G, B, D, u, v, z, inv_tol; /* the samples and their projection */
+    int32_t off[4];                           /* each sample's pixel offset from the block */
+    int32_t oi[4];                            /* level-0 offset of each single tap's texel 00 */
+    unsigned sm;                              /* lanes whose single tap is pending */
+} taa_group;
+
+/* A group of four samples (core/x86/reproject_avx2.c has the eight-lane twin and the design):
+ * projection and flow sums in sample order; single level-0 taps left pending in g with their
+ * history prefetched; wider footprints through the scalar taps at once. */
+static inline unsigned group_project(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                                     const int32_t off[4], const int32_t xs[4], const int32_t ys[4], int n,
+                                     int keep_sample, float *fdx, float *fdy, float *fn, taa_group *g)
+{
+#define PX(k) (rgbd_blk + 4 * (ptrdiff_t)off[k])
+    float32x4_t R, G, B, D;
+    transpose4(vld1q_f32(PX(0)), vld1q_f32(PX(1)), vld1q_f32(PX(2)), vld1q_f32(PX(3)), &R, &G, &B, &D);
+    const float32x4_t half = vdupq_n_f32(0.5f), one = vdupq_n_f32(1.0f), zero = vdupq_n_f32(0.0f);
+    const float32x4_t pxc = vaddq_f32(vcvtq_f32_s32(vld1q_s32(xs)), half), py = vaddq_f32(vcvtq_f32_s32(vld1q_s32(ys)), half);
+    float32x4_t u, v, z, rz;
+    uint32x4_t valid;
+    if (f->identity) {
+        u = pxc, v = py, z = D;
+        rz = vdivq_f32(one, z);
+        valid = vdupq_n_u32(~0u);
+    } else {
+        float32x4_t c[3];
+        for (int k = 0; k < 3; k++) {
+            const float32x4_t b = vaddq_f32(vdupq_n_f32(f->M0[k]), vmulq_f32(py, vdupq_n_f32(f->MY[k])));
+            c[k] = vaddq_f32(vdupq_n_f32(f->T[k]), vmulq_f32(D, vaddq_f32(b, vmulq_f32(pxc, vdupq_n_f32(f->MX[k])))));
+        }
+        z = c[2];
+        valid = vcgtq_f32(z, vdupq_n_f32(1e-4f));
+        rz = vdivq_f32(one, z);
+        u = vmulq_f32(c[0], rz);
+        v = vmulq_f32(c[1], rz);
+    }
+    valid = vandq_u32(valid, vandq_u32(vandq_u32(vcgeq_f32(u, zero), vcltq_f32(u, vdupq_n_f32(f->prev_w))),
+                                       vandq_u32(vcgeq_f32(v, zero), vcltq_f32(v, vdupq_n_f32(f->prev_h)))));
+    const unsigned vm = lane_bits(valid) & ((1u << n) - 1u);
+    if (!vm)
+        return 0;
+    { /* the flow sums, in sample order as the reference adds them */
+        float du[4], dv[4];
+        vst1q_f32(du, vsubq_f32(u, pxc));
+        vst1q_f32(dv, vsubq_f32(v, py));
+        float sx = *fdx, sy = *fdy, sn = *fn;
+        for (unsigned m = vm; m; m &= m - 1) {
+            const int k = __builtin_ctz(m);
+            sx = sx + du[k], sy = sy + dv[k], sn = sn + 1.0f;
+        }
+        *fdx = sx, *fdy = sy, *fn = sn;
+    }
+    if (keep_sample)
+        return 0; /* history has no weight here: the samples stay exactly as traced */
+    const float32x4_t fp = vmulq_f32(vmulq_f32(D, rz), vdupq_n_f32(t->widen));
+    float32x4_t o = vmulq_f32(vsubq_f32(fp, one), half);
+    o = vbslq_f32(vcltq_f32(o, half), o, half); /* o < 0.5 ? o : 0.5 */
+    const uint32x4_t wide = vorrq_u32(vcgeq_f32(fp, vdupq_n_f32(2.0f)), vcgeq_f32(o, vdupq_n_f32(0.125f)));
+    const unsigned sm = lane_bits(vbicq_u32(valid, wide)) & vm;
+    const float32x4_t inv_tol = vmulq_f32(rz, vdupq_n_f32(f->inv_depth_tol));
+    if (sm != vm) { /* wider footprints: the scalar taps */
+        float uu[4], vv[4], zz[4], it[4], ff[4];
+        vst1q_f32(uu, u), vst1q_f32(vv, v), vst1q_f32(zz, z), vst1q_f32(it, inv_tol), vst1q_f32(ff, fp);
+        for (unsigned m = vm & ~sm; m; m &= m - 1) {
+            const int k = __builtin_ctz(m);
+            taa_pending q;
+            q.px = PX(k);
+            q.u = uu[k], q.v = vv[k], q.z = zz[k], q.inv_tol = it[k];
+            q.l = taa_footprint(f, ff[k], &q.o);
+            taa_taps(f, t, &q);
+        }
+    }
+#undef PX
+    if (!sm)
+        return 0;
+    const fv_pyr_level *L = &f->hist->lv[0];
+    int32x4_t o00 = vaddq_s32(vmulq_s32(vcvtq_s32_f32(vrndmq_f32(vsubq_f32(v, half))), vdupq_n_s32((int32_t)L->stride)),
+                              vcvtq_s32_f32(vrndmq_f32(vsubq_f32(u, half))));
+    const uint32x4_t single_lanes = vtstq_u32(vdupq_n_u32(sm), (uint32x4_t){1, 2, 4, 8});
+    o00 = vandq_s32(o00, vreinterpretq_s32_u32(single_lanes)); /* other lanes read texel (0, 0) */
+    vst1q_s32(g->oi, o00);
+    for (int k = 0; k < 4; k++) {
+        const float *c = L->rgbd + 4 * (ptrdiff_t)g->oi[k], *wr = L->wgt + g->oi[k];
+        __builtin_prefetch(c);
+        __builtin_prefetch(c + 4 * L->stride);
+        __builtin_prefetch(wr);
+        __builtin_prefetch(wr + L->stride);
+    }
+    for (int k = 0; k < 4; k++)
+        g->off[k] = off[k];
+    g->R = R, g->G = G, g->B = B, g->D = D, g->u = u, g->v = v, g->z = z, g->inv_tol = inv_tol;
+    g->sm = sm;
+    return sm;
+}
+
+static inline void group_taps(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                              const taa_group *g)
+{
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const float32x4_t half = vdupq_n_f32(0.5f), one = vdupq_n_f32(1.0f), zero = vdupq_n_f32(0.0f);
+    const float32x4_t z = g->z, inv_tol = g->inv_tol;
+    const int32_t *oi = g->oi;
+    const float32x4_t s = vsubq_f32(g->u, half), tt = vsubq_f32(g->v, half);
+    const float32x4_t fx = vsubq_f32(s, vrndmq_f32(s)), fy = vsubq_f32(tt, vrndmq_f32(tt));
+    const float32x4_t omx = vsubq_f32(one, fx), omy = vsubq_f32(one, fy);
+    const float *h0 = L->rgbd, *h1 = L->rgbd + 4 * L->stride;
+#define T(h, k, dx) vld1q_f32(h + 4 * (ptrdiff_t)oi[k] + (dx))
+    float32x4_t c00[4], c10[4], c01[4], c11[4]; /* r, g, b, depth of each texel of the four samples */
+    transpose4(T(h0, 0, 0), T(h0, 1, 0), T(h0, 2, 0), T(h0, 3, 0), &c00[0], &c00[1], &c00[2], &c00[3]);
+    transpose4(T(h0, 0, 4), T(h0, 1, 4), T(h0, 2, 4), T(h0, 3, 4), &c10[0], &c10[1], &c10[2], &c10[3]);
+    transpose4(T(h1, 0, 0), T(h1, 1, 0), T(h1, 2, 0), T(h1, 3, 0), &c01[0], &c01[1], &c01[2], &c01[3]);
+    transpose4(T(h1, 0, 4), T(h1, 1, 4), T(h1, 2, 4), T(h1, 3, 4), &c11[0], &c11[1], &c11[2], &c11[3]);
+#undef T
+    const float *w0 = L->wgt, *w1 = L->wgt + L->stride;
+    const float32x4_t q0 = vcombine_f32(vld1_f32(w0 + oi[0]), vld1_f32(w0 + oi[1]));
+    const float32x4_t q1 = vcombine_f32(vld1_f32(w0 + oi[2]), vld1_f32(w0 + oi[3]));
+    const float32x4_t q2 = vcombine_f32(vld1_f32(w1 + oi[0]), vld1_f32(w1 + oi[1]));
+    const float32x4_t q3 = vcombine_f32(vld1_f32(w1 + oi[2]), vld1_f32(w1 + oi[3]));
+    const float32x4_t W00 = vuzp1q_f32(q0, q1), W10 = vuzp2q_f32(q0, q1);
+    const float32x4_t W01 = vuzp1q_f32(q2, q3), W11 = vuzp2q_f32(q2, q3);
+#define AGREE(d) sel_gt(vsubq_f32(one, vmulq_f32(vabsq_f32(vsubq_f32(d, z)), inv_tol)), zero)
+    const float32x4_t w00 = vmulq_f32(vmulq_f32(vmulq_f32(omx, omy), W00), AGREE(c00[3]));
+    const float32x4_t w01 = vmulq_f32(vmulq_f32(vmulq_f32(omx, fy), W01), AGREE(c01[3]));
+    const float32x4_t w10 = vmulq_f32(vmulq_f32(vmulq_f32(fx, omy), W10), AGREE(c10[3]));
+    const float32x4_t w11 = vmulq_f32(vmulq_f32(vmulq_f32(fx, fy), W11), AGREE(c11[3]));
+#undef AGREE
+    const float32x4_t accw = vaddq_f32(zero, vaddq_f32(vaddq_f32(w00, w01), vaddq_f32(w10, w11)));
+    const uint32x4_t ok = vcgtq_f32(accw, zero);
+    const unsigned bm = lane_bits(ok) & g->sm;
+    if (!bm)
+        return; /* no valid history: the samples stand alone */
+    const float32x4_t alpha = sel_gt(vsubq_f32(one, accw), vdupq_n_f32(t->alpha)); /* a1 > alpha ? a1 : alpha */
+    const float32x4_t px[3] = {g->R, g->G, g->B};
+    float32x4_t res[3];
+    for (int c = 0; c < 3; c++) {
+        const float32x4_t acc = vaddq_f32(zero, vaddq_f32(vaddq_f32(vmulq_f32(w00, c00[c]), vmulq_f32(w01, c01[c])),
+                                                          vaddq_f32(vmulq_f32(w10, c10[c]), vmulq_f32(w11, c11[c]))));
+        const float32x4_t hh = vdivq_f32(acc, accw);
+        res[c] = vbslq_f32(ok, vaddq_f32(hh, vmulq_f32(alpha, vsubq_f32(px[c], hh))), px[c]);
+    }
+    float32x4_t pk[4];
+    transpose4(res[0], res[1], res[2], g->D, &pk[0], &pk[1], &pk[2], &pk[3]);
+    for (unsigned m = g->sm == 0xfu ? 0xfu : bm; m; m &= m - 1) { /* all four: those without history unchanged */
+        const int k = __builtin_ctz(m);
+        vst1q_f32(rgbd_blk + 4 * (ptrdiff_t)g->off[k], pk[k]);
+    }
+}
+
+/* Groups run their taps TAA_GROUP_DIST groups (16 samples) after their projection. */
+#define TAA_GROUP_DIST 4
+#define TAA_GROUP_RING 8
+#define TAA_CHUNK_ROWS 16
+
+static void taa_blend_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                           const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
+                           struct fv_taa_flow *flow)
+{
+    float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
+    const int keep_sample = t->alpha >= 1.0f;
+    int32_t off[64 * TAA_CHUNK_ROWS + 4], xs[64 * TAA_CHUNK_ROWS + 4], ys[64 * TAA_CHUNK_ROWS + 4];
+    taa_group ring[TAA_GROUP_RING];
+    unsigned head = 0, tail = 0;
+    for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
+        int n = 0;
+        for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
+            uint64_t m = sample_mask(wgt_blk + r * stride, w);
+            const int32_t ro = (int32_t)(r * stride), y = y0 + r;
+            while (m) {
+                const int i = __builtin_ctzll(m);
+                m &= m - 1;
+                off[n] = ro + i;
+                xs[n] = x0 + i;
+                ys[n] = y;
+                n++;
+                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
+            }
+        }
+        for (int k = n; k < ((n + 3) & ~3); k++) /* idle lanes of the last group repeat its first sample */
+            off[k] = off[n & ~3], xs[k] = xs[n & ~3], ys[k] = ys[n & ~3];
+        for (int k = 0; k < n; k += 4) {
+            const int nk = n - k < 4 ? n - k : 4;
+            if (group_project(f, t, rgbd_blk, off + k, xs + k, ys + k, nk, keep_sample, &fdx, &fdy, &fn,
+                              &ring[head % TAA_GROUP_RING]))
+                head++;
+            if (head - tail > TAA_GROUP_DIST)
+                group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
+        }
+    }
+    while (tail != head)
+        group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
+    flow->dx = fdx;
+    flow->dy = fdy;
+    flow->n = fn;
+}
 
 /* The fill, four pixels at a time (vld4 / vst4 de-interleave r, g, b, depth): each lane does the
  * reference's operations (taa_fill_px). */

@@ -1,13 +1,17 @@
-/* fovea: temporal reprojection kernels, AVX2. The blend goes sample by sample (the shared loop
- * of core/reproject_tmpl.h) with each bilinear tap's two texel rows as one 256-bit load each;
- * the fill takes eight pixels at a time. Same operations in the same order as the reference
- * (built with -mfma but -ffp-contract=off, no FMA intrinsics): bit-identical.
- * (Blending eight samples at a time, with AVX2 gathers or with 128-bit loads and transposes,
- * measured 3.5x and 1.8x slower than this on the project's AMD EPYC machines: the taps of
- * neighbouring samples are scattered, and the per-sample chain overlaps well out of order.) */
+/* fovea: temporal reprojection kernels, AVX2. The blend takes eight samples a step: the tile's
+ * samples are gathered in row-major groups of eight, projected lane by lane, and where the
+ * footprint is one texel of level 0 (the default configuration, a dense rotating history) the
+ * single bilinear tap runs in SoA form (each sample's two texel rows one 256-bit load each, 8x8
+ * transposes); wider footprints go through the shared scalar taps. The fill takes eight pixels
+ * at a time. Same operations in the same order per lane as the reference (built with -mfma but
+ * -ffp-contract=off, no FMA intrinsics): bit-identical.
+ * (A first version was no faster than the per-sample loop: its taps waited on history misses
+ * one group at a time and its per-lane loops over arrays of vectors went through the stack;
+ * here groups are prefetched two ahead and the per-lane code is straight-line; docs/reproject.md.) */
 #include <immintrin.h>
 
 #include <stdint.h>
+#include <string.h>
 
 #include "reproject_dsp.h"
 #include "reproject.h"
@@ -45,17 +49,305 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 }
 
 #define TAA_FN FV_X86_FN
+#define TAA_OWN_BLEND /* eight samples a step, below */
 #include "../reproject_tmpl.h" /* the row loops every ISA shares */
 
-static inline __m256 pair(__m128 lo, __m128 hi) { return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1); }
+/* Lanes k and k + 4 of eight 256-bit rows -> in-lane 4x4 transposes: with x[k] holding sample k's
+ * (c0, c1, c2, c3 | c0', c1', c2', c3'), returns c0..c3 (out[0..3]) and c0'..c3' (out[4..7]) as
+ * vectors of the eight samples (lanes 0-3: samples 0-3, lanes 4-7: samples 4-7). */
+#define SOA4(a0, a1, a2, a3, o0, o1, o2, o3)                                                        \
+    do {                                                                                            \
+        const __m256 t0_ = _mm256_unpacklo_ps(a0, a1), t1_ = _mm256_unpackhi_ps(a0, a1);            \
+        const __m256 t2_ = _mm256_unpacklo_ps(a2, a3), t3_ = _mm256_unpackhi_ps(a2, a3);            \
+        o0 = _mm256_shuffle_ps(t0_, t2_, _MM_SHUFFLE(1, 0, 1, 0));                                  \
+        o1 = _mm256_shuffle_ps(t0_, t2_, _MM_SHUFFLE(3, 2, 3, 2));                                  \
+        o2 = _mm256_shuffle_ps(t1_, t3_, _MM_SHUFFLE(1, 0, 1, 0));                                  \
+        o3 = _mm256_shuffle_ps(t1_, t3_, _MM_SHUFFLE(3, 2, 3, 2));                                  \
+    } while (0)
+#define SOA8(x, out)                                                                                 \
+    do {                                                                                            \
+        SOA4(_mm256_permute2f128_ps(x[0], x[4], 0x20), _mm256_permute2f128_ps(x[1], x[5], 0x20),     \
+             _mm256_permute2f128_ps(x[2], x[6], 0x20), _mm256_permute2f128_ps(x[3], x[7], 0x20),     \
+             out[0], out[1], out[2], out[3]);                                                       \
+        SOA4(_mm256_permute2f128_ps(x[0], x[4], 0x31), _mm256_permute2f128_ps(x[1], x[5], 0x31),     \
+             _mm256_permute2f128_ps(x[2], x[6], 0x31), _mm256_permute2f128_ps(x[3], x[7], 0x31),     \
+             out[4], out[5], out[6], out[7]);                                                       \
+    } while (0)
 
-/* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). */
-static inline int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                              const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
+/* Two floats (a weight and its right neighbour's) at p + o[k] for eight samples k -> the first and
+ * the second as vectors of the eight samples (lane order as SOA8). */
+static inline __attribute__((always_inline)) void soa8_pairs(const float *p, const int32_t o[8], __m256 *first,
+                                                             __m256 *second)
+{
+#define PAIR(k) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + o[k])))), \
+                                     _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + o[k + 4]))), 1)
+    const __m256 q0 = PAIR(0), q1 = PAIR(1), q2 = PAIR(2), q3 = PAIR(3);
+#undef PAIR
+    const __m256 a = _mm256_unpacklo_ps(q0, q1), b = _mm256_unpacklo_ps(q2, q3);
+    *first = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(1, 0, 1, 0));
+    *second = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 2, 3, 2));
+}
+
+typedef struct {
+    __m256 R, G, B, D, u, v, z, inv_tol; /* the samples and their projection */
+    int32_t off[8];                      /* each sample's pixel offset from the block */
+    int32_t oi[8];                       /* level-0 offset of each single tap's texel 00 */
+    unsigned sm;                         /* lanes whose single tap is pending */
+} taa_group;
+
+/* A group of eight samples in row-major order (off[]: pixel offsets from rgbd_blk; xs[], ys[]:
+ * pixel coordinates; lanes n..7 repeat an earlier sample and are never written), projected as
+ * the reference does, lane by lane (core/reproject_tmpl.h): the flow sums are added in sample
+ * order; where the footprint is one texel of level 0 (the default configuration: a dense
+ * rotating history) the single tap is left pending in g with its history prefetched; samples
+ * with wider footprints take the scalar taps at once. Returns the pending lanes. */
+static inline __attribute__((always_inline)) unsigned group_project(const struct fv_taa_frame *f,
+                                                                    const struct fv_taa_tile *t, float *rgbd_blk,
+                                                                    const int32_t off[8], const int32_t xs[8],
+                                                                    const int32_t ys[8], int n, int keep_sample,
+                                                                    float *fdx, float *fdy, float *fn, taa_group *g)
+{
+#define PX(k) (rgbd_blk + 4 * (ptrdiff_t)off[k])
+#define LD2(k) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(PX(k))), _mm_loadu_ps(PX(k + 4)), 1)
+    __m256 R, G, B, D;
+    SOA4(LD2(0), LD2(1), LD2(2), LD2(3), R, G, B, D); /* samples 0-3 | 4-7 as r, g, b, depth */
+#undef LD2
+    const __m256i xi = _mm256_loadu_si256((const __m256i *)xs), yi = _mm256_loadu_si256((const __m256i *)ys);
+    const __m256 half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+    const __m256 pxc = _mm256_add_ps(_mm256_cvtepi32_ps(xi), half), py = _mm256_add_ps(_mm256_cvtepi32_ps(yi), half);
+    __m256 u, v, z, rz, valid;
+    if (f->identity) {
+        u = pxc, v = py, z = D;
+        rz = _mm256_div_ps(one, z);
+        valid = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    } else {
+        __m256 c[3];
+        for (int k = 0; k < 3; k++) {
+            const __m256 b = _mm256_add_ps(_mm256_set1_ps(f->M0[k]), _mm256_mul_ps(py, _mm256_set1_ps(f->MY[k])));
+            c[k] = _mm256_add_ps(_mm256_set1_ps(f->T[k]),
+                                 _mm256_mul_ps(D, _mm256_add_ps(b, _mm256_mul_ps(pxc, _mm256_set1_ps(f->MX[k])))));
+        }
+        z = c[2];
+        valid = _mm256_cmp_ps(z, _mm256_set1_ps(1e-4f), _CMP_GT_OQ);
+        rz = _mm256_div_ps(one, z);
+        u = _mm256_mul_ps(c[0], rz);
+        v = _mm256_mul_ps(c[1], rz);
+    }
+    valid = _mm256_and_ps(valid, _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ),
+                                                             _mm256_cmp_ps(u, _mm256_set1_ps(f->prev_w), _CMP_LT_OQ)),
+                                               _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GE_OQ),
+                                                             _mm256_cmp_ps(v, _mm256_set1_ps(f->prev_h), _CMP_LT_OQ))));
+    const unsigned vm = (unsigned)_mm256_movemask_ps(valid) & ((1u << n) - 1u);
+    if (!vm)
+        return 0;
+    { /* the flow sums, in sample order as the reference adds them */
+        float du[8], dv[8];
+        _mm256_storeu_ps(du, _mm256_sub_ps(u, pxc));
+        _mm256_storeu_ps(dv, _mm256_sub_ps(v, py));
+        float sx = *fdx, sy = *fdy, sn = *fn;
+        if (vm == 0xffu) {
+            for (int k = 0; k < 8; k++) /* unrolled by the compiler: no branch per lane */
+                sx = sx + du[k], sy = sy + dv[k], sn = sn + 1.0f;
+        } else {
+            for (unsigned m = vm; m; m &= m - 1) {
+                const int k = __builtin_ctz(m);
+                sx = sx + du[k], sy = sy + dv[k], sn = sn + 1.0f;
+            }
+        }
+        *fdx = sx, *fdy = sy, *fn = sn;
+    }
+    if (keep_sample)
+        return 0; /* history has no weight here: the samples stay exactly as traced */
+    /* footprint: one texel of level 0 where !(fp >= 2) and the half extent o < 1/8 */
+    const __m256 fp = _mm256_mul_ps(_mm256_mul_ps(D, rz), _mm256_set1_ps(t->widen));
+    __m256 o = _mm256_mul_ps(_mm256_sub_ps(fp, one), half);
+    o = _mm256_blendv_ps(half, o, _mm256_cmp_ps(o, half, _CMP_LT_OQ)); /* o < 0.5 ? o : 0.5 */
+    const __m256 single = _mm256_andnot_ps(_mm256_or_ps(_mm256_cmp_ps(fp, _mm256_set1_ps(2.0f), _CMP_GE_OQ),
+                                                        _mm256_cmp_ps(o, _mm256_set1_ps(0.125f), _CMP_GE_OQ)),
+                                           valid);
+    const unsigned sm = (unsigned)_mm256_movemask_ps(single) & vm;
+    const __m256 inv_tol = _mm256_mul_ps(rz, _mm256_set1_ps(f->inv_depth_tol));
+    if (sm != vm) { /* wider footprints: the scalar taps (rare in the default configuration) */
+        float uu[8], vv[8], zz[8], it[8], ff[8];
+        _mm256_storeu_ps(uu, u), _mm256_storeu_ps(vv, v), _mm256_storeu_ps(zz, z);
+        _mm256_storeu_ps(it, inv_tol), _mm256_storeu_ps(ff, fp);
+        for (unsigned m = vm & ~sm; m; m &= m - 1) {
+            const int k = __builtin_ctz(m);
+            taa_pending q;
+            q.px = PX(k);
+            q.u = uu[k], q.v = vv[k], q.z = zz[k], q.inv_tol = it[k];
+            q.l = taa_footprint(f, ff[k], &q.o);
+            taa_taps(f, t, &q);
+        }
+    }
+#undef PX
+    if (!sm)
+        return 0;
+    /* the single tap reads texels floor(u - 0.5), floor(v - 0.5) and their neighbours at level 0:
+     * prefetch their lines now, the taps run TAA_GROUP_DIST groups later */
+    const fv_pyr_level *L = &f->hist->lv[0];
+    __m256i o00 = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(v, half))),
+                                                      _mm256_set1_epi32((int)L->stride)),
+                                   _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(u, half))));
+    o00 = _mm256_and_si256(o00, _mm256_castps_si256(single)); /* other lanes read texel (0, 0) */
+    _mm256_storeu_si256((__m256i *)g->oi, o00);
+    for (int k = 0; k < 8; k++) { /* unrolled; idle lanes prefetch texel (0, 0), harmless */
+        const float *c = L->rgbd + 4 * (ptrdiff_t)g->oi[k], *wr = L->wgt + g->oi[k];
+        _mm_prefetch((const char *)c, _MM_HINT_T0);
+        _mm_prefetch((const char *)(c + 4 * L->stride), _MM_HINT_T0);
+        _mm_prefetch((const char *)wr, _MM_HINT_T0);
+        _mm_prefetch((const char *)(wr + L->stride), _MM_HINT_T0);
+    }
+    memcpy(g->off, off, sizeof g->off);
+    g->R = R, g->G = G, g->B = B, g->D = D, g->u = u, g->v = v, g->z = z, g->inv_tol = inv_tol;
+    g->sm = sm;
+    return sm;
+}
+
+/* The single taps of a projected group and the blend of its samples (the reference's tap at
+ * level 0 and out_blend, lane by lane). */
+static inline __attribute__((always_inline)) void group_taps(const struct fv_taa_frame *f,
+                                                             const struct fv_taa_tile *t, float *rgbd_blk,
+                                                             const taa_group *g)
+{
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const __m256 half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+    const __m256 z = g->z, inv_tol = g->inv_tol;
+    const int32_t *oi = g->oi;
+    /* s = u * 1 - 0.5, t = v * 1 - 0.5 */
+    const __m256 s = _mm256_sub_ps(g->u, half), tt = _mm256_sub_ps(g->v, half);
+    const __m256 fx = _mm256_sub_ps(s, _mm256_floor_ps(s)), fy = _mm256_sub_ps(tt, _mm256_floor_ps(tt));
+    const __m256 omx = _mm256_sub_ps(one, fx), omy = _mm256_sub_ps(one, fy);
+    const float *h0 = L->rgbd, *h1 = L->rgbd + 4 * L->stride;
+    __m256 x[8], ct[8], cb[8]; /* r, g, b, depth of texels 00, 10 (ct) and 01, 11 (cb) */
+#define LT(k) x[k] = _mm256_loadu_ps(h0 + 4 * (ptrdiff_t)oi[k]) /* c00 | c10 */
+    LT(0), LT(1), LT(2), LT(3), LT(4), LT(5), LT(6), LT(7);
+#undef LT
+    SOA8(x, ct);
+#define LB(k) x[k] = _mm256_loadu_ps(h1 + 4 * (ptrdiff_t)oi[k]) /* c01 | c11 */
+    LB(0), LB(1), LB(2), LB(3), LB(4), LB(5), LB(6), LB(7);
+#undef LB
+    SOA8(x, cb);
+    __m256 W00, W10, W01, W11;
+    soa8_pairs(L->wgt, oi, &W00, &W10);
+    soa8_pairs(L->wgt + L->stride, oi, &W01, &W11);
+    const __m256 absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+#define AGREE(d) _mm256_max_ps(_mm256_sub_ps(one, _mm256_mul_ps(_mm256_and_ps(_mm256_sub_ps(d, z), absmask), inv_tol)), zero)
+    const __m256 w00 = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(omx, omy), W00), AGREE(ct[3]));
+    const __m256 w01 = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(omx, fy), W01), AGREE(cb[3]));
+    const __m256 w10 = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(fx, omy), W10), AGREE(ct[7]));
+    const __m256 w11 = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(fx, fy), W11), AGREE(cb[7]));
+#undef AGREE
+    const __m256 accw = _mm256_add_ps(zero, _mm256_add_ps(_mm256_add_ps(w00, w01), _mm256_add_ps(w10, w11)));
+    const __m256 ok = _mm256_cmp_ps(accw, zero, _CMP_GT_OQ);
+    const unsigned bm = (unsigned)_mm256_movemask_ps(ok) & g->sm;
+    if (!bm)
+        return; /* no valid history: the samples stand alone */
+    const __m256 alpha = _mm256_max_ps(_mm256_sub_ps(one, accw), _mm256_set1_ps(t->alpha)); /* a1 > alpha ? a1 : alpha */
+    const __m256 px[3] = {g->R, g->G, g->B};
+    __m256 res[3];
+    for (int c = 0; c < 3; c++) {
+        const __m256 acc = _mm256_add_ps(zero, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w00, ct[c]), _mm256_mul_ps(w01, cb[c])),
+                                                             _mm256_add_ps(_mm256_mul_ps(w10, ct[4 + c]), _mm256_mul_ps(w11, cb[4 + c]))));
+        const __m256 hh = _mm256_div_ps(acc, accw);
+        /* lanes without history keep their colour (stored back unchanged below) */
+        res[c] = _mm256_blendv_ps(px[c], _mm256_add_ps(hh, _mm256_mul_ps(alpha, _mm256_sub_ps(px[c], hh))), ok);
+    }
+    /* back to pixels (r, g, b, depth: the depth stays the sample's), lanes k | k + 4 */
+    __m256 pk[4];
+    SOA4(res[0], res[1], res[2], g->D, pk[0], pk[1], pk[2], pk[3]);
+#define ST(k) _mm_storeu_ps(rgbd_blk + 4 * (ptrdiff_t)g->off[k], k < 4 ? _mm256_castps256_ps128(pk[k & 3]) \
+                                                                        : _mm256_extractf128_ps(pk[k & 3], 1))
+    if (g->sm == 0xffu) { /* every lane a pending sample: store all, those without history unchanged */
+        ST(0), ST(1), ST(2), ST(3), ST(4), ST(5), ST(6), ST(7);
+    } else {
+        for (unsigned m = bm; m; m &= m - 1) {
+            switch (__builtin_ctz(m)) {
+            case 0: ST(0); break;
+            case 1: ST(1); break;
+            case 2: ST(2); break;
+            case 3: ST(3); break;
+            case 4: ST(4); break;
+            case 5: ST(5); break;
+            case 6: ST(6); break;
+            default: ST(7); break;
+            }
+        }
+    }
+#undef ST
+}
+
+/* Groups are projected (flow sums in sample order) and their history prefetched; their taps run
+ * TAA_GROUP_DIST groups later, so the misses of 16 samples are in flight together (as the scalar
+ * ring of reproject_tmpl.h does one sample at a time). Blends change only their own samples'
+ * colours, which no projection reads: the result does not depend on the distance. */
+#define TAA_GROUP_DIST 2
+#define TAA_GROUP_RING 4 /* a power of two > TAA_GROUP_DIST */
+
+#define TAA_CHUNK_ROWS 16 /* rows collected before their groups run (64 x 16 samples at most) */
+
+static void taa_blend_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                           const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
+                           struct fv_taa_flow *flow)
+{
+    float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
+    const int keep_sample = t->alpha >= 1.0f;
+    /* The samples of up to 16 rows are listed first and grouped afterwards: the groups' 32-byte
+     * loads of the lists would otherwise wait on the just-made 4-byte stores (store forwarding
+     * fails; perf showed 7 % of the blend on one such load). */
+    int32_t off[64 * TAA_CHUNK_ROWS + 8], xs[64 * TAA_CHUNK_ROWS + 8], ys[64 * TAA_CHUNK_ROWS + 8];
+    taa_group ring[TAA_GROUP_RING];
+    unsigned head = 0, tail = 0;
+    for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
+        int n = 0;
+        for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
+            uint64_t m = sample_mask(wgt_blk + r * stride, w);
+            const int32_t ro = (int32_t)(r * stride), y = y0 + r;
+            while (m) {
+                const int i = __builtin_ctzll(m);
+                m &= m - 1;
+                off[n] = ro + i;
+                xs[n] = x0 + i;
+                ys[n] = y;
+                n++;
+                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
+            }
+        }
+        for (int k = n; k < ((n + 7) & ~7); k++) /* idle lanes of the last group repeat its first sample */
+            off[k] = off[n & ~7], xs[k] = xs[n & ~7], ys[k] = ys[n & ~7];
+        for (int k = 0; k < n; k += 8) {
+            const int nk = n - k < 8 ? n - k : 8;
+            if (group_project(f, t, rgbd_blk, off + k, xs + k, ys + k, nk, keep_sample, &fdx, &fdy, &fn,
+                              &ring[head % TAA_GROUP_RING]))
+                head++;
+            if (head - tail > TAA_GROUP_DIST)
+                group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
+        }
+    }
+    while (tail != head)
+        group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
+    flow->dx = fdx;
+    flow->dy = fdy;
+    flow->n = fn;
+}
+
+/* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). The
+ * history pixels stay as loaded, two per 256-bit register; their depths are taken out in the
+ * lane order 0, 2, 4, 6, 1, 3, 5, 7 (two shuffles), checked in that order, and only the depth
+ * lanes of the stored pixels are replaced. */
+static inline __attribute__((always_inline)) int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
+                                const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
 {
     const int sx0 = x0 + t->flow_x;
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), mhalf = _mm256_set1_ps(-0.5f);
-    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);       /* lane -> pixel of the depth order */
+    const __m256i to_linear = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);   /* depth order -> pixel order */
+    const __m256i pair_mask0 = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), pair_mask1 = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
+    const __m256i pair_mask2 = _mm256_setr_epi32(4, 4, 4, 4, 5, 5, 5, 5), pair_mask3 = _mm256_setr_epi32(6, 6, 6, 6, 7, 7, 7, 7);
+    __m256 T2[3], Bk[3], NX[3];
+    for (int k = 0; k < 3; k++)
+        T2[k] = _mm256_set1_ps(f->T2[k]), Bk[k] = _mm256_set1_ps(B[k]), NX[k] = _mm256_set1_ps(f->NX[k]);
+    const __m256 pyv = _mm256_set1_ps(py), zmin = _mm256_set1_ps(1e-4f), one = _mm256_set1_ps(1.0f);
     int i = ilo;
     for (; i + 8 <= ihi; i += 8) {
         const __m256 w = _mm256_loadu_ps(wgt + i);
@@ -65,43 +357,46 @@ static inline int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_ta
         if (!_mm256_movemask_ps(m))
             continue;
         const float *src = hrow + 4 * sx;
-        __m128 r0 = _mm_loadu_ps(src), g0 = _mm_loadu_ps(src + 4), b0 = _mm_loadu_ps(src + 8), z0 = _mm_loadu_ps(src + 12);
-        __m128 r1 = _mm_loadu_ps(src + 16), g1 = _mm_loadu_ps(src + 20), b1 = _mm_loadu_ps(src + 24),
-               z1 = _mm_loadu_ps(src + 28);
-        _MM_TRANSPOSE4_PS(r0, g0, b0, z0);
-        _MM_TRANSPOSE4_PS(r1, g1, b1, z1);
-        __m256 z = pair(z0, z1);
+        /* pixels 0|1, 2|3, 4|5, 6|7 (named, not an array: GCC copied an array through the stack in
+         * 16-byte halves, and the 32-byte reloads then missed store forwarding) */
+        __m256 p0 = _mm256_loadu_ps(src), p1 = _mm256_loadu_ps(src + 8), p2 = _mm256_loadu_ps(src + 16),
+               p3 = _mm256_loadu_ps(src + 24);
         if (!f->identity) {
-            const __m256 D = z;
+            const __m256 a = _mm256_unpackhi_ps(p0, p1), b = _mm256_unpackhi_ps(p2, p3);
+            const __m256 D = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 2, 3, 2)); /* depths 0, 2, 4, 6 | 1, 3, 5, 7 */
+            const __m256i lane = order;
             const __m256 uc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(sx), lane)), half);
             const __m256 pxc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x0 + i), lane)), half);
             __m256 c[3];
             for (int k = 0; k < 3; k++)
-                c[k] = _mm256_add_ps(_mm256_set1_ps(f->T2[k]),
-                                     _mm256_mul_ps(D, _mm256_add_ps(_mm256_set1_ps(B[k]),
-                                                                    _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[k])))));
-            z = c[2];
-            const __m256 rz = _mm256_div_ps(_mm256_set1_ps(1.0f), z);
+                c[k] = _mm256_add_ps(T2[k], _mm256_mul_ps(D, _mm256_add_ps(Bk[k], _mm256_mul_ps(uc, NX[k]))));
+            const __m256 z = c[2];
+            const __m256 rz = _mm256_div_ps(one, z);
             const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(c[0], rz), pxc);
-            const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(c[1], rz), _mm256_set1_ps(py));
-            const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
-                                            _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ)));
-            m = _mm256_and_ps(m, _mm256_and_ps(_mm256_cmp_ps(z, _mm256_set1_ps(1e-4f), _CMP_GT_OQ), ok));
+            const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(c[1], rz), pyv);
+            const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
+                                                          _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ))),
+                                            _mm256_cmp_ps(z, zmin, _CMP_GT_OQ));
+            m = _mm256_and_ps(m, _mm256_permutevar8x32_ps(ok, to_linear));
             if (!_mm256_movemask_ps(m))
                 continue;
-            z0 = _mm256_castps256_ps128(z);
-            z1 = _mm256_extractf128_ps(z, 1);
+            /* this view's depth into lanes 3 and 7 of each pixel pair (z's element k of each half) */
+            p0 = _mm256_blend_ps(p0, _mm256_permute_ps(z, 0x00), 0x88);
+            p1 = _mm256_blend_ps(p1, _mm256_permute_ps(z, 0x55), 0x88);
+            p2 = _mm256_blend_ps(p2, _mm256_permute_ps(z, 0xaa), 0x88);
+            p3 = _mm256_blend_ps(p3, _mm256_permute_ps(z, 0xff), 0x88);
         }
-        _MM_TRANSPOSE4_PS(r0, g0, b0, z0); /* back to pixels (r, g, b, depth) */
-        _MM_TRANSPOSE4_PS(r1, g1, b1, z1);
         float *o = rgbd + 4 * i;
-        const __m256 p[4] = {pair(r0, g0), pair(b0, z0), pair(r1, g1), pair(b1, z1)}; /* pixels 0|1, 2|3, ... */
-        for (int k = 0; k < 4; k++) {
-            const __m256 mk = _mm256_permutevar8x32_ps(
-                m, _mm256_setr_epi32(2 * k, 2 * k, 2 * k, 2 * k, 2 * k + 1, 2 * k + 1, 2 * k + 1, 2 * k + 1));
-            _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), p[k], mk));
+        if (_mm256_movemask_ps(m) == 0xff) {
+            _mm256_storeu_ps(o, p0), _mm256_storeu_ps(o + 8, p1);
+            _mm256_storeu_ps(o + 16, p2), _mm256_storeu_ps(o + 24, p3);
+            _mm256_storeu_ps(wgt + i, ws);
+        } else {
+#define ST(k, pk) _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), pk, _mm256_permutevar8x32_ps(m, pair_mask##k)))
+            ST(0, p0), ST(1, p1), ST(2, p2), ST(3, p3);
+#undef ST
+            _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
         }
-        _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
     }
     return i;
 }

@@ -1,6 +1,7 @@
-/* fovea: temporal reprojection kernels, SSE4.1: one texel = one __m128 (r, g, b, depth). The
- * row loops and all scalar arithmetic are shared (core/reproject_tmpl.h); the accumulation
- * below does the reference's operations in the same order, so results are bit-identical. */
+/* fovea: temporal reprojection kernels, SSE4.1. The blend takes four samples a step (the design
+ * of core/x86/reproject_avx2.c at four lanes; wider footprints through the shared scalar taps,
+ * one texel = one __m128 (r, g, b, depth)); every lane does the reference's operations in the
+ * same order, so results are bit-identical. */
 #include <smmintrin.h>
 
 #include <stdint.h>
@@ -39,7 +40,211 @@ static inline uint64_t sample_mask(const float *wgt, int n)
 }
 
 #define TAA_FN FV_X86_FN
+#define TAA_OWN_BLEND /* four samples a step, below */
 #include "../reproject_tmpl.h" /* the row loops every ISA shares */
+
+/* four pixel vectors <-> four channel vectors */
+static inline void transpose4(__m128 p0, __m128 p1, __m128 p2, __m128 p3, __m128 *c0, __m128 *c1, __m128 *c2,
+                              __m128 *c3)
+{
+    _MM_TRANSPOSE4_PS(p0, p1, p2, p3);
+    *c0 = p0, *c1 = p1, *c2 = p2, *c3 = p3;
+}
+
+typedef struct {
+    __m128 R, G, B, D, u, v, z, inv_tol; /* the samples and their projection */
+    int32_t off[4];                      /* each sample's pixel offset from the block */
+    int32_t oi[4];                       /* level-0 offset of each single tap's texel 00 */
+    unsigned sm;                         /* lanes whose single tap is pending */
+} taa_group;
+
+/* A group of four samples (core/x86/reproject_avx2.c has the eight-lane twin and the design). */
+static inline unsigned group_project(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                                     const int32_t off[4], const int32_t xs[4], const int32_t ys[4], int n,
+                                     int keep_sample, float *fdx, float *fdy, float *fn, taa_group *g)
+{
+#define PX(k) (rgbd_blk + 4 * (ptrdiff_t)off[k])
+    __m128 R, G, B, D;
+    transpose4(_mm_loadu_ps(PX(0)), _mm_loadu_ps(PX(1)), _mm_loadu_ps(PX(2)), _mm_loadu_ps(PX(3)), &R, &G, &B, &D);
+    const __m128 half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+    const __m128 pxc = _mm_add_ps(_mm_cvtepi32_ps(_mm_loadu_si128((const __m128i *)xs)), half);
+    const __m128 py = _mm_add_ps(_mm_cvtepi32_ps(_mm_loadu_si128((const __m128i *)ys)), half);
+    __m128 u, v, z, rz, valid;
+    if (f->identity) {
+        u = pxc, v = py, z = D;
+        rz = _mm_div_ps(one, z);
+        valid = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    } else {
+        __m128 c[3];
+        for (int k = 0; k < 3; k++) {
+            const __m128 b = _mm_add_ps(_mm_set1_ps(f->M0[k]), _mm_mul_ps(py, _mm_set1_ps(f->MY[k])));
+            c[k] = _mm_add_ps(_mm_set1_ps(f->T[k]), _mm_mul_ps(D, _mm_add_ps(b, _mm_mul_ps(pxc, _mm_set1_ps(f->MX[k])))));
+        }
+        z = c[2];
+        valid = _mm_cmpgt_ps(z, _mm_set1_ps(1e-4f));
+        rz = _mm_div_ps(one, z);
+        u = _mm_mul_ps(c[0], rz);
+        v = _mm_mul_ps(c[1], rz);
+    }
+    valid = _mm_and_ps(valid, _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(u, zero), _mm_cmplt_ps(u, _mm_set1_ps(f->prev_w))),
+                                         _mm_and_ps(_mm_cmpge_ps(v, zero), _mm_cmplt_ps(v, _mm_set1_ps(f->prev_h)))));
+    const unsigned vm = (unsigned)_mm_movemask_ps(valid) & ((1u << n) - 1u);
+    if (!vm)
+        return 0;
+    { /* the flow sums, in sample order as the reference adds them */
+        float du[4], dv[4];
+        _mm_storeu_ps(du, _mm_sub_ps(u, pxc));
+        _mm_storeu_ps(dv, _mm_sub_ps(v, py));
+        float sx = *fdx, sy = *fdy, sn = *fn;
+        for (unsigned m = vm; m; m &= m - 1) {
+            const int k = __builtin_ctz(m);
+            sx = sx + du[k], sy = sy + dv[k], sn = sn + 1.0f;
+        }
+        *fdx = sx, *fdy = sy, *fn = sn;
+    }
+    if (keep_sample)
+        return 0; /* history has no weight here: the samples stay exactly as traced */
+    const __m128 fp = _mm_mul_ps(_mm_mul_ps(D, rz), _mm_set1_ps(t->widen));
+    __m128 o = _mm_mul_ps(_mm_sub_ps(fp, one), half);
+    o = _mm_blendv_ps(half, o, _mm_cmplt_ps(o, half)); /* o < 0.5 ? o : 0.5 */
+    const __m128 single = _mm_andnot_ps(_mm_or_ps(_mm_cmpge_ps(fp, _mm_set1_ps(2.0f)), _mm_cmpge_ps(o, _mm_set1_ps(0.125f))),
+                                        valid);
+    const unsigned sm = (unsigned)_mm_movemask_ps(single) & vm;
+    const __m128 inv_tol = _mm_mul_ps(rz, _mm_set1_ps(f->inv_depth_tol));
+    if (sm != vm) { /* wider footprints: the scalar taps */
+        float uu[4], vv[4], zz[4], it[4], ff[4];
+        _mm_storeu_ps(uu, u), _mm_storeu_ps(vv, v), _mm_storeu_ps(zz, z), _mm_storeu_ps(it, inv_tol), _mm_storeu_ps(ff, fp);
+        for (unsigned m = vm & ~sm; m; m &= m - 1) {
+            const int k = __builtin_ctz(m);
+            taa_pending q;
+            q.px = PX(k);
+            q.u = uu[k], q.v = vv[k], q.z = zz[k], q.inv_tol = it[k];
+            q.l = taa_footprint(f, ff[k], &q.o);
+            taa_taps(f, t, &q);
+        }
+    }
+#undef PX
+    if (!sm)
+        return 0;
+    const fv_pyr_level *L = &f->hist->lv[0];
+    __m128i o00 = _mm_add_epi32(_mm_mullo_epi32(_mm_cvttps_epi32(_mm_floor_ps(_mm_sub_ps(v, half))), _mm_set1_epi32((int)L->stride)),
+                                _mm_cvttps_epi32(_mm_floor_ps(_mm_sub_ps(u, half))));
+    o00 = _mm_and_si128(o00, _mm_castps_si128(single)); /* other lanes read texel (0, 0) */
+    _mm_storeu_si128((__m128i *)g->oi, o00);
+    for (int k = 0; k < 4; k++) {
+        const float *c = L->rgbd + 4 * (ptrdiff_t)g->oi[k], *wr = L->wgt + g->oi[k];
+        _mm_prefetch((const char *)c, _MM_HINT_T0);
+        _mm_prefetch((const char *)(c + 4 * L->stride), _MM_HINT_T0);
+        _mm_prefetch((const char *)wr, _MM_HINT_T0);
+        _mm_prefetch((const char *)(wr + L->stride), _MM_HINT_T0);
+    }
+    for (int k = 0; k < 4; k++)
+        g->off[k] = off[k];
+    g->R = R, g->G = G, g->B = B, g->D = D, g->u = u, g->v = v, g->z = z, g->inv_tol = inv_tol;
+    g->sm = sm;
+    return sm;
+}
+
+static inline void group_taps(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                              const taa_group *g)
+{
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const __m128 half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+    const __m128 z = g->z, inv_tol = g->inv_tol;
+    const int32_t *oi = g->oi;
+    const __m128 s = _mm_sub_ps(g->u, half), tt = _mm_sub_ps(g->v, half);
+    const __m128 fx = _mm_sub_ps(s, _mm_floor_ps(s)), fy = _mm_sub_ps(tt, _mm_floor_ps(tt));
+    const __m128 omx = _mm_sub_ps(one, fx), omy = _mm_sub_ps(one, fy);
+    const float *h0 = L->rgbd, *h1 = L->rgbd + 4 * L->stride;
+#define T(h, k, dx) _mm_loadu_ps(h + 4 * (ptrdiff_t)oi[k] + (dx))
+    __m128 c00[4], c10[4], c01[4], c11[4]; /* r, g, b, depth of each texel of the four samples */
+    transpose4(T(h0, 0, 0), T(h0, 1, 0), T(h0, 2, 0), T(h0, 3, 0), &c00[0], &c00[1], &c00[2], &c00[3]);
+    transpose4(T(h0, 0, 4), T(h0, 1, 4), T(h0, 2, 4), T(h0, 3, 4), &c10[0], &c10[1], &c10[2], &c10[3]);
+    transpose4(T(h1, 0, 0), T(h1, 1, 0), T(h1, 2, 0), T(h1, 3, 0), &c01[0], &c01[1], &c01[2], &c01[3]);
+    transpose4(T(h1, 0, 4), T(h1, 1, 4), T(h1, 2, 4), T(h1, 3, 4), &c11[0], &c11[1], &c11[2], &c11[3]);
+#undef T
+    const float *w0 = L->wgt, *w1 = L->wgt + L->stride;
+#define PR(p, a, b) _mm_movelh_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + oi[a]))), \
+                                  _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(p + oi[b]))))
+    const __m128 q0 = PR(w0, 0, 1), q1 = PR(w0, 2, 3), q2 = PR(w1, 0, 1), q3 = PR(w1, 2, 3);
+#undef PR
+    const __m128 W00 = _mm_shuffle_ps(q0, q1, _MM_SHUFFLE(2, 0, 2, 0)), W10 = _mm_shuffle_ps(q0, q1, _MM_SHUFFLE(3, 1, 3, 1));
+    const __m128 W01 = _mm_shuffle_ps(q2, q3, _MM_SHUFFLE(2, 0, 2, 0)), W11 = _mm_shuffle_ps(q2, q3, _MM_SHUFFLE(3, 1, 3, 1));
+    const __m128 absmask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+#define AGREE(d) _mm_max_ps(_mm_sub_ps(one, _mm_mul_ps(_mm_and_ps(_mm_sub_ps(d, z), absmask), inv_tol)), zero)
+    const __m128 w00 = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(omx, omy), W00), AGREE(c00[3]));
+    const __m128 w01 = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(omx, fy), W01), AGREE(c01[3]));
+    const __m128 w10 = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(fx, omy), W10), AGREE(c10[3]));
+    const __m128 w11 = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(fx, fy), W11), AGREE(c11[3]));
+#undef AGREE
+    const __m128 accw = _mm_add_ps(zero, _mm_add_ps(_mm_add_ps(w00, w01), _mm_add_ps(w10, w11)));
+    const __m128 ok = _mm_cmpgt_ps(accw, zero);
+    const unsigned bm = (unsigned)_mm_movemask_ps(ok) & g->sm;
+    if (!bm)
+        return; /* no valid history: the samples stand alone */
+    const __m128 alpha = _mm_max_ps(_mm_sub_ps(one, accw), _mm_set1_ps(t->alpha)); /* a1 > alpha ? a1 : alpha */
+    const __m128 px[3] = {g->R, g->G, g->B};
+    __m128 res[3];
+    for (int c = 0; c < 3; c++) {
+        const __m128 acc = _mm_add_ps(zero, _mm_add_ps(_mm_add_ps(_mm_mul_ps(w00, c00[c]), _mm_mul_ps(w01, c01[c])),
+                                                       _mm_add_ps(_mm_mul_ps(w10, c10[c]), _mm_mul_ps(w11, c11[c]))));
+        const __m128 hh = _mm_div_ps(acc, accw);
+        res[c] = _mm_blendv_ps(px[c], _mm_add_ps(hh, _mm_mul_ps(alpha, _mm_sub_ps(px[c], hh))), ok);
+    }
+    __m128 pk[4];
+    transpose4(res[0], res[1], res[2], g->D, &pk[0], &pk[1], &pk[2], &pk[3]);
+    for (unsigned m = g->sm == 0xfu ? 0xfu : bm; m; m &= m - 1) { /* all four: those without history unchanged */
+        const int k = __builtin_ctz(m);
+        _mm_storeu_ps(rgbd_blk + 4 * (ptrdiff_t)g->off[k], pk[k]);
+    }
+}
+
+/* Groups run their taps TAA_GROUP_DIST groups (16 samples) after their projection. */
+#define TAA_GROUP_DIST 4
+#define TAA_GROUP_RING 8
+#define TAA_CHUNK_ROWS 16
+
+static void taa_blend_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
+                            const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
+                            struct fv_taa_flow *flow)
+{
+    float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
+    const int keep_sample = t->alpha >= 1.0f;
+    int32_t off[64 * TAA_CHUNK_ROWS + 4], xs[64 * TAA_CHUNK_ROWS + 4], ys[64 * TAA_CHUNK_ROWS + 4];
+    taa_group ring[TAA_GROUP_RING];
+    unsigned head = 0, tail = 0;
+    for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
+        int n = 0;
+        for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
+            uint64_t m = sample_mask(wgt_blk + r * stride, w);
+            const int32_t ro = (int32_t)(r * stride), y = y0 + r;
+            while (m) {
+                const int i = __builtin_ctzll(m);
+                m &= m - 1;
+                off[n] = ro + i;
+                xs[n] = x0 + i;
+                ys[n] = y;
+                n++;
+                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
+            }
+        }
+        for (int k = n; k < ((n + 3) & ~3); k++) /* idle lanes of the last group repeat its first sample */
+            off[k] = off[n & ~3], xs[k] = xs[n & ~3], ys[k] = ys[n & ~3];
+        for (int k = 0; k < n; k += 4) {
+            const int nk = n - k < 4 ? n - k : 4;
+            if (group_project(f, t, rgbd_blk, off + k, xs + k, ys + k, nk, keep_sample, &fdx, &fdy, &fn,
+                              &ring[head % TAA_GROUP_RING]))
+                head++;
+            if (head - tail > TAA_GROUP_DIST)
+                group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
+        }
+    }
+    while (tail != head)
+        group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
+    flow->dx = fdx;
+    flow->dy = fdy;
+    flow->n = fn;
+}
 
 /* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px). */
 static inline int fill_vec_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,

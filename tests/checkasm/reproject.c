@@ -212,9 +212,11 @@ static void test_taa_blocks(void **state)
                     assert_int_equal(f.identity, motion == 0);
                     const int wmax = W < 64 ? W : 64;
                     for (int r = 0; r < 40; r++) {
-                        /* single rows of the edge-case widths first, then random blocks up to 64x16 */
+                        /* single rows of the edge-case widths first, then random blocks up to 64x16,
+                         * the last ones up to 64x40 (the SIMD blends list samples 16 rows at a time) */
                         int w = 1 + (int)(fv_test_rand(&checkasm_rng) % (unsigned)wmax);
-                        int h = r < 20 ? 1 : 1 + (int)(fv_test_rand(&checkasm_rng) % (unsigned)(H < 16 ? H : 16));
+                        const int hmax = r < 36 ? 16 : 40;
+                        int h = r < 20 ? 1 : 1 + (int)(fv_test_rand(&checkasm_rng) % (unsigned)(H < hmax ? H : hmax));
                         if (r < NSIZES && sizes[r] <= wmax)
                             w = sizes[r];
                         const int pad = (int)(fv_test_rand(&checkasm_rng) % 6), off = (int)(fv_test_rand(&checkasm_rng) % 4);
