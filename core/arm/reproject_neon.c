@@ -238,52 +238,10 @@ static inline void group_taps(const struct fv_taa_frame *f, const struct fv_taa_
     }
 }
 
-/* Groups run their taps TAA_GROUP_DIST groups (16 samples) after their projection. */
-#define TAA_GROUP_DIST 4
+#define TAA_GROUP_LANES 4
+#define TAA_GROUP_DIST 4 /* groups (16 samples) between a group's projection and its taps */
 #define TAA_GROUP_RING 8
-#define TAA_CHUNK_ROWS 16
-
-static void taa_blend_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
-                           const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
-                           struct fv_taa_flow *flow)
-{
-    float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
-    const int keep_sample = t->alpha >= 1.0f;
-    int32_t off[64 * TAA_CHUNK_ROWS + 4], xs[64 * TAA_CHUNK_ROWS + 4], ys[64 * TAA_CHUNK_ROWS + 4];
-    taa_group ring[TAA_GROUP_RING];
-    unsigned head = 0, tail = 0;
-    for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
-        int n = 0;
-        for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
-            uint64_t m = sample_mask(wgt_blk + r * stride, w);
-            const int32_t ro = (int32_t)(r * stride), y = y0 + r;
-            while (m) {
-                const int i = __builtin_ctzll(m);
-                m &= m - 1;
-                off[n] = ro + i;
-                xs[n] = x0 + i;
-                ys[n] = y;
-                n++;
-                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
-            }
-        }
-        for (int k = n; k < ((n + 3) & ~3); k++) /* idle lanes of the last group repeat its first sample */
-            off[k] = off[n & ~3], xs[k] = xs[n & ~3], ys[k] = ys[n & ~3];
-        for (int k = 0; k < n; k += 4) {
-            const int nk = n - k < 4 ? n - k : 4;
-            if (group_project(f, t, rgbd_blk, off + k, xs + k, ys + k, nk, keep_sample, &fdx, &fdy, &fn,
-                              &ring[head % TAA_GROUP_RING]))
-                head++;
-            if (head - tail > TAA_GROUP_DIST)
-                group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
-        }
-    }
-    while (tail != head)
-        group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
-    flow->dx = fdx;
-    flow->dy = fdy;
-    flow->n = fn;
-}
+#include "../reproject_blend_tmpl.h"
 
 /* The fill, four pixels at a time (vld4 / vst4 de-interleave r, g, b, depth): each lane does the
  * reference's operations (taa_fill_px). */

@@ -277,59 +277,10 @@ static inline __attribute__((always_inline)) void group_taps(const struct fv_taa
 #undef ST
 }
 
-/* Groups are projected (flow sums in sample order) and their history prefetched; their taps run
- * TAA_GROUP_DIST groups later, so the misses of 16 samples are in flight together (as the scalar
- * ring of reproject_tmpl.h does one sample at a time). Blends change only their own samples'
- * colours, which no projection reads: the result does not depend on the distance. */
-#define TAA_GROUP_DIST 2
-#define TAA_GROUP_RING 4 /* a power of two > TAA_GROUP_DIST */
-
-#define TAA_CHUNK_ROWS 16 /* rows collected before their groups run (64 x 16 samples at most) */
-
-static void taa_blend_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,
-                           const float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h,
-                           struct fv_taa_flow *flow)
-{
-    float fdx = flow->dx, fdy = flow->dy, fn = flow->n;
-    const int keep_sample = t->alpha >= 1.0f;
-    /* The samples of up to 16 rows are listed first and grouped afterwards: the groups' 32-byte
-     * loads of the lists would otherwise wait on the just-made 4-byte stores (store forwarding
-     * fails; perf showed 7 % of the blend on one such load). */
-    int32_t off[64 * TAA_CHUNK_ROWS + 8], xs[64 * TAA_CHUNK_ROWS + 8], ys[64 * TAA_CHUNK_ROWS + 8];
-    taa_group ring[TAA_GROUP_RING];
-    unsigned head = 0, tail = 0;
-    for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
-        int n = 0;
-        for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
-            uint64_t m = sample_mask(wgt_blk + r * stride, w);
-            const int32_t ro = (int32_t)(r * stride), y = y0 + r;
-            while (m) {
-                const int i = __builtin_ctzll(m);
-                m &= m - 1;
-                off[n] = ro + i;
-                xs[n] = x0 + i;
-                ys[n] = y;
-                n++;
-                __builtin_prefetch(rgbd_blk + 4 * (ptrdiff_t)(ro + i)); /* the sample: hot after shading, cold in checkasm --bench */
-            }
-        }
-        for (int k = n; k < ((n + 7) & ~7); k++) /* idle lanes of the last group repeat its first sample */
-            off[k] = off[n & ~7], xs[k] = xs[n & ~7], ys[k] = ys[n & ~7];
-        for (int k = 0; k < n; k += 8) {
-            const int nk = n - k < 8 ? n - k : 8;
-            if (group_project(f, t, rgbd_blk, off + k, xs + k, ys + k, nk, keep_sample, &fdx, &fdy, &fn,
-                              &ring[head % TAA_GROUP_RING]))
-                head++;
-            if (head - tail > TAA_GROUP_DIST)
-                group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
-        }
-    }
-    while (tail != head)
-        group_taps(f, t, rgbd_blk, &ring[tail++ % TAA_GROUP_RING]);
-    flow->dx = fdx;
-    flow->dy = fdy;
-    flow->n = fn;
-}
+#define TAA_GROUP_LANES 8
+#define TAA_GROUP_DIST 2 /* groups (16 samples) between a group's projection and its taps */
+#define TAA_GROUP_RING 4
+#include "../reproject_blend_tmpl.h"
 
 /* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). The
  * history pixels stay as loaded, two per 256-bit register; their depths are taken out in the
