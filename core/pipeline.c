@@ -57,6 +57,14 @@ struct fv_pipeline {
 };
 
 
+/* Bytes of an eye's float image (level 0's layout) and of its sample bits (one row word per tile row). */
+static size_t image_bytes(const fv_pyr_level *l0) { return (size_t)l0->stride * (size_t)l0->h * 4 * sizeof(float); }
+static size_t rows_bytes(const fv_camera_desc *c)
+{
+    return (size_t)((c->width + FV_TILE - 1) / FV_TILE) * (size_t)((c->height + FV_TILE - 1) / FV_TILE) * FV_TILE *
+           sizeof(uint32_t);
+}
+
 void fv_pipeline_config_default(fv_pipeline_config *c)
 {
     memset(c, 0, sizeof *c);
@@ -136,7 +144,7 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         const int need_out = cfg->keep_image || dp->model != FV_DOF_MODEL_WEIER;
         for (int e = 0; e < 2; e++) {
             fv_focus_init(&p->eyes[e].focus, &dp->focus);
-            if (need_out && !(p->eyes[e].out = malloc((size_t)l0->stride * (size_t)l0->h * 4 * sizeof(float)))) {
+            if (need_out && !(p->eyes[e].out = malloc(image_bytes(l0)))) {
                 fv_err(err, err_len, "out of memory for depth-of-field buffers");
                 goto bad;
             }
@@ -147,10 +155,8 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
             fv_err(err, err_len, "DoF sampling parameters out of range: need kappa > 0, CoC cap >= kappa");
             goto bad;
         }
-        const size_t tiles = (size_t)((cfg->cam.width + FV_TILE - 1) / FV_TILE) *
-                             (size_t)((cfg->cam.height + FV_TILE - 1) / FV_TILE);
         for (int e = 0; e < 2 && p->dofsamp; e++)
-            if (!(p->eyes[e].rows = malloc(tiles * FV_TILE * sizeof(uint32_t)))) {
+            if (!(p->eyes[e].rows = malloc(rows_bytes(&cfg->cam)))) {
                 fv_err(err, err_len, "out of memory");
                 goto bad;
             }
@@ -321,11 +327,8 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         return -1;
     if (es->cam.lens_on && !es->lca) /* built once: the lens does not change */
         es->lca = fv_output_lca_create(&es->cam);
-    if (p->dof && !es->out && es->lca && es->lca->on) { /* the output is a pass of its own */
-        const fv_pyr_level *l0 = &es->pyr[0].lv[0];
-        if (!(es->out = malloc((size_t)l0->stride * (size_t)l0->h * 4 * sizeof(float))))
-            return -1;
-    }
+    if (p->dof && !es->out && es->lca && es->lca->on && !(es->out = malloc(image_bytes(&es->pyr[0].lv[0]))))
+        return -1; /* the lens's output is a pass of its own, from the float image */
     for (int i = 0; i < FV_STAGE_COUNT; i++)
         st->stage_ms[i] = NAN;
     /* with reprojection, render into the other pyramid and read this one as history */
@@ -462,14 +465,11 @@ static size_t pyramid_bytes(const fv_pyramid *p)
 void fv_pipeline_memory_bytes(const fv_pipeline *p, fv_eye eye, fv_pipeline_memory *m)
 {
     const eye_state *es = &p->eyes[slot(eye)];
-    const fv_pyr_level *l0 = &es->pyr[0].lv[0];
-    const size_t px = (size_t)l0->stride * (size_t)l0->h, tiles = (size_t)((p->cfg.cam.width + FV_TILE - 1) / FV_TILE) *
-                                                                    (size_t)((p->cfg.cam.height + FV_TILE - 1) / FV_TILE);
     memset(m, 0, sizeof *m);
     m->pyramids = pyramid_bytes(&es->pyr[0]) + pyramid_bytes(&es->pyr[1]);
-    m->image = es->out ? px * 4 * sizeof(float) : 0;
+    m->image = es->out ? image_bytes(&es->pyr[0].lv[0]) : 0;
     m->display = (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height * 3;
-    m->other = es->rows ? tiles * FV_TILE * sizeof(uint32_t) : 0;
+    m->other = es->rows ? rows_bytes(&p->cfg.cam) : 0;
     if (p->dof) {
         const fv_dof_work *wk = &p->dof_work;
         m->shared = (size_t)wk->stride * (size_t)wk->h * (4 * FV_DOF_PLANES4 + FV_DOF_PLANES1) * sizeof(float) +
