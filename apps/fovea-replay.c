@@ -74,12 +74,12 @@ static void on_ref_progress(void *ctx, long done, long total)
 }
 static long ref_tiles(int w, int h) { return (long)((w + 15) / 16) * ((h + 15) / 16); }
 static void render_reference(const fv_scene *scene, const fv_camera *cam, const fv_reference_params *prm,
-                             fv_pool *pool, float *rgbd, uint8_t *rgb8, ptrdiff_t stride, ref_progress *rp,
-                             fv_frame_stats *st)
+                             fv_pool *pool, float *rgbd, uint8_t *rgb8, ptrdiff_t stride, unsigned isa_mask,
+                             ref_progress *rp, fv_frame_stats *st)
 {
     const int64_t t0 = fv_time_ns();
     st->samples = fv_reference_render(scene, cam, prm, pool, rgbd, on_ref_progress, rp);
-    fv_reference_to_rgb8(rgbd, cam->width, cam->height, rgb8, stride);
+    fv_reference_to_rgb8(rgbd, cam->width, cam->height, rgb8, stride, isa_mask);
     for (int s = 0; s < FV_STAGE_COUNT; s++)
         st->stage_ms[s] = NAN; /* none of the pipeline's stages ran */
     st->total_ms = (double)(fv_time_ns() - t0) * 1e-6;
@@ -274,7 +274,7 @@ int main(int argc, char **argv)
                     refp.focus_m = refp.focus_m > 0.05f ? refp.focus_m : 0.05f; /* as --focus-m's minimum */
                 }
                 render_reference(scene, &cam, &refp, fv_pipeline_pool(pl), refbuf, rgb + (size_t)e * W * 3,
-                                 (ptrdiff_t)outw * 3, &rprog, &st[e]);
+                                 (ptrdiff_t)outw * 3, cfg.isa_mask, &rprog, &st[e]);
             } else {
                 if (fv_pipeline_render(pl, eye, &head, smp.gaze_x, smp.gaze_y, &st[e])) {
                     fprintf(stderr, "%s: frame %ld%s: rendering failed\n", prog, f, eye_name(eye));

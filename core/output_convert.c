@@ -10,12 +10,7 @@
 void fv_output_conv_init(fv_output_conv *p, unsigned isa_mask)
 {
     fv_output_dsp_init(&p->dsp, isa_mask);
-    memset(p->srgb, 0, sizeof p->srgb);
-    for (int i = 0; i <= FV_SRGB_LUT; i++) {
-        double v = (double)i / FV_SRGB_LUT;
-        double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
-        p->srgb[i] = (uint8_t)(s * 255.0 + 0.5);
-    }
+    fv_srgb_lut_init(p->srgb);
 }
 
 fv_lens_lca *fv_output_lca_create(const fv_camera *cam)

@@ -1,5 +1,18 @@
 #include "output_dsp.h"
 
+#include <math.h>
+#include <string.h>
+
+void fv_srgb_lut_init(uint8_t lut[FV_SRGB_LUT + 1 + FV_SRGB_LUT_PAD])
+{
+    memset(lut, 0, FV_SRGB_LUT + 1 + FV_SRGB_LUT_PAD);
+    for (int i = 0; i <= FV_SRGB_LUT; i++) {
+        const double v = (double)i / FV_SRGB_LUT;
+        const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+        lut[i] = (uint8_t)(s * 255.0 + 0.5);
+    }
+}
+
 void fv_rgb8_row_c(uint8_t *restrict dst, const float *rgbd, int n, const uint8_t *lut)
 {
     for (int x = 0; x < n; x++)

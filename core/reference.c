@@ -1,5 +1,7 @@
 #include "reference.h"
 
+#include "output_convert.h"
+
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -194,23 +196,9 @@ float fv_reference_depth_at(const fv_scene *scene, const fv_camera *cam, float p
     return rh.ray.tfar;
 }
 
-#define SRGB_LUT 4096
-void fv_reference_to_rgb8(const float *rgbd, int w, int h, uint8_t *dst, ptrdiff_t dst_stride)
+void fv_reference_to_rgb8(const float *rgbd, int w, int h, uint8_t *dst, ptrdiff_t dst_stride, unsigned isa_mask)
 {
-    uint8_t lut[SRGB_LUT + 1];
-    for (int i = 0; i <= SRGB_LUT; i++) {
-        double v = (double)i / SRGB_LUT;
-        double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
-        lut[i] = (uint8_t)(s * 255.0 + 0.5);
-    }
-    for (int y = 0; y < h; y++) {
-        const float *s = rgbd + 4 * (size_t)y * w;
-        uint8_t *o = dst + y * dst_stride;
-        for (int x = 0; x < w; x++)
-            for (int c = 0; c < 3; c++) {
-                const float v = s[4 * x + c];
-                const int i = v > 0.0f ? (v < 1.0f ? (int)(v * SRGB_LUT + 0.5f) : SRGB_LUT) : 0;
-                o[3 * x + c] = lut[i];
-            }
-    }
+    fv_output_conv conv;
+    fv_output_conv_init(&conv, isa_mask);
+    fv_output_convert(&conv, rgbd, w, w, h, NULL, NULL, dst, dst_stride);
 }

@@ -50,8 +50,9 @@ long fv_reference_render(const fv_scene *scene, const fv_camera *cam, const fv_r
  * default focus distance is this at the point of regard. */
 float fv_reference_depth_at(const fv_scene *scene, const fv_camera *cam, float px, float py);
 
-/* rgbd (as above) to sRGB 8-bit RGB, rows of dst_stride bytes: the same conversion (4096-entry
- * LUT, clamped) as fv_pipeline_to_rgb8, so equal linear values give equal bytes. */
-void fv_reference_to_rgb8(const float *rgbd, int w, int h, uint8_t *dst, ptrdiff_t dst_stride);
+/* rgbd (as above) to sRGB 8-bit RGB, rows of dst_stride bytes: the output stage's conversion
+ * (core/output_convert.h) with the kernels isa_mask allows, so with the pipeline's mask equal
+ * linear values give the pipeline's bytes. */
+void fv_reference_to_rgb8(const float *rgbd, int w, int h, uint8_t *dst, ptrdiff_t dst_stride, unsigned isa_mask);
 
 #endif

@@ -90,7 +90,7 @@ static void test_zero_pupil_is_pinhole(void **st)
     fv_reference_params prm = {.spp = 1, .pupil_mm = 0.0f, .focus_m = 0.7f};
     assert_int_equal(fv_reference_render(s, &cam, &prm, NULL, ref, NULL, NULL), 2L * W * H);
     assert_memory_equal(ref, pin, sizeof(float) * 4 * W * H);
-    fv_reference_to_rgb8(ref, W, H, b8, 3 * W);
+    fv_reference_to_rgb8(ref, W, H, b8, 3 * W, ~0u); /* the pipeline's default kernels */
     assert_memory_equal(a8, b8, sizeof a8);
     /* the scene really has three depths: 3 m, 1 m and misses */
     assert_float_equal(ref[4 * (20 * W + 2) + 3], 3.0f, 1e-4f);
