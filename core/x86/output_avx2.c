@@ -2,8 +2,8 @@
  * table gathers bound the old version): v^(5/12) as 2^(5e/12), e the exponent (a permute from 9
  * constants), times a cubic in the mantissa m in [1, 2) (relative error 1.1e-4, 0.03 of a step
  * of 255); within 1 of the reference's table bytes (the table itself rounds v to 1/4096 first,
- * up to 0.4 of a step), exactly 0 for v <= 0 or NaN and 255 for v >= 1 (output_dsp.h). The depth
- * lanes are computed and dropped by the shuffles. */
+ * up to 0.4 of a step), exactly 0 for v <= 0 or NaN and 255 for v >= 1 (output_dsp.h). The 24
+ * colour values of 8 pixels are permuted into 3 vectors first (the depth is never converted). */
 #include <immintrin.h>
 #include <string.h>
 
@@ -35,25 +35,29 @@ static inline __m256i srgb8(__m256 v)
     return _mm256_cvttps_epi32(_mm256_fmadd_ps(s, _mm256_set1_ps(255.0f), _mm256_set1_ps(0.5f)));
 }
 
+static inline __m256 perm(__m256 v, int a, int b, int c, int d, int e, int f, int g, int h)
+{
+    return _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(a, b, c, d, e, f, g, h));
+}
+
 static void rgb8_row_avx2(uint8_t *restrict dst, const float *rgbd, int n, const uint8_t *lut)
 {
-    const __m128i keep = _mm_setr_epi8(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1); /* drop d */
     int x = 0;
     for (; x + 8 <= n; x += 8) {
         const float *p = rgbd + 4 * x;
-        /* a: pixels 0 | 1 (one per 128-bit lane), b: 2 | 3, c: 4 | 5, d: 6 | 7 */
-        const __m256i a = srgb8(_mm256_loadu_ps(p)), b = srgb8(_mm256_loadu_ps(p + 8));
-        const __m256i c = srgb8(_mm256_loadu_ps(p + 16)), d = srgb8(_mm256_loadu_ps(p + 24));
-        /* the packs work per 128-bit lane: lane 0 ends as pixels 0 2 4 6, lane 1 as 1 3 5 7 */
-        const __m256i bytes = _mm256_packus_epi16(_mm256_packus_epi32(a, b), _mm256_packus_epi32(c, d));
-        const __m128i even = _mm256_castsi256_si128(bytes), odd = _mm256_extracti128_si256(bytes, 1);
-        const __m128i k0 = _mm_shuffle_epi8(_mm_unpacklo_epi32(even, odd), keep); /* pixels 0-3 */
-        const __m128i k1 = _mm_shuffle_epi8(_mm_unpackhi_epi32(even, odd), keep); /* pixels 4-7 */
-        const int32_t t0 = _mm_extract_epi32(k0, 2), t1 = _mm_extract_epi32(k1, 2);
-        _mm_storel_epi64((__m128i *)(void *)(dst + 3 * x), k0);
-        memcpy(dst + 3 * x + 8, &t0, 4);
-        _mm_storel_epi64((__m128i *)(void *)(dst + 3 * x + 12), k1);
-        memcpy(dst + 3 * x + 20, &t1, 4);
+        /* pixels 0-1, 2-3, 4-5, 6-7 as r g b d r g b d; the 24 colour values in order as
+         * X = r0 g0 b0 r1 g1 b1 r2 g2, Y = b2 r3 g3 b3 r4 g4 b4 r5, Z = g5 b5 r6 g6 b6 r7 g7 b7
+         * (the depth lanes are not computed) */
+        const __m256 A = _mm256_loadu_ps(p), B = _mm256_loadu_ps(p + 8);
+        const __m256 C = _mm256_loadu_ps(p + 16), D = _mm256_loadu_ps(p + 24);
+        const __m256i X = srgb8(_mm256_blend_ps(perm(A, 0, 1, 2, 4, 5, 6, 0, 0), perm(B, 0, 0, 0, 0, 0, 0, 0, 1), 0xc0));
+        const __m256i Y = srgb8(_mm256_blend_ps(perm(B, 2, 4, 5, 6, 0, 0, 0, 0), perm(C, 0, 0, 0, 0, 0, 1, 2, 4), 0xf0));
+        const __m256i Z = srgb8(_mm256_blend_ps(perm(C, 5, 6, 0, 0, 0, 0, 0, 0), perm(D, 0, 0, 0, 1, 2, 4, 5, 6), 0xfc));
+        /* per 128-bit lane the packs give X0-3 Y0-3 Z0-3 Z0-3 | X4-7 Y4-7 Z4-7 Z4-7 (4-byte groups) */
+        const __m256i b = _mm256_packus_epi16(_mm256_packus_epi32(X, Y), _mm256_packus_epi32(Z, Z));
+        const __m256i o = _mm256_permutevar8x32_epi32(b, _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7));
+        _mm_storeu_si128((__m128i *)(void *)(dst + 3 * x), _mm256_castsi256_si128(o));
+        _mm_storel_epi64((__m128i *)(void *)(dst + 3 * x + 16), _mm256_extracti128_si256(o, 1));
     }
     fv_rgb8_row_c(dst + 3 * x, rgbd + 4 * x, n - x, lut);
 }
