@@ -69,18 +69,10 @@ static int parse_int(const char *tok, int *v)
     return 0;
 }
 
-int fv_eyesrc_open_y4m(fv_eyesrc **out, const char *path, char *err, size_t err_len)
+/* Reads the header from s->f (owned by s from here on). */
+static int open_y4m_stream(fv_eyesrc **out, fv_eyesrc *s, char *err, size_t err_len)
 {
-    *out = NULL;
-    fv_eyesrc *s = alloc_src(path);
-    if (!s)
-        return fv_err(err, err_len, "out of memory");
-    s->f = fopen(path, "rb");
-    if (!s->f) {
-        fv_err(err, err_len, "%s: %s", path, strerror(errno));
-        free(s);
-        return -1;
-    }
+    const char *path = s->path;
     char hdr[1024];
     size_t n = 0;
     int c;
@@ -139,6 +131,39 @@ int fv_eyesrc_open_y4m(fv_eyesrc **out, const char *path, char *err, size_t err_
     return 0;
 }
 
+int fv_eyesrc_open_y4m(fv_eyesrc **out, const char *path, char *err, size_t err_len)
+{
+    *out = NULL;
+    fv_eyesrc *s = alloc_src(path);
+    if (!s)
+        return fv_err(err, err_len, "out of memory");
+    s->f = fopen(path, "rb");
+    if (!s->f) {
+        fv_err(err, err_len, "%s: %s", path, strerror(errno));
+        free(s);
+        return -1;
+    }
+    return open_y4m_stream(out, s, err, err_len);
+}
+
+int fv_eyesrc_open_y4m_mem(fv_eyesrc **out, const void *data, size_t size, const char *name, char *err,
+                           size_t err_len)
+{
+    *out = NULL;
+    fv_eyesrc *s = alloc_src(name);
+    if (!s)
+        return fv_err(err, err_len, "out of memory");
+    /* a read-only stream over the caller's bytes: the same stdio reads as a file (fmemopen takes a
+     * non-const pointer for its write modes; "rb" never writes) */
+    s->f = fmemopen((void *)(uintptr_t)data, size, "rb");
+    if (!s->f) {
+        fv_err(err, err_len, "%s: %s", name, strerror(errno));
+        free(s);
+        return -1;
+    }
+    return open_y4m_stream(out, s, err, err_len);
+}
+
 static int next_y4m(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)
 {
     char tag[256];
@@ -178,24 +203,12 @@ static int parse_float(const char *t, float *v)
     return 0;
 }
 
-int fv_eyesrc_open_list(fv_eyesrc **out, const char *path, char *err, size_t err_len)
+/* Parses the list from f (closed here); entries resolve against dir. */
+static int open_list_stream(fv_eyesrc **out, fv_eyesrc *s, FILE *f, const char *dir, char *err, size_t err_len)
 {
-    *out = NULL;
-    fv_eyesrc *s = alloc_src(path);
-    if (!s)
-        return fv_err(err, err_len, "out of memory");
+    const char *path = s->path;
     s->is_list = 1;
-    const char *slash = strrchr(path, '/');
-    if (slash)
-        snprintf(s->dir, sizeof s->dir, "%.*s", (int)(slash - path), path);
-    else
-        snprintf(s->dir, sizeof s->dir, ".");
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        fv_err(err, err_len, "%s: %s", path, strerror(errno));
-        free(s);
-        return -1;
-    }
+    snprintf(s->dir, sizeof s->dir, "%s", dir);
     char line[8192];
     long cap = 0;
     int ln = 0, labelled = 0, unlabelled = 0, rc = 0;
@@ -258,6 +271,43 @@ int fv_eyesrc_open_list(fv_eyesrc **out, const char *path, char *err, size_t err
     (void)unlabelled;
     *out = s;
     return 0;
+}
+
+int fv_eyesrc_open_list(fv_eyesrc **out, const char *path, char *err, size_t err_len)
+{
+    *out = NULL;
+    fv_eyesrc *s = alloc_src(path);
+    if (!s)
+        return fv_err(err, err_len, "out of memory");
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (slash)
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    else
+        snprintf(dir, sizeof dir, ".");
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fv_err(err, err_len, "%s: %s", path, strerror(errno));
+        free(s);
+        return -1;
+    }
+    return open_list_stream(out, s, f, dir, err, err_len);
+}
+
+int fv_eyesrc_open_list_mem(fv_eyesrc **out, const void *data, size_t size, const char *name, const char *dir,
+                            char *err, size_t err_len)
+{
+    *out = NULL;
+    fv_eyesrc *s = alloc_src(name);
+    if (!s)
+        return fv_err(err, err_len, "out of memory");
+    FILE *f = fmemopen((void *)(uintptr_t)data, size, "r"); /* as in fv_eyesrc_open_y4m_mem */
+    if (!f) {
+        fv_err(err, err_len, "%s: %s", name, strerror(errno));
+        free(s);
+        return -1;
+    }
+    return open_list_stream(out, s, f, dir, err, err_len);
 }
 
 static int next_list(fv_eyesrc *s, fv_eye_frame *f, char *err, size_t err_len)

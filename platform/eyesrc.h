@@ -28,6 +28,14 @@ typedef struct fv_eye_frame {
  * colour space; for lists: a malformed line, no entries). The whole list is parsed here. */
 int fv_eyesrc_open_y4m(fv_eyesrc **s, const char *path, char *err, size_t err_len);
 int fv_eyesrc_open_list(fv_eyesrc **s, const char *path, char *err, size_t err_len);
+/* The same parsers on bytes in memory (the fuzz harnesses; a video or list already read): name
+ * stands for the path in errors; a list's entries resolve against dir. The bytes are read through
+ * a stdio stream (fmemopen) exactly as a file's are, and must stay valid until close (a video's
+ * frames are read as they are asked for). */
+int fv_eyesrc_open_y4m_mem(fv_eyesrc **s, const void *data, size_t size, const char *name, char *err,
+                           size_t err_len);
+int fv_eyesrc_open_list_mem(fv_eyesrc **s, const void *data, size_t size, const char *name, const char *dir,
+                            char *err, size_t err_len);
 /* A live V4L2 camera (platform/v4l2.h; cfg as there). Frames come as they are captured; a
  * camera that vanishes is reopened with back-off (fv_v4l2_next), and next() fails only when no
  * frame has come for silent_ms. It ends (returns 0) once *stop is non-zero (a signal handler's

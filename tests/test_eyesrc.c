@@ -1,7 +1,8 @@
 /* fovea platform: eye sources. Y4M in every supported colour space gives back exactly the luma
  * written (so the chroma planes are skipped by the right amount), header parameters in any
  * order are tolerated, truncated / corrupt files give one-line errors naming the file and
- * frame; image lists with and without labels, comments, relative paths. */
+ * frame; image lists with and without labels, comments, relative paths; the in-memory entries
+ * give what the path ones give on the same bytes. */
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -186,12 +187,109 @@ static void test_image_list(void **state)
     fv_eyesrc_close(s);
 }
 
+/* Reads the whole file written at path. */
+static size_t slurp(const char *path, char *buf, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    const size_t n = fread(buf, 1, cap, f);
+    fclose(f);
+    assert_true(n < cap);
+    return n;
+}
+
+/* The in-memory entries (fv_eyesrc_open_*_mem, what the fuzz harnesses call) against the path
+ * ones on the same bytes: the same open result and message, then the same frames (index, size,
+ * luma, label) or the same error, to the end. */
+static void expect_same(int list, const char *path)
+{
+    static char bytes[1 << 16];
+    const size_t n = slurp(path, bytes, sizeof bytes);
+    fv_eyesrc *a = NULL, *b = NULL;
+    char ea[256] = "", eb[256] = "";
+    const int ra = list ? fv_eyesrc_open_list(&a, path, ea, sizeof ea) : fv_eyesrc_open_y4m(&a, path, ea, sizeof ea);
+    const int rb = list ? fv_eyesrc_open_list_mem(&b, bytes, n, path, dir, eb, sizeof eb)
+                        : fv_eyesrc_open_y4m_mem(&b, bytes, n, path, eb, sizeof eb);
+    assert_int_equal(ra, rb);
+    assert_string_equal(ea, eb);
+    if (ra) {
+        assert_null(a);
+        assert_null(b);
+        return;
+    }
+    assert_int_equal(fv_eyesrc_count(a), fv_eyesrc_count(b));
+    assert_int_equal(fv_eyesrc_has_labels(a), fv_eyesrc_has_labels(b));
+    for (int k = 0;; k++) {
+        fv_eye_frame fa, fb;
+        const int na = fv_eyesrc_next(a, &fa, ea, sizeof ea), nb = fv_eyesrc_next(b, &fb, eb, sizeof eb);
+        assert_int_equal(na, nb);
+        if (na < 0)
+            assert_string_equal(ea, eb);
+        if (na != 1)
+            break;
+        assert_int_equal(fa.index, fb.index);
+        assert_int_equal(fa.w, fb.w);
+        assert_int_equal(fa.h, fb.h);
+        assert_memory_equal(fa.luma, fb.luma, (size_t)fa.w * fa.h);
+        assert_int_equal(fa.has_label, fb.has_label);
+        if (fa.has_label) /* unset on frames without one */
+            assert_true(fa.label_x == fb.label_x && fa.label_y == fb.label_y);
+        if (fa.name)
+            assert_string_equal(fa.name, fb.name);
+        assert_true(k < 100);
+    }
+    fv_eyesrc_close(a);
+    fv_eyesrc_close(b);
+}
+
+static void test_in_memory_matches_file(void **state)
+{
+    (void)state;
+    char path[128];
+    path_in(path, sizeof path, "m.y4m");
+    write_y4m(path, "YUV4MPEG2 W7 H5 C420jpeg\n", 7, 5, 3, 2 * 4 * 3);
+    expect_same(0, path);
+    write_y4m(path, "YUV4MPEG2 W7 H5 Cmono\n", 7, 5, 2, 0);
+    expect_same(0, path);
+    assert_int_equal(truncate(path, 22 + 6 + 35 + 11 + 20), 0); /* the second frame cut short */
+    expect_same(0, path);
+    static const char *const bad_y4m[] = {
+        "", "YUV4MPEG W4 H4\n", "YUV4MPEG2 W4 H4", "YUV4MPEG2 W0 H4\n", "YUV4MPEG2 W4\n", "YUV4MPEG2 W4 H4 C411\n",
+        "YUV4MPEG2 W2 H2 Cmono\nFRAME\nabcdFRAMX\nabcd", "YUV4MPEG2 W2 H2 Cmono\nFRAME\nab",
+    };
+    for (size_t i = 0; i < sizeof bad_y4m / sizeof bad_y4m[0]; i++) {
+        FILE *f = fopen(path, "wb");
+        fputs(bad_y4m[i], f);
+        fclose(f);
+        expect_same(0, path);
+    }
+    /* lists: entries resolve against the list's folder in both */
+    char img[128];
+    path_in(img, sizeof img, "b.pgm");
+    FILE *f = fopen(img, "wb");
+    fputs("P5 2 2 255\n", f);
+    fwrite("\x09\x08\x07\x06", 1, 4, f);
+    fclose(f);
+    static const char *const lists[] = {
+        "# c\n\nb.pgm 1.5 0.25\n  b.pgm\t2 3  \nb.pgm\n", "b.pgm\nmissing.png 1 2\nb.pgm\n", "b.pgm 1\n",
+        "b.pgm 1 nan\n", "# nothing\n", "", "b.pgm", /* no final newline */
+    };
+    path_in(path, sizeof path, "m.txt");
+    for (size_t i = 0; i < sizeof lists / sizeof lists[0]; i++) {
+        f = fopen(path, "wb");
+        fputs(lists[i], f);
+        fclose(f);
+        expect_same(1, path);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_y4m_colour_spaces),
         cmocka_unit_test(test_y4m_errors),
         cmocka_unit_test(test_image_list),
+        cmocka_unit_test(test_in_memory_matches_file),
     };
     return cmocka_run_group_tests_name("eyesrc", tests, setup, teardown);
 }

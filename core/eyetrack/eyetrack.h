@@ -45,6 +45,10 @@ typedef struct fv_eye_mode_settings {
     int search_clip_grey;       /* the search image is clipped at its median + this before the
                                    box search (a frame's rim, a lens reflection's halo or bright
                                    skin do not make a ring look bright); 0 = off */
+    float spot_margin_grey;     /* when no bright spot (spot_min_grey) lies within the best
+                                   box's half-size, the best box near a spot within twice it on
+                                   the dark eye (ring median <= the image's) wins if it scores
+                                   within this many grey levels of the best; 0 = off */
     float lost_contrast;        /* below this contrast (grey levels) no pupil is reported */
     /* refinement */
     int refine_on_search_image; /* refine on the (inpainted) search image, not the frame */

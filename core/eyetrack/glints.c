@@ -277,6 +277,31 @@ int fv_et_find_glints(const fv_eyetrack_dsp *d, const uint8_t *luma, int w, int 
     return fv_mini(n, max_glints);
 }
 
+/* The median of the 24 pixels of the square ring 3 px around q (insertion sort). */
+static int ring3_median(const uint8_t *q, ptrdiff_t stride)
+{
+    uint8_t ring[24];
+    int n = 0;
+    for (int k = -3; k <= 3; k++) {
+        ring[n++] = q[-3 * stride + k], ring[n++] = q[3 * stride + k];
+        if (k > -3 && k < 3)
+            ring[n++] = q[k * stride - 3], ring[n++] = q[k * stride + 3];
+    }
+    for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && ring[j - 1] > ring[j]; j--) {
+            const uint8_t tmp = ring[j];
+            ring[j] = ring[j - 1], ring[j - 1] = tmp;
+        }
+    return (ring[11] + ring[12] + 1) / 2;
+}
+
+static inline int local_max3(const uint8_t *q, ptrdiff_t stride)
+{
+    const int v = q[0];
+    return !(v < q[-1] || v < q[1] || v < q[-stride] || v < q[stride] || v < q[-stride - 1] || v < q[-stride + 1] ||
+             v < q[stride - 1] || v < q[stride + 1]);
+}
+
 /* The most prominent small reflection within r of (cx, cy) in a small crop: a 3x3 local maximum
  * at least min_grey grey levels above the median of the square ring 3 px around it (weaker and
  * smaller than what find_glints accepts: at these sizes the reflection is a few pixels of
@@ -290,24 +315,9 @@ int fv_et_bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float 
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
             const uint8_t *q = img + y * stride + x;
-            const int v = q[0];
-            if (v - best <= 0 || v < q[-1] || v < q[1] || v < q[-stride] || v < q[stride] || v < q[-stride - 1] ||
-                v < q[-stride + 1] || v < q[stride - 1] || v < q[stride + 1])
+            if (q[0] - best <= 0 || !local_max3(q, stride))
                 continue;
-            /* median of the 24 ring pixels (insertion sort) */
-            uint8_t ring[24];
-            int n = 0;
-            for (int k = -3; k <= 3; k++) {
-                ring[n++] = q[-3 * stride + k], ring[n++] = q[3 * stride + k];
-                if (k > -3 && k < 3)
-                    ring[n++] = q[k * stride - 3], ring[n++] = q[k * stride + 3];
-            }
-            for (int i = 1; i < n; i++)
-                for (int j = i; j > 0 && ring[j - 1] > ring[j]; j--) {
-                    const uint8_t tmp = ring[j];
-                    ring[j] = ring[j - 1], ring[j - 1] = tmp;
-                }
-            const int con = v - (ring[11] + ring[12] + 1) / 2;
+            const int con = q[0] - ring3_median(q, stride);
             if (con > best)
                 best = con, bx = x, by = y;
         }
@@ -315,4 +325,22 @@ int fv_et_bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float 
         return 0;
     *ox = bx + 0.5f, *oy = by + 0.5f;
     return 1;
+}
+
+int fv_et_dark_spots(const uint8_t *img, int w, int h, ptrdiff_t stride, float cx, float cy, float r, int min_grey,
+                     int max_ring_grey, int max_n, int *xs, int *ys)
+{
+    const int x0 = fv_maxi(3, (int)floorf(cx - r)), x1 = fv_mini(w - 4, (int)floorf(cx + r));
+    const int y0 = fv_maxi(3, (int)floorf(cy - r)), y1 = fv_mini(h - 4, (int)floorf(cy + r));
+    int n = 0;
+    for (int y = y0; y <= y1 && n < max_n; y++)
+        for (int x = x0; x <= x1 && n < max_n; x++) {
+            const uint8_t *q = img + y * stride + x;
+            if (q[0] < min_grey || !local_max3(q, stride))
+                continue;
+            const int ring = ring3_median(q, stride);
+            if (q[0] - ring >= min_grey && ring <= max_ring_grey)
+                xs[n] = x, ys[n] = y, n++;
+        }
+    return n;
 }

@@ -39,6 +39,9 @@ const fv_eye_mode_settings fv_eye_crop_settings = {
     .sides_frac = 0.3f,
     .sides_min_grey = 3.0f,
     .search_clip_grey = 20,
+    /* a corneal reflection beside a box nearly as good as the best marks the eye: the best can
+     * be the iris's shadowed side or a dark patch of a tinted lens (docs/eyetrack.md) */
+    .spot_margin_grey = 5.0f,
     .lost_contrast = 2.0f, /* 3 behind a lens passing ~70 % */
     .refine_on_search_image = 1,
     .centroid_iters = 2,

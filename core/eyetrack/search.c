@@ -159,6 +159,33 @@ static int sides_ok(const box_ctx *b, int x, int y, int k, float inner, float ri
     return fails <= 1;
 }
 
+/* Crop mode: a corneal reflection marks the eye. When no bright spot (spot_min_grey above its
+ * ring) lies within the best box's half-size, each spot within twice that on the dark eye (its
+ * ring's median at most the image's: not skin, not a spectacle rim) proposes the best box whose
+ * centre is within the best's half-size of it; the best proposal wins if it scores within
+ * spot_margin_grey of b. Without it the box settles on the darkest part of a wide dark region
+ * (the iris's shadowed side, a tinted lens's darker patch) beside the pupil that carries the
+ * reflection. u: full-resolution pixels per pixel of C, whose integral image is ii. */
+static box_hit spot_alternative(const fv_eyetrack_dsp *d, const fv_eye_params *p, const fv_eye_mode_settings *set,
+                                const uint8_t *luma, int w, int h, ptrdiff_t stride, float u, int median,
+                                const uint32_t *ii, int cw, int ch, int kmin, int kmax, int mx, float dark, box_hit b)
+{
+    enum { MAX_SPOTS = 16 };
+    const float cx = (b.x + 0.5f) * u, cy = (b.y + 0.5f) * u, r = (b.k + 0.5f) * u;
+    float gx, gy;
+    if (fv_et_bright_spot(luma, w, h, stride, cx, cy, r, set->spot_min_grey, &gx, &gy))
+        return b; /* the best box has its reflection */
+    int xs[MAX_SPOTS], ys[MAX_SPOTS];
+    const int n = fv_et_dark_spots(luma, w, h, stride, cx, cy, 2.0f * r, set->spot_min_grey, median, MAX_SPOTS, xs, ys);
+    box_hit alt = { -1e30f, 0, 0, 0, 0, 0 };
+    for (int i = 0; i < n; i++) {
+        const int sx = (int)((xs[i] + 0.5f) / u), sy = (int)((ys[i] + 0.5f) / u);
+        box_search(d, ii, cw, ch, kmin, kmax, 0, fv_maxi(mx, sx - b.k), fv_mini(cw - mx, sx + b.k + 1), fv_maxi(mx, sy - b.k),
+                   fv_mini(ch - mx, sy + b.k + 1), dark, p->centre_prior, set->search_sides ? set : NULL, &alt);
+    }
+    return alt.score > -1e30f && alt.score >= b.score - set->spot_margin_grey ? alt : b;
+}
+
 /* Two levels: F (halved until min side <= SEARCH_MAX_SIDE; reflections inpainted there) and C
  * (F halved again until min side <= SEARCH_C_SIDE). The exhaustive search runs on C;
  * F only refines position and size around C's answer, which costs ~25x less than searching F. */
@@ -222,6 +249,9 @@ fv_et_candidate fv_et_search(const fv_eyetrack_dsp *d, const fv_eye_params *p, c
     }
     if (b.score <= -1e30f)
         return c;
+    if (set->spot_margin_grey > 0)
+        b = spot_alternative(d, p, set, luma, w, h, stride, (float)(f * scale), lv.median, ii, cw, ch, kmin, kmax, mx,
+                             dark, b);
     if (f > 1) { /* refine on F around C's answer */
         const int fx = b.x * f + f / 2, fy = b.y * f + f / 2, fk = b.k * f + f / 2;
         box_hit bf = { -1e30f, 0, 0, 0, 0, 0 };

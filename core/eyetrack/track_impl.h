@@ -82,6 +82,12 @@ int fv_et_find_glints(const fv_eyetrack_dsp *d, const uint8_t *luma, int w, int 
 int fv_et_bright_spot(const uint8_t *img, int w, int h, ptrdiff_t stride, float cx, float cy, float r,
                       int min_grey, float *ox, float *oy);
 
+/* The same spots (contrast >= min_grey) within r of (cx, cy) whose 3 px ring's median is at most
+ * max_ring_grey (on the dark eye, not on skin or a spectacle rim), in raster order, at most
+ * max_n: their pixels in xs, ys; the count. */
+int fv_et_dark_spots(const uint8_t *img, int w, int h, ptrdiff_t stride, float cx, float cy, float r, int min_grey,
+                     int max_ring_grey, int max_n, int *xs, int *ys);
+
 /* ---- refine.c */
 
 typedef struct fv_et_refine_args {
