@@ -2,6 +2,7 @@
  * material's inputs gathered here, the BRDF and lights in core/shade_lane.h / the kernels. */
 #include "scene_impl.h"
 #include "shade_lane.h"
+#include "texture_tap.h"
 #include "base/util.h"
 
 #include <math.h>
@@ -210,8 +211,8 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
                 if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
                 float su, sv;
                 slot_uv(m, j, tu, tv, &su, &sv);
-                fv_texture_taps(&s->textures[id], su, sv, lod + m->lod_bias[j], &taps[j][q]);
-                fv_texture_taps_prefetch(&taps[j][q]);
+                fv_tex_taps_at(&s->textures[id], su, sv, lod + m->lod_bias[j], &taps[j][q]);
+                fv_tex_taps_prefetch(&taps[j][q]);
             }
             textured |= 1u << q;
         } else {
@@ -233,7 +234,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         for (int j = 0; j < 4; j++)
             if (slot_texture(m, j) >= 0) {
                 if (m->slot_src[j] == j)
-                    fv_texture_blend(&taps[j][q], texel[j]);
+                    fv_tex_blend(&taps[j][q], texel[j]);
                 tx[j] = texel[m->slot_src[j]];
             }
         fv_brdf_mat mat;
