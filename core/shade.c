@@ -218,7 +218,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
                 /* maps of one size sampled at the same point (no own texture transform): the
                  * same texel offsets and weights in another texture */
                 if (jp >= 0 && su == psu && sv == psv && lj == plod && fv_tex_same_layout(&s->textures[slot_texture(m, jp)], tj))
-                    fv_tex_taps_rebase(&s->textures[slot_texture(m, jp)], tj, lj, &taps[jp][q], &taps[j][q]);
+                    fv_tex_taps_rebase(&s->textures[slot_texture(m, jp)], tj, &taps[jp][q], &taps[j][q]);
                 else
                     fv_tex_taps_at(tj, su, sv, lj, &taps[j][q]), jp = j, psu = su, psv = sv, plod = lj;
                 fv_tex_taps_prefetch(&taps[j][q]);

@@ -79,26 +79,24 @@ static inline void fv_tex_taps_at(const fv_texture *t, float u, float v, float l
         fv_tex_tap_at(t, l0 + 1, u, v, &tp->tap[1]);
 }
 
-/* Textures of the same size and wrap modes (so the same levels): fv_tex_taps_at of one at (u, v,
- * lod) is the other's at the same coordinates moved to its texels (fv_tex_taps_rebase). */
+/* Textures of the same size and wrap modes: fv_tex_taps_at of one at (u, v, lod) is the other's
+ * at the same coordinates moved to its texels (fv_tex_taps_rebase). */
 static inline int fv_tex_same_layout(const fv_texture *a, const fv_texture *b)
 {
     return a->w[0] == b->w[0] && a->h[0] == b->h[0] && a->wrap_s == b->wrap_s && a->wrap_t == b->wrap_t;
 }
 
 /* The taps fv_tex_taps_at(to, u, v, lod) gives, from src = fv_tex_taps_at(from, u, v, lod) with
- * fv_tex_same_layout(from, to): the same texel offsets and weights in to's levels. */
-static inline void fv_tex_taps_rebase(const fv_texture *from, const fv_texture *to, float lod, const fv_tex_taps *src,
+ * fv_tex_same_layout(from, to): the same weights and texel offsets. A texture's levels lie in one
+ * block (data) at offsets that depend on its size only, so an offset from level 0 carries over
+ * whatever the level. */
+static inline void fv_tex_taps_rebase(const fv_texture *from, const fv_texture *to, const fv_tex_taps *src,
                                       fv_tex_taps *dst)
 {
-    if (!(lod > 0.0f)) lod = 0.0f; /* as fv_tex_taps_at picks its levels */
-    const int top = from->levels - 1, l0 = lod >= (float)top ? top : (int)lod;
     *dst = *src;
-    for (int i = 0; i < 4; i++)
-        dst->tap[0].p[i] = to->level[l0] + (src->tap[0].p[i] - from->level[l0]);
-    if (src->f > 0.0f)
+    for (int l = 0; l < (src->f > 0.0f ? 2 : 1); l++)
         for (int i = 0; i < 4; i++)
-            dst->tap[1].p[i] = to->level[l0 + 1] + (src->tap[1].p[i] - from->level[l0 + 1]);
+            dst->tap[l].p[i] = to->level[0] + (src->tap[l].p[i] - from->level[0]);
 }
 
 static inline void fv_tex_taps_prefetch(const fv_tex_taps *tp)
