@@ -106,6 +106,7 @@ void fv_frame_stats_sum(fv_frame_stats *sum, const fv_frame_stats *st, int first
         memset(sum, 0, sizeof *sum);
     for (int s = 0; s < FV_STAGE_COUNT; s++)
         sum->stage_ms[s] = first ? st->stage_ms[s] : sum->stage_ms[s] + st->stage_ms[s];
+    sum->shade_ms = first ? st->shade_ms : sum->shade_ms + st->shade_ms; /* NAN: not timed */
     sum->total_ms += st->total_ms;
     sum->samples += st->samples;
 }

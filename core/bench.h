@@ -52,8 +52,8 @@ void fv_bench_acc_add(fv_bench_acc *a, const fv_frame_stats *st);
 void fv_bench_acc_finish(fv_bench_acc *a);
 /* One timed frame's ceiling time (--ceiling): finish sets ceiling_ms to their mean. */
 void fv_bench_acc_add_ceiling(fv_bench_acc *a, double ms);
-/* One timed frame's shading time in ms (fv_raycast_shade_ns's increase over the frame, over the
- * pool's threads): finish sets shade_ms to their mean. */
+/* One timed frame's shading time in ms (fv_frame_stats.shade_ms, with the pipeline's
+ * time_shading: the workers' time over their count): finish sets shade_ms to their mean. */
 void fv_bench_acc_add_shade(fv_bench_acc *a, double ms);
 /* shade_ms as a fraction of the ray stage's time (NAN when either is missing). */
 double fv_bench_shade_share(const fv_bench_run *r);

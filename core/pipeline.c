@@ -331,6 +331,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         return -1; /* the lens's output is a pass of its own, from the float image */
     for (int i = 0; i < FV_STAGE_COUNT; i++)
         st->stage_ms[i] = NAN;
+    st->shade_ms = NAN;
     /* with reprojection, render into the other pyramid and read this one as history */
     const int dst = p->taa ? es->cur ^ 1 : 0;
     fv_pyramid *pyr = &es->pyr[dst];
@@ -362,6 +363,8 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     }
     es->rows_valid = opt.dofs != NULL;
     double taa_ms = NAN;
+    int64_t shade_ns = 0;
+    opt.shade_ns = p->cfg.time_shading ? &shade_ns : NULL;
     st->samples = fv_tile_pass(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
     const int64_t tr0 = fv_prof_stage_begin(p->prof, FV_STAGE_RECONSTRUCT);
@@ -397,6 +400,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         st->stage_ms[FV_STAGE_TRACE] = cast_ms;
     }
     st->stage_ms[FV_STAGE_RECONSTRUCT] = (double)(t2 - t1) * 1e-6;
+    st->shade_ms = p->cfg.time_shading ? (double)shade_ns * 1e-6 / fv_pool_threads(p->pool) : NAN;
     st->total_ms = (double)(t3 - t0) * 1e-6;
     return 0;
 }

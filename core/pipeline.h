@@ -27,6 +27,8 @@ typedef struct fv_pipeline_config {
                               * 0 (default): with the layered DoF the combine's rows go straight to
                               * the display format and never to memory as floats (29.5 MB a
                               * 1280x1440 eye a frame saved) */
+    int time_shading;        /* 1: time the shading inside the ray stage (fv_frame_stats.shade_ms,
+                              * two clock reads a tile); 0 (default): not timed, shade_ms NAN */
     int threads;             /* 0 = online CPUs */
     unsigned isa_mask;       /* kernels allowed (FV_ISA_* bits); ~0u = the best this CPU runs */
 } fv_pipeline_config;
@@ -35,6 +37,9 @@ typedef struct fv_frame_stats {
     double stage_ms[FV_STAGE_COUNT]; /* NAN for a stage that is not built */
     double total_ms;                 /* wall time of the whole frame */
     long samples;                    /* rays cast */
+    double shade_ms;                 /* with cfg.time_shading: the workers' time shading hits inside
+                                      * the ray stage over their count (comparable with its wall
+                                      * time); else NAN */
     float focus_m;                   /* the accommodated focus distance (NAN without DoF) */
 } fv_frame_stats;
 

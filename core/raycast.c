@@ -3,6 +3,7 @@
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "base/clock.h"
@@ -76,14 +77,10 @@ static const float lane_inf[16] = {INFINITY, INFINITY, INFINITY, INFINITY, INFIN
 static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
 #define lane_valid(j) (lane_valid_all + (j))
 
-/* Shading time of every tile since the start, summed over threads (fv_raycast_shade_ns). */
-static atomic_llong shade_ns_total;
-long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_total, memory_order_relaxed); }
-
 /* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths). A tile's packets are all
  * traced first, then all shaded, then written: the triangle records and image lines of every hit,
  * prefetched right after its packet was traced, have the rest of the tile's tracing to arrive
- * (they were the shading's main cost), and shading is timed with two clock reads per tile. */
+ * (they were the shading's main cost), and shading, when asked, is timed with two clock reads per tile. */
 #define FV_TILE_PACKETS(N) (FV_TILE * FV_TILE / (N))
 #define DEF_PACKETS(N)                                                                                            \
     /* Camera rays through the pixel centres px[0 .. N) (as fv_camera_ray computes them) straight into      \
@@ -137,7 +134,7 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
     static _Thread_local _Alignas(64) float tile_rgb_##N[FV_TILE_PACKETS(N)][3][16];                         \
     static _Thread_local float tile_org_##N[3] = {NAN, NAN, NAN};                                            \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
-                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                  \
+                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n, int64_t *shade_ns) \
     {                                                                                                         \
         struct RTCIntersectContext ictx;                                                                      \
         rtcInitIntersectContext(&ictx);                                                                       \
@@ -160,14 +157,15 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
         for (int b = 0; b < np; b++)                                                                          \
             trace_##N(scene, cam, dsp, &rc, &ictx, &rh[b], valid, px + b * N, n - b * N < N ? n - b * N : N,     \
                       x0, y0);                                                                                \
-        const int64_t t0 = fv_time_ns();                                                                      \
+        const int64_t t0 = shade_ns ? fv_time_ns() : 0;                                                       \
         for (int b = 0; b < np; b++) {                                                                        \
             const fv_hit_packet hp = {rh[b].hit.geomID, rh[b].hit.primID, rh[b].hit.u, rh[b].hit.v,           \
                                       rh[b].ray.tfar, {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z}};   \
             fv_scene_shade_packet(scene, &dsp->shade, &hp, n - b * N < N ? n - b * N : N, cam->px_tan,        \
                                   cam->eye_pos, tile_rgb_##N[b]);                                             \
         }                                                                                                     \
-        atomic_fetch_add_explicit(&shade_ns_total, fv_time_ns() - t0, memory_order_relaxed);                  \
+        if (shade_ns)                                                                                         \
+            *shade_ns += fv_time_ns() - t0;                                                                   \
         for (int b = 0; b < np; b++)                                                                          \
             write_##N(l0, &rh[b], (const float(*)[16])tile_rgb_##N[b], px + b * N,                             \
                       n - b * N < N ? n - b * N : N, x0, y0);                                                 \
@@ -176,7 +174,7 @@ DEF_PACKETS(8)
 DEF_PACKETS(16)
 
 long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
-                     int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE])
+                     int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], int64_t *shade_ns)
 {
     /* every pixel's weight, from the rows' bits (pull-push never reads the colour of a zero-weight
      * pixel, so the others' colours are left alone) */
@@ -203,8 +201,8 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_rende
     for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
         px[q] = px[n - 1];
     if (fv_raycast_packet_width() == 16)
-        packets_16(scene, cam, dsp, l0, x0, y0, px, n);
+        packets_16(scene, cam, dsp, l0, x0, y0, px, n, shade_ns);
     else
-        packets_8(scene, cam, dsp, l0, x0, y0, px, n);
+        packets_8(scene, cam, dsp, l0, x0, y0, px, n, shade_ns);
     return n;
 }

@@ -50,13 +50,11 @@ int fv_raycast_pixels(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[F
 /* Casts a ray through the centre of every pixel of the tile [x0, x0+tw) x [y0, y0+th) whose bit
  * is set in rows[y - y0] (bit x - x0), generates and shades them with dsp's kernels (ray, shade) and writes r, g, b,
  * depth_m with weight 1 into level 0 (l0's planes); every other pixel of the tile gets weight 0
- * and keeps its colour. Returns the number of rays cast. */
+ * and keeps its colour. Returns the number of rays cast. shade_ns: NULL, or the tile's shading
+ * time (the packets' fv_scene_shade_packet, not tracing or writing) is added to *shade_ns (two
+ * clock reads; NULL reads no clock: the bench asks for the shading share, nothing else pays). */
 long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const struct fv_render_dsp *dsp,
-                     const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE]);
-
-/* Nanoseconds spent shading in fv_raycast_tile since the program started, summed over all threads
- * and tiles (the packets' fv_scene_shade_packet, not tracing or writing): the bench reads it before
- * and after a frame for the shading share of the ray stage. */
-long long fv_raycast_shade_ns(void);
+                     const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE],
+                     int64_t *shade_ns);
 
 #endif

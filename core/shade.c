@@ -2,6 +2,7 @@
  * material's inputs gathered here, the BRDF and lights in core/shade_lane.h / the kernels. */
 #include "scene_impl.h"
 #include "shade_lane.h"
+#include "texture_tap.h"
 #include "base/util.h"
 
 #include <math.h>
@@ -205,13 +206,22 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             const float fp = px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
+            int jp = -1; /* the last slot whose taps were computed here */
+            float psu = 0.0f, psv = 0.0f, plod = 0.0f;
             for (int j = 0; j < 4; j++) {
                 const int id = slot_texture(m, j);
                 if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
                 float su, sv;
                 slot_uv(m, j, tu, tv, &su, &sv);
-                fv_texture_taps(&s->textures[id], su, sv, lod + m->lod_bias[j], &taps[j][q]);
-                fv_texture_taps_prefetch(&taps[j][q]);
+                const float lj = lod + m->lod_bias[j];
+                const fv_texture *tj = &s->textures[id];
+                /* maps of one size sampled at the same point (no own texture transform): the
+                 * same texel offsets and weights in another texture */
+                if (jp >= 0 && su == psu && sv == psv && lj == plod && fv_tex_same_layout(&s->textures[slot_texture(m, jp)], tj))
+                    fv_tex_taps_rebase(&s->textures[slot_texture(m, jp)], tj, &taps[jp][q], &taps[j][q]);
+                else
+                    fv_tex_taps_at(tj, su, sv, lj, &taps[j][q]), jp = j, psu = su, psv = sv, plod = lj;
+                fv_tex_taps_prefetch(&taps[j][q]);
             }
             textured |= 1u << q;
         } else {
@@ -233,7 +243,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         for (int j = 0; j < 4; j++)
             if (slot_texture(m, j) >= 0) {
                 if (m->slot_src[j] == j)
-                    fv_texture_blend(&taps[j][q], texel[j]);
+                    fv_tex_blend(&taps[j][q], texel[j]);
                 tx[j] = texel[m->slot_src[j]];
             }
         fv_brdf_mat mat;

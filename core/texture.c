@@ -1,6 +1,7 @@
 /* fovea: scene textures: sRGB (or linear data) 8-bit RGBA stored as linear float RGBA with a box-filtered mip
  * chain, sampled trilinearly with REPEAT, CLAMP or MIRROR addressing (glTF samplers). */
 #include "scene_impl.h"
+#include "texture_tap.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -86,89 +87,14 @@ int fv_scene_set_texture_wrap(fv_scene *s, int tex, fv_wrap wrap_s, fv_wrap wrap
     return 0;
 }
 
-/* A coordinate folded into [0, 1] by the wrap mode (glTF samplers; NaN and infinities give 0). */
-static float wrap_coord(float u, fv_wrap mode)
-{
-    if (!isfinite(u)) return 0.0f;
-    if (mode == FV_WRAP_CLAMP) return u < 0.0f ? 0.0f : u > 1.0f ? 1.0f : u;
-    if (mode == FV_WRAP_MIRROR) {
-        const float f = u - 2.0f * floorf(0.5f * u); /* [0, 2] */
-        return f > 1.0f ? 2.0f - f : f;
-    }
-    return u - floorf(u); /* [0,1] (1 only by rounding) */
-}
-
-/* A bilinear tap's neighbour index on one axis, i in [-1, side]: wrapped for REPEAT, the edge
- * texel for CLAMP and MIRROR (a mirror repeats the edge texel across the edge). */
-static int wrap_index(int i, int side, fv_wrap mode)
-{
-    if (mode == FV_WRAP_REPEAT) return i < 0 ? i + side : i >= side ? i - side : i;
-    return i < 0 ? 0 : i >= side ? side - 1 : i;
-}
-
-/* Bilinear with the texture's wrap modes; uv (0,0) is the first texel of the first row (glTF).
- * A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. */
-static void tex_tap(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp)
-{
-    const int w = t->w[l], h = t->h[l];
-    const float *px = t->level[l];
-    u = wrap_coord(u, t->wrap_s);
-    v = wrap_coord(v, t->wrap_t);
-    const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
-    const float xf = floorf(x), yf = floorf(y);
-    tp->fx = x - xf, tp->fy = y - yf;
-    const int x0 = wrap_index((int)xf, w, t->wrap_s), y0 = wrap_index((int)yf, h, t->wrap_t);
-    const int x1 = wrap_index((int)xf + 1, w, t->wrap_s), y1 = wrap_index((int)yf + 1, h, t->wrap_t);
-    tp->p[0] = px + ((size_t)y0 * (size_t)w + (size_t)x0) * 4, tp->p[1] = px + ((size_t)y0 * (size_t)w + (size_t)x1) * 4;
-    tp->p[2] = px + ((size_t)y1 * (size_t)w + (size_t)x0) * 4, tp->p[3] = px + ((size_t)y1 * (size_t)w + (size_t)x1) * 4;
-}
-
-static void tex_blend(const fv_tex_tap *tp, float out[4])
-{
-    const float *a = tp->p[0], *b = tp->p[1], *c = tp->p[2], *d = tp->p[3];
-    for (int k = 0; k < 4; k++) {
-        const float top = a[k] + (b[k] - a[k]) * tp->fx, bot = c[k] + (d[k] - c[k]) * tp->fx;
-        out[k] = top + (bot - top) * tp->fy;
-    }
-}
-
-void fv_texture_taps(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp)
-{
-    if (!(lod > 0.0f)) lod = 0.0f; /* also NaN */
-    const float top = (float)(t->levels - 1);
-    tp->f = 0.0f;
-    if (lod >= top) {
-        tex_tap(t, t->levels - 1, u, v, &tp->tap[0]);
-        return;
-    }
-    const int l0 = (int)lod;
-    tp->f = lod - (float)l0;
-    tex_tap(t, l0, u, v, &tp->tap[0]);
-    if (tp->f > 0.0f)
-        tex_tap(t, l0 + 1, u, v, &tp->tap[1]);
-}
-
-void fv_texture_taps_prefetch(const fv_tex_taps *tp)
-{
-    for (int l = 0; l < (tp->f > 0.0f ? 2 : 1); l++)
-        for (int i = 0; i < 4; i++)
-            __builtin_prefetch(tp->tap[l].p[i]);
-}
-
-void fv_texture_blend(const fv_tex_taps *tp, float out[4])
-{
-    tex_blend(&tp->tap[0], out);
-    if (tp->f > 0.0f) {
-        float o1[4];
-        tex_blend(&tp->tap[1], o1);
-        for (int k = 0; k < 4; k++) out[k] += (o1[k] - out[k]) * tp->f;
-    }
-}
+void fv_texture_taps(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp) { fv_tex_taps_at(t, u, v, lod, tp); }
+void fv_texture_taps_prefetch(const fv_tex_taps *tp) { fv_tex_taps_prefetch(tp); }
+void fv_texture_blend(const fv_tex_taps *tp, float out[4]) { fv_tex_blend(tp, out); }
 
 /* Trilinear between the two mip levels around lod (lod 0 = full resolution). */
 void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4])
 {
     fv_tex_taps tp;
-    fv_texture_taps(t, u, v, lod, &tp);
-    fv_texture_blend(&tp, out);
+    fv_tex_taps_at(t, u, v, lod, &tp);
+    fv_tex_blend(&tp, out);
 }

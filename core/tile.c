@@ -21,6 +21,8 @@ typedef struct {
     const fv_taa_params *taa_prm;
     atomic_long rays;
     atomic_llong taa_ns;
+    atomic_llong shade_ns;
+    int time_shading;
     struct fv_prof *prof; /* NULL: no trace recording */
     const struct fv_dofsamp_frame *dofs;
     uint32_t *rows_out;
@@ -49,7 +51,11 @@ static void run_tile(void *ctx, int index, int thread_id)
             j->rows_out[(size_t)index * FV_TILE + y] = y < th ? rows[y] : 0u;
 
     /* writes every weight of the tile: pixels without a sample get 0 */
-    const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
+    int64_t shade_ns = 0;
+    const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows,
+                                      j->time_shading ? &shade_ns : NULL);
+    if (shade_ns)
+        atomic_fetch_add_explicit(&j->shade_ns, shade_ns, memory_order_relaxed);
     if (j->taa) {
         const int64_t t0 = fv_time_ns();
         fv_taa_tile_run_keep(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th,
@@ -82,12 +88,16 @@ long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler 
         j.prof = opt->prof;
         j.dofs = opt->dofs;
         j.rows_out = opt->rows_out;
+        j.time_shading = opt->shade_ns != NULL;
     }
     j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
     j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
     atomic_init(&j.rays, 0);
     atomic_init(&j.taa_ns, 0);
+    atomic_init(&j.shade_ns, 0);
     fv_pool_run(pool, j.tiles_x * j.tiles_y, run_tile, &j);
+    if (j.time_shading)
+        *opt->shade_ns = atomic_load(&j.shade_ns);
     if (taa_ms)
         *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
     return atomic_load(&j.rays);

@@ -38,6 +38,8 @@ typedef struct fv_tile_opts {
                                           * (core/sampling_dof.h); NULL = off */
     uint32_t *rows_out;           /* NULL, or every tile's final sample bits: tile i's rows at
                                    * rows_out + FV_TILE * i (the bench's ceiling retraces them) */
+    int64_t *shade_ns;            /* NULL: shading not timed (no clock reads); else set to the
+                                   * workers' summed time shading hits in this pass (ns) */
 } fv_tile_opts;
 
 /* Runs every tile of the eye image: the sampler's pixels around the point of regard (gx, gy

@@ -31,6 +31,7 @@ int fv_bench_run_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, c
 {
     const int warmup = bo->warmup, frames = bo->frames;
     cfg.samp.full = full;
+    cfg.time_shading = 1; /* the shading share of the ray stage (two clock reads a tile) */
     fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, err_len);
     if (!pl)
         return -1;
@@ -67,16 +68,13 @@ int fv_bench_run_mode(const fv_scene *scene, fv_pipeline_config cfg, int full, c
         const fv_pose head = fv_bench_head_at(view, bo->yaw_rate, f);
         fv_frame_stats st;
         cs.on = f >= warmup;
-        const long long sh0 = fv_raycast_shade_ns();
         if (fv_pipeline_render(pl, FV_EYE_CENTER, &head, 0.5f, 0.5f, &st)) {
             rc = fv_err(err, err_len, "%s frame %d: rendering failed", r->mode, f);
             break;
         }
         if (f >= warmup) {
             fv_bench_acc_add(&acc, &st);
-            /* all threads' shading time over their count: comparable with the stage's wall time */
-            fv_bench_acc_add_shade(&acc, (double)(fv_raycast_shade_ns() - sh0) * 1e-6 /
-                                             fv_pool_threads(fv_pipeline_pool(pl)));
+            fv_bench_acc_add_shade(&acc, st.shade_ms); /* all threads' over their count */
         }
         if (bo->ceiling) {
             const fv_camera *cam = fv_pipeline_camera(pl, FV_EYE_CENTER);

@@ -90,8 +90,10 @@ static void test_stats_sum(void **state)
 {
     (void)state;
     fv_frame_stats sum, l = frame(2, 1, 4, 100), r = frame(3, 0.5, 5, 50);
+    l.shade_ms = 0.75, r.shade_ms = 1.5;
     fv_frame_stats_sum(&sum, &l, 1);
     fv_frame_stats_sum(&sum, &r, 0);
+    assert_near(sum.shade_ms, 2.25, 0);
     assert_near(sum.stage_ms[FV_STAGE_TRACE], 5.0, 0);
     assert_near(sum.stage_ms[FV_STAGE_RECONSTRUCT], 1.5, 0);
     assert_true(isnan(sum.stage_ms[FV_STAGE_COMBINE]));

@@ -364,10 +364,46 @@ static void test_stereo_eyes(void **st)
     assert_float_equal(py, 1000.5f, 1e-2);
 }
 
+/* Shading is timed only when the configuration asks (cfg.time_shading, the bench): otherwise
+ * shade_ms is NAN; when timed it is positive and, being the workers' time inside the ray stage
+ * over their count, no more than the stage's wall time; the image is the same bytes either way. */
+static void test_shade_timing(void **st)
+{
+    (void)st;
+    fv_scene *s = hand_scene();
+    const fv_pyr_level *lv[2];
+    fv_pipeline *p[2];
+    for (int timed = 0; timed < 2; timed++) {
+        fv_pipeline_config cfg;
+        fv_pipeline_config_default(&cfg);
+        cfg.cam.width = 64, cfg.cam.height = 72, cfg.samp.full = 1, cfg.threads = 2;
+        cfg.time_shading = timed;
+        char err[256];
+        p[timed] = fv_pipeline_create(s, &cfg, err, sizeof err);
+        assert_non_null(p[timed]);
+        fv_frame_stats stats;
+        stats.shade_ms = 123.0; /* overwritten either way */
+        assert_int_equal(fv_pipeline_render(p[timed], FV_EYE_CENTER, &origin, 0.5f, 0.5f, &stats), 0);
+        if (timed)
+            assert_true(stats.shade_ms > 0.0 && stats.shade_ms <= stats.stage_ms[FV_STAGE_TRACE]);
+        else
+            assert_true(isnan(stats.shade_ms));
+        lv[timed] = &fv_pipeline_pyramid(p[timed], FV_EYE_CENTER)->lv[0];
+    }
+    for (int y = 0; y < 72; y++) {
+        assert_memory_equal(lv[0]->rgbd + 4 * y * lv[0]->stride, lv[1]->rgbd + 4 * y * lv[1]->stride, 4 * 64 * sizeof(float));
+        assert_memory_equal(lv[0]->wgt + y * lv[0]->stride, lv[1]->wgt + y * lv[1]->stride, 64 * sizeof(float));
+    }
+    fv_pipeline_destroy(p[0]);
+    fv_pipeline_destroy(p[1]);
+    fv_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hand_scene_full),
+        cmocka_unit_test(test_shade_timing),
         cmocka_unit_test(test_foveated_samples),
         cmocka_unit_test(test_fovea_scale),
         cmocka_unit_test(test_thread_determinism),

@@ -6,6 +6,7 @@
 
 #include "scene.h"
 #include "shade_dsp.h"
+#include "texture_tap.h" /* the packet shading's inline taps (internal) */
 
 #include <stb/stb_image_write.h>
 
@@ -436,6 +437,54 @@ static void test_texture_bilinear_wrap(void **state)
     shade_uv(s, 1.125f, -0.75f, 0, rgb2);
     assert_rgb(rgb2, rgb[0], rgb[1], rgb[2], 1e-5f, __LINE__);
 #undef LIN
+    fv_scene_free(s);
+}
+
+/* The taps one map shares with another of the same size and wrap modes (fv_tex_taps_rebase, the
+ * packet shading's shortcut) are the ones computed for the other map directly: same texels of
+ * the other texture, same weights, for coordinates across and beyond [0, 1], NaN, every level
+ * and lod range, every wrap mode; and a texture of another size is not the same layout. */
+static void test_texture_taps_rebase(void **state)
+{
+    (void)state;
+    uint8_t a[8 * 4 * 4], b[8 * 4 * 4], c[4 * 4 * 4];
+    for (int i = 0; i < (int)sizeof a; i++) a[i] = (uint8_t)(i * 7), b[i] = (uint8_t)(255 - i * 3);
+    memset(c, 9, sizeof c);
+    fv_scene *s = fv_scene_create();
+    assert_non_null(s);
+    assert_int_equal(fv_scene_add_texture(s, a, 8, 4), 0);
+    assert_int_equal(fv_scene_add_texture_linear(s, b, 8, 4), 1);
+    assert_int_equal(fv_scene_add_texture(s, c, 4, 4), 2);
+    const fv_texture *ta = &s->textures[0], *tb = &s->textures[1];
+    assert_false(fv_tex_same_layout(ta, &s->textures[2]));
+    uint64_t seed = 5;
+    static const fv_wrap modes[3] = {FV_WRAP_REPEAT, FV_WRAP_CLAMP, FV_WRAP_MIRROR};
+    int two_levels = 0;
+    for (int m = 0; m < 9; m++) {
+        for (int k = 0; k < 2; k++)
+            assert_int_equal(fv_scene_set_texture_wrap(s, k, modes[m % 3], modes[m / 3]), 0);
+        assert_true(fv_tex_same_layout(ta, tb));
+        for (int it = 0; it < 2000; it++) {
+            float u = -2.0f + 5.0f * fv_test_randf(&seed), v = -2.0f + 5.0f * fv_test_randf(&seed);
+            float lod = -1.0f + 8.0f * fv_test_randf(&seed); /* levels 0 .. 3, and beyond the last */
+            if (it % 97 == 0) u = NAN;
+            if (it % 89 == 0) lod = NAN;
+            if (it % 83 == 0) lod = (float)(it % 4); /* whole levels: f = 0 */
+            fv_tex_taps ra, want, got;
+            fv_tex_taps_at(ta, u, v, lod, &ra);
+            fv_tex_taps_at(tb, u, v, lod, &want);
+            fv_tex_taps_rebase(ta, tb, &ra, &got);
+            assert_memory_equal(&got.f, &want.f, sizeof want.f);
+            for (int l = 0; l < (want.f > 0.0f ? 2 : 1); l++) {
+                for (int i = 0; i < 4; i++)
+                    assert_ptr_equal(got.tap[l].p[i], want.tap[l].p[i]);
+                assert_memory_equal(&got.tap[l].fx, &want.tap[l].fx, sizeof want.tap[l].fx);
+                assert_memory_equal(&got.tap[l].fy, &want.tap[l].fy, sizeof want.tap[l].fy);
+            }
+            two_levels += want.f > 0.0f;
+        }
+    }
+    assert_true(two_levels > 1000);
     fv_scene_free(s);
 }
 
@@ -1714,6 +1763,7 @@ int main(void)
         cmocka_unit_test(test_builder_normals_inverse_transpose),
         cmocka_unit_test(test_texture_bilinear_wrap),
         cmocka_unit_test(test_texture_mips),
+        cmocka_unit_test(test_texture_taps_rebase),
         cmocka_unit_test(test_builder_rejects_bad_meshes),
         cmocka_unit_test(test_lights_directional),
         cmocka_unit_test(test_lights_point_spot),

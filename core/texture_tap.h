@@ -1,0 +1,125 @@
+/* fovea: the texel taps and blends of core/texture.c as inline functions, so the packet shading
+ * (core/shade.c) runs them without five calls per lane and slot; texture.c's fv_texture_taps /
+ * fv_texture_blend / fv_texture_sample are these, so both give the same bits. Texels are linear
+ * float RGBA: a blend works on whole texels (4 floats), which the compiler keeps in one vector
+ * register (the copies into locals tell it the output cannot alias the texels). */
+#ifndef FOVEA_TEXTURE_TAP_H
+#define FOVEA_TEXTURE_TAP_H
+
+#include "scene_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+/* A coordinate folded into [0, 1] by the wrap mode (glTF samplers; NaN and infinities give 0). */
+static inline float fv_tex_wrap_coord(float u, fv_wrap mode)
+{
+    if (!isfinite(u)) return 0.0f;
+    if (mode == FV_WRAP_CLAMP) return u < 0.0f ? 0.0f : u > 1.0f ? 1.0f : u;
+    if (mode == FV_WRAP_MIRROR) {
+        const float f = u - 2.0f * floorf(0.5f * u); /* [0, 2] */
+        return f > 1.0f ? 2.0f - f : f;
+    }
+    return u - floorf(u); /* [0,1] (1 only by rounding) */
+}
+
+/* A bilinear tap's neighbour index on one axis, i in [-1, side]: wrapped for REPEAT, the edge
+ * texel for CLAMP and MIRROR (a mirror repeats the edge texel across the edge). */
+static inline int fv_tex_wrap_index(int i, int side, fv_wrap mode)
+{
+    if (mode == FV_WRAP_REPEAT) return i < 0 ? i + side : i >= side ? i - side : i;
+    return i < 0 ? 0 : i >= side ? side - 1 : i;
+}
+
+/* Bilinear with the texture's wrap modes; uv (0,0) is the first texel of the first row (glTF).
+ * A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. */
+static inline void fv_tex_tap_at(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp)
+{
+    const int w = t->w[l], h = t->h[l];
+    const float *px = t->level[l];
+    u = fv_tex_wrap_coord(u, t->wrap_s);
+    v = fv_tex_wrap_coord(v, t->wrap_t);
+    const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
+    const float xf = floorf(x), yf = floorf(y);
+    tp->fx = x - xf, tp->fy = y - yf;
+    const int x0 = fv_tex_wrap_index((int)xf, w, t->wrap_s), y0 = fv_tex_wrap_index((int)yf, h, t->wrap_t);
+    const int x1 = fv_tex_wrap_index((int)xf + 1, w, t->wrap_s), y1 = fv_tex_wrap_index((int)yf + 1, h, t->wrap_t);
+    tp->p[0] = px + ((size_t)y0 * (size_t)w + (size_t)x0) * 4, tp->p[1] = px + ((size_t)y0 * (size_t)w + (size_t)x1) * 4;
+    tp->p[2] = px + ((size_t)y1 * (size_t)w + (size_t)x0) * 4, tp->p[3] = px + ((size_t)y1 * (size_t)w + (size_t)x1) * 4;
+}
+
+/* One level's bilinear blend of whole texels. */
+static inline void fv_tex_blend1(const fv_tex_tap *tp, float out[4])
+{
+    float a[4], b[4], c[4], d[4], o[4];
+    memcpy(a, tp->p[0], sizeof a), memcpy(b, tp->p[1], sizeof b);
+    memcpy(c, tp->p[2], sizeof c), memcpy(d, tp->p[3], sizeof d);
+    const float fx = tp->fx, fy = tp->fy;
+    for (int k = 0; k < 4; k++) {
+        const float top = a[k] + (b[k] - a[k]) * fx, bot = c[k] + (d[k] - c[k]) * fx;
+        o[k] = top + (bot - top) * fy;
+    }
+    memcpy(out, o, sizeof o);
+}
+
+/* fv_texture_taps (scene_impl.h): the taps of the one or two mip levels around lod. */
+static inline void fv_tex_taps_at(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp)
+{
+    if (!(lod > 0.0f)) lod = 0.0f; /* also NaN */
+    const float top = (float)(t->levels - 1);
+    tp->f = 0.0f;
+    if (lod >= top) {
+        fv_tex_tap_at(t, t->levels - 1, u, v, &tp->tap[0]);
+        return;
+    }
+    const int l0 = (int)lod;
+    tp->f = lod - (float)l0;
+    fv_tex_tap_at(t, l0, u, v, &tp->tap[0]);
+    if (tp->f > 0.0f)
+        fv_tex_tap_at(t, l0 + 1, u, v, &tp->tap[1]);
+}
+
+/* Textures of the same size and wrap modes: fv_tex_taps_at of one at (u, v, lod) is the other's
+ * at the same coordinates moved to its texels (fv_tex_taps_rebase). */
+static inline int fv_tex_same_layout(const fv_texture *a, const fv_texture *b)
+{
+    return a->w[0] == b->w[0] && a->h[0] == b->h[0] && a->wrap_s == b->wrap_s && a->wrap_t == b->wrap_t;
+}
+
+/* The taps fv_tex_taps_at(to, u, v, lod) gives, from src = fv_tex_taps_at(from, u, v, lod) with
+ * fv_tex_same_layout(from, to): the same weights and texel offsets. A texture's levels lie in one
+ * block (data) at offsets that depend on its size only, so an offset from level 0 carries over
+ * whatever the level. */
+static inline void fv_tex_taps_rebase(const fv_texture *from, const fv_texture *to, const fv_tex_taps *src,
+                                      fv_tex_taps *dst)
+{
+    *dst = *src;
+    for (int l = 0; l < (src->f > 0.0f ? 2 : 1); l++)
+        for (int i = 0; i < 4; i++)
+            dst->tap[l].p[i] = to->level[0] + (src->tap[l].p[i] - from->level[0]);
+}
+
+static inline void fv_tex_taps_prefetch(const fv_tex_taps *tp)
+{
+    for (int i = 0; i < 4; i++)
+        __builtin_prefetch(tp->tap[0].p[i]);
+    if (tp->f > 0.0f)
+        for (int i = 0; i < 4; i++)
+            __builtin_prefetch(tp->tap[1].p[i]);
+}
+
+/* fv_texture_blend: trilinear between the taps' levels. */
+static inline void fv_tex_blend(const fv_tex_taps *tp, float out[4])
+{
+    float o[4];
+    fv_tex_blend1(&tp->tap[0], o);
+    if (tp->f > 0.0f) {
+        float o1[4];
+        fv_tex_blend1(&tp->tap[1], o1);
+        const float f = tp->f;
+        for (int k = 0; k < 4; k++) o[k] += (o1[k] - o[k]) * f;
+    }
+    memcpy(out, o, sizeof o);
+}
+
+#endif
