@@ -89,11 +89,13 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                 d.base_color[0] = d.base_color[1] = d.base_color[2] = d.base_color[3] = 1.0f;
                 d.texture = -1;
                 d.metallic = d.roughness = d.specular = 1.0f; /* the glTF default material */
+                d.single_sided = 1;                           /* (doubleSided false) */
                 if (p->material >= 0) {
                     const fv_gltf_material *mat = &g->materials[p->material];
                     memcpy(d.base_color, mat->base_color, sizeof d.base_color);
                     d.metallic = mat->metallic, d.roughness = mat->roughness, d.specular = mat->specular;
                     d.alpha_cutoff = mat->alpha_cutoff;
+                    d.single_sided = !mat->double_sided;
                     memcpy(d.emissive, mat->emissive, sizeof d.emissive);
                     /* no uvs: factors only */
                     const int img[4] = {mat->image, mat->mr_image, mat->occlusion_image, mat->emissive_image};

@@ -488,7 +488,7 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
         const std::string at = "material " + str(i);
         const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
         fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1, 0, {{0, 0}, {0, 0}, {0, 0}, {0, 0}},
-                                0, {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}}};
+                                0, {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}}, 0};
         const tinygltf::Material &mt = m.materials[i];
         auto unit = [&](double d, const char *name) {
             const float f = to_float(d, at + " " + name);
@@ -575,6 +575,7 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
         texture(3, mt.emissiveTexture.index, mt.emissiveTexture.texCoord, mt.emissiveTexture.extensions, "emissive", &mat.emissive_image);
         if (texcoord < 0) texcoord = 0;
         if (mt.alphaMode == "MASK") mat.alpha_cutoff = unit(mt.alphaCutoff, "alphaCutoff");
+        mat.double_sided = mt.doubleSided ? 1 : 0;
         if (mat.occlusion_image >= 0) mat.occlusion_strength = unit(mt.occlusionTexture.strength, "occlusion strength");
         h.materials.push_back(mat);
         h.material_texcoord.push_back(texcoord);

@@ -51,6 +51,7 @@ typedef struct fv_gltf_material {
                           * wrapS, wrapT: 0 REPEAT, 1 CLAMP_TO_EDGE, 2 MIRRORED_REPEAT (fv_wrap) */
     int has_uvx;         /* some texture has KHR_texture_transform: */
     float uvx[4][6];     /* per texture as wrap[]: u' = [0] u + [1] v + [2], v' = [3] u + [4] v + [5] */
+    int double_sided;    /* doubleSided (default false: back faces culled) */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {

@@ -159,18 +159,27 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out)
     return 0;
 }
 
-/* glTF alpha MASK as an Embree intersect filter: a hit where the base colour's alpha (factor x
- * texture, bilinear at mip 0: the filter does not know the ray's footprint) is below the cutoff
- * is rejected, so the ray goes on to whatever lies behind the cut-out. */
-static void mask_filter(const struct RTCFilterFunctionNArguments *a)
+/* The Embree intersect filter of single-sided (glTF doubleSided false) and alpha-MASK meshes:
+ * a hit on a back face, or where the base colour's alpha (factor x texture, bilinear at mip 0:
+ * the filter does not know the ray's footprint) is below the cutoff, is rejected, so the ray
+ * goes on to whatever lies behind. Embree's Ng is cross(p1 - p0, p2 - p0), glTF's front side
+ * (counter-clockwise corners), so a back face is Ng . dir > 0; grazing hits (0) are kept. */
+static void surface_filter(const struct RTCFilterFunctionNArguments *a)
 {
     const fv_mesh_rec *m = a->geometryUserPtr;
     const unsigned n = a->N;
-    /* RTCHitN is N-wide SoA: Ng x y z, u, v, primID, ... (the C++-only RTCHitN_* accessors) */
+    /* RTCHitN is N-wide SoA: Ng x y z, u, v, primID, ...; RTCRayN: org x y z, tnear, dir x y z,
+     * ... (the C++-only RTCHitN_* / RTCRayN_* accessors) */
+    const float *ng = (const float *)a->hit, *dir = (const float *)a->ray + 4 * n;
     const float *hu = (const float *)a->hit + 3 * n, *hv = (const float *)a->hit + 4 * n;
     const unsigned *hprim = (const unsigned *)a->hit + 5 * n;
     for (unsigned i = 0; i < n; i++) {
         if (a->valid[i] != -1) continue;
+        if (m->single_sided && ng[i] * dir[i] + ng[n + i] * dir[n + i] + ng[2 * n + i] * dir[2 * n + i] > 0.0f) {
+            a->valid[i] = 0;
+            continue;
+        }
+        if (!(m->alpha_cutoff > 0.0f)) continue;
         const unsigned prim = hprim[i];
         if (prim >= m->tri_count) continue;
         float alpha = m->base_color[3];
@@ -199,11 +208,11 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     for (size_t i = 0; i < s->mesh_count; i++) { /* the arrays no longer move: hand out pointers */
         fv_mesh_rec *m = &s->meshes[i];
-        if (!(m->alpha_cutoff > 0.0f)) continue;
-        m->mask_tex = m->texture >= 0 ? &s->textures[m->texture] : NULL;
+        if (!(m->alpha_cutoff > 0.0f) && !m->single_sided) continue;
+        m->mask_tex = m->alpha_cutoff > 0.0f && m->texture >= 0 ? &s->textures[m->texture] : NULL;
         RTCGeometry g = rtcGetGeometry(s->rtc, (unsigned)i);
         rtcSetGeometryUserData(g, m);
-        rtcSetGeometryIntersectFilterFunction(g, mask_filter);
+        rtcSetGeometryIntersectFilterFunction(g, surface_filter);
         rtcCommitGeometry(g);
     }
     rtcCommitScene(s->rtc);

@@ -19,8 +19,8 @@ typedef struct fv_scene fv_scene;
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
  * transforms. Materials as docs/materials.md says: metallic-roughness with base colour,
- * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK, sampler wrap
- * modes and KHR_texture_transform (normal maps, BLEND and filter modes are not read yet). Skins,
+ * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK, doubleSided,
+ * sampler wrap modes and KHR_texture_transform (BLEND and filter modes are not read yet). Skins,
  * morph targets and animations are ignored. The first perspective camera in depth-first node
  * order becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
@@ -66,6 +66,8 @@ typedef struct fv_mesh_desc {
     const fv_material_maps *maps; /* NULL: none */
     float alpha_cutoff;     /* > 0: glTF alpha MASK: rays pass through where the base alpha (factor x
                              * texture, bilinear at mip 0) is below it; 0: opaque */
+    int single_sided;       /* glTF doubleSided false: rays pass through the back faces (those whose
+                             * corners 0, 1, 2 appear clockwise); 0 (memset): double-sided */
     float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
 } fv_mesh_desc;
 fv_scene *fv_scene_create(void);
@@ -116,7 +118,8 @@ int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, floa
  * ray-cone spread), so the footprint at the hit is about t*|dir|*footprint_rad metres.
  * KHR light contributions are scaled by one exposure per scene, fixed at commit so that the
  * brightest light gives irradiance 1.0 at the bounds' centre (glTF intensities are often in
- * the thousands). Normals face the ray (double-sided). Writes linear RGB. */
+ * the thousands). Normals face the ray (a single-sided mesh's back faces are never hit: the
+ * ray query passes through them). Writes linear RGB. */
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
                     const float org[3], const float dir[3], float t, float footprint_rad,
                     const float eye_pos[3], float rgb[3]);

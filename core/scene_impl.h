@@ -61,6 +61,7 @@ typedef struct fv_mesh_rec {
     float *col;                   /* per triangle 9 floats, its corners' vertex colours, or NULL */
     float alpha_cutoff;           /* > 0: alpha MASK (an Embree intersect filter, set at commit) */
     const fv_texture *mask_tex;   /* the base colour texture the filter reads (set at commit), or NULL */
+    int single_sided;             /* back faces culled (the same Embree intersect filter) */
 } fv_mesh_rec;
 
 struct fv_scene {

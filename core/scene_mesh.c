@@ -110,6 +110,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular, r.roughness = m->roughness;
     r.tex_ref = tex_ref;
     r.alpha_cutoff = m->alpha_cutoff;
+    r.single_sided = m->single_sided != 0;
     if (m->maps && m->maps->has_uv_transform) {
         for (int j = 0; j < 4; j++)
             for (int k = 0; k < 6; k++)

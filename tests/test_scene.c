@@ -1104,6 +1104,89 @@ static void test_gltf_alpha_mask(void **state)
     tmpdir_remove(dir);
 }
 
+/* Casts 16 rays (lane q: origin o[q % 4], direction d) through rtcIntersect16 and writes their
+ * hit distances (INFINITY for a miss). */
+static void cast16(const fv_scene *s, const float o[4][3], const float d[3], float t[16])
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    _Alignas(64) struct RTCRayHit16 rh;
+    memset(&rh, 0, sizeof rh);
+    _Alignas(64) int valid[16];
+    for (int q = 0; q < 16; q++) {
+        valid[q] = -1;
+        rh.ray.org_x[q] = o[q % 4][0], rh.ray.org_y[q] = o[q % 4][1], rh.ray.org_z[q] = o[q % 4][2];
+        rh.ray.dir_x[q] = d[0], rh.ray.dir_y[q] = d[1], rh.ray.dir_z[q] = d[2];
+        rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
+        rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+    for (int q = 0; q < 16; q++) t[q] = rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar[q];
+}
+
+/* doubleSided: the quad [-1,1]^2 at z = 0 (corners counter-clockwise seen from +z: its front
+ * faces +z) as a default (single-sided) material at x = 0 and as a doubleSided one at x = 3,
+ * each with a single-sided wall at z = +2 turned 180 degrees about y (so it faces -z).
+ * Rays from z = -5 along +z meet the quads' back faces at t = 5: through the single-sided one
+ * they reach the wall's front at t = 7, the double-sided one stops them at t = 5. Rays from
+ * z = 1 along -z hit both quads' fronts at t = 1. rtcIntersect1 and rtcIntersect16 alike. From
+ * z = 5 along -z the wall is seen from behind (passed) and the double-sided quad's front is hit
+ * at t = 5: it shades as its back does from z = -5 (the normal turned to face the ray; the
+ * head light at the eye, the same distance and angle). */
+static void test_gltf_double_sided(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    unsigned char bin[92];
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0}},"
+        "{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"doubleSided\":true}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":1}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+        "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[3,0,0]},"
+        "{\"mesh\":2,\"translation\":[0,0,2],\"rotation\":[0,1,0,0]},"
+        "{\"mesh\":2,\"translation\":[3,0,2],\"rotation\":[0,1,0,0]}],"
+        "\"scenes\":[{\"nodes\":[0,1,2,3]}],\"scene\":0";
+    path_join(p, sizeof p, dir, "sides.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    const float back[3] = {0, 0, 1}, front[3] = {0, 0, -1};
+    const float ob[4][3] = {{-0.5f, 0.1f, -5}, {0.5f, -0.3f, -5}, {2.5f, 0.1f, -5}, {3.5f, -0.3f, -5}};
+    const float of[4][3] = {{-0.5f, 0.1f, 1}, {0.5f, -0.3f, 1}, {2.5f, 0.1f, 1}, {3.5f, -0.3f, 1}};
+    const float want_back[4] = {7, 7, 5, 5}, want_front[4] = {1, 1, 1, 1};
+    hit h;
+    for (int i = 0; i < 4; i++) {
+        assert_true(cast(s, ob[i], back, &h));
+        assert_near(h.t, want_back[i], 1e-5f);
+        assert_true(cast(s, of[i], front, &h));
+        assert_near(h.t, want_front[i], 1e-5f);
+    }
+    float t16[16];
+    cast16(s, ob, back, t16);
+    for (int q = 0; q < 16; q++) assert_near(t16[q], want_back[q % 4], 1e-5f);
+    cast16(s, of, front, t16);
+    for (int q = 0; q < 16; q++) assert_near(t16[q], want_front[q % 4], 1e-5f);
+    /* the double-sided quad from behind and from the front, both at distance 5 */
+    const float o_back[3] = {3, 0, -5}, o_front[3] = {3, 0, 5};
+    float rgb_b[3], rgb_f[3];
+    cast_shade(s, o_back, back, 0, &h, rgb_b);
+    assert_near(h.t, 5, 1e-5f);
+    cast_shade(s, o_front, front, 0, &h, rgb_f);
+    assert_near(h.t, 5, 1e-5f);
+    assert_true(rgb_b[0] > 0.5f);
+    assert_rgb(rgb_b, rgb_f[0], rgb_f[1], rgb_f[2], 1e-6f, __LINE__);
+    fv_scene_free(s);
+    tmpdir_remove(dir);
+}
+
 /* COLOR_0 multiplies the base colour, interpolated: corners red, green, blue, white (VEC4
  * float; alpha dropped) on the quad [-1,1]^2, matte (specularFactor 0, metallic 0), head-on:
  * base x (1 + 0.15). (0.5, -0.5) lies in triangle (0, 1, 2) at u = 0.5, v = 0.25, w = 0.25:
@@ -1724,6 +1807,7 @@ int main(void)
         cmocka_unit_test(test_gltf_pbr_materials),
         cmocka_unit_test(test_gltf_material_maps),
         cmocka_unit_test(test_gltf_alpha_mask),
+        cmocka_unit_test(test_gltf_double_sided),
         cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_gltf_sampler_wrap),
         cmocka_unit_test(test_gltf_texture_transform),
