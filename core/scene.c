@@ -86,6 +86,7 @@ void fv_scene_free(fv_scene *s)
         free(s->meshes[i].attr);
         free(s->meshes[i].face);
         free(s->meshes[i].col);
+        free(s->meshes[i].tan);
     }
     free(s->meshes);
     for (int i = 0; i < s->texture_count; i++) free(s->textures[i].data);

@@ -19,7 +19,7 @@ typedef struct fv_scene fv_scene;
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
  * transforms. Materials as docs/materials.md says: metallic-roughness with base colour,
- * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK, doubleSided,
+ * metallic-roughness, occlusion, emissive and normal maps, vertex colours, alpha MASK, doubleSided,
  * sampler wrap modes and KHR_texture_transform (BLEND and filter modes are not read yet). Skins,
  * morph targets and animations are ignored. The first perspective camera in depth-first node
  * order becomes the default view. */
@@ -42,17 +42,21 @@ typedef struct fv_material_maps {
     int occlusion;          /* R: ambient occlusion, applied as 1 + strength (R - 1) */
     int emissive;           /* RGB (sRGB), multiplying the emissive factor */
     float occlusion_strength; /* [0, 1] */
-    /* KHR_texture_transform of the base colour, metallic-roughness, occlusion and emissive
-     * textures when has_uv_transform: u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]
+    int normal;             /* tangent-space normal map (linear texture): RGB = (x, y, z) / 2 + 1/2 */
+    float normal_scale;     /* normalTexture.scale: multiplies the map's x and y */
+    /* KHR_texture_transform of the base colour, metallic-roughness, occlusion, emissive and
+     * normal textures when has_uv_transform: u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]
      * (the mip level is not adjusted for the scale) */
     int has_uv_transform;
-    float uv_transform[4][6];
+    float uv_transform[5][6];
 } fv_material_maps;
 typedef struct fv_mesh_desc {
     const float *positions; /* 3 floats per vertex, world space (the transform below is applied) */
     const float *normals;   /* 3 per vertex, or NULL: computed (area-weighted smooth) */
     const float *uvs;       /* 2 per vertex, or NULL */
     const float *colors;    /* 3 per vertex, linear RGB multiplying the base colour (glTF COLOR_0), or NULL */
+    const float *tangents;  /* 4 per vertex (glTF TANGENT: x y z, w = +-1, bitangent = w n x t), or NULL:
+                             * generated from the uvs when a normal map needs them (docs/materials.md) */
     const uint32_t *indices;/* 3 per triangle, or NULL: non-indexed, vertex_count/3 triangles */
     size_t vertex_count, index_count;
     float base_color[4];    /* linear RGBA factor */

@@ -1187,6 +1187,82 @@ static void test_gltf_double_sided(void **state)
     tmpdir_remove(dir);
 }
 
+/* Normal maps: the quad [-1,1]^2 at z = 0 with uv = (x + 1, y + 1) / 2, so dp/du = +x and
+ * dp/dv = +y: tangent +x, bitangent +y, normal +z. Its 2x1 normal map (linear) tilts the normal
+ * towards +x on the left half (texel (218, 128, 218): m = (2 c / 255 - 1) = (0.7098, 0.0039,
+ * 0.7098), 45 degrees) and towards +y on the right (128, 218, 218). One directional light
+ * towards l = (2, 1, 2) / 3 (irradiance 1 after the exposure), a matte white material
+ * (metallic 0, specularFactor 0): rgb = 0.15 + n.l with n = m / |m| in (t, b, n), so about
+ * left (2 + 2) / (3 sqrt 2) = 0.9428 + 0.15, right (1 + 2) / (3 sqrt 2) = 0.7071 + 0.15 (the
+ * expected values below are worked from the bytes exactly). A tangent of the wrong sign gives
+ * 0 on the left; x and y swapped give 0.7071 and 0.9428; the bitangent's sign wrong gives
+ * (-1 + 2) / (3 sqrt 2) = 0.2357 on the right. Three ways: tangents generated from the uvs (no
+ * TANGENT), TANGENT (1, 0, 0, +1) from the file (the same frame), and TANGENT (1, 0, 0, -1)
+ * (bitangent -y: the right half's tilt mirrored). Then normalTexture.scale 0.5: left
+ * m = (0.3549, 0.0020, 0.7098), a 26.6-degree tilt: n.l = (0.7098 + 0.0020 + 1.4196) / 3 / 0.7936
+ * = 0.8953; right m = (0.0020, 0.3549, 0.7098): (0.0039 + 0.3549 + 1.4196) / 3 / 0.7936 = 0.7470. And check_packets: the packet path gives the scalar path's bits. */
+static void test_gltf_normal_map(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char nm[8] = {218, 128, 218, 255, 128, 218, 218, 255};
+    path_join(p, sizeof p, dir, "n.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, nm, 8) != 0);
+    unsigned char bin[156];
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
+    const double l[3] = {2.0 / 3, 1.0 / 3, 2.0 / 3};
+    for (int variant = 0; variant < 4; variant++) {
+        const float w = variant == 2 ? -1.0f : 1.0f, tan[16] = {1, 0, 0, w, 1, 0, 0, w, 1, 0, 0, w, 1, 0, 0, w};
+        memcpy(bin + 92, tan, 64);
+        const double scale = variant == 3 ? 0.5 : 1.0;
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"extensionsUsed\":[\"KHR_materials_specular\",\"KHR_lights_punctual\"],"
+                 "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"intensity\":2}]}},"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":92,\"byteLength\":64}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"},"
+                 "{\"bufferView\":3,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"}],"
+                 "\"images\":[{\"uri\":\"n.png\"}],\"textures\":[{\"source\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"normalTexture\":{\"index\":0%s},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1%s},\"indices\":2,"
+                 "\"material\":0}]}],"
+                 "\"nodes\":[{\"mesh\":0},{\"rotation\":[-0.18257419,0.36514837,0,0.91287093],"
+                 "\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],\"scenes\":[{\"nodes\":[0,1]}],\"scene\":0",
+                 variant == 3 ? ",\"scale\":0.5" : "", variant == 1 || variant == 2 ? ",\"TANGENT\":3" : "");
+        path_join(p, sizeof p, dir, "nm.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        fv_light lt;
+        assert_int_equal(fv_scene_get_light(s, 0, &lt), 0); /* the node turns -z to -l */
+        for (int k = 0; k < 3; k++) assert_near(lt.dir[k], (float)-l[k], 1e-6f);
+        for (int half = 0; half < 2; half++) {
+            const unsigned char *c = nm + 4 * half;
+            double m[3] = {(2.0 * c[0] / 255 - 1) * scale, (2.0 * c[1] / 255 - 1) * scale, 2.0 * c[2] / 255 - 1};
+            if (w < 0) m[1] = -m[1]; /* bitangent -y */
+            const double ml = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            const double nl = (m[0] * l[0] + m[1] * l[1] + m[2] * l[2]) / ml;
+            static const double by_hand[4][2] = {{0.9428, 0.7071}, {0.9428, 0.7071}, {0.9428, 0.2357}, {0.8953, 0.7470}};
+            assert_near((float)nl, (float)by_hand[variant][half], 3e-3f); /* the comment's values */
+            const float o[3] = {half ? 0.5f : -0.5f, 0, 5}, d[3] = {0, 0, -1};
+            hit h;
+            float rgb[3];
+            cast_shade(s, o, d, 0, &h, rgb);
+            const float want = (float)(0.15 + nl);
+            assert_rgb(rgb, want, want, want, 2e-5f, __LINE__);
+        }
+        check_packets(s, 40 + (uint64_t)variant);
+        fv_scene_free(s);
+    }
+    tmpdir_remove(dir);
+}
+
 /* COLOR_0 multiplies the base colour, interpolated: corners red, green, blue, white (VEC4
  * float; alpha dropped) on the quad [-1,1]^2, matte (specularFactor 0, metallic 0), head-on:
  * base x (1 + 0.15). (0.5, -0.5) lies in triangle (0, 1, 2) at u = 0.5, v = 0.25, w = 0.25:
@@ -1808,6 +1884,7 @@ int main(void)
         cmocka_unit_test(test_gltf_material_maps),
         cmocka_unit_test(test_gltf_alpha_mask),
         cmocka_unit_test(test_gltf_double_sided),
+        cmocka_unit_test(test_gltf_normal_map),
         cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_gltf_sampler_wrap),
         cmocka_unit_test(test_gltf_texture_transform),
