@@ -165,7 +165,7 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out)
  * the filter does not know the ray's footprint) is below the cutoff, is rejected, so the ray
  * goes on to whatever lies behind. Embree's Ng is cross(p1 - p0, p2 - p0), glTF's front side
  * (counter-clockwise corners), so a back face is Ng . dir > 0; grazing hits (0) are kept. */
-static void surface_filter(const struct RTCFilterFunctionNArguments *a)
+static void filter(const struct RTCFilterFunctionNArguments *a, int cull)
 {
     const fv_mesh_rec *m = a->geometryUserPtr;
     const unsigned n = a->N;
@@ -176,7 +176,7 @@ static void surface_filter(const struct RTCFilterFunctionNArguments *a)
     const unsigned *hprim = (const unsigned *)a->hit + 5 * n;
     for (unsigned i = 0; i < n; i++) {
         if (a->valid[i] != -1) continue;
-        if (m->single_sided && ng[i] * dir[i] + ng[n + i] * dir[n + i] + ng[2 * n + i] * dir[2 * n + i] > 0.0f) {
+        if (cull && m->single_sided && ng[i] * dir[i] + ng[n + i] * dir[n + i] + ng[2 * n + i] * dir[2 * n + i] > 0.0f) {
             a->valid[i] = 0;
             continue;
         }
@@ -199,6 +199,11 @@ static void surface_filter(const struct RTCFilterFunctionNArguments *a)
     }
 }
 
+static void surface_filter(const struct RTCFilterFunctionNArguments *a) { filter(a, 1); }
+/* Occlusion rays (shadows, core/shadow.c) see MASK cut-outs but every side: a single-sided
+ * surface blocks light from behind too. */
+static void occluded_filter(const struct RTCFilterFunctionNArguments *a) { filter(a, 0); }
+
 int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
 {
     if (!s) {
@@ -214,12 +219,25 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
         RTCGeometry g = rtcGetGeometry(s->rtc, (unsigned)i);
         rtcSetGeometryUserData(g, m);
         rtcSetGeometryIntersectFilterFunction(g, surface_filter);
+        if (m->alpha_cutoff > 0.0f)
+            rtcSetGeometryOccludedFilterFunction(g, occluded_filter);
         rtcCommitGeometry(g);
     }
     rtcCommitScene(s->rtc);
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     update_exposure(s);
     s->committed = 1;
+    return 0;
+}
+
+int fv_scene_set_shadows(fv_scene *s, int on)
+{
+    if (!s) return -1;
+    if (on && s->light_count > 16) { /* FV_SHADOW_MAX_LIGHTS (core/shadow.h) */
+        s->shadows = 0;
+        return -1;
+    }
+    s->shadows = on != 0;
     return 0;
 }
 

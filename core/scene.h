@@ -108,6 +108,11 @@ int fv_scene_light_count(const fv_scene *s);
 /* Copies light i (world space, dir normalised) into out; 0 on success, -1 if out of range. */
 int fv_scene_get_light(const fv_scene *s, int i, fv_light *out);
 
+/* Shadows from the KHR punctual lights (off by default): shading traces an occlusion ray from
+ * each hit towards each light (core/shadow.c, docs/materials.md). Returns 0, or -1 (shadows stay
+ * off) if the scene has more than 16 KHR lights. Set it before rendering, not during. */
+int fv_scene_set_shadows(fv_scene *s, int on);
+
 /* Default viewpoint: the first glTF camera node if the file has one (returns 1), otherwise
  * looking down -Z from in front of the bounds, framing them in the vertical FOV (returns 0).
  * quat is x,y,z,w, rotating eye space (looking down -Z, +Y up) into world space. */

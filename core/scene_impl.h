@@ -80,6 +80,7 @@ struct fv_scene {
     size_t triangle_count;
     float lo[3], hi[3];
     int committed;
+    int shadows;          /* fv_scene_set_shadows: occlusion rays towards the KHR lights (core/shadow.c) */
     float light_exposure; /* multiplies every KHR light contribution, see update_exposure (scene.c) */
     int has_view;
     float view_pos[3], view_quat[4];

@@ -2,6 +2,7 @@
  * material's inputs gathered here, the BRDF and lights in core/shade_lane.h / the kernels. */
 #include "scene_impl.h"
 #include "shade_lane.h"
+#include "shadow.h"
 #include "base/util.h"
 
 #include <math.h>
@@ -118,7 +119,14 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
     float occ, emit[3], ntex[4];
     if (material(s, m, prim_id, u, v, w, dir, t, footprint_rad, &mat, &occ, emit, ntex))
         fv_shade_normal_mapped(m, prim_id, u, v, w, ntex, n, &nn); /* core/shade_normal.c */
-    fv_shade_lane(&mat, occ, emit, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure, rgb);
+    float lit[FV_SHADOW_MAX_LIGHTS];
+    const int shadows = s->shadows && s->light_count > 0 && nn > 1e-24f;
+    if (shadows) { /* core/shadow.c */
+        const float hit[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
+        fv_shadow_scalar(s, hit, n, nn, dir, lit);
+    }
+    fv_shade_lane(&mat, occ, emit, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure,
+                  shadows ? lit : NULL, 1, rgb);
 }
 
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
@@ -262,8 +270,13 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             for (int k = 0; k < 3; k++) rgb[k][__builtin_ctz(black)] = 0.0f;
         return;
     }
-    const fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
-                              .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
+    fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
+                        .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
+    if (s->shadows && s->light_count > 0) { /* occlusion rays towards the lights: core/shadow.c */
+        static _Thread_local _Alignas(64) float lit[FV_SHADOW_MAX_LIGHTS][FV_SHADE_LANES];
+        fv_shadow_packet(s, &pk, hits, eye_pos, lit);
+        env.lit = &lit[0][0];
+    }
     unsigned rest = dsp->brdf(&pk, &env, rgb) & hits;
     while (rest) { /* degenerate smooth normals: the scalar path's face normal */
         const int q = __builtin_ctz(rest);

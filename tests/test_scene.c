@@ -1263,6 +1263,74 @@ static void test_gltf_normal_map(void **state)
     tmpdir_remove(dir);
 }
 
+/* Shadows (fv_scene_set_shadows): a ground quad y = 0 over [-4, 4]^2, a unit box [-0.5, 0.5] x
+ * [0, 1] x [-0.5, 0.5] on it, matte white (builder meshes), one directional light travelling
+ * along (-1, -1, 0) (towards the light: l = (1, 1, 0) / sqrt 2, irradiance 1). A ground point
+ * (x, 0, z) sees the light along (x + s, s, z), s > 0, which passes through the box iff
+ * |z| < 0.5 and x + s in [-0.5, 0.5] for some s in [0, 1]: x in [-1.5, 0.5]; outside the box's
+ * foot that is x in (-1.5, -0.5): the shadow. Seen from 50 m above (matte: the view direction
+ * does not matter; the light is not the head light): lit 0.15 + n.l = 0.15 + 0.7071, shadowed 0.15. Through fv_scene_shade and the packet path (every ISA), and
+ * with shadows off everything is lit. */
+static void test_shadows(void **state)
+{
+    (void)state;
+    static const float ground[] = {-4, 0, -4, 4, 0, -4, 4, 0, 4, -4, 0, 4};
+    static const uint32_t gidx[] = {0, 1, 2, 0, 2, 3};
+    static const float box[] = {-0.5f, 0, -0.5f, 0.5f, 0, -0.5f, 0.5f, 1, -0.5f, -0.5f, 1, -0.5f,
+                                -0.5f, 0, 0.5f,  0.5f, 0, 0.5f,  0.5f, 1, 0.5f,  -0.5f, 1, 0.5f};
+    static const uint32_t bidx[] = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6, 0, 4, 5, 0, 5, 1,
+                                    3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2};
+    static const float flat_up[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    fv_scene *s = fv_scene_create();
+    char err[256];
+    fv_mesh_desc g = mesh(ground, 4, gidx, 6), b = mesh(box, 8, bidx, 36);
+    g.normals = flat_up;
+    assert_int_equal(fv_scene_add_mesh(s, &g, err, sizeof err), 0);
+    assert_int_equal(fv_scene_add_mesh(s, &b, err, sizeof err), 0);
+    const fv_light l = {.type = FV_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .dir = {-1, -1, 0}};
+    fv_scene_add_light(s, &l);
+    s = commit_or_fail(s);
+    const float lit = 0.15f + SQ2, dark = 0.15f;
+    /* ground points, and expected with shadows on: (-1, 0), (-1.4, 0.4), (-0.6, -0.45) in the
+     * shadow; (-1.6, 0), (-1, 0.6), (1, 0) beside it (the box's smooth computed normals are not
+     * the faces', so its own faces are left out) */
+    const float pts[6][2] = {{-1, 0}, {-1.4f, 0.4f}, {-1.6f, 0}, {-1, 0.6f}, {1, 0}, {-0.6f, -0.45f}};
+    const float want_on[6] = {dark, dark, lit, lit, lit, dark};
+    for (int on = 0; on < 2; on++) {
+        assert_int_equal(fv_scene_set_shadows(s, on), 0);
+        const float eye[3] = {0, 50, 0}; /* high enough that no ray to these points meets the box */
+        unsigned geom[16], prim[16];
+        float u[16], v[16], t[16], dir[3][16];
+        for (int i = 0; i < 6; i++) {
+            const float d[3] = {pts[i][0], -50, pts[i][1]};
+            hit h;
+            float rgb[3];
+            cast_shade(s, eye, d, 0, &h, rgb);
+            const float want = on ? want_on[i] : lit;
+            assert_rgb(rgb, want, want, want, 1e-5f, __LINE__);
+            for (int q = i; q < 16; q += 6) {
+                geom[q] = h.geom, prim[q] = h.prim, u[q] = h.u, v[q] = h.v, t[q] = h.t;
+                for (int k = 0; k < 3; k++) dir[k][q] = d[k];
+            }
+        }
+        const fv_hit_packet hp = {geom, prim, u, v, t, {dir[0], dir[1], dir[2]}};
+        static const unsigned isas[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_AVX2, FV_ISA_NEON};
+        for (size_t i = 0; i < sizeof isas / sizeof isas[0]; i++) {
+            if (isas[i] && !(fv_cpu_isas() & isas[i])) continue;
+            fv_shade_dsp dsp;
+            fv_shade_dsp_init(&dsp, isas[i] ? isas[i] : FV_ISA_C);
+            float rgb[3][16];
+            fv_scene_shade_packet(s, &dsp, &hp, 16, 0.001f, eye, rgb);
+            for (int q = 0; q < 16; q++) {
+                const float want = on ? want_on[q % 6] : lit;
+                for (int k = 0; k < 3; k++) assert_near(rgb[k][q], want, 1e-5f);
+            }
+        }
+        check_packets(s, 50 + (uint64_t)on);
+    }
+    fv_scene_free(s);
+}
+
 /* COLOR_0 multiplies the base colour, interpolated: corners red, green, blue, white (VEC4
  * float; alpha dropped) on the quad [-1,1]^2, matte (specularFactor 0, metallic 0), head-on:
  * base x (1 + 0.15). (0.5, -0.5) lies in triangle (0, 1, 2) at u = 0.5, v = 0.25, w = 0.25:
@@ -1885,6 +1953,7 @@ int main(void)
         cmocka_unit_test(test_gltf_alpha_mask),
         cmocka_unit_test(test_gltf_double_sided),
         cmocka_unit_test(test_gltf_normal_map),
+        cmocka_unit_test(test_shadows),
         cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_gltf_sampler_wrap),
         cmocka_unit_test(test_gltf_texture_transform),
