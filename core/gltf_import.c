@@ -96,6 +96,7 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                     d.metallic = mat->metallic, d.roughness = mat->roughness, d.specular = mat->specular;
                     d.alpha_cutoff = mat->alpha_cutoff;
                     d.single_sided = !mat->double_sided;
+                    d.alpha_blend = mat->alpha_blend;
                     memcpy(d.emissive, mat->emissive, sizeof d.emissive);
                     /* no uvs: factors only */
                     const int img[5] = {mat->image, mat->mr_image, mat->occlusion_image, mat->emissive_image,

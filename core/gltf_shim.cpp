@@ -582,6 +582,7 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
         if (texcoord < 0) texcoord = 0;
         if (mt.alphaMode == "MASK") mat.alpha_cutoff = unit(mt.alphaCutoff, "alphaCutoff");
         mat.double_sided = mt.doubleSided ? 1 : 0;
+        mat.alpha_blend = mt.alphaMode == "BLEND" ? 1 : 0;
         if (mat.occlusion_image >= 0) mat.occlusion_strength = unit(mt.occlusionTexture.strength, "occlusion strength");
         h.materials.push_back(mat);
         h.material_texcoord.push_back(texcoord);

@@ -54,6 +54,7 @@ typedef struct fv_gltf_material {
     int has_uvx;         /* some texture has KHR_texture_transform: */
     float uvx[5][6];     /* per texture as wrap[]: u' = [0] u + [1] v + [2], v' = [3] u + [4] v + [5] */
     int double_sided;    /* doubleSided (default false: back faces culled) */
+    int alpha_blend;     /* alphaMode BLEND */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {

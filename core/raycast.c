@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "blend.h"
 #include "render_dsp.h"
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
@@ -136,6 +137,7 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
     static _Thread_local _Alignas(64) struct RTCRayHit##N tile_rh_##N[FV_TILE_PACKETS(N)];                   \
     static _Thread_local _Alignas(64) float tile_rgb_##N[FV_TILE_PACKETS(N)][3][16];                         \
     static _Thread_local float tile_org_##N[3] = {NAN, NAN, NAN};                                            \
+    static _Thread_local fv_blend_lane tile_blend_##N[FV_TILE_PACKETS(N)][16]; /* alpha BLEND: blend.c */     \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
                             const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n)                  \
     {                                                                                                         \
@@ -156,16 +158,27 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
                 }                                                                                             \
             memcpy(tile_org_##N, cam->eye_pos, sizeof tile_org_##N);                                          \
         }                                                                                                     \
-        const int np = (n + N - 1) / N;                                                                       \
-        for (int b = 0; b < np; b++)                                                                          \
+        const int np = (n + N - 1) / N, blend = fv_scene_has_blend(scene);                                    \
+        for (int b = 0; b < np; b++) {                                                                        \
+            if (blend)                                                                                        \
+                fv_blend_begin(tile_blend_##N[b]);                                                            \
             trace_##N(scene, cam, dsp, &rc, &ictx, &rh[b], valid, px + b * N, n - b * N < N ? n - b * N : N,     \
                       x0, y0);                                                                                \
+        }                                                                                                     \
+        if (blend)                                                                                            \
+            fv_blend_end();                                                                                   \
         const int64_t t0 = fv_time_ns();                                                                      \
         for (int b = 0; b < np; b++) {                                                                        \
             const fv_hit_packet hp = {rh[b].hit.geomID, rh[b].hit.primID, rh[b].hit.u, rh[b].hit.v,           \
                                       rh[b].ray.tfar, {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z}};   \
             fv_scene_shade_packet(scene, &dsp->shade, &hp, n - b * N < N ? n - b * N : N, cam->px_tan,        \
                                   cam->eye_pos, tile_rgb_##N[b]);                                             \
+            if (blend) { /* blended layers over the shaded hits (misses become the nearest layer's hits) */    \
+                const float *const dirs[3] = {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z};             \
+                fv_blend_composite(scene, tile_blend_##N[b], rh[b].hit.geomID, rh[b].ray.tfar, dirs,           \
+                                   n - b * N < N ? n - b * N : N, cam->px_tan, cam->eye_pos, fv_background_rgb, \
+                                   tile_rgb_##N[b]);                                                          \
+            }                                                                                                 \
         }                                                                                                     \
         atomic_fetch_add_explicit(&shade_ns_total, fv_time_ns() - t0, memory_order_relaxed);                  \
         for (int b = 0; b < np; b++)                                                                          \

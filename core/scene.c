@@ -2,6 +2,7 @@
  * commit, queries and the default view. Meshes: scene_mesh.c; textures: texture.c; shading:
  * shade.c; glTF: gltf_import.c (a client of the builder API). */
 #include "scene_impl.h"
+#include "blend.h"
 #include "base/err.h"
 
 #include <float.h>
@@ -165,6 +166,31 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out)
  * the filter does not know the ray's footprint) is below the cutoff, is rejected, so the ray
  * goes on to whatever lies behind. Embree's Ng is cross(p1 - p0, p2 - p0), glTF's front side
  * (counter-clockwise corners), so a back face is Ng . dir > 0; grazing hits (0) are kept. */
+/* base alpha at a hit (factor x texture, bilinear at mip 0) */
+static float mesh_alpha(const fv_mesh_rec *m, unsigned prim, float u, float v)
+{
+    float alpha = m->base_color[3];
+    if (m->mask_tex) {
+        const float w = 1.0f - u - v;
+        const float *uv = m->attr[prim].uv;
+        float tu = w * uv[0] + u * uv[2] + v * uv[4], tv = w * uv[1] + u * uv[3] + v * uv[5], texel[4];
+        if (m->has_uvx) { /* the base colour's KHR_texture_transform */
+            const float *x = m->uvx[0], su = x[0] * tu + x[1] * tv + x[2];
+            tv = x[3] * tu + x[4] * tv + x[5], tu = su;
+        }
+        fv_texture_sample(m->mask_tex, tu, tv, 0.0f, texel);
+        alpha *= texel[3];
+    }
+    return alpha;
+}
+
+float fv_scene_alpha(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v)
+{
+    if (!s || geom_id >= s->mesh_count || prim_id >= s->meshes[geom_id].tri_count) return 1.0f;
+    const float a = mesh_alpha(&s->meshes[geom_id], prim_id, u, v);
+    return a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f;
+}
+
 static void filter(const struct RTCFilterFunctionNArguments *a, int cull)
 {
     const fv_mesh_rec *m = a->geometryUserPtr;
@@ -180,21 +206,17 @@ static void filter(const struct RTCFilterFunctionNArguments *a, int cull)
             a->valid[i] = 0;
             continue;
         }
+        if (m->blend) { /* recorded (camera rays in the ray stage) and passed: core/blend.c */
+            if (cull) /* RTCRayN: tfar (the hit's distance here) at 8, id at 10; RTCHitN: geomID at 6 */
+                fv_blend_record(((const unsigned *)a->ray)[10 * n + i], ((const unsigned *)a->hit)[6 * n + i], hprim[i],
+                                hu[i], hv[i], ((const float *)a->ray)[8 * n + i]);
+            a->valid[i] = 0;
+            continue;
+        }
         if (!(m->alpha_cutoff > 0.0f)) continue;
         const unsigned prim = hprim[i];
         if (prim >= m->tri_count) continue;
-        float alpha = m->base_color[3];
-        if (m->mask_tex) {
-            const float u = hu[i], v = hv[i], w = 1.0f - u - v;
-            const float *uv = m->attr[prim].uv;
-            float tu = w * uv[0] + u * uv[2] + v * uv[4], tv = w * uv[1] + u * uv[3] + v * uv[5], texel[4];
-            if (m->has_uvx) { /* the base colour's KHR_texture_transform */
-                const float *x = m->uvx[0], su = x[0] * tu + x[1] * tv + x[2];
-                tv = x[3] * tu + x[4] * tv + x[5], tu = su;
-            }
-            fv_texture_sample(m->mask_tex, tu, tv, 0.0f, texel);
-            alpha *= texel[3];
-        }
+        const float alpha = mesh_alpha(m, prim, hu[i], hv[i]);
         if (!(alpha >= m->alpha_cutoff)) a->valid[i] = 0;
     }
 }
@@ -214,12 +236,12 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     for (size_t i = 0; i < s->mesh_count; i++) { /* the arrays no longer move: hand out pointers */
         fv_mesh_rec *m = &s->meshes[i];
-        if (!(m->alpha_cutoff > 0.0f) && !m->single_sided) continue;
-        m->mask_tex = m->alpha_cutoff > 0.0f && m->texture >= 0 ? &s->textures[m->texture] : NULL;
+        if (!(m->alpha_cutoff > 0.0f) && !m->single_sided && !m->blend) continue;
+        m->mask_tex = (m->alpha_cutoff > 0.0f || m->blend) && m->texture >= 0 ? &s->textures[m->texture] : NULL;
         RTCGeometry g = rtcGetGeometry(s->rtc, (unsigned)i);
         rtcSetGeometryUserData(g, m);
         rtcSetGeometryIntersectFilterFunction(g, surface_filter);
-        if (m->alpha_cutoff > 0.0f)
+        if (m->alpha_cutoff > 0.0f || m->blend) /* shadows: cut-outs and blended surfaces let light through */
             rtcSetGeometryOccludedFilterFunction(g, occluded_filter);
         rtcCommitGeometry(g);
     }

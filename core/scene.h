@@ -70,6 +70,8 @@ typedef struct fv_mesh_desc {
     const fv_material_maps *maps; /* NULL: none */
     float alpha_cutoff;     /* > 0: glTF alpha MASK: rays pass through where the base alpha (factor x
                              * texture, bilinear at mip 0) is below it; 0: opaque */
+    int alpha_blend;        /* glTF alpha BLEND: composited over what lies behind, front to back, by the ray
+                             * stage (core/blend.c); a ray query without it passes through */
     int single_sided;       /* glTF doubleSided false: rays pass through the back faces (those whose
                              * corners 0, 1, 2 appear clockwise); 0 (memset): double-sided */
     float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
@@ -117,6 +119,10 @@ int fv_scene_set_shadows(fv_scene *s, int on);
  * looking down -Z from in front of the bounds, framing them in the vertical FOV (returns 0).
  * quat is x,y,z,w, rotating eye space (looking down -Z, +Y up) into world space. */
 int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, float pos[3], float quat[4]);
+
+/* A hit's alpha: base colour factor x texture alpha (bilinear at mip 0), in [0, 1]; 1 for no
+ * such hit. The MASK filter compares it with the cutoff, BLEND (core/blend.c) composites with it. */
+float fv_scene_alpha(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v);
 
 /* Shades one hit: the glTF metallic-roughness BRDF (core/brdf.h, docs/materials.md) with base
  * colour (factor x texture, bilinear, mip level from the ray footprint), metallic, roughness and

@@ -66,6 +66,7 @@ typedef struct fv_mesh_rec {
     float alpha_cutoff;           /* > 0: alpha MASK (an Embree intersect filter, set at commit) */
     const fv_texture *mask_tex;   /* the base colour texture the filter reads (set at commit), or NULL */
     int single_sided;             /* back faces culled (the same Embree intersect filter) */
+    int blend;                    /* alpha BLEND: hits recorded and passed (core/blend.c) */
 } fv_mesh_rec;
 
 struct fv_scene {
@@ -80,6 +81,7 @@ struct fv_scene {
     size_t triangle_count;
     float lo[3], hi[3];
     int committed;
+    int has_blend;        /* some mesh is alpha BLEND */
     int shadows;          /* fv_scene_set_shadows: occlusion rays towards the KHR lights (core/shadow.c) */
     float light_exposure; /* multiplies every KHR light contribution, see update_exposure (scene.c) */
     int has_view;

@@ -115,6 +115,8 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     r.tex_ref = tex_ref;
     r.alpha_cutoff = m->alpha_cutoff;
     r.single_sided = m->single_sided != 0;
+    r.blend = m->alpha_blend != 0 && !(m->alpha_cutoff > 0.0f);
+    s->has_blend |= r.blend;
     if (m->maps && m->maps->has_uv_transform) {
         for (int j = 0; j < 4; j++)
             for (int k = 0; k < 6; k++)

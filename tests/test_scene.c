@@ -6,6 +6,7 @@
 
 #include "scene.h"
 #include "shade_dsp.h"
+#include "blend.h"
 
 #include <stb/stb_image_write.h>
 
@@ -1038,7 +1039,8 @@ static void test_gltf_material_maps(void **state)
  * opaque). From z = 5 straight down, a ray through the left half passes the cut-out and reaches
  * the wall (t = 7), one through the right half stops at the quad (t = 5), through rtcIntersect1
  * and rtcIntersect16 alike. A third, untextured quad at z = 2 (x + 3) with base alpha 0.5 <
- * 0.6 lets every ray through; the same quad as BLEND (not composited yet) is opaque. */
+ * 0.6 lets every ray through; the same quad as BLEND is passed by a plain ray query too (the
+ * ray stage composites it: test_gltf_alpha_blend). */
 static void test_gltf_alpha_mask(void **state)
 {
     (void)state;
@@ -1073,7 +1075,7 @@ static void test_gltf_alpha_mask(void **state)
         if (!s) print_error("%s\n", err);
         assert_non_null(s);
         const float d[3] = {0, 0, -1}, xs[4] = {-0.5f, 0.5f, 2.5f, 3.5f};
-        const float want_t[2][4] = {{7, 5, 7, 7}, {7, 5, 3, 3}};
+        const float want_t[2][4] = {{7, 5, 7, 7}, {7, 5, 7, 7}};
         hit h;
         for (int i = 0; i < 4; i++) {
             const float o[3] = {xs[i], 0.1f, 5};
@@ -1329,6 +1331,98 @@ static void test_shadows(void **state)
         check_packets(s, 50 + (uint64_t)on);
     }
     fv_scene_free(s);
+}
+
+/* Alpha BLEND composited front to back (core/blend.c): matte (metallic 0, specularFactor 0)
+ * quads [-1,1]^2 seen from the eye (0, 0.1, 5) with the head light, rays through (x, 0.1, 0),
+ * direction (x / 5, 0, -1): an opaque-shaded layer is base x (0.15 + n.v), n.v = 1 / sqrt(1 +
+ * x^2 / 25), written c below (1.1450 at x = -0.5, 1.1078 at x = 1.5): a red pane of alpha 0.4 at z = 0 and a blue opaque wall at z = -2, both
+ * over x in [-1, 1], and a green pane of alpha 0.5 at z = 1 over x in [1, 3]. Lanes (rays from (x, 0.1, 5) along -z):
+ *   x = -0.5: red over blue: 0.4 (c, 0, 0) + 0.6 (0, 0, c), depth 7 (the wall at x = -0.7)
+ *   x =  1.5: green (at x = 1.2) over nothing: 0.5 (0, c, 0) + 0.5 background, depth 4
+ *   x = -3:   nothing: a miss
+ * and, with the green pane moved over the red one (node at x = 0), x = -0.5: green, then red,
+ * then blue: 0.5 G + 0.5 (0.4 R + 0.6 B) = (0.2 c, 0.5 c, 0.3 c), and x = 1.5 misses. Through the ray stage's calls
+ * (fv_blend_begin, rtcIntersect16, fv_scene_shade_packet, fv_blend_composite). */
+static void test_gltf_alpha_blend(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    unsigned char bin[92];
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
+    for (int stacked = 0; stacked < 2; stacked++) {
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"extensionsUsed\":[\"KHR_materials_specular\"],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"materials\":["
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,0.4],\"metallicFactor\":0},\"alphaMode\":\"BLEND\","
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}},"
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,1,0,0.5],\"metallicFactor\":0},\"alphaMode\":\"BLEND\","
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}},"
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,1,1],\"metallicFactor\":0},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":1}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":2}]}],"
+                 "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[%d,0,1]},{\"mesh\":2,\"translation\":[0,0,-2]}],"
+                 "\"scenes\":[{\"nodes\":[0,1,2]}],\"scene\":0",
+                 stacked ? 0 : 2);
+        path_join(p, sizeof p, dir, "blend.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        assert_true(fv_scene_has_blend(s));
+        const float xs[3] = {-0.5f, 1.5f, -3}, eye[3] = {0, 0.1f, 5};
+        _Alignas(64) struct RTCRayHit16 rh;
+        memset(&rh, 0, sizeof rh);
+        _Alignas(64) int valid[16];
+        for (int q = 0; q < 16; q++) {
+            valid[q] = -1;
+            rh.ray.org_x[q] = eye[0], rh.ray.org_y[q] = eye[1], rh.ray.org_z[q] = eye[2];
+            rh.ray.dir_x[q] = xs[q % 3] / 5, rh.ray.dir_y[q] = 0, rh.ray.dir_z[q] = -1; /* through (x, 0.1, 0) */
+            rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu, rh.ray.id[q] = (unsigned)q;
+            rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
+        }
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        fv_blend_lane lanes[16];
+        fv_blend_begin(lanes);
+        rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+        fv_blend_end();
+        fv_shade_dsp dsp;
+        fv_shade_dsp_init(&dsp, FV_ISA_C);
+        const fv_hit_packet hp = {rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar,
+                                  {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z}};
+        float rgb[3][16];
+        fv_scene_shade_packet(s, &dsp, &hp, 16, 0.001f, eye, rgb);
+        const float bg[3] = {0.02f, 0.025f, 0.035f};
+        const float *const dirs[3] = {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
+        fv_blend_composite(s, lanes, rh.hit.geomID, rh.ray.tfar, dirs, 16, 0.001f, eye, bg, rgb);
+        for (int q = 0; q < 16; q++) {
+            const int i = q % 3;
+            if (i == 2 || (i == 1 && stacked)) { /* a miss stays a miss (with the green pane moved, x = 1.5
+                                                    * crosses nothing) */
+                assert_true(rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID);
+                continue;
+            }
+            assert_true(rh.hit.geomID[q] != RTC_INVALID_GEOMETRY_ID);
+            const float c = 0.15f + 1.0f / sqrtf(1.0f + xs[i] * xs[i] / 25); /* n.v off the axis */
+            float want[3], want_t;
+            if (i == 0 && !stacked) want[0] = 0.4f * c, want[1] = 0, want[2] = 0.6f * c, want_t = 7;
+            else if (i == 0) want[0] = 0.5f * 0.4f * c, want[1] = 0.5f * c, want[2] = 0.5f * 0.6f * c, want_t = 7;
+            else if (!stacked) want[0] = 0.5f * bg[0], want[1] = 0.5f * c + 0.5f * bg[1], want[2] = 0.5f * bg[2], want_t = 4;
+            else want[0] = 0.5f * bg[0], want[1] = 0.5f * c + 0.5f * bg[1], want[2] = 0.5f * bg[2], want_t = 4;
+            for (int k = 0; k < 3; k++) assert_near(rgb[k][q], want[k], 1e-5f);
+            assert_near(rh.ray.tfar[q], want_t, 1e-5f);
+        }
+        fv_scene_free(s);
+    }
+    tmpdir_remove(dir);
 }
 
 /* COLOR_0 multiplies the base colour, interpolated: corners red, green, blue, white (VEC4
@@ -1954,6 +2048,7 @@ int main(void)
         cmocka_unit_test(test_gltf_double_sided),
         cmocka_unit_test(test_gltf_normal_map),
         cmocka_unit_test(test_shadows),
+        cmocka_unit_test(test_gltf_alpha_blend),
         cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_gltf_sampler_wrap),
         cmocka_unit_test(test_gltf_texture_transform),
