@@ -113,7 +113,7 @@ long long fv_raycast_shade_ns(void) { return atomic_load_explicit(&shade_ns_tota
         memset(rh->hit.geomID, 0xff, sizeof(unsigned) * N); /* RTC_INVALID_GEOMETRY_ID */                    \
         memset(rh->hit.instID[0], 0xff, sizeof(unsigned) * N);                                                \
         memcpy(valid, lane_valid(16 - k), sizeof(int) * N);                                                      \
-        rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
+        fv_scene_intersect##N(scene, valid, ictx, rh);                                                     \
         fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                                    \
     }                                                                                                         \
     /* Writes lanes 0 .. k-1 (shaded into rgb) to level 0. */                                               \

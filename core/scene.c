@@ -226,6 +226,72 @@ static void surface_filter(const struct RTCFilterFunctionNArguments *a) { filter
  * surface blocks light from behind too. */
 static void occluded_filter(const struct RTCFilterFunctionNArguments *a) { filter(a, 0); }
 
+/* The second trace's context filter: back faces of single-sided meshes rejected (Embree calls it
+ * for every mesh, after a mesh's own filter). */
+static void cull_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    const fv_mesh_rec *m = a->geometryUserPtr;
+    if (!m || !m->single_sided) return;
+    const unsigned n = a->N;
+    const float *ng = (const float *)a->hit, *dir = (const float *)a->ray + 4 * n;
+    for (unsigned i = 0; i < n; i++)
+        if (a->valid[i] == -1 && ng[i] * dir[i] + ng[n + i] * dir[n + i] + ng[2 * n + i] * dir[2 * n + i] > 0.0f)
+            a->valid[i] = 0;
+}
+
+/* A closest hit on the back face of a single-sided mesh (only plain ones report such hits). */
+static inline int back_face(const fv_scene *s, unsigned g, float nx, float ny, float nz, float dx, float dy, float dz)
+{
+    return g != RTC_INVALID_GEOMETRY_ID && s->meshes[g].single_sided && nx * dx + ny * dy + nz * dz > 0.0f;
+}
+
+void fv_scene_intersect1(const fv_scene *s, struct RTCIntersectContext *ictx, struct RTCRayHit *rh)
+{
+    const float tfar0 = rh->ray.tfar;
+    rtcIntersect1(s->rtc, ictx, rh);
+    if (!s->cull_retrace || !back_face(s, rh->hit.geomID, rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z, rh->ray.dir_x,
+                                       rh->ray.dir_y, rh->ray.dir_z))
+        return;
+    struct RTCIntersectContext c = *ictx;
+    c.filter = cull_filter;
+    rh->ray.tfar = tfar0;
+    rh->hit.geomID = rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(s->rtc, &c, rh);
+}
+
+#define DEF_INTERSECT_N(N)                                                                                       \
+    void fv_scene_intersect##N(const fv_scene *s, const int *valid, struct RTCIntersectContext *ictx,            \
+                               struct RTCRayHit##N *rh)                                                          \
+    {                                                                                                            \
+        float tfar0[N];                                                                                          \
+        if (s->cull_retrace)                                                                                     \
+            memcpy(tfar0, rh->ray.tfar, sizeof tfar0);                                                           \
+        rtcIntersect##N(valid, s->rtc, ictx, rh);                                                                \
+        if (!s->cull_retrace)                                                                                    \
+            return;                                                                                              \
+        _Alignas(4 * N) int again[N];                                                                            \
+        int any = 0;                                                                                             \
+        for (int i = 0; i < N; i++) {                                                                            \
+            again[i] = valid[i] == -1 && back_face(s, rh->hit.geomID[i], rh->hit.Ng_x[i], rh->hit.Ng_y[i],       \
+                                                   rh->hit.Ng_z[i], rh->ray.dir_x[i], rh->ray.dir_y[i],          \
+                                                   rh->ray.dir_z[i])                                             \
+                           ? -1                                                                                  \
+                           : 0;                                                                                  \
+            if (again[i]) {                                                                                      \
+                any = 1;                                                                                         \
+                rh->ray.tfar[i] = tfar0[i];                                                                      \
+                rh->hit.geomID[i] = rh->hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;                              \
+            }                                                                                                    \
+        }                                                                                                        \
+        if (!any)                                                                                                \
+            return;                                                                                              \
+        struct RTCIntersectContext c = *ictx;                                                                    \
+        c.filter = cull_filter;                                                                                  \
+        rtcIntersect##N(again, s->rtc, &c, rh);                                                                  \
+    }
+DEF_INTERSECT_N(8)
+DEF_INTERSECT_N(16)
+
 int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
 {
     if (!s) {
@@ -236,15 +302,21 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     for (size_t i = 0; i < s->mesh_count; i++) { /* the arrays no longer move: hand out pointers */
         fv_mesh_rec *m = &s->meshes[i];
-        if (!(m->alpha_cutoff > 0.0f) && !m->single_sided && !m->blend) continue;
-        m->mask_tex = (m->alpha_cutoff > 0.0f || m->blend) && m->texture >= 0 ? &s->textures[m->texture] : NULL;
         RTCGeometry g = rtcGetGeometry(s->rtc, (unsigned)i);
-        rtcSetGeometryUserData(g, m);
+        rtcSetGeometryUserData(g, m); /* the culling context filter reads it on every mesh */
+        if (!(m->alpha_cutoff > 0.0f) && !m->blend) {
+            s->cull_retrace |= m->single_sided;
+            rtcCommitGeometry(g);
+            continue;
+        }
+        m->mask_tex = m->texture >= 0 ? &s->textures[m->texture] : NULL;
         rtcSetGeometryIntersectFilterFunction(g, surface_filter);
         if (m->alpha_cutoff > 0.0f || m->blend) /* shadows: cut-outs and blended surfaces let light through */
             rtcSetGeometryOccludedFilterFunction(g, occluded_filter);
         rtcCommitGeometry(g);
     }
+    if (s->cull_retrace)
+        rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcCommitScene(s->rtc);
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     update_exposure(s);

@@ -104,6 +104,16 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len); /* builds the BVH; 
 void fv_scene_free(fv_scene *s);
 
 RTCScene fv_scene_rtc(const fv_scene *s);
+/* Closest hits as the materials define them (use these, not rtcIntersect*, for camera rays):
+ * rtcIntersectN, then the lanes whose hit is the back face of a single-sided (glTF doubleSided
+ * false) mesh traced again, from the start, with a context filter that culls such faces. A
+ * MASK or BLEND mesh culls in its own filter; a plain one carries no filter on the common path,
+ * since a filter on every single-sided mesh cost the range scene ~20 % of its ray stage and
+ * back faces are rarely the closest hit. ictx as rtcInitIntersectContext leaves it. */
+void fv_scene_intersect1(const fv_scene *s, struct RTCIntersectContext *ictx, struct RTCRayHit *rh);
+void fv_scene_intersect8(const fv_scene *s, const int *valid, struct RTCIntersectContext *ictx, struct RTCRayHit8 *rh);
+void fv_scene_intersect16(const fv_scene *s, const int *valid, struct RTCIntersectContext *ictx,
+                          struct RTCRayHit16 *rh);
 size_t fv_scene_triangle_count(const fv_scene *s);
 void fv_scene_bounds(const fv_scene *s, float lo[3], float hi[3]);
 int fv_scene_light_count(const fv_scene *s);

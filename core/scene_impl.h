@@ -65,7 +65,8 @@ typedef struct fv_mesh_rec {
     float *col;                   /* per triangle 9 floats, its corners' vertex colours, or NULL */
     float alpha_cutoff;           /* > 0: alpha MASK (an Embree intersect filter, set at commit) */
     const fv_texture *mask_tex;   /* the base colour texture the filter reads (set at commit), or NULL */
-    int single_sided;             /* back faces culled (the same Embree intersect filter) */
+    int single_sided;             /* back faces culled: in the filter of a MASK / BLEND mesh, else by
+                                   * fv_scene_intersect*'s second trace (scene.c) */
     int blend;                    /* alpha BLEND: hits recorded and passed (core/blend.c) */
 } fv_mesh_rec;
 
@@ -82,6 +83,7 @@ struct fv_scene {
     float lo[3], hi[3];
     int committed;
     int has_blend;        /* some mesh is alpha BLEND */
+    int cull_retrace;     /* some single-sided mesh has no filter: fv_scene_intersect* checks the hits */
     int shadows;          /* fv_scene_set_shadows: occlusion rays towards the KHR lights (core/shadow.c) */
     float light_exposure; /* multiplies every KHR light contribution, see update_exposure (scene.c) */
     int has_view;

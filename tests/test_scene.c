@@ -56,7 +56,7 @@ static int cast(const fv_scene *s, const float o[3], const float d[3], hit *h)
     rh.ray.tfar = INFINITY;
     rh.ray.mask = 0xFFFFFFFFu;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(fv_scene_rtc(s), &ctx, &rh);
+    fv_scene_intersect1(s, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
     h->t = rh.ray.tfar, h->u = rh.hit.u, h->v = rh.hit.v, h->geom = rh.hit.geomID, h->prim = rh.hit.primID;
     return 1;
@@ -1094,7 +1094,7 @@ static void test_gltf_alpha_mask(void **state)
             rh.ray.dir_z[q] = -1, rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
             rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+        fv_scene_intersect16(s, valid, &ctx, &rh);
         for (int q = 0; q < 16; q++) assert_near(rh.ray.tfar[q], want_t[blend][q % 4], 1e-5f);
         fv_scene_free(s);
     }
@@ -1122,7 +1122,7 @@ static void cast16(const fv_scene *s, const float o[4][3], const float d[3], flo
         rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
         rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+    fv_scene_intersect16(s, valid, &ctx, &rh);
     for (int q = 0; q < 16; q++) t[q] = rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar[q];
 }
 
@@ -1392,7 +1392,7 @@ static void test_gltf_alpha_blend(void **state)
         rtcInitIntersectContext(&ctx);
         fv_blend_lane lanes[16];
         fv_blend_begin(lanes);
-        rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+        fv_scene_intersect16(s, valid, &ctx, &rh);
         fv_blend_end();
         fv_shade_dsp dsp;
         fv_shade_dsp_init(&dsp, FV_ISA_C);
