@@ -31,7 +31,7 @@ static void usage(FILE *f)
             "table of Weier et al. 2018 (Table 1) and writes JSON. Times are means over the frames\n"
             "after warm-up (medians are in the JSON too).\n"
             "  --scene FILE       glTF 2.0 scene (.gltf or .glb)\n"
-            FV_ASSET_ROOT_HELP FV_LENS_HELP
+            FV_ASSET_ROOT_HELP FV_SHADOWS_HELP FV_LENS_HELP
             "  --frames N         timed frames per mode (default 30)\n"
             "  --warmup N         untimed frames first (default 3)\n"
             "  --mode M           foveated, full or both (default both)\n"
@@ -82,6 +82,7 @@ int main(int argc, char **argv)
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
     const char *asset_root = NULL; /* --asset-root */
+    int shadows = 0;               /* --shadows */
     const char *lens_path = NULL;  /* --lens */
     int reproject_given = 0;
     const char *scene_path = NULL, *json_path = NULL, *mode = "both", *trace_path = NULL, *kernel = NULL;
@@ -94,7 +95,7 @@ int main(int argc, char **argv)
     enum { OPT_LENS = 500, OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_YAW, OPT_HELP, OPT_TRACE_OUT, OPT_COUNTERS,
            OPT_SWEEP, OPT_KERNELS, OPT_KREPS, OPT_KERNEL, OPT_CALLS, OPT_CEILING };
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"lens", required_argument, 0, OPT_LENS}, {"frames", required_argument, 0, OPT_FRAMES},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, FV_SHADOWS_LONGOPT, {"lens", required_argument, 0, OPT_LENS}, {"frames", required_argument, 0, OPT_FRAMES},
         {"warmup", required_argument, 0, OPT_WARMUP}, {"mode", required_argument, 0, OPT_MODE},
         {"json", required_argument, 0, OPT_JSON}, {"yaw-rate", required_argument, 0, OPT_YAW},
         {"trace-out", required_argument, 0, OPT_TRACE_OUT}, {"counters", required_argument, 0, OPT_COUNTERS},
@@ -109,6 +110,7 @@ int main(int argc, char **argv)
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
         case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
+        case FV_OPT_SHADOWS: shadows = fv_arg_onoff(prog, "--shadows", optarg); break;
         case OPT_LENS: lens_path = optarg; break;
         case OPT_FRAMES: bo.frames = (int)fv_arg_long(prog, "--frames", optarg, 1, 100000); break;
         case OPT_WARMUP: bo.warmup = (int)fv_arg_long(prog, "--warmup", optarg, 0, 100000); break;
@@ -167,6 +169,8 @@ int main(int argc, char **argv)
         fv_usage_error(prog, "%s", err);
     if (fv_scene_warning(scene)[0]) /* once, before any output */
         fprintf(stderr, "%s: %s: warning: %s\n", prog, scene_path, fv_scene_warning(scene));
+    if (shadows && fv_scene_set_shadows(scene, 1))
+        fprintf(stderr, "%s: %s: warning: more than 16 KHR lights, shadows off\n", prog, scene_path);
     fv_bench_report rep = {.scene_path = scene_path, .triangles = fv_scene_triangle_count(scene),
                            .load_ms = (double)(fv_time_ns() - t0) * 1e-6, .width = cfg.cam.width,
                            .height = cfg.cam.height, .warmup = bo.warmup, .frames = bo.frames,

@@ -44,7 +44,7 @@ static void usage(FILE *f)
             "                     [--calibration FILE] [--seconds S] [options]\n"
             "Renders both eyes locked to vsync with the newest gaze; prints a latency summary at exit.\n"
             "  --scene FILE        glTF 2.0 scene\n"
-            FV_ASSET_ROOT_HELP
+            FV_ASSET_ROOT_HELP FV_SHADOWS_HELP
             "  --camera SRC        eye camera (V4L2 device or a Y4M replayed at --camera-fps); default\n"
             "                      none: gaze from --trace, the mouse (--display window) or the centre\n"
             "  --vsync SRC         vsync source (default timer:90)\n"
@@ -437,6 +437,7 @@ int main(int argc, char **argv)
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
     const char *asset_root = NULL; /* --asset-root */
+    int shadows = 0;               /* --shadows */
     const char *scene_path = NULL, *camera = "none", *vsync_spec = "timer:90", *display_spec = "none";
     const char *calib_path = NULL, *trace_path = NULL, *lens_path = NULL, *csv_path = NULL, *prof_path = NULL;
     double seconds = 0.0;
@@ -446,7 +447,7 @@ int main(int argc, char **argv)
     const char *calibrate_path = NULL; /* --calibrate */
     int calib_dwell_ms = 1500;
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"camera", required_argument, 0, OPT_CAMERA},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, FV_SHADOWS_LONGOPT, {"camera", required_argument, 0, OPT_CAMERA},
         {"vsync", required_argument, 0, OPT_VSYNC}, {"display", required_argument, 0, OPT_DISPLAY},
         {"calibration", required_argument, 0, OPT_CALIB}, {"seconds", required_argument, 0, OPT_SECONDS},
         {"trace", required_argument, 0, OPT_TRACE}, {"lens", required_argument, 0, OPT_LENS},
@@ -462,6 +463,7 @@ int main(int argc, char **argv)
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
         case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
+        case FV_OPT_SHADOWS: shadows = fv_arg_onoff(prog, "--shadows", optarg); break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_VSYNC: vsync_spec = optarg; break;
         case OPT_DISPLAY: display_spec = optarg; break;
@@ -571,6 +573,8 @@ int main(int argc, char **argv)
     }
     if (fv_scene_warning(scene)[0]) /* once, before any output */
         fprintf(stderr, "%s: %s: warning: %s\n", prog, scene_path, fv_scene_warning(scene));
+    if (shadows && fv_scene_set_shadows(scene, 1))
+        fprintf(stderr, "%s: %s: warning: more than 16 KHR lights, shadows off\n", prog, scene_path);
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)a.W / (float)a.H, a.view.pos, a.view.quat);
     a.pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
     fv_gaze_ring ring;

@@ -32,7 +32,7 @@ static void usage(FILE *f)
             "Renders the scene along a gaze/head trace; writes DIR/frame_NNNNN.png (left eye, or\n"
             "both eyes side by side with --stereo) and DIR/stats.csv (per-stage ms and samples).\n"
             "  --scene FILE       glTF 2.0 scene (.gltf or .glb)\n"
-            FV_ASSET_ROOT_HELP FV_LENS_HELP
+            FV_ASSET_ROOT_HELP FV_SHADOWS_HELP FV_LENS_HELP
             "  --trace FILE       CSV t_ms,gaze_x,gaze_y[,head pose]; without it the gaze rests at the\n"
             "                     image centre and the head at the scene's default viewpoint\n"
             "  --frames N         frames to render (default: the trace's length at --hz, or 1)\n"
@@ -94,6 +94,7 @@ int main(int argc, char **argv)
     fv_pipeline_config cfg;
     fv_pipeline_config_default(&cfg);
     const char *asset_root = NULL; /* --asset-root */
+    int shadows = 0;               /* --shadows */
     const char *lens_path = NULL;  /* --lens */
     int reproject_given = 0;
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
@@ -102,7 +103,7 @@ int main(int argc, char **argv)
     fv_reference_params refp = {.spp = 0, .pupil_mm = 4.49f, .focus_m = 0.0f}; /* spp 0: no --reference */
     float hz = 90.0f;
     static const struct option opts[] = {
-        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, {"lens", required_argument, 0, OPT_LENS}, {"trace", required_argument, 0, OPT_TRACE},
+        {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, FV_SHADOWS_LONGOPT, {"lens", required_argument, 0, OPT_LENS}, {"trace", required_argument, 0, OPT_TRACE},
         {"frames", required_argument, 0, OPT_FRAMES}, {"out", required_argument, 0, OPT_OUT},
         {"full", no_argument, 0, OPT_FULL}, {"stereo", no_argument, 0, OPT_STEREO},
         {"y4m", required_argument, 0, OPT_Y4M}, {"reference", required_argument, 0, OPT_REF},
@@ -116,6 +117,7 @@ int main(int argc, char **argv)
         switch (o) {
         case OPT_SCENE: scene_path = optarg; break;
         case FV_OPT_ASSET_ROOT: asset_root = optarg; break;
+        case FV_OPT_SHADOWS: shadows = fv_arg_onoff(prog, "--shadows", optarg); break;
         case OPT_LENS: lens_path = optarg; break;
         case OPT_TRACE: trace_path = optarg; break;
         case OPT_FRAMES: frames = fv_arg_long(prog, "--frames", optarg, 1, 10000000); break;
@@ -167,6 +169,8 @@ int main(int argc, char **argv)
     }
     if (fv_scene_warning(scene)[0]) /* once, before any output */
         fprintf(stderr, "%s: %s: warning: %s\n", prog, scene_path, fv_scene_warning(scene));
+    if (shadows && fv_scene_set_shadows(scene, 1))
+        fprintf(stderr, "%s: %s: warning: more than 16 KHR lights, shadows off\n", prog, scene_path);
     const int W = cfg.cam.width, H = cfg.cam.height, outw = stereo ? 2 * W : W;
     fv_pose view;
     fv_scene_default_view(scene, cfg.cam.fov_y_deg, (float)W / (float)H, view.pos, view.quat);

@@ -19,7 +19,7 @@ typedef struct {
 /* Packets of N lanes filled from one tile's pixel list; the lanes' layout is Embree's SoA
  * RTCRayHitN, so one routine serves both widths. */
 #define DEF_TILE_N(N)                                                                                   \
-    static long tile_##N(const ceil_job *j, RTCScene rs, const uint8_t *px, int n, int x0, int y0) \
+    static long tile_##N(const ceil_job *j, const uint8_t *px, int n, int x0, int y0) \
     {                                                                                                   \
         const fv_camera *cam = j->cam;                                                                  \
         struct RTCIntersectContext ictx;                                                                \
@@ -42,7 +42,7 @@ typedef struct {
                 rh.hit.instID[0][q] = RTC_INVALID_GEOMETRY_ID;                                          \
                 valid[q] = q < k ? -1 : 0;                                                              \
             }                                                                                           \
-            rtcIntersect##N(valid, rs, &ictx, &rh);                                                     \
+            fv_scene_intersect##N(j->scene, valid, &ictx, &rh);                                                     \
             if (j->depth)                                                                               \
                 for (int q = 0; q < k; q++) {                                                           \
                     const int p = px[i + q];                                                            \
@@ -71,8 +71,7 @@ static void ceil_tile(void *ctx, int index, int thread_id)
     const int n = fv_raycast_pixels(rows, tw, th, px);
     if (n == 0)
         return;
-    RTCScene rs = fv_scene_rtc(j->scene);
-    const long r = j->o.packet == 8 ? tile_8(j, rs, px, n, x0, y0) : tile_16(j, rs, px, n, x0, y0);
+    const long r = j->o.packet == 8 ? tile_8(j, px, n, x0, y0) : tile_16(j, px, n, x0, y0);
     atomic_fetch_add_explicit(&j->rays, r, memory_order_relaxed);
 }
 

@@ -89,17 +89,21 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                 d.base_color[0] = d.base_color[1] = d.base_color[2] = d.base_color[3] = 1.0f;
                 d.texture = -1;
                 d.metallic = d.roughness = d.specular = 1.0f; /* the glTF default material */
+                d.single_sided = 1;                           /* (doubleSided false) */
                 if (p->material >= 0) {
                     const fv_gltf_material *mat = &g->materials[p->material];
                     memcpy(d.base_color, mat->base_color, sizeof d.base_color);
                     d.metallic = mat->metallic, d.roughness = mat->roughness, d.specular = mat->specular;
                     d.alpha_cutoff = mat->alpha_cutoff;
+                    d.single_sided = !mat->double_sided;
+                    d.alpha_blend = mat->alpha_blend;
                     memcpy(d.emissive, mat->emissive, sizeof d.emissive);
                     /* no uvs: factors only */
-                    const int img[4] = {mat->image, mat->mr_image, mat->occlusion_image, mat->emissive_image};
-                    int tx[4];
-                    for (int j = 0; j < 4 && rc == 0; j++) {
-                        tx[j] = image_texture(s, g, tex_of_image, img[j], j == 1 || j == 2, mat->wrap[j], p->uvs);
+                    const int img[5] = {mat->image, mat->mr_image, mat->occlusion_image, mat->emissive_image,
+                                        mat->normal_image};
+                    int tx[5];
+                    for (int j = 0; j < 5 && rc == 0; j++) { /* data maps (MR, occlusion, normal) are linear */
+                        tx[j] = image_texture(s, g, tex_of_image, img[j], j == 1 || j == 2 || j == 4, mat->wrap[j], p->uvs);
                         if (tx[j] == -2) {
                             fv_err(err, err_len, "image %d: cannot add texture", img[j]);
                             rc = -1;
@@ -109,6 +113,8 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                     d.texture = tx[0];
                     memset(&maps, 0, sizeof maps);
                     maps.metallic_roughness = tx[1], maps.occlusion = tx[2], maps.emissive = tx[3];
+                    maps.normal = tx[4], maps.normal_scale = mat->normal_scale;
+                    d.tangents = p->tangents;
                     maps.occlusion_strength = mat->occlusion_strength;
                     maps.has_uv_transform = mat->has_uvx;
                     memcpy(maps.uv_transform, mat->uvx, sizeof maps.uv_transform);

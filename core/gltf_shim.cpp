@@ -487,8 +487,12 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
     for (size_t i = 0; i < m.materials.size(); i++) {
         const std::string at = "material " + str(i);
         const tinygltf::PbrMetallicRoughness &pbr = m.materials[i].pbrMetallicRoughness;
-        fv_gltf_material mat = {{1, 1, 1, 1}, -1, 1, 1, 1, {0, 0, 0}, -1, -1, -1, 1, 0, {{0, 0}, {0, 0}, {0, 0}, {0, 0}},
-                                0, {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}}};
+        fv_gltf_material mat{}; // wrap 0 (REPEAT), no transform, single-sided
+        for (int c = 0; c < 4; c++) mat.base_color[c] = 1.0f;
+        mat.image = mat.mr_image = mat.occlusion_image = mat.emissive_image = mat.normal_image = -1;
+        mat.metallic = mat.roughness = mat.specular = 1.0f;
+        mat.occlusion_strength = 1.0f, mat.normal_scale = 1.0f;
+        for (float *x : mat.uvx) x[0] = 1.0f, x[4] = 1.0f;
         const tinygltf::Material &mt = m.materials[i];
         auto unit = [&](double d, const char *name) {
             const float f = to_float(d, at + " " + name);
@@ -573,8 +577,12 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
                 &mat.mr_image);
         texture(2, mt.occlusionTexture.index, mt.occlusionTexture.texCoord, mt.occlusionTexture.extensions, "occlusion", &mat.occlusion_image);
         texture(3, mt.emissiveTexture.index, mt.emissiveTexture.texCoord, mt.emissiveTexture.extensions, "emissive", &mat.emissive_image);
+        texture(4, mt.normalTexture.index, mt.normalTexture.texCoord, mt.normalTexture.extensions, "normal", &mat.normal_image);
+        if (mat.normal_image >= 0) mat.normal_scale = to_float(mt.normalTexture.scale, at + " normalTexture scale");
         if (texcoord < 0) texcoord = 0;
         if (mt.alphaMode == "MASK") mat.alpha_cutoff = unit(mt.alphaCutoff, "alphaCutoff");
+        mat.double_sided = mt.doubleSided ? 1 : 0;
+        mat.alpha_blend = mt.alphaMode == "BLEND" ? 1 : 0;
         if (mat.occlusion_image >= 0) mat.occlusion_strength = unit(mt.occlusionTexture.strength, "occlusion strength");
         h.materials.push_back(mat);
         h.material_texcoord.push_back(texcoord);
@@ -670,9 +678,10 @@ void convert_meshes(const tinygltf::Model &m, Holder &h)
             }
             const fv_gltf_material *pm = out.material >= 0 ? &h.materials[size_t(out.material)] : nullptr;
             const int set = pm && (pm->image >= 0 || pm->mr_image >= 0 || pm->occlusion_image >= 0 ||
-                                   pm->emissive_image >= 0)
+                                   pm->emissive_image >= 0 || pm->normal_image >= 0)
                                 ? h.material_texcoord[size_t(out.material)] : -1;
             out.uvs = set >= 0 ? attr("TEXCOORD_" + str(set), 2) : nullptr;
+            out.tangents = pm && pm->normal_image >= 0 ? attr("TANGENT", 4) : nullptr;
 
             if (mode != TINYGLTF_MODE_TRIANGLES) {
                 // strips and fans become an index list, in the specification's vertex order (3.7.2.1):

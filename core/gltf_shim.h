@@ -18,6 +18,7 @@ typedef struct fv_gltf_prim {
     const float *normals;    /* 3 per vertex, or NULL */
     const float *uvs;        /* 2 per vertex (the set the material's textures use), or NULL */
     const float *colors;     /* 3 per vertex: COLOR_0's RGB (linear; alpha dropped), or NULL */
+    const float *tangents;   /* 4 per vertex: TANGENT (x y z, w handedness), or NULL */
     const uint32_t *indices; /* index_count, each < vertex_count; NULL: non-indexed */
     size_t vertex_count, index_count; /* index_count (or vertex_count if non-indexed) % 3 == 0 */
     int material;            /* index into materials, or -1 (glTF default material) */
@@ -42,15 +43,18 @@ typedef struct fv_gltf_material {
     float metallic, roughness; /* pbrMetallicRoughness factors, [0, 1] (default 1, 1) */
     float specular;      /* KHR_materials_specular specularFactor, [0, 1] (default 1) */
     float emissive[3];   /* emissiveFactor x KHR_materials_emissive_strength, >= 0 */
-    /* metallicRoughnessTexture, occlusionTexture, emissiveTexture images (decoded), or -1; only
-     * those on the same TEXCOORD set as the material's first texture (prim uvs) are kept */
-    int mr_image, occlusion_image, emissive_image;
+    /* metallicRoughnessTexture, occlusionTexture, emissiveTexture, normalTexture images (decoded),
+     * or -1; only those on the same TEXCOORD set as the material's first texture (prim uvs) are kept */
+    int mr_image, occlusion_image, emissive_image, normal_image;
+    float normal_scale;  /* normalTexture.scale (default 1) */
     float occlusion_strength; /* occlusionTexture.strength, [0, 1] */
     float alpha_cutoff;  /* alphaMode MASK: alphaCutoff (default 0.5); OPAQUE and BLEND: 0 */
-    int wrap[4][2];      /* base colour, metallic-roughness, occlusion, emissive textures' sampler
+    int wrap[5][2];      /* base colour, metallic-roughness, occlusion, emissive, normal textures' sampler
                           * wrapS, wrapT: 0 REPEAT, 1 CLAMP_TO_EDGE, 2 MIRRORED_REPEAT (fv_wrap) */
     int has_uvx;         /* some texture has KHR_texture_transform: */
-    float uvx[4][6];     /* per texture as wrap[]: u' = [0] u + [1] v + [2], v' = [3] u + [4] v + [5] */
+    float uvx[5][6];     /* per texture as wrap[]: u' = [0] u + [1] v + [2], v' = [3] u + [4] v + [5] */
+    int double_sided;    /* doubleSided (default false: back faces culled) */
+    int alpha_blend;     /* alphaMode BLEND */
 } fv_gltf_material;
 
 typedef struct fv_gltf_image {

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "blend.h"
 #include "render_dsp.h"
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
@@ -109,7 +110,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
         memset(rh->hit.geomID, 0xff, sizeof(unsigned) * N); /* RTC_INVALID_GEOMETRY_ID */                    \
         memset(rh->hit.instID[0], 0xff, sizeof(unsigned) * N);                                                \
         memcpy(valid, lane_valid(16 - k), sizeof(int) * N);                                                      \
-        rtcIntersect##N(valid, fv_scene_rtc(scene), ictx, rh);                                                \
+        fv_scene_intersect##N(scene, valid, ictx, rh);                                                     \
         fv_scene_shade_prefetch(scene, rh->hit.geomID, rh->hit.primID, k);                                    \
     }                                                                                                         \
     /* Writes lanes 0 .. k-1 (shaded into rgb) to level 0. */                                               \
@@ -133,6 +134,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
     static _Thread_local _Alignas(64) struct RTCRayHit##N tile_rh_##N[FV_TILE_PACKETS(N)];                   \
     static _Thread_local _Alignas(64) float tile_rgb_##N[FV_TILE_PACKETS(N)][3][16];                         \
     static _Thread_local float tile_org_##N[3] = {NAN, NAN, NAN};                                            \
+    static _Thread_local fv_blend_lane tile_blend_##N[FV_TILE_PACKETS(N)][16]; /* alpha BLEND: blend.c */     \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
                             const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n, int64_t *shade_ns) \
     {                                                                                                         \
@@ -153,16 +155,27 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
                 }                                                                                             \
             memcpy(tile_org_##N, cam->eye_pos, sizeof tile_org_##N);                                          \
         }                                                                                                     \
-        const int np = (n + N - 1) / N;                                                                       \
-        for (int b = 0; b < np; b++)                                                                          \
+        const int np = (n + N - 1) / N, blend = fv_scene_has_blend(scene);                                    \
+        for (int b = 0; b < np; b++) {                                                                        \
+            if (blend)                                                                                        \
+                fv_blend_begin(tile_blend_##N[b]);                                                            \
             trace_##N(scene, cam, dsp, &rc, &ictx, &rh[b], valid, px + b * N, n - b * N < N ? n - b * N : N,     \
                       x0, y0);                                                                                \
+        }                                                                                                     \
+        if (blend)                                                                                            \
+            fv_blend_end();                                                                                   \
         const int64_t t0 = shade_ns ? fv_time_ns() : 0;                                                       \
         for (int b = 0; b < np; b++) {                                                                        \
             const fv_hit_packet hp = {rh[b].hit.geomID, rh[b].hit.primID, rh[b].hit.u, rh[b].hit.v,           \
                                       rh[b].ray.tfar, {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z}};   \
             fv_scene_shade_packet(scene, &dsp->shade, &hp, n - b * N < N ? n - b * N : N, cam->px_tan,        \
                                   cam->eye_pos, tile_rgb_##N[b]);                                             \
+            if (blend) { /* blended layers over the shaded hits (misses become the nearest layer's hits) */    \
+                const float *const dirs[3] = {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z};             \
+                fv_blend_composite(scene, tile_blend_##N[b], rh[b].hit.geomID, rh[b].ray.tfar, dirs,           \
+                                   n - b * N < N ? n - b * N : N, cam->px_tan, cam->eye_pos, fv_background_rgb, \
+                                   tile_rgb_##N[b]);                                                          \
+            }                                                                                                 \
         }                                                                                                     \
         if (shade_ns)                                                                                         \
             *shade_ns += fv_time_ns() - t0;                                                                   \

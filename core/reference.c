@@ -118,7 +118,7 @@ static void ref_tile(void *ctx, int index, int thread_id)
             break;
         for (int q = k; q < 8; q++)
             valid[q] = 0;
-        rtcIntersect8(valid, fv_scene_rtc(j->scene), &ictx, &rh);
+        fv_scene_intersect8(j->scene, valid, &ictx, &rh);
         for (int q = 0; q < k; q++) {
             const int p = lane_px[q];
             const int hit = rh.hit.geomID[q] != RTC_INVALID_GEOMETRY_ID;
@@ -190,7 +190,7 @@ float fv_reference_depth_at(const fv_scene *scene, const fv_camera *cam, float p
     rh.ray.mask = ~0u;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(fv_scene_rtc(scene), &ictx, &rh);
+    fv_scene_intersect1(scene, &ictx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || !(rh.ray.tfar < FV_DEPTH_MISS_M))
         return FV_DEPTH_MISS_M;
     return rh.ray.tfar;

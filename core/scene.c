@@ -2,6 +2,7 @@
  * commit, queries and the default view. Meshes: scene_mesh.c; textures: texture.c; shading:
  * shade.c; glTF: gltf_import.c (a client of the builder API). */
 #include "scene_impl.h"
+#include "blend.h"
 #include "base/err.h"
 
 #include <float.h>
@@ -86,6 +87,7 @@ void fv_scene_free(fv_scene *s)
         free(s->meshes[i].attr);
         free(s->meshes[i].face);
         free(s->meshes[i].col);
+        free(s->meshes[i].tan);
     }
     free(s->meshes);
     for (int i = 0; i < s->texture_count; i++) free(s->textures[i].data);
@@ -159,35 +161,136 @@ int fv_scene_get_light(const fv_scene *s, int i, fv_light *out)
     return 0;
 }
 
-/* glTF alpha MASK as an Embree intersect filter: a hit where the base colour's alpha (factor x
- * texture, bilinear at mip 0: the filter does not know the ray's footprint) is below the cutoff
- * is rejected, so the ray goes on to whatever lies behind the cut-out. */
-static void mask_filter(const struct RTCFilterFunctionNArguments *a)
+/* The Embree intersect filter of single-sided (glTF doubleSided false) and alpha-MASK meshes:
+ * a hit on a back face, or where the base colour's alpha (factor x texture, bilinear at mip 0:
+ * the filter does not know the ray's footprint) is below the cutoff, is rejected, so the ray
+ * goes on to whatever lies behind. Embree's Ng is cross(p1 - p0, p2 - p0), glTF's front side
+ * (counter-clockwise corners), so a back face is Ng . dir > 0; grazing hits (0) are kept. */
+/* base alpha at a hit (factor x texture, bilinear at mip 0) */
+static float mesh_alpha(const fv_mesh_rec *m, unsigned prim, float u, float v)
+{
+    float alpha = m->base_color[3];
+    if (m->mask_tex) {
+        const float w = 1.0f - u - v;
+        const float *uv = m->attr[prim].uv;
+        float tu = w * uv[0] + u * uv[2] + v * uv[4], tv = w * uv[1] + u * uv[3] + v * uv[5], texel[4];
+        if (m->has_uvx) { /* the base colour's KHR_texture_transform */
+            const float *x = m->uvx[0], su = x[0] * tu + x[1] * tv + x[2];
+            tv = x[3] * tu + x[4] * tv + x[5], tu = su;
+        }
+        fv_texture_sample(m->mask_tex, tu, tv, 0.0f, texel);
+        alpha *= texel[3];
+    }
+    return alpha;
+}
+
+float fv_scene_alpha(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v)
+{
+    if (!s || geom_id >= s->mesh_count || prim_id >= s->meshes[geom_id].tri_count) return 1.0f;
+    const float a = mesh_alpha(&s->meshes[geom_id], prim_id, u, v);
+    return a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f;
+}
+
+static void filter(const struct RTCFilterFunctionNArguments *a, int cull)
 {
     const fv_mesh_rec *m = a->geometryUserPtr;
     const unsigned n = a->N;
-    /* RTCHitN is N-wide SoA: Ng x y z, u, v, primID, ... (the C++-only RTCHitN_* accessors) */
+    /* RTCHitN is N-wide SoA: Ng x y z, u, v, primID, ...; RTCRayN: org x y z, tnear, dir x y z,
+     * ... (the C++-only RTCHitN_* / RTCRayN_* accessors) */
+    const float *ng = (const float *)a->hit, *dir = (const float *)a->ray + 4 * n;
     const float *hu = (const float *)a->hit + 3 * n, *hv = (const float *)a->hit + 4 * n;
     const unsigned *hprim = (const unsigned *)a->hit + 5 * n;
     for (unsigned i = 0; i < n; i++) {
         if (a->valid[i] != -1) continue;
+        if (cull && m->single_sided && ng[i] * dir[i] + ng[n + i] * dir[n + i] + ng[2 * n + i] * dir[2 * n + i] > 0.0f) {
+            a->valid[i] = 0;
+            continue;
+        }
+        if (m->blend) { /* recorded (camera rays in the ray stage) and passed: core/blend.c */
+            if (cull) /* RTCRayN: tfar (the hit's distance here) at 8, id at 10; RTCHitN: geomID at 6 */
+                fv_blend_record(((const unsigned *)a->ray)[10 * n + i], ((const unsigned *)a->hit)[6 * n + i], hprim[i],
+                                hu[i], hv[i], ((const float *)a->ray)[8 * n + i]);
+            a->valid[i] = 0;
+            continue;
+        }
+        if (!(m->alpha_cutoff > 0.0f)) continue;
         const unsigned prim = hprim[i];
         if (prim >= m->tri_count) continue;
-        float alpha = m->base_color[3];
-        if (m->mask_tex) {
-            const float u = hu[i], v = hv[i], w = 1.0f - u - v;
-            const float *uv = m->attr[prim].uv;
-            float tu = w * uv[0] + u * uv[2] + v * uv[4], tv = w * uv[1] + u * uv[3] + v * uv[5], texel[4];
-            if (m->has_uvx) { /* the base colour's KHR_texture_transform */
-                const float *x = m->uvx[0], su = x[0] * tu + x[1] * tv + x[2];
-                tv = x[3] * tu + x[4] * tv + x[5], tu = su;
-            }
-            fv_texture_sample(m->mask_tex, tu, tv, 0.0f, texel);
-            alpha *= texel[3];
-        }
+        const float alpha = mesh_alpha(m, prim, hu[i], hv[i]);
         if (!(alpha >= m->alpha_cutoff)) a->valid[i] = 0;
     }
 }
+
+static void surface_filter(const struct RTCFilterFunctionNArguments *a) { filter(a, 1); }
+/* Occlusion rays (shadows, core/shadow.c) see MASK cut-outs but every side: a single-sided
+ * surface blocks light from behind too. */
+static void occluded_filter(const struct RTCFilterFunctionNArguments *a) { filter(a, 0); }
+
+/* The second trace's context filter: back faces of single-sided meshes rejected (Embree calls it
+ * for every mesh, after a mesh's own filter). */
+static void cull_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    const fv_mesh_rec *m = a->geometryUserPtr;
+    if (!m || !m->single_sided) return;
+    const unsigned n = a->N;
+    const float *ng = (const float *)a->hit, *dir = (const float *)a->ray + 4 * n;
+    for (unsigned i = 0; i < n; i++)
+        if (a->valid[i] == -1 && ng[i] * dir[i] + ng[n + i] * dir[n + i] + ng[2 * n + i] * dir[2 * n + i] > 0.0f)
+            a->valid[i] = 0;
+}
+
+/* A closest hit on the back face of a single-sided mesh (only plain ones report such hits). */
+static inline int back_face(const fv_scene *s, unsigned g, float nx, float ny, float nz, float dx, float dy, float dz)
+{
+    return g != RTC_INVALID_GEOMETRY_ID && s->meshes[g].single_sided && nx * dx + ny * dy + nz * dz > 0.0f;
+}
+
+void fv_scene_intersect1(const fv_scene *s, struct RTCIntersectContext *ictx, struct RTCRayHit *rh)
+{
+    const float tfar0 = rh->ray.tfar;
+    rtcIntersect1(s->rtc, ictx, rh);
+    if (!s->cull_retrace || !back_face(s, rh->hit.geomID, rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z, rh->ray.dir_x,
+                                       rh->ray.dir_y, rh->ray.dir_z))
+        return;
+    struct RTCIntersectContext c = *ictx;
+    c.filter = cull_filter;
+    rh->ray.tfar = tfar0;
+    rh->hit.geomID = rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(s->rtc, &c, rh);
+}
+
+#define DEF_INTERSECT_N(N)                                                                                       \
+    void fv_scene_intersect##N(const fv_scene *s, const int *valid, struct RTCIntersectContext *ictx,            \
+                               struct RTCRayHit##N *rh)                                                          \
+    {                                                                                                            \
+        float tfar0[N];                                                                                          \
+        if (s->cull_retrace)                                                                                     \
+            memcpy(tfar0, rh->ray.tfar, sizeof tfar0);                                                           \
+        rtcIntersect##N(valid, s->rtc, ictx, rh);                                                                \
+        if (!s->cull_retrace)                                                                                    \
+            return;                                                                                              \
+        _Alignas(4 * N) int again[N];                                                                            \
+        int any = 0;                                                                                             \
+        for (int i = 0; i < N; i++) {                                                                            \
+            again[i] = valid[i] == -1 && back_face(s, rh->hit.geomID[i], rh->hit.Ng_x[i], rh->hit.Ng_y[i],       \
+                                                   rh->hit.Ng_z[i], rh->ray.dir_x[i], rh->ray.dir_y[i],          \
+                                                   rh->ray.dir_z[i])                                             \
+                           ? -1                                                                                  \
+                           : 0;                                                                                  \
+            if (again[i]) {                                                                                      \
+                any = 1;                                                                                         \
+                rh->ray.tfar[i] = tfar0[i];                                                                      \
+                rh->hit.geomID[i] = rh->hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;                              \
+            }                                                                                                    \
+        }                                                                                                        \
+        if (!any)                                                                                                \
+            return;                                                                                              \
+        struct RTCIntersectContext c = *ictx;                                                                    \
+        c.filter = cull_filter;                                                                                  \
+        rtcIntersect##N(again, s->rtc, &c, rh);                                                                  \
+    }
+DEF_INTERSECT_N(8)
+DEF_INTERSECT_N(16)
 
 int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
 {
@@ -199,17 +302,36 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len)
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     for (size_t i = 0; i < s->mesh_count; i++) { /* the arrays no longer move: hand out pointers */
         fv_mesh_rec *m = &s->meshes[i];
-        if (!(m->alpha_cutoff > 0.0f)) continue;
-        m->mask_tex = m->texture >= 0 ? &s->textures[m->texture] : NULL;
         RTCGeometry g = rtcGetGeometry(s->rtc, (unsigned)i);
-        rtcSetGeometryUserData(g, m);
-        rtcSetGeometryIntersectFilterFunction(g, mask_filter);
+        rtcSetGeometryUserData(g, m); /* the culling context filter reads it on every mesh */
+        if (!(m->alpha_cutoff > 0.0f) && !m->blend) {
+            s->cull_retrace |= m->single_sided;
+            rtcCommitGeometry(g);
+            continue;
+        }
+        m->mask_tex = m->texture >= 0 ? &s->textures[m->texture] : NULL;
+        rtcSetGeometryIntersectFilterFunction(g, surface_filter);
+        if (m->alpha_cutoff > 0.0f || m->blend) /* shadows: cut-outs and blended surfaces let light through */
+            rtcSetGeometryOccludedFilterFunction(g, occluded_filter);
         rtcCommitGeometry(g);
     }
+    if (s->cull_retrace)
+        rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcCommitScene(s->rtc);
     if (fv_scene_take_rtc_error(s, err, err_len)) return -1;
     update_exposure(s);
     s->committed = 1;
+    return 0;
+}
+
+int fv_scene_set_shadows(fv_scene *s, int on)
+{
+    if (!s) return -1;
+    if (on && s->light_count > 16) { /* FV_SHADOW_MAX_LIGHTS (core/shadow.h) */
+        s->shadows = 0;
+        return -1;
+    }
+    s->shadows = on != 0;
     return 0;
 }
 

@@ -19,8 +19,8 @@ typedef struct fv_scene fv_scene;
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
  * transforms. Materials as docs/materials.md says: metallic-roughness with base colour,
- * metallic-roughness, occlusion and emissive maps, vertex colours, alpha MASK, sampler wrap
- * modes and KHR_texture_transform (normal maps, BLEND and filter modes are not read yet). Skins,
+ * metallic-roughness, occlusion, emissive and normal maps, vertex colours, alpha MASK, doubleSided,
+ * sampler wrap modes and KHR_texture_transform (BLEND and filter modes are not read yet). Skins,
  * morph targets and animations are ignored. The first perspective camera in depth-first node
  * order becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
@@ -42,17 +42,21 @@ typedef struct fv_material_maps {
     int occlusion;          /* R: ambient occlusion, applied as 1 + strength (R - 1) */
     int emissive;           /* RGB (sRGB), multiplying the emissive factor */
     float occlusion_strength; /* [0, 1] */
-    /* KHR_texture_transform of the base colour, metallic-roughness, occlusion and emissive
-     * textures when has_uv_transform: u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]
+    int normal;             /* tangent-space normal map (linear texture): RGB = (x, y, z) / 2 + 1/2 */
+    float normal_scale;     /* normalTexture.scale: multiplies the map's x and y */
+    /* KHR_texture_transform of the base colour, metallic-roughness, occlusion, emissive and
+     * normal textures when has_uv_transform: u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]
      * (the mip level is not adjusted for the scale) */
     int has_uv_transform;
-    float uv_transform[4][6];
+    float uv_transform[5][6];
 } fv_material_maps;
 typedef struct fv_mesh_desc {
     const float *positions; /* 3 floats per vertex, world space (the transform below is applied) */
     const float *normals;   /* 3 per vertex, or NULL: computed (area-weighted smooth) */
     const float *uvs;       /* 2 per vertex, or NULL */
     const float *colors;    /* 3 per vertex, linear RGB multiplying the base colour (glTF COLOR_0), or NULL */
+    const float *tangents;  /* 4 per vertex (glTF TANGENT: x y z, w = +-1, bitangent = w n x t), or NULL:
+                             * generated from the uvs when a normal map needs them (docs/materials.md) */
     const uint32_t *indices;/* 3 per triangle, or NULL: non-indexed, vertex_count/3 triangles */
     size_t vertex_count, index_count;
     float base_color[4];    /* linear RGBA factor */
@@ -66,6 +70,10 @@ typedef struct fv_mesh_desc {
     const fv_material_maps *maps; /* NULL: none */
     float alpha_cutoff;     /* > 0: glTF alpha MASK: rays pass through where the base alpha (factor x
                              * texture, bilinear at mip 0) is below it; 0: opaque */
+    int alpha_blend;        /* glTF alpha BLEND: composited over what lies behind, front to back, by the ray
+                             * stage (core/blend.c); a ray query without it passes through */
+    int single_sided;       /* glTF doubleSided false: rays pass through the back faces (those whose
+                             * corners 0, 1, 2 appear clockwise); 0 (memset): double-sided */
     float transform[16];    /* column-major 4x4, glTF convention; all zero = identity */
 } fv_mesh_desc;
 fv_scene *fv_scene_create(void);
@@ -96,16 +104,35 @@ int fv_scene_commit(fv_scene *s, char *err, size_t err_len); /* builds the BVH; 
 void fv_scene_free(fv_scene *s);
 
 RTCScene fv_scene_rtc(const fv_scene *s);
+/* Closest hits as the materials define them (use these, not rtcIntersect*, for camera rays):
+ * rtcIntersectN, then the lanes whose hit is the back face of a single-sided (glTF doubleSided
+ * false) mesh traced again, from the start, with a context filter that culls such faces. A
+ * MASK or BLEND mesh culls in its own filter; a plain one carries no filter on the common path,
+ * since a filter on every single-sided mesh cost the range scene ~20 % of its ray stage and
+ * back faces are rarely the closest hit. ictx as rtcInitIntersectContext leaves it. */
+void fv_scene_intersect1(const fv_scene *s, struct RTCIntersectContext *ictx, struct RTCRayHit *rh);
+void fv_scene_intersect8(const fv_scene *s, const int *valid, struct RTCIntersectContext *ictx, struct RTCRayHit8 *rh);
+void fv_scene_intersect16(const fv_scene *s, const int *valid, struct RTCIntersectContext *ictx,
+                          struct RTCRayHit16 *rh);
 size_t fv_scene_triangle_count(const fv_scene *s);
 void fv_scene_bounds(const fv_scene *s, float lo[3], float hi[3]);
 int fv_scene_light_count(const fv_scene *s);
 /* Copies light i (world space, dir normalised) into out; 0 on success, -1 if out of range. */
 int fv_scene_get_light(const fv_scene *s, int i, fv_light *out);
 
+/* Shadows from the KHR punctual lights (off by default): shading traces an occlusion ray from
+ * each hit towards each light (core/shadow.c, docs/materials.md). Returns 0, or -1 (shadows stay
+ * off) if the scene has more than 16 KHR lights. Set it before rendering, not during. */
+int fv_scene_set_shadows(fv_scene *s, int on);
+
 /* Default viewpoint: the first glTF camera node if the file has one (returns 1), otherwise
  * looking down -Z from in front of the bounds, framing them in the vertical FOV (returns 0).
  * quat is x,y,z,w, rotating eye space (looking down -Z, +Y up) into world space. */
 int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, float pos[3], float quat[4]);
+
+/* A hit's alpha: base colour factor x texture alpha (bilinear at mip 0), in [0, 1]; 1 for no
+ * such hit. The MASK filter compares it with the cutoff, BLEND (core/blend.c) composites with it. */
+float fv_scene_alpha(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v);
 
 /* Shades one hit: the glTF metallic-roughness BRDF (core/brdf.h, docs/materials.md) with base
  * colour (factor x texture, bilinear, mip level from the ray footprint), metallic, roughness and
@@ -116,7 +143,8 @@ int fv_scene_default_view(const fv_scene *s, float fov_y_deg, float aspect, floa
  * ray-cone spread), so the footprint at the hit is about t*|dir|*footprint_rad metres.
  * KHR light contributions are scaled by one exposure per scene, fixed at commit so that the
  * brightest light gives irradiance 1.0 at the bounds' centre (glTF intensities are often in
- * the thousands). Normals face the ray (double-sided). Writes linear RGB. */
+ * the thousands). Normals face the ray (a single-sided mesh's back faces are never hit: the
+ * ray query passes through them). Writes linear RGB. */
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
                     const float org[3], const float dir[3], float t, float footprint_rad,
                     const float eye_pos[3], float rgb[3]);

@@ -38,7 +38,8 @@ typedef struct fv_tri_face {
     float ng[3], ng_len;
 } fv_tri_face;
 
-enum { FV_MAP_MR, FV_MAP_OCC, FV_MAP_EMIS };
+enum { FV_MAP_MR, FV_MAP_OCC, FV_MAP_EMIS, FV_MAP_NRM, FV_MAPS };
+#define FV_SLOTS (1 + FV_MAPS) /* base colour, then the maps */
 typedef struct fv_mesh_rec {
     const float *pos;      /* world positions, 3 per vertex: Embree's vertex buffer */
     const uint32_t *tri;   /* 3 per triangle: Embree's index buffer */
@@ -50,17 +51,23 @@ typedef struct fv_mesh_rec {
     float metallic, a2, specular; /* the BRDF's (core/brdf.h); a2 = fv_ggx_a2(roughness) */
     float roughness;              /* the factor (a metallic-roughness map multiplies it) */
     float emissive[3];            /* emitted radiance, strength applied */
-    int map[3];                   /* FV_MAP_*: texture index or -1 */
+    int map[FV_MAPS];             /* FV_MAP_*: texture index or -1 */
+    float normal_scale;           /* the normal map's x, y factor */
+    float *tan;                   /* with a normal map: per triangle 12 floats, its corners' world tangent
+                                     x y z (unit) and handedness w (+-1); else NULL */
     float occlusion_strength;
     int tex_ref;                  /* the texture texel_density counts (first of texture, map[]), or -1 */
-    float lod_bias[4];            /* base colour, map[0..2]: log2 of the texel ratio to tex_ref */
-    signed char slot_src[4];      /* per slot: the first slot sampled the same way (same texture and
+    float lod_bias[FV_SLOTS];     /* base colour, map[]: log2 of the texel ratio to tex_ref */
+    signed char slot_src[FV_SLOTS];      /* per slot: the first slot sampled the same way (same texture and
                                      uv transform: glTF's packed occlusion-roughness-metallic), or itself */
     int has_uvx;                  /* uvx is used */
-    float uvx[4][6];              /* per slot (base colour, map[]): fv_material_maps.uv_transform */
+    float uvx[FV_SLOTS][6];       /* per slot (base colour, map[]): fv_material_maps.uv_transform */
     float *col;                   /* per triangle 9 floats, its corners' vertex colours, or NULL */
     float alpha_cutoff;           /* > 0: alpha MASK (an Embree intersect filter, set at commit) */
     const fv_texture *mask_tex;   /* the base colour texture the filter reads (set at commit), or NULL */
+    int single_sided;             /* back faces culled: in the filter of a MASK / BLEND mesh, else by
+                                   * fv_scene_intersect*'s second trace (scene.c) */
+    int blend;                    /* alpha BLEND: hits recorded and passed (core/blend.c) */
 } fv_mesh_rec;
 
 struct fv_scene {
@@ -75,6 +82,9 @@ struct fv_scene {
     size_t triangle_count;
     float lo[3], hi[3];
     int committed;
+    int has_blend;        /* some mesh is alpha BLEND */
+    int cull_retrace;     /* some single-sided mesh has no filter: fv_scene_intersect* checks the hits */
+    int shadows;          /* fv_scene_set_shadows: occlusion rays towards the KHR lights (core/shadow.c) */
     float light_exposure; /* multiplies every KHR light contribution, see update_exposure (scene.c) */
     int has_view;
     float view_pos[3], view_quat[4];
@@ -89,6 +99,17 @@ struct fv_scene {
 int fv_scene_grow(void **p, size_t *cap, size_t n, size_t elem);
 /* Returns 1 and copies the first recorded Embree error into err, or 0 if none. */
 int fv_scene_take_rtc_error(fv_scene *s, char *err, size_t err_len);
+/* (scene_tangent.c) Per triangle, its corners' world tangents (x y z unit, w = +-1) into out
+ * (12 floats a triangle) for a normal map: file_tan (4 per vertex, mesh space; M the mesh's
+ * transform) when given, else generated from uvs and the world vertex normals (unit or zero).
+ * 0, or -1 with err (non-finite tangent, out of memory). */
+int fv_scene_mesh_tangents(const float *pos, const uint32_t *tri, size_t nv, size_t nt, const float *normals,
+                           const float *uvs, const float *file_tan, const double M[16], float *out, char *err,
+                           size_t err_len);
+/* (shade_normal.c) The shading normal (unnormalised, and its squared length) of a hit on mesh
+ * m (which has a normal map and m->tan) from the map's texel there. */
+void fv_shade_normal_mapped(const fv_mesh_rec *m, unsigned prim, float u, float v, float w, const float texel[4],
+                            float n[3], float *nn);
 /* Trilinear between the two mip levels around lod (lod 0 = full resolution), with the texture's
  * wrap modes. */
 void fv_texture_sample(const fv_texture *t, float u, float v, float lod, float out[4]);

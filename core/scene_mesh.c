@@ -48,10 +48,10 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         fv_err(err, err_len, "texture %d does not exist", m->texture);
         return -1;
     }
-    const int map[3] = {m->maps ? m->maps->metallic_roughness : -1, m->maps ? m->maps->occlusion : -1,
-                        m->maps ? m->maps->emissive : -1};
+    const int map[FV_MAPS] = {m->maps ? m->maps->metallic_roughness : -1, m->maps ? m->maps->occlusion : -1,
+                              m->maps ? m->maps->emissive : -1, m->maps ? m->maps->normal : -1};
     int tex_ref = m->texture;
-    for (int j = 0; j < 3; j++) {
+    for (int j = 0; j < FV_MAPS; j++) {
         if (map[j] < -1 || map[j] >= s->texture_count) {
             fv_err(err, err_len, "material map texture %d does not exist", map[j]);
             return -1;
@@ -64,6 +64,10 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     }
     if (!(m->alpha_cutoff >= 0.0f && m->alpha_cutoff <= 1.0f)) {
         fv_err(err, err_len, "alpha cutoff %g is outside [0, 1]", (double)m->alpha_cutoff);
+        return -1;
+    }
+    if (map[FV_MAP_NRM] >= 0 && !isfinite(m->maps->normal_scale)) {
+        fv_err(err, err_len, "normal scale is not finite");
         return -1;
     }
     if (m->maps && !(m->maps->occlusion_strength >= 0.0f && m->maps->occlusion_strength <= 1.0f)) {
@@ -110,6 +114,9 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     r.metallic = m->metallic, r.a2 = fv_ggx_a2(m->roughness), r.specular = m->specular, r.roughness = m->roughness;
     r.tex_ref = tex_ref;
     r.alpha_cutoff = m->alpha_cutoff;
+    r.single_sided = m->single_sided != 0;
+    r.blend = m->alpha_blend != 0 && !(m->alpha_cutoff > 0.0f);
+    s->has_blend |= r.blend;
     if (m->maps && m->maps->has_uv_transform) {
         for (int j = 0; j < 4; j++)
             for (int k = 0; k < 6; k++)
@@ -121,7 +128,8 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
         memcpy(r.uvx, m->maps->uv_transform, sizeof r.uvx);
     }
     r.occlusion_strength = m->maps ? m->maps->occlusion_strength : 0.0f;
-    for (int j = 0; j < 4; j++) { /* a map with 4x the texels of tex_ref is one mip level further down at the same footprint */
+    r.normal_scale = map[FV_MAP_NRM] >= 0 ? m->maps->normal_scale : 0.0f;
+    for (int j = 0; j < FV_SLOTS; j++) { /* a map with 4x the texels of tex_ref is one mip level further down at the same footprint */
         const int tx = j == 0 ? m->texture : map[j - 1];
         if (j > 0) r.map[j - 1] = tx;
         r.lod_bias[j] = 0.0f;
@@ -133,7 +141,7 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
     /* maps that cannot change the result are not sampled */
     if (r.occlusion_strength == 0.0f) r.map[FV_MAP_OCC] = -1;
     if (m->emissive[0] == 0.0f && m->emissive[1] == 0.0f && m->emissive[2] == 0.0f) r.map[FV_MAP_EMIS] = -1;
-    for (int j = 0; j < 4; j++) { /* slots that would fetch the same texels: the packet path fetches them once */
+    for (int j = 0; j < FV_SLOTS; j++) { /* slots that would fetch the same texels: the packet path fetches them once */
         const int tj = j == 0 ? r.texture : r.map[j - 1];
         r.slot_src[j] = (signed char)j;
         for (int i = 0; i < j && tj >= 0; i++)
@@ -230,6 +238,15 @@ int fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, char *err, size_t err_
             }
         memcpy(uvs, m->uvs, nv * 2 * sizeof(float));
     }
+    if (r.map[FV_MAP_NRM] >= 0) {
+        r.tan = malloc(nt * 12 * sizeof(float));
+        if (!r.tan) {
+            fv_err(err, err_len, "out of memory");
+            goto fail;
+        }
+        if (fv_scene_mesh_tangents(pos, tri, nv, nt, normals, uvs, m->tangents, M, r.tan, err, err_len))
+            goto fail;
+    }
     if (density) {
         const fv_texture *tx = &s->textures[tex_ref];
         const double texels = (double)tx->w[0] * (double)tx->h[0];
@@ -303,5 +320,6 @@ fail:
     free(r.attr);
     free(r.face);
     free(r.col);
+    free(r.tan);
     return -1;
 }

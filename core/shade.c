@@ -2,6 +2,7 @@
  * material's inputs gathered here, the BRDF and lights in core/shade_lane.h / the kernels. */
 #include "scene_impl.h"
 #include "shade_lane.h"
+#include "shadow.h"
 #include "texture_tap.h"
 #include "base/util.h"
 
@@ -63,16 +64,18 @@ static void slot_uv(const fv_mesh_rec *m, int j, float tu, float tv, float *su, 
     *sv = x[3] * tu + x[4] * tv + x[5];
 }
 
-/* The material at the hit, every map sampled trilinearly at the footprint's mip level. */
-static void material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
-                     const float dir[3], float t, float footprint_rad, fv_brdf_mat *mat, float *occ, float emit[3])
+/* The material at the hit, every map sampled trilinearly at the footprint's mip level; the
+ * normal map's texel into ntex (returns 1 if there is one). */
+static int material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, float u, float v, float w,
+                    const float dir[3], float t, float footprint_rad, fv_brdf_mat *mat, float *occ, float emit[3],
+                    float ntex[4])
 {
-    float texel[4][4];
-    const float *tx[4] = {NULL, NULL, NULL, NULL};
+    float texel[FV_SLOTS][4];
+    const float *tx[FV_SLOTS] = {NULL, NULL, NULL, NULL, NULL};
     if (m->tex_ref >= 0) {
         float tu, tv, lod;
         tex_coords(m, prim, u, v, w, dir, t, footprint_rad, &tu, &tv, &lod);
-        for (int j = 0; j < 4; j++) {
+        for (int j = 0; j < FV_SLOTS; j++) {
             const int id = slot_texture(m, j);
             if (id < 0) continue;
             float su, sv;
@@ -82,6 +85,9 @@ static void material(const fv_scene *s, const fv_mesh_rec *m, unsigned prim, flo
         }
     }
     material_at(m, prim, u, v, w, tx[0], tx[1], tx[2], tx[3], mat, occ, emit);
+    if (!tx[1 + FV_MAP_NRM]) return 0;
+    memcpy(ntex, tx[1 + FV_MAP_NRM], 4 * sizeof(float));
+    return 1;
 }
 
 void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float u, float v,
@@ -111,9 +117,17 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
         nn = dot3(n, n);
     }
     fv_brdf_mat mat;
-    float occ, emit[3];
-    material(s, m, prim_id, u, v, w, dir, t, footprint_rad, &mat, &occ, emit);
-    fv_shade_lane(&mat, occ, emit, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure, rgb);
+    float occ, emit[3], ntex[4];
+    if (material(s, m, prim_id, u, v, w, dir, t, footprint_rad, &mat, &occ, emit, ntex))
+        fv_shade_normal_mapped(m, prim_id, u, v, w, ntex, n, &nn); /* core/shade_normal.c */
+    float lit[FV_SHADOW_MAX_LIGHTS];
+    const int shadows = s->shadows && s->light_count > 0 && nn > 1e-24f;
+    if (shadows) { /* core/shadow.c */
+        const float hit[3] = {org[0] + t * dir[0], org[1] + t * dir[1], org[2] + t * dir[2]};
+        fv_shadow_scalar(s, hit, n, nn, dir, lit);
+    }
+    fv_shade_lane(&mat, occ, emit, n, nn, org, dir, t, eye_pos, s->lights, s->light_count, s->light_exposure,
+                  shadows ? lit : NULL, 1, rgb);
 }
 
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
@@ -124,6 +138,8 @@ void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsi
             __builtin_prefetch(&m->attr[prim[q]]);
             if (m->face)
                 __builtin_prefetch(&m->face[prim[q]]);
+            if (m->tan) /* a normal map's corner tangents (48 bytes) */
+                __builtin_prefetch(&m->tan[12 * (size_t)prim[q]]), __builtin_prefetch(&m->tan[12 * (size_t)prim[q] + 11]);
         }
 }
 
@@ -133,7 +149,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     /* Per thread, zero at start: lanes of misses keep whatever an earlier packet left there
      * (finite, initialised: their results are not used), so a miss costs no stores. */
     static _Thread_local _Alignas(64) fv_shade_packet pk;
-    fv_tex_taps taps[4][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
+    fv_tex_taps taps[FV_SLOTS][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
     /* the lanes' ray data straight across (a miss lane's values are finite and unused); whole
      * 64-byte rows for a full packet. Locals: the stores to pk would make the compiler reload h. */
@@ -208,7 +224,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
             int jp = -1; /* the last slot whose taps were computed here */
             float psu = 0.0f, psv = 0.0f, plod = 0.0f;
-            for (int j = 0; j < 4; j++) {
+            for (int j = 0; j < FV_SLOTS; j++) {
                 const int id = slot_texture(m, j);
                 if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
                 float su, sv;
@@ -238,9 +254,9 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     for (unsigned r = textured; r; r &= r - 1) {
         const int q = __builtin_ctz(r);
         const fv_mesh_rec *m = &s->meshes[h->geom[q]];
-        float texel[4][4];
-        const float *tx[4] = {NULL, NULL, NULL, NULL};
-        for (int j = 0; j < 4; j++)
+        float texel[FV_SLOTS][4];
+        const float *tx[FV_SLOTS] = {NULL, NULL, NULL, NULL, NULL};
+        for (int j = 0; j < FV_SLOTS; j++)
             if (slot_texture(m, j) >= 0) {
                 if (m->slot_src[j] == j)
                     fv_tex_blend(&taps[j][q], texel[j]);
@@ -252,14 +268,25 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         material_at(m, h->prim[q], u, v, 1.0f - u - v, tx[0], tx[1], tx[2], tx[3], &mat, &occ, emit);
         for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
         pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
+        if (tx[1 + FV_MAP_NRM]) { /* normal map: the kernel gets the mapped normal as corner 0 at u = v = 0 */
+            float nm[3], nn;
+            fv_shade_normal_mapped(m, h->prim[q], u, v, 1.0f - u - v, tx[1 + FV_MAP_NRM], nm, &nn);
+            for (int k = 0; k < 3; k++) pk.nrm[k][q] = nm[k], pk.nrm[3 + k][q] = 0.0f, pk.nrm[6 + k][q] = 0.0f;
+            pk.u[q] = 0.0f, pk.v[q] = 0.0f;
+        }
     }
     if (!hits) { /* all misses: nothing to shade */
         for (; black; black &= black - 1)
             for (int k = 0; k < 3; k++) rgb[k][__builtin_ctz(black)] = 0.0f;
         return;
     }
-    const fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
-                              .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
+    fv_shade_env env = {.lights = s->lights, .nlights = s->light_count, .exposure = s->light_exposure,
+                        .eye = {eye_pos[0], eye_pos[1], eye_pos[2]}};
+    if (s->shadows && s->light_count > 0) { /* occlusion rays towards the lights: core/shadow.c */
+        static _Thread_local _Alignas(64) float lit[FV_SHADOW_MAX_LIGHTS][FV_SHADE_LANES];
+        fv_shadow_packet(s, &pk, hits, eye_pos, lit);
+        env.lit = &lit[0][0];
+    }
     unsigned rest = dsp->brdf(&pk, &env, rgb) & hits;
     while (rest) { /* degenerate smooth normals: the scalar path's face normal */
         const int q = __builtin_ctz(rest);

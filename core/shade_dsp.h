@@ -27,6 +27,10 @@ typedef struct fv_shade_env {
     int nlights;
     float exposure; /* multiplies every KHR light's contribution */
     float eye[3];   /* every ray's origin, and the head light */
+    /* shadows (core/shadow.c): nlights rows of FV_SHADE_LANES, lit[j * FV_SHADE_LANES + i] > 0
+     * where KHR light j reaches lane i's hit, 0 where it is occluded; NULL: every light reaches
+     * every hit */
+    const float *lit;
 } fv_shade_env;
 
 /* One packet's hits, lane i in element i of every array. */

@@ -46,10 +46,12 @@ static inline void fv_lane_add_light(const fv_brdf_mat *m, const float n[3], con
 
 /* occlusion: the material's ambient occlusion (1 none) at the hit.
  * n: the interpolated (or face) normal, unnormalised, nn = |n|^2 > 0; the hit is org + t dir.
- * Normals are turned to face the ray (every material is shaded two-sided). */
+ * Normals are turned to face the ray (every material is shaded two-sided).
+ * lit: NULL, or light j reaches the hit where lit[j * lit_stride] > 0 (shadows, core/shadow.c). */
 static inline void fv_shade_lane(const fv_brdf_mat *m, float occlusion, const float emit[3], const float n_in[3], float nn,
                                  const float org[3], const float dir[3], float t, const float eye[3],
-                                 const fv_light_rec *lights, int nlights, float exposure, float rgb[3])
+                                 const fv_light_rec *lights, int nlights, float exposure, const float *lit, int lit_stride,
+                                 float rgb[3])
 {
     float n[3] = {n_in[0], n_in[1], n_in[2]};
     if (fv_lane_dot3(n, dir) > 0.0f)
@@ -98,6 +100,7 @@ static inline void fv_shade_lane(const fv_brdf_mat *m, float occlusion, const fl
             const float nl = fv_lane_dot3(n, L);
             const float e = atten * l->intensity * exposure;
             if (!(nl > 0.0f) || !(e > 0.0f) || !isfinite(e)) continue;
+            if (lit && !(lit[j * lit_stride] > 0.0f)) continue; /* in the shadow of light j */
             fv_lane_add_light(m, n, v, nv, L, nl, l->color, e, rgb);
         }
     }

@@ -18,7 +18,8 @@ unsigned fv_shade_brdf_c(const fv_shade_packet *p, const fv_shade_env *env, floa
         const fv_brdf_mat m = {{p->base[0][i], p->base[1][i], p->base[2][i]}, p->metal[i], p->a2[i], p->spec[i]};
         const float emit[3] = {p->emit[0][i], p->emit[1][i], p->emit[2][i]};
         float c[3];
-        fv_shade_lane(&m, p->occl[i], emit, n, nn, env->eye, d, p->t[i], env->eye, env->lights, env->nlights, env->exposure, c);
+        fv_shade_lane(&m, p->occl[i], emit, n, nn, env->eye, d, p->t[i], env->eye, env->lights, env->nlights, env->exposure,
+                      env->lit ? env->lit + i : NULL, FV_SHADE_LANES, c);
         for (int k = 0; k < 3; k++) rgb[k][i] = c[k];
     }
     return degenerate;

@@ -161,6 +161,8 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
                 const V nl = dot3v(n, L);
                 const V e = VMUL(VMUL(atten, VS(l->intensity)), VS(env->exposure));
                 ok = MAND(ok, MAND(VGT(nl, VS(0.0f)), MAND(VGT(e, VS(0.0f)), VLT(e, VS(INFINITY)))));
+                if (env->lit) /* shadows: light j occluded on some lanes */
+                    ok = MAND(ok, VGT(VLD(env->lit + j * FV_SHADE_LANES + i), VS(0.0f)));
                 const V col_e[3] = {VMUL(VS(l->color[0]), e), VMUL(VS(l->color[1]), e), VMUL(VS(l->color[2]), e)};
                 add_lightv(base, metal, a2, specw, n, vw, nv, L, nl, col_e, ok, out);
             }

@@ -100,6 +100,13 @@ void fv_cli_lens(const char *prog, const char *path, struct fv_lens *lens, fv_pi
 #define FV_ASSET_ROOT_HELP                                                                         \
     "  --asset-root DIR   folder tree the scene's buffers and textures may come from (default:\n" \
     "                     the scene file's folder; a URI leading elsewhere is refused)\n"
+/* --shadows on|off (replay, bench, headset): shadows from the scene's KHR punctual lights
+ * (fv_scene_set_shadows, docs/materials.md); default off. */
+#define FV_OPT_SHADOWS 1101
+#define FV_SHADOWS_LONGOPT {"shadows", required_argument, 0, FV_OPT_SHADOWS}
+#define FV_SHADOWS_HELP                                                                            \
+    "  --shadows on|off   shadows from the scene's KHR lights, an occlusion ray per hit and\n"   \
+    "                     light (default off; the head light at the eye casts none)\n"
 /* After getopt_long: no stray words, a scene was given, option combinations agree (r0 <= r1);
  * exits 2 with a reason otherwise. */
 void fv_common_validate(const char *prog, int argc, char **argv, const char *scene_path, const fv_pipeline_config *cfg);

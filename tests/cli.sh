@@ -57,6 +57,8 @@ for p in fovea-replay fovea-bench; do
     expect_usage "$p bad pattern" '--pattern: .spiral. is not one of rotate, static' $B/$p --scene $SCENE $O --pattern spiral
     expect_usage "$p bad sampling" '--sampling: .polar. is not one of weier, liu' $B/$p --scene $SCENE $O --sampling polar
     expect_usage "$p bad liu density" '--liu-density 0.5: must be 0' $B/$p --scene $SCENE $O --sampling liu --liu-density 0.5
+    expect_usage "$p bad shadows" '--shadows: .maybe. is not one of on, off' $B/$p --scene $SCENE $O --shadows maybe
+    $B/$p --help 2>&1 | grep -q -- '--shadows on|off' && ok || bad "$p --help lacks --shadows"
     if $B/$p --help >"$T/help" 2>&1 && grep -q -- --scene "$T/help"; then ok; else bad "$p --help"; fi
 done
 [ ! -e "$T/o1" ] && ok || bad "bad input left output directory $T/o1 behind"
@@ -492,6 +494,8 @@ fi
 # ---- fovea-headset: start-up faults exit 2 with one line; mid-run faults fall back and go on
 HS=$B/fovea-headset
 HO="--scene $SCENE --size 64x72 --threads 2"
+expect_usage "headset bad shadows" '--shadows: .1. is not one of on, off' $HS $HO --shadows 1
+$HS --help 2>&1 | grep -q -- '--shadows on|off' && ok || bad "headset --help lacks --shadows"
 expect_usage "headset bad gpio chip" 'gpiod_chip_open_lookup\(nochip\)' $HS $HO --vsync gpio:nochip:3
 expect_usage "headset bad gpio line" 'gpio:gpiochip0:x.*LINE must be' $HS $HO --vsync gpio:gpiochip0:x
 expect_usage "headset bad gpio edge" 'LINE must be.*EDGE' $HS $HO --vsync gpio:gpiochip0:3:sideways

@@ -6,6 +6,7 @@
 
 #include "scene.h"
 #include "shade_dsp.h"
+#include "blend.h"
 #include "texture_tap.h" /* the packet shading's inline taps (internal) */
 
 #include <stb/stb_image_write.h>
@@ -56,7 +57,7 @@ static int cast(const fv_scene *s, const float o[3], const float d[3], hit *h)
     rh.ray.tfar = INFINITY;
     rh.ray.mask = 0xFFFFFFFFu;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(fv_scene_rtc(s), &ctx, &rh);
+    fv_scene_intersect1(s, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
     h->t = rh.ray.tfar, h->u = rh.hit.u, h->v = rh.hit.v, h->geom = rh.hit.geomID, h->prim = rh.hit.primID;
     return 1;
@@ -1087,7 +1088,8 @@ static void test_gltf_material_maps(void **state)
  * opaque). From z = 5 straight down, a ray through the left half passes the cut-out and reaches
  * the wall (t = 7), one through the right half stops at the quad (t = 5), through rtcIntersect1
  * and rtcIntersect16 alike. A third, untextured quad at z = 2 (x + 3) with base alpha 0.5 <
- * 0.6 lets every ray through; the same quad as BLEND (not composited yet) is opaque. */
+ * 0.6 lets every ray through; the same quad as BLEND is passed by a plain ray query too (the
+ * ray stage composites it: test_gltf_alpha_blend). */
 static void test_gltf_alpha_mask(void **state)
 {
     (void)state;
@@ -1122,7 +1124,7 @@ static void test_gltf_alpha_mask(void **state)
         if (!s) print_error("%s\n", err);
         assert_non_null(s);
         const float d[3] = {0, 0, -1}, xs[4] = {-0.5f, 0.5f, 2.5f, 3.5f};
-        const float want_t[2][4] = {{7, 5, 7, 7}, {7, 5, 3, 3}};
+        const float want_t[2][4] = {{7, 5, 7, 7}, {7, 5, 7, 7}};
         hit h;
         for (int i = 0; i < 4; i++) {
             const float o[3] = {xs[i], 0.1f, 5};
@@ -1141,7 +1143,7 @@ static void test_gltf_alpha_mask(void **state)
             rh.ray.dir_z[q] = -1, rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
             rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect16(valid, fv_scene_rtc(s), &ctx, &rh);
+        fv_scene_intersect16(s, valid, &ctx, &rh);
         for (int q = 0; q < 16; q++) assert_near(rh.ray.tfar[q], want_t[blend][q % 4], 1e-5f);
         fv_scene_free(s);
     }
@@ -1150,6 +1152,325 @@ static void test_gltf_alpha_mask(void **state)
     memcpy(c, "\"alphaCutoff\":1.6", 17);
     write_gltf(p, bin, sizeof bin, json);
     expect_load_fails(p, "alphaCutoff");
+    tmpdir_remove(dir);
+}
+
+/* Casts 16 rays (lane q: origin o[q % 4], direction d) through rtcIntersect16 and writes their
+ * hit distances (INFINITY for a miss). */
+static void cast16(const fv_scene *s, const float o[4][3], const float d[3], float t[16])
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    _Alignas(64) struct RTCRayHit16 rh;
+    memset(&rh, 0, sizeof rh);
+    _Alignas(64) int valid[16];
+    for (int q = 0; q < 16; q++) {
+        valid[q] = -1;
+        rh.ray.org_x[q] = o[q % 4][0], rh.ray.org_y[q] = o[q % 4][1], rh.ray.org_z[q] = o[q % 4][2];
+        rh.ray.dir_x[q] = d[0], rh.ray.dir_y[q] = d[1], rh.ray.dir_z[q] = d[2];
+        rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
+        rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
+    }
+    fv_scene_intersect16(s, valid, &ctx, &rh);
+    for (int q = 0; q < 16; q++) t[q] = rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar[q];
+}
+
+/* doubleSided: the quad [-1,1]^2 at z = 0 (corners counter-clockwise seen from +z: its front
+ * faces +z) as a default (single-sided) material at x = 0 and as a doubleSided one at x = 3,
+ * each with a single-sided wall at z = +2 turned 180 degrees about y (so it faces -z).
+ * Rays from z = -5 along +z meet the quads' back faces at t = 5: through the single-sided one
+ * they reach the wall's front at t = 7, the double-sided one stops them at t = 5. Rays from
+ * z = 1 along -z hit both quads' fronts at t = 1. rtcIntersect1 and rtcIntersect16 alike. From
+ * z = 5 along -z the wall is seen from behind (passed) and the double-sided quad's front is hit
+ * at t = 5: it shades as its back does from z = -5 (the normal turned to face the ray; the
+ * head light at the eye, the same distance and angle). */
+static void test_gltf_double_sided(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    unsigned char bin[92];
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0}},"
+        "{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"doubleSided\":true}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":1}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+        "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[3,0,0]},"
+        "{\"mesh\":2,\"translation\":[0,0,2],\"rotation\":[0,1,0,0]},"
+        "{\"mesh\":2,\"translation\":[3,0,2],\"rotation\":[0,1,0,0]}],"
+        "\"scenes\":[{\"nodes\":[0,1,2,3]}],\"scene\":0";
+    path_join(p, sizeof p, dir, "sides.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    fv_scene *s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    const float back[3] = {0, 0, 1}, front[3] = {0, 0, -1};
+    const float ob[4][3] = {{-0.5f, 0.1f, -5}, {0.5f, -0.3f, -5}, {2.5f, 0.1f, -5}, {3.5f, -0.3f, -5}};
+    const float of[4][3] = {{-0.5f, 0.1f, 1}, {0.5f, -0.3f, 1}, {2.5f, 0.1f, 1}, {3.5f, -0.3f, 1}};
+    const float want_back[4] = {7, 7, 5, 5}, want_front[4] = {1, 1, 1, 1};
+    hit h;
+    for (int i = 0; i < 4; i++) {
+        assert_true(cast(s, ob[i], back, &h));
+        assert_near(h.t, want_back[i], 1e-5f);
+        assert_true(cast(s, of[i], front, &h));
+        assert_near(h.t, want_front[i], 1e-5f);
+    }
+    float t16[16];
+    cast16(s, ob, back, t16);
+    for (int q = 0; q < 16; q++) assert_near(t16[q], want_back[q % 4], 1e-5f);
+    cast16(s, of, front, t16);
+    for (int q = 0; q < 16; q++) assert_near(t16[q], want_front[q % 4], 1e-5f);
+    /* the double-sided quad from behind and from the front, both at distance 5 */
+    const float o_back[3] = {3, 0, -5}, o_front[3] = {3, 0, 5};
+    float rgb_b[3], rgb_f[3];
+    cast_shade(s, o_back, back, 0, &h, rgb_b);
+    assert_near(h.t, 5, 1e-5f);
+    cast_shade(s, o_front, front, 0, &h, rgb_f);
+    assert_near(h.t, 5, 1e-5f);
+    assert_true(rgb_b[0] > 0.5f);
+    assert_rgb(rgb_b, rgb_f[0], rgb_f[1], rgb_f[2], 1e-6f, __LINE__);
+    fv_scene_free(s);
+    tmpdir_remove(dir);
+}
+
+/* Normal maps: the quad [-1,1]^2 at z = 0 with uv = (x + 1, y + 1) / 2, so dp/du = +x and
+ * dp/dv = +y: tangent +x, bitangent +y, normal +z. Its 2x1 normal map (linear) tilts the normal
+ * towards +x on the left half (texel (218, 128, 218): m = (2 c / 255 - 1) = (0.7098, 0.0039,
+ * 0.7098), 45 degrees) and towards +y on the right (128, 218, 218). One directional light
+ * towards l = (2, 1, 2) / 3 (irradiance 1 after the exposure), a matte white material
+ * (metallic 0, specularFactor 0): rgb = 0.15 + n.l with n = m / |m| in (t, b, n), so about
+ * left (2 + 2) / (3 sqrt 2) = 0.9428 + 0.15, right (1 + 2) / (3 sqrt 2) = 0.7071 + 0.15 (the
+ * expected values below are worked from the bytes exactly). A tangent of the wrong sign gives
+ * 0 on the left; x and y swapped give 0.7071 and 0.9428; the bitangent's sign wrong gives
+ * (-1 + 2) / (3 sqrt 2) = 0.2357 on the right. Three ways: tangents generated from the uvs (no
+ * TANGENT), TANGENT (1, 0, 0, +1) from the file (the same frame), and TANGENT (1, 0, 0, -1)
+ * (bitangent -y: the right half's tilt mirrored). Then normalTexture.scale 0.5: left
+ * m = (0.3549, 0.0020, 0.7098), a 26.6-degree tilt: n.l = (0.7098 + 0.0020 + 1.4196) / 3 / 0.7936
+ * = 0.8953; right m = (0.0020, 0.3549, 0.7098): (0.0039 + 0.3549 + 1.4196) / 3 / 0.7936 = 0.7470. And check_packets: the packet path gives the scalar path's bits. */
+static void test_gltf_normal_map(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char nm[8] = {218, 128, 218, 255, 128, 218, 218, 255};
+    path_join(p, sizeof p, dir, "n.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, nm, 8) != 0);
+    unsigned char bin[156];
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
+    const double l[3] = {2.0 / 3, 1.0 / 3, 2.0 / 3};
+    for (int variant = 0; variant < 4; variant++) {
+        const float w = variant == 2 ? -1.0f : 1.0f, tan[16] = {1, 0, 0, w, 1, 0, 0, w, 1, 0, 0, w, 1, 0, 0, w};
+        memcpy(bin + 92, tan, 64);
+        const double scale = variant == 3 ? 0.5 : 1.0;
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"extensionsUsed\":[\"KHR_materials_specular\",\"KHR_lights_punctual\"],"
+                 "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"intensity\":2}]}},"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+                 "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":92,\"byteLength\":64}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"},"
+                 "{\"bufferView\":3,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"}],"
+                 "\"images\":[{\"uri\":\"n.png\"}],\"textures\":[{\"source\":0}],"
+                 "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"normalTexture\":{\"index\":0%s},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1%s},\"indices\":2,"
+                 "\"material\":0}]}],"
+                 "\"nodes\":[{\"mesh\":0},{\"rotation\":[-0.18257419,0.36514837,0,0.91287093],"
+                 "\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],\"scenes\":[{\"nodes\":[0,1]}],\"scene\":0",
+                 variant == 3 ? ",\"scale\":0.5" : "", variant == 1 || variant == 2 ? ",\"TANGENT\":3" : "");
+        path_join(p, sizeof p, dir, "nm.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        fv_light lt;
+        assert_int_equal(fv_scene_get_light(s, 0, &lt), 0); /* the node turns -z to -l */
+        for (int k = 0; k < 3; k++) assert_near(lt.dir[k], (float)-l[k], 1e-6f);
+        for (int half = 0; half < 2; half++) {
+            const unsigned char *c = nm + 4 * half;
+            double m[3] = {(2.0 * c[0] / 255 - 1) * scale, (2.0 * c[1] / 255 - 1) * scale, 2.0 * c[2] / 255 - 1};
+            if (w < 0) m[1] = -m[1]; /* bitangent -y */
+            const double ml = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            const double nl = (m[0] * l[0] + m[1] * l[1] + m[2] * l[2]) / ml;
+            static const double by_hand[4][2] = {{0.9428, 0.7071}, {0.9428, 0.7071}, {0.9428, 0.2357}, {0.8953, 0.7470}};
+            assert_near((float)nl, (float)by_hand[variant][half], 3e-3f); /* the comment's values */
+            const float o[3] = {half ? 0.5f : -0.5f, 0, 5}, d[3] = {0, 0, -1};
+            hit h;
+            float rgb[3];
+            cast_shade(s, o, d, 0, &h, rgb);
+            const float want = (float)(0.15 + nl);
+            assert_rgb(rgb, want, want, want, 2e-5f, __LINE__);
+        }
+        check_packets(s, 40 + (uint64_t)variant);
+        fv_scene_free(s);
+    }
+    tmpdir_remove(dir);
+}
+
+/* Shadows (fv_scene_set_shadows): a ground quad y = 0 over [-4, 4]^2, a unit box [-0.5, 0.5] x
+ * [0, 1] x [-0.5, 0.5] on it, matte white (builder meshes), one directional light travelling
+ * along (-1, -1, 0) (towards the light: l = (1, 1, 0) / sqrt 2, irradiance 1). A ground point
+ * (x, 0, z) sees the light along (x + s, s, z), s > 0, which passes through the box iff
+ * |z| < 0.5 and x + s in [-0.5, 0.5] for some s in [0, 1]: x in [-1.5, 0.5]; outside the box's
+ * foot that is x in (-1.5, -0.5): the shadow. Seen from 50 m above (matte: the view direction
+ * does not matter; the light is not the head light): lit 0.15 + n.l = 0.15 + 0.7071, shadowed 0.15. Through fv_scene_shade and the packet path (every ISA), and
+ * with shadows off everything is lit. */
+static void test_shadows(void **state)
+{
+    (void)state;
+    static const float ground[] = {-4, 0, -4, 4, 0, -4, 4, 0, 4, -4, 0, 4};
+    static const uint32_t gidx[] = {0, 1, 2, 0, 2, 3};
+    static const float box[] = {-0.5f, 0, -0.5f, 0.5f, 0, -0.5f, 0.5f, 1, -0.5f, -0.5f, 1, -0.5f,
+                                -0.5f, 0, 0.5f,  0.5f, 0, 0.5f,  0.5f, 1, 0.5f,  -0.5f, 1, 0.5f};
+    static const uint32_t bidx[] = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6, 0, 4, 5, 0, 5, 1,
+                                    3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2};
+    static const float flat_up[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    fv_scene *s = fv_scene_create();
+    char err[256];
+    fv_mesh_desc g = mesh(ground, 4, gidx, 6), b = mesh(box, 8, bidx, 36);
+    g.normals = flat_up;
+    assert_int_equal(fv_scene_add_mesh(s, &g, err, sizeof err), 0);
+    assert_int_equal(fv_scene_add_mesh(s, &b, err, sizeof err), 0);
+    const fv_light l = {.type = FV_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .dir = {-1, -1, 0}};
+    fv_scene_add_light(s, &l);
+    s = commit_or_fail(s);
+    const float lit = 0.15f + SQ2, dark = 0.15f;
+    /* ground points, and expected with shadows on: (-1, 0), (-1.4, 0.4), (-0.6, -0.45) in the
+     * shadow; (-1.6, 0), (-1, 0.6), (1, 0) beside it (the box's smooth computed normals are not
+     * the faces', so its own faces are left out) */
+    const float pts[6][2] = {{-1, 0}, {-1.4f, 0.4f}, {-1.6f, 0}, {-1, 0.6f}, {1, 0}, {-0.6f, -0.45f}};
+    const float want_on[6] = {dark, dark, lit, lit, lit, dark};
+    for (int on = 0; on < 2; on++) {
+        assert_int_equal(fv_scene_set_shadows(s, on), 0);
+        const float eye[3] = {0, 50, 0}; /* high enough that no ray to these points meets the box */
+        unsigned geom[16], prim[16];
+        float u[16], v[16], t[16], dir[3][16];
+        for (int i = 0; i < 6; i++) {
+            const float d[3] = {pts[i][0], -50, pts[i][1]};
+            hit h;
+            float rgb[3];
+            cast_shade(s, eye, d, 0, &h, rgb);
+            const float want = on ? want_on[i] : lit;
+            assert_rgb(rgb, want, want, want, 1e-5f, __LINE__);
+            for (int q = i; q < 16; q += 6) {
+                geom[q] = h.geom, prim[q] = h.prim, u[q] = h.u, v[q] = h.v, t[q] = h.t;
+                for (int k = 0; k < 3; k++) dir[k][q] = d[k];
+            }
+        }
+        const fv_hit_packet hp = {geom, prim, u, v, t, {dir[0], dir[1], dir[2]}};
+        static const unsigned isas[] = {FV_ISA_C, FV_ISA_SSE41, FV_ISA_AVX2, FV_ISA_NEON};
+        for (size_t i = 0; i < sizeof isas / sizeof isas[0]; i++) {
+            if (isas[i] && !(fv_cpu_isas() & isas[i])) continue;
+            fv_shade_dsp dsp;
+            fv_shade_dsp_init(&dsp, isas[i] ? isas[i] : FV_ISA_C);
+            float rgb[3][16];
+            fv_scene_shade_packet(s, &dsp, &hp, 16, 0.001f, eye, rgb);
+            for (int q = 0; q < 16; q++) {
+                const float want = on ? want_on[q % 6] : lit;
+                for (int k = 0; k < 3; k++) assert_near(rgb[k][q], want, 1e-5f);
+            }
+        }
+        check_packets(s, 50 + (uint64_t)on);
+    }
+    fv_scene_free(s);
+}
+
+/* Alpha BLEND composited front to back (core/blend.c): matte (metallic 0, specularFactor 0)
+ * quads [-1,1]^2 seen from the eye (0, 0.1, 5) with the head light, rays through (x, 0.1, 0),
+ * direction (x / 5, 0, -1): an opaque-shaded layer is base x (0.15 + n.v), n.v = 1 / sqrt(1 +
+ * x^2 / 25), written c below (1.1450 at x = -0.5, 1.1078 at x = 1.5): a red pane of alpha 0.4 at z = 0 and a blue opaque wall at z = -2, both
+ * over x in [-1, 1], and a green pane of alpha 0.5 at z = 1 over x in [1, 3]. Lanes (rays from (x, 0.1, 5) along -z):
+ *   x = -0.5: red over blue: 0.4 (c, 0, 0) + 0.6 (0, 0, c), depth 7 (the wall at x = -0.7)
+ *   x =  1.5: green (at x = 1.2) over nothing: 0.5 (0, c, 0) + 0.5 background, depth 4
+ *   x = -3:   nothing: a miss
+ * and, with the green pane moved over the red one (node at x = 0), x = -0.5: green, then red,
+ * then blue: 0.5 G + 0.5 (0.4 R + 0.6 B) = (0.2 c, 0.5 c, 0.3 c), and x = 1.5 misses. Through the ray stage's calls
+ * (fv_blend_begin, rtcIntersect16, fv_scene_shade_packet, fv_blend_composite). */
+static void test_gltf_alpha_blend(void **state)
+{
+    (void)state;
+    char *dir = tmpdir_make(), p[512], err[512];
+    unsigned char bin[92];
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    quad_buffer(bin, uv);
+    for (int stacked = 0; stacked < 2; stacked++) {
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "\"extensionsUsed\":[\"KHR_materials_specular\"],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+                 "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                 "\"materials\":["
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,0.4],\"metallicFactor\":0},\"alphaMode\":\"BLEND\","
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}},"
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,1,0,0.5],\"metallicFactor\":0},\"alphaMode\":\"BLEND\","
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}},"
+                 "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,1,1],\"metallicFactor\":0},"
+                 "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":1}]},"
+                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":2}]}],"
+                 "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[%d,0,1]},{\"mesh\":2,\"translation\":[0,0,-2]}],"
+                 "\"scenes\":[{\"nodes\":[0,1,2]}],\"scene\":0",
+                 stacked ? 0 : 2);
+        path_join(p, sizeof p, dir, "blend.gltf");
+        write_gltf(p, bin, sizeof bin, json);
+        fv_scene *s = fv_scene_load(p, err, sizeof err);
+        if (!s) print_error("%s\n", err);
+        assert_non_null(s);
+        assert_true(fv_scene_has_blend(s));
+        const float xs[3] = {-0.5f, 1.5f, -3}, eye[3] = {0, 0.1f, 5};
+        _Alignas(64) struct RTCRayHit16 rh;
+        memset(&rh, 0, sizeof rh);
+        _Alignas(64) int valid[16];
+        for (int q = 0; q < 16; q++) {
+            valid[q] = -1;
+            rh.ray.org_x[q] = eye[0], rh.ray.org_y[q] = eye[1], rh.ray.org_z[q] = eye[2];
+            rh.ray.dir_x[q] = xs[q % 3] / 5, rh.ray.dir_y[q] = 0, rh.ray.dir_z[q] = -1; /* through (x, 0.1, 0) */
+            rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu, rh.ray.id[q] = (unsigned)q;
+            rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
+        }
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        fv_blend_lane lanes[16];
+        fv_blend_begin(lanes);
+        fv_scene_intersect16(s, valid, &ctx, &rh);
+        fv_blend_end();
+        fv_shade_dsp dsp;
+        fv_shade_dsp_init(&dsp, FV_ISA_C);
+        const fv_hit_packet hp = {rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar,
+                                  {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z}};
+        float rgb[3][16];
+        fv_scene_shade_packet(s, &dsp, &hp, 16, 0.001f, eye, rgb);
+        const float bg[3] = {0.02f, 0.025f, 0.035f};
+        const float *const dirs[3] = {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
+        fv_blend_composite(s, lanes, rh.hit.geomID, rh.ray.tfar, dirs, 16, 0.001f, eye, bg, rgb);
+        for (int q = 0; q < 16; q++) {
+            const int i = q % 3;
+            if (i == 2 || (i == 1 && stacked)) { /* a miss stays a miss (with the green pane moved, x = 1.5
+                                                    * crosses nothing) */
+                assert_true(rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID);
+                continue;
+            }
+            assert_true(rh.hit.geomID[q] != RTC_INVALID_GEOMETRY_ID);
+            const float c = 0.15f + 1.0f / sqrtf(1.0f + xs[i] * xs[i] / 25); /* n.v off the axis */
+            float want[3], want_t;
+            if (i == 0 && !stacked) want[0] = 0.4f * c, want[1] = 0, want[2] = 0.6f * c, want_t = 7;
+            else if (i == 0) want[0] = 0.5f * 0.4f * c, want[1] = 0.5f * c, want[2] = 0.5f * 0.6f * c, want_t = 7;
+            else if (!stacked) want[0] = 0.5f * bg[0], want[1] = 0.5f * c + 0.5f * bg[1], want[2] = 0.5f * bg[2], want_t = 4;
+            else want[0] = 0.5f * bg[0], want[1] = 0.5f * c + 0.5f * bg[1], want[2] = 0.5f * bg[2], want_t = 4;
+            for (int k = 0; k < 3; k++) assert_near(rgb[k][q], want[k], 1e-5f);
+            assert_near(rh.ray.tfar[q], want_t, 1e-5f);
+        }
+        fv_scene_free(s);
+    }
     tmpdir_remove(dir);
 }
 
@@ -1774,6 +2095,10 @@ int main(void)
         cmocka_unit_test(test_gltf_pbr_materials),
         cmocka_unit_test(test_gltf_material_maps),
         cmocka_unit_test(test_gltf_alpha_mask),
+        cmocka_unit_test(test_gltf_double_sided),
+        cmocka_unit_test(test_gltf_normal_map),
+        cmocka_unit_test(test_shadows),
+        cmocka_unit_test(test_gltf_alpha_blend),
         cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_gltf_sampler_wrap),
         cmocka_unit_test(test_gltf_texture_transform),

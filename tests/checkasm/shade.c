@@ -107,8 +107,12 @@ static void test_brdf(void **state)
             fv_light_rec lights[6];
             gen_packet(&p, mode);
             const int nl = r < 200 ? 0 : gen_lights(lights, 6, mode);
+            /* every third run with shadows: each light occluded on random lanes (fv_shade_env.lit) */
+            float lit[6][FV_SHADE_LANES];
+            for (int j = 0; j < 6; j++)
+                for (int q = 0; q < FV_SHADE_LANES; q++) lit[j][q] = rnd(0, 1) < 0.4f ? 0.0f : 1.0f;
             const fv_shade_env env = {.lights = lights, .nlights = nl, .exposure = rnd(0.01f, 2.0f),
-                                      .eye = {rnd(-5, 5), rnd(-5, 5), rnd(-5, 5)}};
+                                      .eye = {rnd(-5, 5), rnd(-5, 5), rnd(-5, 5)}, .lit = r % 3 == 2 ? &lit[0][0] : NULL};
             float ref[3][FV_SHADE_LANES];
             buf got = checkasm_out_f32(3 * FV_SHADE_LANES, r & 3);
             const unsigned dr = fv_shade_brdf_c(&p, &env, ref);
