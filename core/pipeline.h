@@ -49,6 +49,16 @@ void fv_pipeline_destroy(fv_pipeline *p);
  * from head pose `head` with the point of regard at normalised image coordinates (gaze_x, gaze_y). */
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
                        fv_frame_stats *stats);
+/* Renders both eyes (st[0] left, st[1] right) from one head pose and gaze, the same bytes as
+ * fv_pipeline_render of FV_EYE_LEFT then FV_EYE_RIGHT. The eyes' set-ups run first, then all
+ * their ray-casting tiles as one pool job (no barrier between the eyes: a worker done with the
+ * left eye's tiles takes the right's), then each eye's pull-push, depth of field and output, left
+ * then right (those passes share the depth of field's scratch and each is a barrier of its own).
+ * Stats: each eye's own stages; the pair's ray stage (and its set-up) is split between the eyes
+ * in proportion to the workers' time in each eye's tiles (the two add up to it); total_ms likewise. Stage spans of the pair's frame and
+ * ray stage carry the arg FV_PIPELINE_PAIR. 0, or -1 (camera or memory). */
+#define FV_PIPELINE_PAIR 3
+int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x, float gaze_y, fv_frame_stats st[2]);
 /* The time of the frames rendered next (CLOCK_MONOTONIC or a trace's clock), for the focus
  * filter's accommodation. Without it every frame counts as 1/90 s after the last. */
 void fv_pipeline_set_time_ns(fv_pipeline *p, int64_t t_ns);

@@ -71,22 +71,67 @@ static void run_tile(void *ctx, int index, int thread_id)
         fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_time_ns(), index);
 }
 
+static void job_init(tile_job *j, const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
+                     fv_pyramid *pyr, const fv_render_dsp *dsp, const fv_tile_opts *opt)
+{
+    memset(j, 0, sizeof *j);
+    j->scene = scene, j->cam = cam, j->smp = smp, j->gx = gx, j->gy = gy, j->pyr = pyr, j->dsp = dsp;
+    if (opt) {
+        j->phase = opt->phase;
+        j->taa = opt->taa;
+        j->taa_prm = opt->taa_prm;
+        j->prof = opt->prof;
+        j->dofs = opt->dofs;
+        j->rows_out = opt->rows_out;
+    }
+    j->tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
+    j->tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
+    atomic_init(&j->rays, 0);
+    atomic_init(&j->taa_ns, 0);
+}
+
+typedef struct {
+    tile_job job[FV_TILE_EYES_MAX];
+    atomic_llong tile_ns[FV_TILE_EYES_MAX]; /* the workers' time in each eye's tiles */
+    int first[FV_TILE_EYES_MAX + 1]; /* eye k's tiles are items [first[k], first[k + 1]) */
+    int n;
+} eyes_job;
+
+static void run_eye_tile(void *ctx, int index, int thread_id)
+{
+    eyes_job *e = ctx;
+    int k = 0;
+    while (k + 1 < e->n && index >= e->first[k + 1])
+        k++;
+    const int64_t t0 = fv_time_ns();
+    run_tile(&e->job[k], index - e->first[k], thread_id);
+    atomic_fetch_add_explicit(&e->tile_ns[k], fv_time_ns() - t0, memory_order_relaxed);
+}
+
+void fv_tile_pass_eyes(const fv_scene *scene, const fv_sampler *smp, const fv_render_dsp *dsp, fv_pool *pool,
+                       fv_tile_eye *eyes, int n)
+{
+    eyes_job e;
+    e.n = n < FV_TILE_EYES_MAX ? n : FV_TILE_EYES_MAX;
+    e.first[0] = 0;
+    for (int k = 0; k < e.n; k++) {
+        job_init(&e.job[k], scene, eyes[k].cam, smp, eyes[k].gx, eyes[k].gy, eyes[k].pyr, dsp, &eyes[k].opt);
+        atomic_init(&e.tile_ns[k], 0);
+        e.first[k + 1] = e.first[k] + e.job[k].tiles_x * e.job[k].tiles_y;
+    }
+    fv_pool_run(pool, e.first[e.n], run_eye_tile, &e);
+    for (int k = 0; k < e.n; k++) {
+        eyes[k].rays = atomic_load(&e.job[k].rays);
+        eyes[k].tile_ms = (double)atomic_load(&e.tile_ns[k]) * 1e-6;
+        eyes[k].taa_ms = e.job[k].taa ? (double)atomic_load(&e.job[k].taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
+    }
+}
+
 long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
                   const fv_render_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms)
 {
-    tile_job j = {.scene = scene, .cam = cam, .smp = smp, .gx = gx, .gy = gy, .pyr = pyr, .dsp = dsp};
-    if (opt) {
-        j.phase = opt->phase;
-        j.taa = opt->taa;
-        j.taa_prm = opt->taa_prm;
-        j.prof = opt->prof;
-        j.dofs = opt->dofs;
-        j.rows_out = opt->rows_out;
-    }
-    j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
-    j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
-    atomic_init(&j.rays, 0);
-    atomic_init(&j.taa_ns, 0);
+    tile_job j;
+    job_init(&j, scene, cam, smp, gx, gy, pyr, dsp, opt);
     fv_pool_run(pool, j.tiles_x * j.tiles_y, run_tile, &j);
     if (taa_ms)
         *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
