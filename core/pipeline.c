@@ -45,7 +45,7 @@ struct fv_pipeline {
     int dof;           /* the depth-of-field stages run */
     int dofsamp;       /* DoF-driven sampling thins the rays (DoF and reprojection on) */
     float *dofsamp_map; /* its defocus map (shared by the eyes, rendered one after the other) */
-    float *dofsamp_map_r; /* the right eye's in fv_pipeline_render_stereo (both eyes' tiles at once) */
+    float *dofsamp_map_r; /* the right eye's in fv_pipeline_render_stereo (its tiles run beside the left eye) */
     fv_dof_model_fn dof_fn;
     fv_dof_work dof_work;    /* scratch shared by the eyes (rendered one after the other) */
     float *enh_fp;           /* contrast enhancement footprint per eccentricity step */
@@ -446,13 +446,12 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
 
 int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x, float gaze_y, fv_frame_stats st[2])
 {
-    /* the right eye's defocus map: its own, as its tiles read it while the left's read theirs */
+    /* the right eye's defocus map: its own, as its tiles read it while the left eye's stages run */
     if (p->dofsamp && !p->dofsamp_map_r &&
         !(p->dofsamp_map_r = malloc(fv_dofsamp_map_len(&p->eyes[1].pyr[0]) * sizeof(float))))
         return -1;
     eye_frame f[2];
-    /* one frame span and one ray-stage span for the pair (arg FV_PIPELINE_PAIR) */
-    const int64_t t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME), tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
+    const int64_t t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME); /* the pair's (arg FV_PIPELINE_PAIR) */
     for (int e = 0; e < 2; e++)
         if (eye_begin(p, &f[e], e ? FV_EYE_RIGHT : FV_EYE_LEFT, head, gaze_x, gaze_y,
                       e ? p->dofsamp_map_r : p->dofsamp_map, 0, &st[e]))
@@ -460,19 +459,32 @@ int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x,
     fv_tile_eye te[2];
     for (int e = 0; e < 2; e++)
         te[e] = (fv_tile_eye){.cam = &f[e].es->cam, .gx = f[e].gx, .gy = f[e].gy, .pyr = f[e].pyr, .opt = f[e].opt};
-    fv_tile_pass_eyes(p->scene, p->smp_cur, &p->dsp, p->pool, te, 2);
-    const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, FV_PIPELINE_PAIR);
-    for (int e = 0; e < 2; e++) {
-        const int64_t te0 = fv_time_ns();
-        eye_finish(p, &f[e], &st[e]);
-        st[e].samples = te[e].rays;
-        /* the pair's ray stage, shared in proportion to the workers' time in each eye's tiles */
-        const double busy = te[0].tile_ms + te[1].tile_ms;
-        const double share = busy > 0.0 ? te[e].tile_ms / busy : 0.5;
-        trace_stats(p, &st[e], (double)(t1 - tc0) * 1e-6 * share, te[e].taa_ms);
-        st[e].total_ms = (double)(fv_time_ns() - te0) * 1e-6 + (double)(t1 - t0) * 1e-6 * share;
-    }
-    fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, FV_PIPELINE_PAIR);
+    /* The right eye's tiles are the pool's background job: workers take them whenever the left
+     * eye's passes leave them nothing to do (its tile pass's tail, the serial and barrier parts
+     * of its pull-push, DoF and output). They touch only the right eye's pyramids, sample bits
+     * and defocus map; the left eye's stages touch none of those. */
+    fv_tile_async *bg = fv_tile_pass_post(p->scene, p->smp_cur, &p->dsp, p->pool, &te[1]);
+    if (!bg)
+        return -1;
+    const int64_t tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
+    double taa_ms = NAN;
+    st[0].samples = fv_tile_pass(p->scene, te[0].cam, p->smp_cur, te[0].gx, te[0].gy, te[0].pyr, &p->dsp, p->pool,
+                                 &te[0].opt, &taa_ms);
+    const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, FV_EYE_LEFT);
+    trace_stats(p, &st[0], (double)(t1 - tc0) * 1e-6, taa_ms);
+    eye_finish(p, &f[0], &st[0]);
+    const int64_t tl = fv_time_ns();
+    st[0].total_ms = (double)(tl - t0) * 1e-6;
+    /* the right eye's tiles left (the caller takes them too), then its stages */
+    const int64_t tw0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
+    fv_tile_pass_wait(bg, p->pool, &te[1]);
+    fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tw0, FV_EYE_RIGHT);
+    st[1].samples = te[1].rays;
+    /* its ray stage ran beside the left eye's stages: the workers' time in its tiles over the threads */
+    trace_stats(p, &st[1], te[1].tile_ms / fv_pool_threads(p->pool), te[1].taa_ms);
+    eye_finish(p, &f[1], &st[1]);
+    const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, FV_PIPELINE_PAIR);
+    st[1].total_ms = (double)(t3 - tl) * 1e-6;
     return 0;
 }
 

@@ -50,13 +50,18 @@ void fv_pipeline_destroy(fv_pipeline *p);
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
                        fv_frame_stats *stats);
 /* Renders both eyes (st[0] left, st[1] right) from one head pose and gaze, the same bytes as
- * fv_pipeline_render of FV_EYE_LEFT then FV_EYE_RIGHT. The eyes' set-ups run first, then all
- * their ray-casting tiles as one pool job (no barrier between the eyes: a worker done with the
- * left eye's tiles takes the right's), then each eye's pull-push, depth of field and output, left
- * then right (those passes share the depth of field's scratch and each is a barrier of its own).
- * Stats: each eye's own stages; the pair's ray stage (and its set-up) is split between the eyes
- * in proportion to the workers' time in each eye's tiles (the two add up to it); total_ms likewise. Stage spans of the pair's frame and
- * ray stage carry the arg FV_PIPELINE_PAIR. 0, or -1 (camera or memory). */
+ * fv_pipeline_render of FV_EYE_LEFT then FV_EYE_RIGHT. Both eyes' set-ups run first (camera,
+ * reprojection, the DoF-driven sampling's defocus map: each eye its own), then the right eye's
+ * ray-casting tiles go to the pool as its background job (fv_pool_post) while the left eye's
+ * tiles, pull-push, depth of field and output run as usual: idle workers take right-eye tiles
+ * wherever the left eye's passes leave them nothing to do, with no barrier between the eyes.
+ * Then the right eye's remaining tiles, then its stages. Barriers left: each pass of an eye
+ * (the per-eye stage order); the right eye's stages wait for its tiles; the two eyes' pull-push,
+ * DoF and output passes run one eye after the other (they share the DoF scratch).
+ * Stats: the left eye's as fv_pipeline_render's; the right eye's ray stage is the workers' time
+ * in its tiles over the threads (it ran beside the left eye's stages); total_ms: left from the
+ * pair's start to its output, right from there to the end (the two add up to the pair). Stage
+ * spans: the pair's frame span carries arg FV_PIPELINE_PAIR. 0, or -1 (camera or memory). */
 #define FV_PIPELINE_PAIR 3
 int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x, float gaze_y, fv_frame_stats st[2]);
 /* The time of the frames rendered next (CLOCK_MONOTONIC or a trace's clock), for the focus

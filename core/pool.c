@@ -26,6 +26,12 @@ struct fv_pool {
     int quit;
     atomic_int next;          /* next item to claim */
     fv_prof *prof;            /* trace recorder (NULL: off), published under mu with the job */
+    /* the background job (fv_pool_post): items claimed under mu, by idle workers between the
+     * foreground jobs' items and by the caller in fv_pool_wait */
+    fv_task_fn bg_fn;
+    void *bg_ctx;
+    int bg_count, bg_next, bg_done, bg_on;
+    pthread_cond_t bg_cv; /* bg_done reached bg_count */
 };
 
 typedef struct { fv_pool *pool; int id; } worker_arg;
@@ -71,10 +77,21 @@ static void *worker_main(void *arg)
     unsigned long seen = 0;
     pthread_mutex_lock(&p->mu);
     for (;;) {
-        while (!p->quit && p->generation == seen)
+        while (!p->quit && p->generation == seen && !(p->bg_on && p->bg_next < p->bg_count))
             pthread_cond_wait(&p->start_cv, &p->mu);
         if (p->quit)
             break;
+        if (p->generation == seen) { /* no new foreground job: one background item */
+            const int i = p->bg_next++;
+            fv_task_fn fn = p->bg_fn;
+            void *ctx = p->bg_ctx;
+            pthread_mutex_unlock(&p->mu);
+            fn(ctx, i, wa.id);
+            pthread_mutex_lock(&p->mu);
+            if (++p->bg_done == p->bg_count)
+                pthread_cond_broadcast(&p->bg_cv);
+            continue;
+        }
         seen = p->generation;
         fv_task_fn fn = p->fn;
         void *ctx = p->ctx;
@@ -102,6 +119,7 @@ fv_pool *fv_pool_create(int threads)
     pthread_mutex_init(&p->mu, NULL);
     pthread_cond_init(&p->start_cv, NULL);
     pthread_cond_init(&p->done_cv, NULL);
+    pthread_cond_init(&p->bg_cv, NULL);
     p->tids = calloc((size_t)threads, sizeof *p->tids);
     if (!p->tids) {
         free(p);
@@ -133,6 +151,7 @@ void fv_pool_destroy(fv_pool *p)
     pthread_mutex_destroy(&p->mu);
     pthread_cond_destroy(&p->start_cv);
     pthread_cond_destroy(&p->done_cv);
+    pthread_cond_destroy(&p->bg_cv);
     free(p->tids);
     free(p);
 }
@@ -175,5 +194,41 @@ void fv_pool_set_prof(fv_pool *p, fv_prof *prof)
         return;
     pthread_mutex_lock(&p->mu);
     p->prof = prof;
+    pthread_mutex_unlock(&p->mu);
+}
+
+void fv_pool_post(fv_pool *p, int count, fv_task_fn fn, void *ctx)
+{
+    if (!p) { /* no pool: run at fv_pool_wait... there is none to hold it, so now */
+        for (int i = 0; i < count; i++)
+            fn(ctx, i, 0);
+        return;
+    }
+    pthread_mutex_lock(&p->mu);
+    p->bg_fn = fn, p->bg_ctx = ctx;
+    p->bg_count = count > 0 ? count : 0, p->bg_next = 0, p->bg_done = 0, p->bg_on = 1;
+    pthread_cond_broadcast(&p->start_cv);
+    pthread_mutex_unlock(&p->mu);
+}
+
+void fv_pool_wait(fv_pool *p)
+{
+    if (!p)
+        return;
+    pthread_mutex_lock(&p->mu);
+    if (!p->bg_on) {
+        pthread_mutex_unlock(&p->mu);
+        return;
+    }
+    while (p->bg_next < p->bg_count) { /* the caller takes the items left, as thread 0 */
+        const int i = p->bg_next++;
+        pthread_mutex_unlock(&p->mu);
+        p->bg_fn(p->bg_ctx, i, 0);
+        pthread_mutex_lock(&p->mu);
+        p->bg_done++;
+    }
+    while (p->bg_done < p->bg_count)
+        pthread_cond_wait(&p->bg_cv, &p->mu);
+    p->bg_on = 0;
     pthread_mutex_unlock(&p->mu);
 }

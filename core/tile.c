@@ -1,6 +1,7 @@
 #include "tile.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdatomic.h>
 #include <string.h>
 
@@ -90,41 +91,18 @@ static void job_init(tile_job *j, const fv_scene *scene, const fv_camera *cam, c
     atomic_init(&j->taa_ns, 0);
 }
 
-typedef struct {
-    tile_job job[FV_TILE_EYES_MAX];
-    atomic_llong tile_ns[FV_TILE_EYES_MAX]; /* the workers' time in each eye's tiles */
-    int first[FV_TILE_EYES_MAX + 1]; /* eye k's tiles are items [first[k], first[k + 1]) */
-    int n;
-} eyes_job;
+/* a background tile pass (fv_tile_pass_post) */
+struct fv_tile_async {
+    tile_job job;
+    atomic_llong tile_ns; /* the workers' time in its tiles */
+};
 
-static void run_eye_tile(void *ctx, int index, int thread_id)
+static void run_async_tile(void *ctx, int index, int thread_id)
 {
-    eyes_job *e = ctx;
-    int k = 0;
-    while (k + 1 < e->n && index >= e->first[k + 1])
-        k++;
+    fv_tile_async *a = ctx;
     const int64_t t0 = fv_time_ns();
-    run_tile(&e->job[k], index - e->first[k], thread_id);
-    atomic_fetch_add_explicit(&e->tile_ns[k], fv_time_ns() - t0, memory_order_relaxed);
-}
-
-void fv_tile_pass_eyes(const fv_scene *scene, const fv_sampler *smp, const fv_render_dsp *dsp, fv_pool *pool,
-                       fv_tile_eye *eyes, int n)
-{
-    eyes_job e;
-    e.n = n < FV_TILE_EYES_MAX ? n : FV_TILE_EYES_MAX;
-    e.first[0] = 0;
-    for (int k = 0; k < e.n; k++) {
-        job_init(&e.job[k], scene, eyes[k].cam, smp, eyes[k].gx, eyes[k].gy, eyes[k].pyr, dsp, &eyes[k].opt);
-        atomic_init(&e.tile_ns[k], 0);
-        e.first[k + 1] = e.first[k] + e.job[k].tiles_x * e.job[k].tiles_y;
-    }
-    fv_pool_run(pool, e.first[e.n], run_eye_tile, &e);
-    for (int k = 0; k < e.n; k++) {
-        eyes[k].rays = atomic_load(&e.job[k].rays);
-        eyes[k].tile_ms = (double)atomic_load(&e.tile_ns[k]) * 1e-6;
-        eyes[k].taa_ms = e.job[k].taa ? (double)atomic_load(&e.job[k].taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
-    }
+    run_tile(&a->job, index, thread_id);
+    atomic_fetch_add_explicit(&a->tile_ns, fv_time_ns() - t0, memory_order_relaxed);
 }
 
 long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
@@ -136,4 +114,25 @@ long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler 
     if (taa_ms)
         *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
     return atomic_load(&j.rays);
+}
+
+fv_tile_async *fv_tile_pass_post(const fv_scene *scene, const fv_sampler *smp, const fv_render_dsp *dsp, fv_pool *pool,
+                                 const fv_tile_eye *eye)
+{
+    fv_tile_async *a = malloc(sizeof *a);
+    if (!a)
+        return NULL;
+    job_init(&a->job, scene, eye->cam, smp, eye->gx, eye->gy, eye->pyr, dsp, &eye->opt);
+    atomic_init(&a->tile_ns, 0);
+    fv_pool_post(pool, a->job.tiles_x * a->job.tiles_y, run_async_tile, a);
+    return a;
+}
+
+void fv_tile_pass_wait(fv_tile_async *a, fv_pool *pool, fv_tile_eye *eye)
+{
+    fv_pool_wait(pool);
+    eye->rays = atomic_load(&a->job.rays);
+    eye->tile_ms = (double)atomic_load(&a->tile_ns) * 1e-6;
+    eye->taa_ms = a->job.taa ? (double)atomic_load(&a->job.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
+    free(a);
 }

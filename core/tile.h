@@ -50,22 +50,25 @@ typedef struct fv_tile_opts {
 long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
                   const fv_render_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms);
 
-/* The tile passes of several eyes (a stereo pair) as one pool job: the eyes' tiles go to the
- * workers together, with no barrier between the eyes (each tile's result depends only on its eye
- * and index, so the pixels are those of fv_tile_pass per eye). eyes[k].rays and .taa_ms are
- * filled as fv_tile_pass returns and sets them (taa_ms: the eye's reprojection time over the
- * pool's threads); tile_ms splits the pass's time between the eyes. */
+/* An eye's tile pass's arguments and results (fv_tile_pass_post / _wait): rays and taa_ms as
+ * fv_tile_pass returns and sets them (taa_ms: the eye's reprojection time over the pool's
+ * threads), tile_ms the workers' time in its tiles, summed. */
 typedef struct fv_tile_eye {
     const fv_camera *cam;
     int gx, gy;
     fv_pyramid *pyr;
     fv_tile_opts opt;
-    long rays;     /* out */
-    double taa_ms; /* out */
-    double tile_ms; /* out: the workers' time in the eye's tiles, summed */
+    long rays;      /* out */
+    double taa_ms;  /* out */
+    double tile_ms; /* out */
 } fv_tile_eye;
-#define FV_TILE_EYES_MAX 2
-void fv_tile_pass_eyes(const fv_scene *scene, const fv_sampler *smp, const fv_render_dsp *dsp, fv_pool *pool,
-                       fv_tile_eye *eyes, int n);
+/* One eye's tile pass as the pool's background job (fv_pool_post): it runs on idle workers while
+ * the caller runs other (foreground) jobs that touch none of its data, and is finished by
+ * fv_tile_pass_wait (the caller takes the tiles left), which fills eye's outputs and frees the
+ * handle. NULL when out of memory (nothing posted). */
+typedef struct fv_tile_async fv_tile_async;
+fv_tile_async *fv_tile_pass_post(const fv_scene *scene, const fv_sampler *smp, const fv_render_dsp *dsp, fv_pool *pool,
+                                 const fv_tile_eye *eye);
+void fv_tile_pass_wait(fv_tile_async *a, fv_pool *pool, fv_tile_eye *eye);
 
 #endif
