@@ -44,7 +44,8 @@ static void usage(FILE *f)
             "                     (rtcIntersect16, no shading: core/ceiling.h) and report the\n"
             "                     ray stage's time against it per mode (ceiling_ms in the JSON)\n"
             "  --stereo           afterwards, time the stereo pair (foveated) one eye after the\n"
-            "                     other and with both eyes' tiles in one pool job, alternately,\n"
+            "                     other and with fv_pipeline_render_stereo (the right eye's tiles\n"
+            "                     beside the left eye's stages), alternately,\n"
             "                     --frames pairs of each (medians; with --ceiling against bare\n"
             "                     Embree on both eyes' rays)\n"
             "  --counters on|off  hardware counters per stage through perf_event_open (default on;\n"
@@ -215,7 +216,7 @@ int main(int argc, char **argv)
             fv_fail(prog, FV_EXIT_FAIL, "--stereo: %s", err);
         }
         printf("stereo pair (foveated, 2 x %dx%d, medians of %d pairs each, alternated): one eye after the other "
-               "%.2f ms, both eyes' tiles in one job %.2f ms (%.3fx)",
+               "%.2f ms, fv_pipeline_render_stereo %.2f ms (%.3fx)",
                rep.width, rep.height, sr.pairs, sr.seq_ms, sr.joint_ms, sr.joint_ms / sr.seq_ms);
         if (bo.ceiling)
             printf("; ceiling (both eyes' rays) %.2f ms: %.2fx / %.2fx of it", sr.ceiling_ms, sr.seq_ms / sr.ceiling_ms,

@@ -381,7 +381,7 @@ int fv_bench_stereo_run(const fv_scene *scene, fv_pipeline_config cfg, const fv_
     }
     int n[2] = {0, 0}, nc = 0, rc = 0;
     for (int f = 0; f < 2 * (warmup + frames) && !rc; f++) {
-        const int joint = f & 1; /* alternately: one eye after the other, both eyes in one job */
+        const int joint = f & 1; /* alternately: one eye after the other, fv_pipeline_render_stereo */
         const fv_pose head = fv_bench_head_at(view, yaw_rate_dps, f);
         fv_frame_stats st[2];
         const int64_t t0 = fv_time_ns();

@@ -128,8 +128,8 @@ int fv_sweep_max_threads(const fv_sweep *sw, int nsweeps, int threads);
 /* The head pose of frame f: the view turned by yaw_rate * f / 90 Hz about its own vertical axis. */
 fv_pose fv_bench_head_at(const fv_pose *view, float yaw_rate_dps, int f);
 /* --stereo: the stereo pair (foveated, gaze at the centre) rendered one eye after the other
- * (fv_pipeline_render left, right) and with both eyes' tiles in one pool job
- * (fv_pipeline_render_stereo), alternating frame by frame on one pipeline (the same bytes either
+ * (fv_pipeline_render left, right) and with fv_pipeline_render_stereo (the right eye's tiles
+ * beside the left eye's stages), alternating frame by frame on one pipeline (the same bytes either
  * way, so the history is the same); medians of `frames` pairs each after `warmup` pairs, wall
  * ms. With ceiling: bare Embree on both eyes' rays after every pair (untimed in the pair). */
 typedef struct fv_bench_stereo {
