@@ -11,6 +11,7 @@ enum { FG_ITEMS = 300, BG_ITEMS = 2000, MAXT = 8 };
 
 typedef struct {
     atomic_int runs[BG_ITEMS]; /* times each item ran */
+    atomic_uint sink[BG_ITEMS]; /* each item's busy work, kept */
     atomic_int inside[MAXT];   /* items running on each thread id now */
     atomic_int bad_id, overlap;
     int threads;
@@ -25,9 +26,10 @@ static void item(void *ctx, int index, int tid)
     }
     if (atomic_fetch_add(&j->inside[tid], 1) != 0) /* another item on this id right now */
         atomic_fetch_add(&j->overlap, 1);
-    volatile unsigned spin = 0; /* some work, so the jobs overlap */
+    unsigned spin = 0; /* some work, so the jobs overlap */
     for (int k = 0; k < 200 + index % 50; k++)
-        spin += (unsigned)k;
+        spin = spin * 31u + (unsigned)k;
+    atomic_store_explicit(&j->sink[index], spin, memory_order_relaxed); /* kept: the loop is not optimised away */
     atomic_fetch_add(&j->runs[index], 1);
     atomic_fetch_sub(&j->inside[tid], 1);
 }
