@@ -43,6 +43,11 @@ static void usage(FILE *f)
             "  --ceiling          after every frame, trace the same rays with bare Embree\n"
             "                     (rtcIntersect16, no shading: core/ceiling.h) and report the\n"
             "                     ray stage's time against it per mode (ceiling_ms in the JSON)\n"
+            "  --stereo           afterwards, time the stereo pair (foveated) one eye after the\n"
+            "                     other and with fv_pipeline_render_stereo (the right eye's tiles\n"
+            "                     beside the left eye's stages), alternately,\n"
+            "                     --frames pairs of each (medians; with --ceiling against bare\n"
+            "                     Embree on both eyes' rays)\n"
             "  --counters on|off  hardware counters per stage through perf_event_open (default on;\n"
             "                     reported as unavailable where the kernel or VM has none)\n"
             "  --sweep P=VALUES   repeatable; runs every value of P after the base run, all in the\n"
@@ -87,13 +92,13 @@ int main(int argc, char **argv)
     int reproject_given = 0;
     const char *scene_path = NULL, *json_path = NULL, *mode = "both", *trace_path = NULL, *kernel = NULL;
     fv_bench_opts bo = {.yaw_rate = 0.0f, .warmup = 3, .frames = 30, .counters = 1, .prof = NULL};
-    int kernels = 0, kreps = 7;
+    int kernels = 0, kreps = 7, stereo = 0;
     long calls = 0;
     static fv_sweep sweeps[FV_BENCH_MAX_SWEEPS];
     int nsweeps = 0;
     char err[512];
     enum { OPT_LENS = 500, OPT_SCENE = 1, OPT_FRAMES, OPT_WARMUP, OPT_MODE, OPT_JSON, OPT_YAW, OPT_HELP, OPT_TRACE_OUT, OPT_COUNTERS,
-           OPT_SWEEP, OPT_KERNELS, OPT_KREPS, OPT_KERNEL, OPT_CALLS, OPT_CEILING };
+           OPT_SWEEP, OPT_KERNELS, OPT_KREPS, OPT_KERNEL, OPT_CALLS, OPT_CEILING, OPT_STEREO };
     static const struct option opts[] = {
         {"scene", required_argument, 0, OPT_SCENE}, FV_ASSET_ROOT_LONGOPT, FV_SHADOWS_LONGOPT, {"lens", required_argument, 0, OPT_LENS}, {"frames", required_argument, 0, OPT_FRAMES},
         {"warmup", required_argument, 0, OPT_WARMUP}, {"mode", required_argument, 0, OPT_MODE},
@@ -102,7 +107,7 @@ int main(int argc, char **argv)
         {"sweep", required_argument, 0, OPT_SWEEP}, {"kernels", no_argument, 0, OPT_KERNELS},
         {"kernel-reps", required_argument, 0, OPT_KREPS}, {"kernel", required_argument, 0, OPT_KERNEL},
         {"calls", required_argument, 0, OPT_CALLS}, {"ceiling", no_argument, 0, OPT_CEILING},
-        {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS,
+        {"stereo", no_argument, 0, OPT_STEREO}, {"help", no_argument, 0, OPT_HELP}, FV_COMMON_LONGOPTS,
         {0, 0, 0, 0}};
     opterr = 0;
     int o;
@@ -131,6 +136,7 @@ int main(int argc, char **argv)
             break;
         case OPT_KERNELS: kernels = 1; break;
         case OPT_CEILING: bo.ceiling = 1; break;
+        case OPT_STEREO: stereo = 1; break;
         case OPT_KREPS: kreps = (int)fv_arg_long(prog, "--kernel-reps", optarg, 1, 64); break;
         case OPT_KERNEL: kernel = optarg; break;
         case OPT_CALLS: calls = fv_arg_long(prog, "--calls", optarg, 0, 100000000); break;
@@ -205,6 +211,21 @@ int main(int argc, char **argv)
             fv_bench_print_sweep_point(stdout, sw, k, bo.frames);
         }
         fv_bench_print_scaling(stdout, sw);
+    }
+
+    if (stereo) {
+        fv_bench_stereo sr;
+        if (fv_bench_stereo_run(scene, cfg, &view, bo.yaw_rate, bo.warmup, bo.frames, bo.ceiling, &sr, err, sizeof err)) {
+            fv_scene_free(scene);
+            fv_fail(prog, FV_EXIT_FAIL, "--stereo: %s", err);
+        }
+        printf("stereo pair (foveated, 2 x %dx%d, medians of %d pairs each, alternated): one eye after the other "
+               "%.2f ms, fv_pipeline_render_stereo %.2f ms (%.3fx)",
+               rep.width, rep.height, sr.pairs, sr.seq_ms, sr.joint_ms, sr.joint_ms / sr.seq_ms);
+        if (bo.ceiling)
+            printf("; ceiling (both eyes' rays) %.2f ms: %.2fx / %.2fx of it", sr.ceiling_ms, sr.seq_ms / sr.ceiling_ms,
+                   sr.joint_ms / sr.ceiling_ms);
+        printf("\n");
     }
 
     int status = FV_EXIT_OK;

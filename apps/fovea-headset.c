@@ -237,16 +237,14 @@ static int a_render(void *c, const fv_gaze_sample *g, int64_t t_ns)
         a->reported_scale = 1;
     }
     uint8_t *dst = a->img[a->back];
-    for (int e = 0; e < 2; e++) {
-        const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
-        fv_frame_stats st;
-        if (fv_pipeline_render(a->pl, eye, &head, gx, gy, &st)) {
-            fprintf(stderr, "%s: frame %ld (%s eye): rendering failed\n", prog, a->frame, e ? "right" : "left");
-            a->render_failed = 1;
-            return -1;
-        }
-        fv_pipeline_to_rgb8(a->pl, eye, dst + (size_t)e * a->W * 3, (ptrdiff_t)a->W * 6);
+    fv_frame_stats st[2];
+    if (fv_pipeline_render_stereo(a->pl, &head, gx, gy, st)) { /* both eyes' tiles in one pool job */
+        fprintf(stderr, "%s: frame %ld: rendering the stereo pair failed\n", prog, a->frame);
+        a->render_failed = 1;
+        return -1;
     }
+    for (int e = 0; e < 2; e++)
+        fv_pipeline_to_rgb8(a->pl, e ? FV_EYE_RIGHT : FV_EYE_LEFT, dst + (size_t)e * a->W * 3, (ptrdiff_t)a->W * 6);
     a->frame++;
     return 0;
 }
@@ -304,16 +302,15 @@ static void *render_main(void *arg)
             a->reported_scale = 1;
         }
         const int s = fv_mailbox_begin_write(&a->mb);
-        for (int e = 0; e < 2; e++) {
-            fv_frame_stats st;
-            if (fv_pipeline_render(a->pl, e ? FV_EYE_RIGHT : FV_EYE_LEFT, &head, hg ? g.x : 0.5f, hg ? g.y : 0.5f, &st)) {
-                fprintf(stderr, "%s: frame %ld (%s eye): rendering failed\n", prog, a->ndone, e ? "right" : "left");
-                __atomic_store_n(&a->render_failed, 1, __ATOMIC_RELEASE);
-                __atomic_store_n(&a->stop, 1, __ATOMIC_RELEASE);
-                return NULL;
-            }
-            fv_tw_frame_capture(&a->slot[s], a->pl, e);
+        fv_frame_stats st[2];
+        if (fv_pipeline_render_stereo(a->pl, &head, hg ? g.x : 0.5f, hg ? g.y : 0.5f, st)) {
+            fprintf(stderr, "%s: frame %ld: rendering the stereo pair failed\n", prog, a->ndone);
+            __atomic_store_n(&a->render_failed, 1, __ATOMIC_RELEASE);
+            __atomic_store_n(&a->stop, 1, __ATOMIC_RELEASE);
+            return NULL;
         }
+        for (int e = 0; e < 2; e++)
+            fv_tw_frame_capture(&a->slot[s], a->pl, e);
         const int64_t done = fv_time_ns();
         a->meta[s].has_gaze = hg;
         if (hg)

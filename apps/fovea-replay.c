@@ -262,6 +262,11 @@ int main(int argc, char **argv)
         fv_pose head = tr.has_head ? smp.head : view;
         fv_prof_instant(prof, 0, FV_PROF_TRACK_MARKERS, "frame", fv_time_ns(), (int)f);
         fv_frame_stats st[2], sum;
+        /* both eyes' tiles in one pool job: the bytes of one eye after the other */
+        if (stereo && !refp.spp && fv_pipeline_render_stereo(pl, &head, smp.gaze_x, smp.gaze_y, st)) {
+            fprintf(stderr, "%s: frame %ld (stereo pair): rendering failed\n", prog, f);
+            goto done;
+        }
         for (int e = 0; e < neyes; e++) {
             fv_eye eye = stereo ? (e == 0 ? FV_EYE_LEFT : FV_EYE_RIGHT) : FV_EYE_CENTER;
             if (refp.spp) {
@@ -280,7 +285,7 @@ int main(int argc, char **argv)
                 render_reference(scene, &cam, &refp, fv_pipeline_pool(pl), refbuf, rgb + (size_t)e * W * 3,
                                  (ptrdiff_t)outw * 3, cfg.isa_mask, &rprog, &st[e]);
             } else {
-                if (fv_pipeline_render(pl, eye, &head, smp.gaze_x, smp.gaze_y, &st[e])) {
+                if (!stereo && fv_pipeline_render(pl, eye, &head, smp.gaze_x, smp.gaze_y, &st[e])) {
                     fprintf(stderr, "%s: frame %ld%s: rendering failed\n", prog, f, eye_name(eye));
                     goto done;
                 }

@@ -9,6 +9,7 @@
 #include "base/clock.h"
 #include "base/err.h"
 #include "base/parse.h"
+#include "ceiling.h"
 #include "pool.h"
 #include "tile.h" /* FV_TILE_PULL_LEVELS: the levels the tiles pull */
 
@@ -365,4 +366,68 @@ int fv_bench_stage_bytes(int stage, int w, int h, double holes, double *rd, doub
     default:
         return -1;
     }
+}
+
+int fv_bench_stereo_run(const fv_scene *scene, fv_pipeline_config cfg, const fv_pose *view, float yaw_rate_dps,
+                        int warmup, int frames, int ceiling, fv_bench_stereo *r, char *err, size_t err_len)
+{
+    cfg.samp.full = 0;
+    fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, err_len);
+    if (!pl)
+        return -1;
+    double *t = malloc(4 * (size_t)frames * sizeof *t); /* frames a kind, the ceiling's 2 frames */
+    if (!t) {
+        fv_pipeline_destroy(pl);
+        return fv_err(err, err_len, "out of memory");
+    }
+    int n[2] = {0, 0}, nc = 0, rc = 0;
+    for (int f = 0; f < 2 * (warmup + frames) && !rc; f++) {
+        const int joint = f & 1; /* alternately: one eye after the other, fv_pipeline_render_stereo */
+        const fv_pose head = fv_bench_head_at(view, yaw_rate_dps, f);
+        fv_frame_stats st[2];
+        const int64_t t0 = fv_time_ns();
+        int bad = 0;
+        if (joint)
+            bad = fv_pipeline_render_stereo(pl, &head, 0.5f, 0.5f, st);
+        else
+            for (int e = 0; e < 2 && !bad; e++)
+                bad = fv_pipeline_render(pl, e ? FV_EYE_RIGHT : FV_EYE_LEFT, &head, 0.5f, 0.5f, &st[e]);
+        const double ms = (double)(fv_time_ns() - t0) * 1e-6;
+        if (bad) {
+            rc = fv_err(err, err_len, "stereo pair %d: rendering failed", f);
+            break;
+        }
+        const int timed = f >= 2 * warmup;
+        if (timed)
+            t[joint * frames + n[joint]++] = ms;
+        if (ceiling) {
+            double cms = 0.0;
+            for (int e = 0; e < 2; e++) {
+                const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
+                const fv_camera *cam = fv_pipeline_camera(pl, eye);
+                const fv_ceiling_opts co = {.smp = fv_pipeline_sampler(pl),
+                                            .gx = (int)floorf(0.5f * (float)cam->width),
+                                            .gy = (int)floorf(0.5f * (float)cam->height),
+                                            .phase = fv_pipeline_last_phase(pl, eye),
+                                            .rows = fv_pipeline_last_rows(pl, eye)};
+                const int64_t c0 = fv_time_ns();
+                const long rays = fv_ceiling_trace(scene, cam, fv_pipeline_pool(pl), &co, NULL);
+                cms += (double)(fv_time_ns() - c0) * 1e-6;
+                if (rays != st[e].samples) { /* not the same rays: the ratio would mean nothing */
+                    rc = fv_err(err, err_len, "stereo pair %d: the ceiling traced %ld rays, the eye %ld", f, rays,
+                                st[e].samples);
+                    break;
+                }
+            }
+            if (timed && !rc)
+                t[2 * frames + nc++] = cms;
+        }
+    }
+    r->pairs = n[0] < n[1] ? n[0] : n[1];
+    r->seq_ms = fv_median(t, n[0]);
+    r->joint_ms = fv_median(t + frames, n[1]);
+    r->ceiling_ms = ceiling ? fv_median(t + 2 * frames, nc) : NAN;
+    free(t);
+    fv_pipeline_destroy(pl);
+    return rc;
 }

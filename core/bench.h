@@ -127,6 +127,18 @@ int fv_sweep_max_threads(const fv_sweep *sw, int nsweeps, int threads);
 /* ---- machine and motion ---- */
 /* The head pose of frame f: the view turned by yaw_rate * f / 90 Hz about its own vertical axis. */
 fv_pose fv_bench_head_at(const fv_pose *view, float yaw_rate_dps, int f);
+/* --stereo: the stereo pair (foveated, gaze at the centre) rendered one eye after the other
+ * (fv_pipeline_render left, right) and with fv_pipeline_render_stereo (the right eye's tiles
+ * beside the left eye's stages), alternating frame by frame on one pipeline (the same bytes either
+ * way, so the history is the same); medians of `frames` pairs each after `warmup` pairs, wall
+ * ms. With ceiling: bare Embree on both eyes' rays after every pair (untimed in the pair). */
+typedef struct fv_bench_stereo {
+    double seq_ms, joint_ms, ceiling_ms; /* ceiling_ms NAN without */
+    int pairs;                           /* timed pairs of each kind */
+} fv_bench_stereo;
+int fv_bench_stereo_run(const fv_scene *scene, fv_pipeline_config cfg, const fv_pose *view, float yaw_rate_dps,
+                        int warmup, int frames, int ceiling, fv_bench_stereo *r, char *err, size_t err_len);
+
 /* memcpy bandwidth in GB/s of read + written bytes (64 MiB, best of 5) on `threads` threads of a
  * core pool; 0 when out of memory. */
 double fv_bench_copy_gbps(int threads);

@@ -45,6 +45,7 @@ struct fv_pipeline {
     int dof;           /* the depth-of-field stages run */
     int dofsamp;       /* DoF-driven sampling thins the rays (DoF and reprojection on) */
     float *dofsamp_map; /* its defocus map (shared by the eyes, rendered one after the other) */
+    float *dofsamp_map_r; /* the right eye's in fv_pipeline_render_stereo (its tiles run beside the left eye) */
     fv_dof_model_fn dof_fn;
     fv_dof_work dof_work;    /* scratch shared by the eyes (rendered one after the other) */
     float *enh_fp;           /* contrast enhancement footprint per eccentricity step */
@@ -206,6 +207,7 @@ void fv_pipeline_destroy(fv_pipeline *p)
     }
     fv_dof_work_free(&p->dof_work);
     free(p->dofsamp_map);
+    free(p->dofsamp_map_r);
     free(p->enh_fp);
     free(p);
 }
@@ -317,10 +319,29 @@ void fv_pipeline_set_prof(fv_pipeline *p, fv_prof *prof)
     fv_pool_set_prof(p->pool, prof);
 }
 
-int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
-                       fv_frame_stats *st)
+/* One eye's frame between its set-up and its tile pass (the stereo path runs both eyes' set-ups,
+ * then their tiles as one pool job, then each eye's remaining stages). */
+typedef struct {
+    eye_state *es;
+    fv_eye eye;
+    int dst; /* the pyramid rendered into */
+    fv_pyramid *pyr;
+    float gaze_x, gaze_y;
+    int gx, gy;
+    fv_taa_frame tf;
+    fv_dofsamp_frame dsf;
+    fv_tile_opts opt; /* points into tf, dsf and shade_ns */
+    int64_t shade_ns; /* the workers' time shading, when the config asks (time_shading) */
+    int64_t t0, tc0;  /* the frame's and the ray stage's span starts (single-eye path) */
+} eye_frame;
+
+/* The eye's camera, reprojection and DoF-sampling set-up (its defocus map into map). */
+static int eye_begin(fv_pipeline *p, eye_frame *f, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
+                     float *map, int spans, fv_frame_stats *st)
 {
     eye_state *es = &p->eyes[slot(eye)];
+    memset(f, 0, sizeof *f);
+    f->es = es, f->eye = eye, f->gaze_x = gaze_x, f->gaze_y = gaze_y;
     fv_camera_desc d = p->cfg.cam;
     d.eye = eye;
     if (fv_camera_setup(&es->cam, &d, head))
@@ -333,18 +354,17 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         st->stage_ms[i] = NAN;
     st->shade_ms = NAN;
     /* with reprojection, render into the other pyramid and read this one as history */
-    const int dst = p->taa ? es->cur ^ 1 : 0;
-    fv_pyramid *pyr = &es->pyr[dst];
-    fv_taa_frame tf;
-    fv_tile_opts opt = {.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa,
-                           .prof = p->prof};
-    const int64_t t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME), tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
+    f->dst = p->taa ? es->cur ^ 1 : 0;
+    f->pyr = &es->pyr[f->dst];
+    f->opt = (fv_tile_opts){.phase = p->taa ? (int)(es->frame % p->smp_cur->phases) : 0, .taa_prm = &p->cfg.taa,
+                            .prof = p->prof, .shade_ns = p->cfg.time_shading ? &f->shade_ns : NULL};
+    if (spans) /* the DoF-sampling map counts in the ray stage's time */
+        f->t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME), f->tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
     /* The S_in pattern moves by whole pixels with the point of regard. */
-    int gx = (int)floorf(gaze_x * (float)d.width), gy = (int)floorf(gaze_y * (float)d.height);
-    fv_dofsamp_frame dsf;
+    f->gx = (int)floorf(gaze_x * (float)d.width), f->gy = (int)floorf(gaze_y * (float)d.height);
     if (p->taa && es->hist_valid) {
-        fv_taa_frame_setup(&tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
-        opt.taa = &tf;
+        fv_taa_frame_setup(&f->tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
+        f->opt.taa = &f->tf;
         /* The focus this frame is not estimated yet (it needs this frame's depth): the eye
          * accommodates from last frame's focus towards last frame's target, so the frame's focus
          * lies between them unless the target jumps (a saccade to another depth, then the focus
@@ -352,27 +372,32 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         if (p->dofsamp && es->focus.valid) {
             const fv_dof_params *dp = &p->cfg.dof;
             const float fa = 1.0f / fmaxf(es->focus.focus_dpt, 1e-6f), fb = 1.0f / fmaxf(es->focus.target_dpt, 1e-6f);
-            fv_dofsamp_frame_setup(&dsf, &p->cfg.dofsamp, &tf, p->smp_cur, gx, gy, fa, fb, dp->tolerance_m,
+            fv_dofsamp_frame_setup(&f->dsf, &p->cfg.dofsamp, &f->tf, p->smp_cur, f->gx, f->gy, fa, fb, dp->tolerance_m,
                                    dp->pupil_mm * 1e-3f * es->cam.focal_px * fv_dof_presets[dp->preset].e_scale,
-                                   (uint32_t)es->frame, opt.phase);
-            fv_dofsamp_map_attach(&dsf, p->dofsamp_map);
-            fv_pool_run(p->pool, DOFSAMP_BANDS, dofsamp_map_band, &dsf);
-            opt.dofs = &dsf;
-            opt.rows_out = es->rows;
+                                   (uint32_t)es->frame, f->opt.phase);
+            fv_dofsamp_map_attach(&f->dsf, map);
+            fv_pool_run(p->pool, DOFSAMP_BANDS, dofsamp_map_band, &f->dsf);
+            f->opt.dofs = &f->dsf;
+            f->opt.rows_out = es->rows;
         }
     }
-    es->rows_valid = opt.dofs != NULL;
-    double taa_ms = NAN;
-    int64_t shade_ns = 0;
-    opt.shade_ns = p->cfg.time_shading ? &shade_ns : NULL;
-    st->samples = fv_tile_pass(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
-    const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
+    es->rows_valid = f->opt.dofs != NULL;
+    return 0;
+}
+
+/* The eye's stages after its tiles: pull-push, depth of field, output; its history advanced. */
+static void eye_finish(fv_pipeline *p, eye_frame *f, fv_frame_stats *st)
+{
+    eye_state *es = f->es;
+    const fv_eye eye = f->eye;
+    fv_pyramid *pyr = f->pyr;
     const int64_t tr0 = fv_prof_stage_begin(p->prof, FV_STAGE_RECONSTRUCT);
     /* the first levels were pulled by the ray-casting tiles (their cost is in the trace time) */
     fv_pullpush_from(pyr, &p->dsp.pp, p->pool, fv_tile_pulled_levels(pyr));
     const int64_t t2 = fv_prof_stage_end(p->prof, FV_STAGE_RECONSTRUCT, tr0, (int)eye);
+    st->stage_ms[FV_STAGE_RECONSTRUCT] = (double)(t2 - tr0) * 1e-6;
     st->focus_m = NAN;
-    const int converted = p->dof && render_dof(p, es, eye, pyr, gaze_x, gaze_y, st);
+    const int converted = p->dof && render_dof(p, es, eye, pyr, f->gaze_x, f->gaze_y, st);
     /* output: the display format, every frame (a headset pays for it each refresh), unless the
      * depth of field wrote it row by row in its last pass */
     if (!converted) {
@@ -384,13 +409,18 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         st->stage_ms[FV_STAGE_OUTPUT] =
             (double)(fv_prof_stage_end(p->prof, FV_STAGE_OUTPUT, to0, (int)eye) - to0) * 1e-6;
     }
-    const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, (int)eye);
-    es->cur = dst;
+    es->cur = f->dst;
     es->prev_cam = es->cam;
     es->hist_valid = 1;
     es->frame++;
+}
+
+/* The ray stage's time (cast_ms, its reprojection share taa_ms, the workers' shading time
+ * shade_ns) into the stats */
+static void trace_stats(const fv_pipeline *p, fv_frame_stats *st, double cast_ms, double taa_ms, int64_t shade_ns)
+{
+    st->shade_ms = p->cfg.time_shading ? (double)shade_ns * 1e-6 / fv_pool_threads(p->pool) : NAN;
     /* reprojection runs inside the ray-casting tiles: its share is the workers' time in it */
-    const double cast_ms = (double)(t1 - tc0) * 1e-6;
     if (p->taa) {
         if (isnan(taa_ms))
             taa_ms = 0.0; /* first frame: no history yet */
@@ -399,9 +429,66 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     } else {
         st->stage_ms[FV_STAGE_TRACE] = cast_ms;
     }
-    st->stage_ms[FV_STAGE_RECONSTRUCT] = (double)(t2 - t1) * 1e-6;
-    st->shade_ms = p->cfg.time_shading ? (double)shade_ns * 1e-6 / fv_pool_threads(p->pool) : NAN;
+}
+
+int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
+                       fv_frame_stats *st)
+{
+    eye_frame f;
+    if (eye_begin(p, &f, eye, head, gaze_x, gaze_y, p->dofsamp_map, 1, st))
+        return -1;
+    const int64_t t0 = f.t0, tc0 = f.tc0;
+    double taa_ms = NAN;
+    st->samples = fv_tile_pass(p->scene, &f.es->cam, p->smp_cur, f.gx, f.gy, f.pyr, &p->dsp, p->pool, &f.opt, &taa_ms);
+    const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
+    eye_finish(p, &f, st);
+    const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, (int)eye);
+    trace_stats(p, st, (double)(t1 - tc0) * 1e-6, taa_ms, f.shade_ns);
     st->total_ms = (double)(t3 - t0) * 1e-6;
+    return 0;
+}
+
+int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x, float gaze_y, fv_frame_stats st[2])
+{
+    /* the right eye's defocus map: its own, as its tiles read it while the left eye's stages run */
+    if (p->dofsamp && !p->dofsamp_map_r &&
+        !(p->dofsamp_map_r = malloc(fv_dofsamp_map_len(&p->eyes[1].pyr[0]) * sizeof(float))))
+        return -1;
+    eye_frame f[2];
+    const int64_t t0 = fv_prof_stage_begin(p->prof, FV_PROF_FRAME); /* the pair's (arg FV_PIPELINE_PAIR) */
+    for (int e = 0; e < 2; e++)
+        if (eye_begin(p, &f[e], e ? FV_EYE_RIGHT : FV_EYE_LEFT, head, gaze_x, gaze_y,
+                      e ? p->dofsamp_map_r : p->dofsamp_map, 0, &st[e]))
+            return -1;
+    fv_tile_eye te[2];
+    for (int e = 0; e < 2; e++)
+        te[e] = (fv_tile_eye){.cam = &f[e].es->cam, .gx = f[e].gx, .gy = f[e].gy, .pyr = f[e].pyr, .opt = f[e].opt};
+    /* The right eye's tiles are the pool's background job: workers take them whenever the left
+     * eye's passes leave them nothing to do (its tile pass's tail, the serial and barrier parts
+     * of its pull-push, DoF and output). They touch only the right eye's pyramids, sample bits
+     * and defocus map; the left eye's stages touch none of those. */
+    fv_tile_async *bg = fv_tile_pass_post(p->scene, p->smp_cur, &p->dsp, p->pool, &te[1]);
+    if (!bg)
+        return -1;
+    const int64_t tc0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
+    double taa_ms = NAN;
+    st[0].samples = fv_tile_pass(p->scene, te[0].cam, p->smp_cur, te[0].gx, te[0].gy, te[0].pyr, &p->dsp, p->pool,
+                                 &te[0].opt, &taa_ms);
+    const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, FV_EYE_LEFT);
+    trace_stats(p, &st[0], (double)(t1 - tc0) * 1e-6, taa_ms, f[0].shade_ns);
+    eye_finish(p, &f[0], &st[0]);
+    const int64_t tl = fv_time_ns();
+    st[0].total_ms = (double)(tl - t0) * 1e-6;
+    /* the right eye's tiles left (the caller takes them too), then its stages */
+    const int64_t tw0 = fv_prof_stage_begin(p->prof, FV_STAGE_TRACE);
+    fv_tile_pass_wait(bg, p->pool, &te[1]);
+    fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tw0, FV_EYE_RIGHT);
+    st[1].samples = te[1].rays;
+    /* its ray stage ran beside the left eye's stages: the workers' time in its tiles over the threads */
+    trace_stats(p, &st[1], te[1].tile_ms / fv_pool_threads(p->pool), te[1].taa_ms, f[1].shade_ns);
+    eye_finish(p, &f[1], &st[1]);
+    const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, FV_PIPELINE_PAIR);
+    st[1].total_ms = (double)(t3 - tl) * 1e-6;
     return 0;
 }
 
@@ -478,7 +565,8 @@ void fv_pipeline_memory_bytes(const fv_pipeline *p, fv_eye eye, fv_pipeline_memo
         const fv_dof_work *wk = &p->dof_work;
         m->shared = (size_t)wk->stride * (size_t)wk->h * (4 * FV_DOF_PLANES4 + FV_DOF_PLANES1) * sizeof(float) +
                     (wk->aux_len + wk->rows_len) * sizeof(float) +
-                    (p->dofsamp_map ? fv_dofsamp_map_len(&es->pyr[0]) * sizeof(float) : 0);
+                    (p->dofsamp_map ? fv_dofsamp_map_len(&es->pyr[0]) * sizeof(float) : 0) +
+                    (p->dofsamp_map_r ? fv_dofsamp_map_len(&es->pyr[0]) * sizeof(float) : 0);
     }
 }
 

@@ -54,6 +54,21 @@ void fv_pipeline_destroy(fv_pipeline *p);
  * from head pose `head` with the point of regard at normalised image coordinates (gaze_x, gaze_y). */
 int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float gaze_x, float gaze_y,
                        fv_frame_stats *stats);
+/* Renders both eyes (st[0] left, st[1] right) from one head pose and gaze, the same bytes as
+ * fv_pipeline_render of FV_EYE_LEFT then FV_EYE_RIGHT. Both eyes' set-ups run first (camera,
+ * reprojection, the DoF-driven sampling's defocus map: each eye its own), then the right eye's
+ * ray-casting tiles go to the pool as its background job (fv_pool_post) while the left eye's
+ * tiles, pull-push, depth of field and output run as usual: idle workers take right-eye tiles
+ * wherever the left eye's passes leave them nothing to do, with no barrier between the eyes.
+ * Then the right eye's remaining tiles, then its stages. Barriers left: each pass of an eye
+ * (the per-eye stage order); the right eye's stages wait for its tiles; the two eyes' pull-push,
+ * DoF and output passes run one eye after the other (they share the DoF scratch).
+ * Stats: the left eye's as fv_pipeline_render's; the right eye's ray stage is the workers' time
+ * in its tiles over the threads (it ran beside the left eye's stages); total_ms: left from the
+ * pair's start to its output, right from there to the end (the two add up to the pair). Stage
+ * spans: the pair's frame span carries arg FV_PIPELINE_PAIR. 0, or -1 (camera or memory). */
+#define FV_PIPELINE_PAIR 3
+int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x, float gaze_y, fv_frame_stats st[2]);
 /* The time of the frames rendered next (CLOCK_MONOTONIC or a trace's clock), for the focus
  * filter's accommodation. Without it every frame counts as 1/90 s after the last. */
 void fv_pipeline_set_time_ns(fv_pipeline *p, int64_t t_ns);

@@ -5,6 +5,7 @@
 
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <unistd.h>
 #if defined(__x86_64__) || defined(__i386__)
@@ -22,10 +23,19 @@ struct fv_pool {
     void *ctx;
     int count;
     unsigned long generation; /* bumped per job so sleepers know there is new work */
-    int busy;                 /* workers still inside the current job */
     int quit;
-    atomic_int next;          /* next item to claim */
+    /* the next item to claim, tagged with its job's generation (high 32 bits): a worker that read
+     * an older job claims nothing from a newer one, so the caller need not wait for every worker
+     * to check in, only for the job's items (done) */
+    _Atomic uint64_t claim;
+    atomic_int done;          /* items of the current job finished */
     fv_prof *prof;            /* trace recorder (NULL: off), published under mu with the job */
+    /* the background job (fv_pool_post): items claimed under mu, by idle workers between the
+     * foreground jobs' items and by the caller in fv_pool_wait */
+    fv_task_fn bg_fn;
+    void *bg_ctx;
+    int bg_count, bg_next, bg_done, bg_on;
+    pthread_cond_t bg_cv; /* bg_done reached bg_count */
 };
 
 typedef struct { fv_pool *pool; int id; } worker_arg;
@@ -49,14 +59,29 @@ int fv_online_cpus(void)
     return n < 1 ? 1 : (int)n;
 }
 
-static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, int id, fv_prof *prof)
+/* the job's next unclaimed item, or -1 when none is left or the job is not the current one */
+static int claim(fv_pool *p, uint32_t gen, int count)
+{
+    uint64_t v = atomic_load_explicit(&p->claim, memory_order_relaxed);
+    for (;;) {
+        if ((uint32_t)(v >> 32) != gen || (int)(uint32_t)v >= count)
+            return -1;
+        if (atomic_compare_exchange_weak_explicit(&p->claim, &v, v + 1, memory_order_relaxed, memory_order_relaxed))
+            return (int)(uint32_t)v;
+    }
+}
+
+static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, uint32_t gen, int id, fv_prof *prof)
 {
     const int64_t t0 = prof ? fv_time_ns() : 0;
-    for (;;) {
-        int i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed);
-        if (i >= count)
-            break;
+    for (int i; (i = claim(p, gen, count)) >= 0;) {
         fn(ctx, i, id);
+        /* release: the item's writes happen before the caller sees the job done */
+        if (atomic_fetch_add_explicit(&p->done, 1, memory_order_acq_rel) + 1 == count) {
+            pthread_mutex_lock(&p->mu);
+            pthread_cond_signal(&p->done_cv);
+            pthread_mutex_unlock(&p->mu);
+        }
     }
     if (prof) /* this worker's share of the job, on its own track */
         fv_prof_span(prof, id, id, "pool job", t0, fv_time_ns(), count);
@@ -71,20 +96,29 @@ static void *worker_main(void *arg)
     unsigned long seen = 0;
     pthread_mutex_lock(&p->mu);
     for (;;) {
-        while (!p->quit && p->generation == seen)
+        while (!p->quit && p->generation == seen && !(p->bg_on && p->bg_next < p->bg_count))
             pthread_cond_wait(&p->start_cv, &p->mu);
         if (p->quit)
             break;
+        if (p->generation == seen) { /* no new foreground job: one background item */
+            const int i = p->bg_next++;
+            fv_task_fn fn = p->bg_fn;
+            void *ctx = p->bg_ctx;
+            pthread_mutex_unlock(&p->mu);
+            fn(ctx, i, wa.id);
+            pthread_mutex_lock(&p->mu);
+            if (++p->bg_done == p->bg_count)
+                pthread_cond_broadcast(&p->bg_cv);
+            continue;
+        }
         seen = p->generation;
         fv_task_fn fn = p->fn;
         void *ctx = p->ctx;
         int count = p->count;
         fv_prof *prof = p->prof;
         pthread_mutex_unlock(&p->mu);
-        drain(p, fn, ctx, count, wa.id, prof);
+        drain(p, fn, ctx, count, (uint32_t)seen, wa.id, prof);
         pthread_mutex_lock(&p->mu);
-        if (--p->busy == 0)
-            pthread_cond_signal(&p->done_cv);
     }
     pthread_mutex_unlock(&p->mu);
     return NULL;
@@ -98,10 +132,12 @@ fv_pool *fv_pool_create(int threads)
     if (!p)
         return NULL;
     p->threads = threads;
-    atomic_init(&p->next, 0);
+    atomic_init(&p->claim, 0);
+    atomic_init(&p->done, 0);
     pthread_mutex_init(&p->mu, NULL);
     pthread_cond_init(&p->start_cv, NULL);
     pthread_cond_init(&p->done_cv, NULL);
+    pthread_cond_init(&p->bg_cv, NULL);
     p->tids = calloc((size_t)threads, sizeof *p->tids);
     if (!p->tids) {
         free(p);
@@ -133,6 +169,7 @@ void fv_pool_destroy(fv_pool *p)
     pthread_mutex_destroy(&p->mu);
     pthread_cond_destroy(&p->start_cv);
     pthread_cond_destroy(&p->done_cv);
+    pthread_cond_destroy(&p->bg_cv);
     free(p->tids);
     free(p);
 }
@@ -156,15 +193,18 @@ void fv_pool_run(fv_pool *p, int count, fv_task_fn fn, void *ctx)
     p->fn = fn;
     p->ctx = ctx;
     p->count = count;
-    atomic_store_explicit(&p->next, 0, memory_order_relaxed);
-    p->busy = p->threads - 1;
     p->generation++;
+    const uint32_t gen = (uint32_t)p->generation;
+    atomic_store_explicit(&p->done, 0, memory_order_relaxed);
+    atomic_store_explicit(&p->claim, (uint64_t)gen << 32, memory_order_relaxed);
     pthread_cond_broadcast(&p->start_cv);
     pthread_mutex_unlock(&p->mu);
     fv_prof *prof = p->prof; /* only the caller writes it (fv_pool_set_prof) */
-    drain(p, fn, ctx, count, 0, prof);
+    drain(p, fn, ctx, count, gen, 0, prof);
+    /* done when every item is: a worker still in a background item, or not yet awake, holds
+     * nothing of this job */
     pthread_mutex_lock(&p->mu);
-    while (p->busy > 0)
+    while (atomic_load_explicit(&p->done, memory_order_acquire) < count)
         pthread_cond_wait(&p->done_cv, &p->mu);
     pthread_mutex_unlock(&p->mu);
 }
@@ -175,5 +215,41 @@ void fv_pool_set_prof(fv_pool *p, fv_prof *prof)
         return;
     pthread_mutex_lock(&p->mu);
     p->prof = prof;
+    pthread_mutex_unlock(&p->mu);
+}
+
+void fv_pool_post(fv_pool *p, int count, fv_task_fn fn, void *ctx)
+{
+    if (!p) { /* no pool: run at fv_pool_wait... there is none to hold it, so now */
+        for (int i = 0; i < count; i++)
+            fn(ctx, i, 0);
+        return;
+    }
+    pthread_mutex_lock(&p->mu);
+    p->bg_fn = fn, p->bg_ctx = ctx;
+    p->bg_count = count > 0 ? count : 0, p->bg_next = 0, p->bg_done = 0, p->bg_on = 1;
+    pthread_cond_broadcast(&p->start_cv);
+    pthread_mutex_unlock(&p->mu);
+}
+
+void fv_pool_wait(fv_pool *p)
+{
+    if (!p)
+        return;
+    pthread_mutex_lock(&p->mu);
+    if (!p->bg_on) {
+        pthread_mutex_unlock(&p->mu);
+        return;
+    }
+    while (p->bg_next < p->bg_count) { /* the caller takes the items left, as thread 0 */
+        const int i = p->bg_next++;
+        pthread_mutex_unlock(&p->mu);
+        p->bg_fn(p->bg_ctx, i, 0);
+        pthread_mutex_lock(&p->mu);
+        p->bg_done++;
+    }
+    while (p->bg_done < p->bg_count)
+        pthread_cond_wait(&p->bg_cv, &p->mu);
+    p->bg_on = 0;
     pthread_mutex_unlock(&p->mu);
 }

@@ -1,6 +1,7 @@
 #include "tile.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdatomic.h>
 #include <string.h>
 
@@ -77,28 +78,73 @@ static void run_tile(void *ctx, int index, int thread_id)
         fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_time_ns(), index);
 }
 
+static void job_init(tile_job *j, const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
+                     fv_pyramid *pyr, const fv_render_dsp *dsp, const fv_tile_opts *opt)
+{
+    memset(j, 0, sizeof *j);
+    j->scene = scene, j->cam = cam, j->smp = smp, j->gx = gx, j->gy = gy, j->pyr = pyr, j->dsp = dsp;
+    if (opt) {
+        j->phase = opt->phase;
+        j->taa = opt->taa;
+        j->taa_prm = opt->taa_prm;
+        j->prof = opt->prof;
+        j->dofs = opt->dofs;
+        j->rows_out = opt->rows_out;
+        j->time_shading = opt->shade_ns != NULL;
+    }
+    j->tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
+    j->tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
+    atomic_init(&j->rays, 0);
+    atomic_init(&j->taa_ns, 0);
+    atomic_init(&j->shade_ns, 0);
+}
+
+/* a background tile pass (fv_tile_pass_post) */
+struct fv_tile_async {
+    tile_job job;
+    atomic_llong tile_ns; /* the workers' time in its tiles */
+};
+
+static void run_async_tile(void *ctx, int index, int thread_id)
+{
+    fv_tile_async *a = ctx;
+    const int64_t t0 = fv_time_ns();
+    run_tile(&a->job, index, thread_id);
+    atomic_fetch_add_explicit(&a->tile_ns, fv_time_ns() - t0, memory_order_relaxed);
+}
+
 long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
                   const fv_render_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms)
 {
-    tile_job j = {.scene = scene, .cam = cam, .smp = smp, .gx = gx, .gy = gy, .pyr = pyr, .dsp = dsp};
-    if (opt) {
-        j.phase = opt->phase;
-        j.taa = opt->taa;
-        j.taa_prm = opt->taa_prm;
-        j.prof = opt->prof;
-        j.dofs = opt->dofs;
-        j.rows_out = opt->rows_out;
-        j.time_shading = opt->shade_ns != NULL;
-    }
-    j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
-    j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
-    atomic_init(&j.rays, 0);
-    atomic_init(&j.taa_ns, 0);
-    atomic_init(&j.shade_ns, 0);
+    tile_job j;
+    job_init(&j, scene, cam, smp, gx, gy, pyr, dsp, opt);
     fv_pool_run(pool, j.tiles_x * j.tiles_y, run_tile, &j);
     if (j.time_shading)
         *opt->shade_ns = atomic_load(&j.shade_ns);
     if (taa_ms)
         *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
     return atomic_load(&j.rays);
+}
+
+fv_tile_async *fv_tile_pass_post(const fv_scene *scene, const fv_sampler *smp, const fv_render_dsp *dsp, fv_pool *pool,
+                                 const fv_tile_eye *eye)
+{
+    fv_tile_async *a = malloc(sizeof *a);
+    if (!a)
+        return NULL;
+    job_init(&a->job, scene, eye->cam, smp, eye->gx, eye->gy, eye->pyr, dsp, &eye->opt);
+    atomic_init(&a->tile_ns, 0);
+    fv_pool_post(pool, a->job.tiles_x * a->job.tiles_y, run_async_tile, a);
+    return a;
+}
+
+void fv_tile_pass_wait(fv_tile_async *a, fv_pool *pool, fv_tile_eye *eye)
+{
+    fv_pool_wait(pool);
+    eye->rays = atomic_load(&a->job.rays);
+    eye->tile_ms = (double)atomic_load(&a->tile_ns) * 1e-6;
+    eye->taa_ms = a->job.taa ? (double)atomic_load(&a->job.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
+    if (a->job.time_shading)
+        *eye->opt.shade_ns = atomic_load(&a->job.shade_ns);
+    free(a);
 }

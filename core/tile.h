@@ -52,4 +52,25 @@ typedef struct fv_tile_opts {
 long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy, fv_pyramid *pyr,
                   const fv_render_dsp *dsp, fv_pool *pool, const fv_tile_opts *opt, double *taa_ms);
 
+/* An eye's tile pass's arguments and results (fv_tile_pass_post / _wait): rays and taa_ms as
+ * fv_tile_pass returns and sets them (taa_ms: the eye's reprojection time over the pool's
+ * threads), tile_ms the workers' time in its tiles, summed. */
+typedef struct fv_tile_eye {
+    const fv_camera *cam;
+    int gx, gy;
+    fv_pyramid *pyr;
+    fv_tile_opts opt;
+    long rays;      /* out */
+    double taa_ms;  /* out */
+    double tile_ms; /* out */
+} fv_tile_eye;
+/* One eye's tile pass as the pool's background job (fv_pool_post): it runs on idle workers while
+ * the caller runs other (foreground) jobs that touch none of its data, and is finished by
+ * fv_tile_pass_wait (the caller takes the tiles left), which fills eye's outputs and frees the
+ * handle. NULL when out of memory (nothing posted). */
+typedef struct fv_tile_async fv_tile_async;
+fv_tile_async *fv_tile_pass_post(const fv_scene *scene, const fv_sampler *smp, const fv_render_dsp *dsp, fv_pool *pool,
+                                 const fv_tile_eye *eye);
+void fv_tile_pass_wait(fv_tile_async *a, fv_pool *pool, fv_tile_eye *eye);
+
 #endif

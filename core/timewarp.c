@@ -108,6 +108,16 @@ static void depth_range(const fv_timewarp_dsp *d, const fv_tw_src *s, const fv_t
     mm[0] = lo, mm[1] = hi;
 }
 
+/* Row translations in fixed point: 1/64 px with 16 more bits, offset by a multiple of 2^22 that
+ * keeps them positive (shifts of negatives are the compiler's choice in C) */
+#define TW_QBIAS ((int64_t)1 << 52)
+static inline void row_offsets(int64_t qu, int64_t qv, int *ox, int *oy, int *fx, int *fy)
+{
+    const int64_t u = (qu + TW_QBIAS + 32768) >> 16, v = (qv + TW_QBIAS + 32768) >> 16; /* 1/64 px, rounded */
+    *ox = (int)(u >> 6) - (int)(TW_QBIAS >> 22), *oy = (int)(v >> 6) - (int)(TW_QBIAS >> 22);
+    *fx = (int)(u & 63), *fy = (int)(v & 63);
+}
+
 /* one block (the proof: timewarp.h); 1 when translated */
 static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *s, const fv_tw_tiles *tiles,
                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *b)
@@ -197,17 +207,16 @@ static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
     const double su = ((double)b->u1 - b->u0) / rows * k, sv = ((double)b->v1 - b->v0) / rows * k;
     b->dqu = (int64_t)(su + (su < 0 ? -0.5 : 0.5)), b->dqv = (int64_t)(sv + (sv < 0 ? -0.5 : 0.5));
     b->fast = 1;
+    /* inner: no row clamps (fv_tw_warp_rows' block_row). The rows' offsets are roundings of a
+     * linear function of y, so the source rows y + oy and columns x + ox are monotonic in y:
+     * the first and the last row bound them all. */
+    int ox0, oy0, ox1, oy1, f0, f1;
+    row_offsets(b->qu, b->qv, &ox0, &oy0, &f0, &f1);
+    row_offsets(b->qu + (int64_t)(Y1 - 1 - Y0) * b->dqu, b->qv + (int64_t)(Y1 - 1 - Y0) * b->dqv, &ox1, &oy1, &f0, &f1);
+    const int sy0 = Y0 + oy0, sy1 = Y1 - 1 + oy1;
+    b->inner = (sy0 < sy1 ? sy0 : sy1) >= 0 && (sy0 > sy1 ? sy0 : sy1) <= s->h - 2 && X0 + (ox0 < ox1 ? ox0 : ox1) >= 0 &&
+               X1 + (ox0 > ox1 ? ox0 : ox1) <= s->w - 1;
     return 1;
-}
-
-/* Row translations in fixed point: 1/64 px with 16 more bits, offset by a multiple of 2^22 that
- * keeps them positive (shifts of negatives are the compiler's choice in C) */
-#define TW_QBIAS ((int64_t)1 << 52)
-static inline void row_offsets(int64_t qu, int64_t qv, int *ox, int *oy, int *fx, int *fy)
-{
-    const int64_t u = (qu + TW_QBIAS + 32768) >> 16, v = (qv + TW_QBIAS + 32768) >> 16; /* 1/64 px, rounded */
-    *ox = (int)(u >> 6) - (int)(TW_QBIAS >> 22), *oy = (int)(v >> 6) - (int)(TW_QBIAS >> 22);
-    *fx = (int)(u & 63), *fy = (int)(v & 63);
 }
 
 void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int *fy)
@@ -239,6 +248,32 @@ static int plan_split(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
     return n;
 }
 
+/* A block, else its left and right halves, else each half's quarters (plan_split). Most of a
+ * block's bound is the spread of the offsets along its rows (a turn's homography stretches rows;
+ * the rows' blend of the top and bottom edges follows the vertical change), so halving the width
+ * usually proves both halves: two plans instead of the quarters' four, and the same pieces a row. */
+static int plan_halves(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
+                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out)
+{
+    const int MIN = FV_TW_BLOCK_MIN, side = X1 - X0 > Y1 - Y0 ? X1 - X0 : Y1 - Y0;
+    if (X1 - X0 <= MIN || Y1 - Y0 <= MIN)
+        return plan_split(d, m, src, tiles, X0, X1, Y0, Y1, guess, out);
+    if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || out->err_px > FV_TW_BLOCK_POS_PX * (float)side / (float)MIN)
+        return 1;
+    const int Xm = X0 + (X1 - X0 + 1) / 2, Ym = Y0 + (Y1 - Y0 + 1) / 2;
+    int n = 0;
+    for (int h = 0; h < 2; h++) {
+        const int xa = h ? Xm : X0, xb = h ? X1 : Xm;
+        if (plan_block(d, m, src, tiles, xa, xb, Y0, Y1, guess, out + n)) {
+            n++;
+            continue;
+        }
+        n += plan_split(d, m, src, tiles, xa, xb, Y0, Ym, guess, out + n);
+        n += plan_split(d, m, src, tiles, xa, xb, Ym, Y1, guess, out + n);
+    }
+    return n;
+}
+
 int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
                       int by, int bx0, int nb, fv_tw_block *out, float *guess)
 {
@@ -248,12 +283,19 @@ int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
         const int X0 = (bx0 + i) * BW, X1 = mini(X0 + BW, src->w);
         if (X0 >= X1)
             break;
-        n += plan_split(d, m, src, tiles, X0, X1, Y0, Y1, guess, out + n);
+        n += plan_halves(d, m, src, tiles, X0, X1, Y0, Y1, guess, out + n);
     }
     return n;
 }
 
 #define FV_TW_PREFETCH_ROWS 3
+
+/* an inner translated block on the rows being warped: its row translation (in row_offsets'
+ * biased fixed point, with its rounding term) and step, its source columns and its bytes */
+typedef struct {
+    int64_t qu, qv, dqu, dqv;
+    int col, dst, n, npf; /* 3 x0; its bytes in the row buffer and their count; lines prefetched */
+} tw_runner;
 
 /* one row of a translated block: its clamped columns written here, the rest as a piece for
  * tw_spans; the source position is clamped to the source as the reference's. o holds columns
@@ -303,8 +345,14 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
     const int BW = FV_TW_BLOCK_W, BH = FV_TW_BLOCK_H, nbx = (src->w + BW - 1) / BW;
     fv_tw_block plan[MAXE];
     fv_tw_piece pc[MAXE];
-    int on[MAXE];                  /* the entries covering the row */
+    /* the entries covering the row, rebuilt where that set changes: the inner translated blocks
+     * as runners (their translation stepped a row at a time: a piece costs a few adds), the
+     * others as items (a clamped translated block, or a run of per-pixel parts in one call: the
+     * kernel interleaves 64 pixels) */
+    tw_runner run[MAXE];
+    struct { const fv_tw_block *b; int xa, xb; } item[MAXE]; /* b NULL: per-pixel columns [xa, xb) */
     uint8_t row[3 * CHUNK * FV_TW_BLOCK_W]; /* a row's columns composed in cache, then streamed (tw_stream) */
+    const ptrdiff_t stride = src->rgb_stride;
     long holes = 0;
     for (int by = y0 / BH; by * BH < y1; by++) {
         const int ya = by * BH > y0 ? by * BH : y0, yb = mini(by * BH + BH, y1);
@@ -312,31 +360,56 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
         for (int bx0 = 0; bx0 < nbx; bx0 += CHUNK) {
             const int n = fv_tw_plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess);
             const int x0 = bx0 * BW, x1 = mini((bx0 + CHUNK) * BW, src->w);
-            int no = 0, next = ya; /* the entries covering the row change on row next */
+            int nr = 0, ni = 0, next = ya; /* the entries covering the row change on row next */
             for (int y = ya; y < yb; y++) {
-                int np = 0;
                 if (y == next) {
-                    no = 0, next = yb;
+                    nr = ni = 0, next = yb;
+                    int prev_slow = 0;
                     for (int i = 0; i < n; i++) {
-                        if (plan[i].y0 <= y && y < plan[i].y1)
-                            on[no++] = i;
-                        const int c = plan[i].y0 > y ? plan[i].y0 : plan[i].y1;
+                        const fv_tw_block *b = &plan[i];
+                        const int c = b->y0 > y ? b->y0 : b->y1;
                         next = c > y && c < next ? c : next;
+                        if (!(b->y0 <= y && y < b->y1))
+                            continue;
+                        if (b->inner) {
+                            tw_runner *r = &run[nr++];
+                            r->qu = b->qu + (int64_t)(y - b->y0) * b->dqu + TW_QBIAS + 32768;
+                            r->qv = b->qv + (int64_t)(y - b->y0) * b->dqv + TW_QBIAS + 32768;
+                            r->dqu = b->dqu, r->dqv = b->dqv;
+                            r->col = 3 * b->x0, r->dst = 3 * (b->x0 - x0), r->n = 3 * (b->x1 - b->x0);
+                            r->npf = (r->n + 3 + 63) / 64;
+                        } else if (b->fast)
+                            item[ni].b = b, item[ni++].xa = 0;
+                        else if (prev_slow)
+                            item[ni - 1].xb = b->x1;
+                        else
+                            item[ni].b = NULL, item[ni].xa = b->x0, item[ni++].xb = b->x1;
+                        prev_slow = !b->fast;
                     }
                 }
-                for (int k = 0; k < no;) {
-                    const fv_tw_block *b = &plan[on[k]];
-                    if (b->fast) {
+                int np = 0;
+                const uint8_t *srow = src->rgb + (ptrdiff_t)y * stride;
+                for (int k = 0; k < nr; k++) { /* block_row without its clamps: the same piece */
+                    tw_runner *r = &run[k];
+                    const int64_t u = r->qu >> 16, v = r->qv >> 16; /* row_offsets */
+                    const int ox = (int)(u >> 6) - (int)(TW_QBIAS >> 22), oy = (int)(v >> 6) - (int)(TW_QBIAS >> 22);
+                    const int fx = (int)(u & 63), fy = (int)(v & 63);
+                    r->qu += r->dqu, r->qv += r->dqv;
+                    fv_tw_piece *p = &pc[np++];
+                    const uint8_t *s0 = srow + (ptrdiff_t)oy * stride + r->col + 3 * (ptrdiff_t)ox;
+                    p->s0 = s0, p->s1 = fy ? s0 + stride : s0;
+                    p->dst = r->dst, p->n = r->n, p->fx = fx, p->fy = fy;
+                    if (y + oy + FV_TW_PREFETCH_ROWS + 1 < src->h) /* as block_row */
+                        for (int j = 0; j < r->npf; j++)
+                            __builtin_prefetch(s0 + FV_TW_PREFETCH_ROWS * stride + 64 * j);
+                }
+                for (int k = 0; k < ni; k++) {
+                    const fv_tw_block *b = item[k].b;
+                    if (b) {
                         const int64_t q[2] = {b->qu + (int64_t)(y - b->y0) * b->dqu, b->qv + (int64_t)(y - b->y0) * b->dqv};
                         np += block_row(&pc[np], row, x0, y, b, q, src);
-                        k++;
-                    } else { /* a run of per-pixel entries in one call: the kernel interleaves 64 pixels */
-                        int j = k + 1;
-                        while (j < no && !plan[on[j]].fast)
-                            j++;
-                        holes += d->tw_row(row + 3 * (b->x0 - x0), b->x0, y, plan[on[j - 1]].x1 - b->x0, m, src);
-                        k = j;
-                    }
+                    } else
+                        holes += d->tw_row(row + 3 * (item[k].xa - x0), item[k].xa, y, item[k].xb - item[k].xa, m, src);
                 }
                 d->tw_spans(row, pc, np);
                 d->tw_stream(dst + (ptrdiff_t)y * dst_stride + 3 * x0, row, 3 * (x1 - x0));

@@ -60,6 +60,8 @@ typedef struct fv_tw_block {
     float u0, v0, u1, v1; /* the translation (source minus display position) of its first and last row */
     int64_t qu, qv, dqu, dqv; /* the first row's in 1/2^22 px and the step a row (fv_tw_block_row) */
     float err_px;       /* the planner's bound on the position error (translated blocks) */
+    int inner;          /* translated and every row's taps inside the source (no clamping): the warp's
+                         * short path, the same bytes */
 } fv_tw_block;
 /* Row y's translation of a translated block, its rows' linear blend of the first's and the last's
  * (in fixed point, within 2^-16 px) rounded to 1/64: display pixel (x, y) resamples the source at (x + ox + fx / 64, y + oy + fy / 64). */

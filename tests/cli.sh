@@ -326,6 +326,15 @@ if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --json "$T/
     else
         bad "--ceiling bench failed: $(cat "$T/err")"
     fi
+    # --stereo: the pair one eye after the other and through fv_pipeline_render_stereo, against
+    # the ceiling on both eyes' rays (the run fails if the ceiling's rays differ from the eyes')
+    if $B/fovea-bench --scene $SCENE --size 96x108 --frames 2 --warmup 1 --threads 2 --mode foveated --dof weak \
+        --ceiling --stereo >"$T/out" 2>"$T/err"; then
+        grep -q '^stereo pair (foveated, 2 x 96x108, medians of 2 pairs each, alternated): one eye after the other [0-9.]* ms, fv_pipeline_render_stereo [0-9.]* ms (.*); ceiling (both eyes. rays) [0-9.]* ms' "$T/out" &&
+            ok || bad "bench --stereo line: $(cat "$T/out")"
+    else
+        bad "bench --stereo failed: $(cat "$T/err")"
+    fi
     # DoF-driven sampling (issue 15 item 4): fewer rays than the acuity sampler alone where the
     # blur is strong (focus fixed near, everything behind blurred), and the ceiling retraces the
     # frame's own thinned rays (the bench fails if the counts differ)

@@ -331,6 +331,93 @@ static void test_fused_pull_matches_pullpush(void **st)
     fv_scene_free(s);
 }
 
+/* fv_pipeline_render_stereo (both eyes' tiles in one pool job) gives the bytes of rendering the
+ * left then the right eye, frame after frame (history, reprojection, the DoF-driven sampling's
+ * per-eye defocus maps, depth of field), for 1, 2 and 5 threads; the stats add up. */
+static void test_stereo_pair_matches_sequential(void **st)
+{
+    (void)st;
+    fv_scene *s = fv_scene_create();
+    uint64_t rng = 7;
+    enum { NT = 1500 };
+    static float pos[NT * 9];
+    for (int i = 0; i < NT; i++) {
+        const float cx = (fv_test_randf(&rng) - 0.5f) * 6.0f, cy = (fv_test_randf(&rng) - 0.5f) * 6.0f;
+        const float cz = -0.6f - fv_test_randf(&rng) * 6.0f;
+        for (int v = 0; v < 3; v++) {
+            pos[i * 9 + v * 3 + 0] = cx + (fv_test_randf(&rng) - 0.5f);
+            pos[i * 9 + v * 3 + 1] = cy + (fv_test_randf(&rng) - 0.5f);
+            pos[i * 9 + v * 3 + 2] = cz + (fv_test_randf(&rng) - 0.5f) * 0.3f;
+        }
+    }
+    fv_mesh_desc m;
+    memset(&m, 0, sizeof m);
+    m.positions = pos;
+    m.vertex_count = NT * 3;
+    m.base_color[0] = 0.3f, m.base_color[1] = 0.7f, m.base_color[2] = 0.9f, m.base_color[3] = 1.0f;
+    m.texture = -1;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    assert_int_equal(fv_scene_commit(s, err, sizeof err), 0);
+    enum { W = 176, H = 150, FRAMES = 4 };
+    const size_t n = (size_t)W * H * 3;
+    uint8_t *want = malloc(2 * n * FRAMES), *got = malloc(2 * n);
+    assert_non_null(want);
+    assert_non_null(got);
+    const int threads[] = {1, 2, 5};
+    for (int k = 0; k < 3; k++)
+        for (int stereo = 0; stereo < 2; stereo++) {
+            fv_pipeline_config cfg;
+            fv_pipeline_config_default(&cfg);
+            cfg.cam.width = W, cfg.cam.height = H;
+            cfg.cam.fov_y_deg = 40.0f;
+            cfg.samp.r0_deg = 3.0f, cfg.samp.r1_deg = 8.0f;
+            cfg.dof.preset = FV_DOF_STRONG; /* with reprojection: DoF-driven sampling from frame 2 */
+            cfg.dof.focus.fixed_m = 0.8f;   /* the far triangles blurred: thinned */
+            cfg.dofsamp.kappa = 2.0f;
+            cfg.threads = threads[k];
+            fv_pipeline *p = fv_pipeline_create(s, &cfg, err, sizeof err);
+            assert_non_null(p);
+            for (int f = 0; f < FRAMES; f++) {
+                const float a = 0.02f * (float)f;
+                const fv_pose head = {{0.05f * (float)f, 0.0f, 0.3f}, {0.0f, sinf(a), 0.0f, cosf(a)}};
+                const float gx = 0.4f + 0.05f * (float)f, gy = 0.55f;
+                fv_pipeline_set_time_ns(p, (int64_t)f * 11111111);
+                fv_frame_stats sts[2];
+                if (stereo) {
+                    assert_int_equal(fv_pipeline_render_stereo(p, &head, gx, gy, sts), 0);
+                    for (int e = 0; e < 2; e++) {
+                        assert_true(sts[e].samples > 0);
+                        assert_true(sts[e].total_ms >= 0.0);
+                        assert_true(sts[e].stage_ms[FV_STAGE_TRACE] >= 0.0);
+                    }
+                } else
+                    for (int e = 0; e < 2; e++)
+                        assert_int_equal(fv_pipeline_render(p, e ? FV_EYE_RIGHT : FV_EYE_LEFT, &head, gx, gy, &sts[e]), 0);
+                for (int e = 0; e < 2; e++) {
+                    const fv_eye eye = e ? FV_EYE_RIGHT : FV_EYE_LEFT;
+                    /* from frame 2 on both eyes' tiles were thinned with their own maps */
+                    assert_true(f > 0 ? fv_pipeline_last_rows(p, eye) != NULL : 1);
+                    fv_pipeline_to_rgb8(p, eye, got + (size_t)e * n, W * 3);
+                }
+                uint8_t *w = want + 2 * n * (size_t)f;
+                if (k == 0 && !stereo)
+                    memcpy(w, got, 2 * n); /* the reference: one thread, one eye after the other */
+                else
+                    for (int e = 0; e < 2; e++)
+                        if (memcmp(w + (size_t)e * n, got + (size_t)e * n, n))
+                            fail_msg("%d threads, %s, frame %d: the %s eye differs from the sequential one-thread render",
+                                     threads[k], stereo ? "stereo" : "sequential", f, e ? "right" : "left");
+            }
+            fv_pipeline_destroy(p);
+        }
+    /* the eyes differ (a check that the comparison sees two images) */
+    assert_true(memcmp(want, want + n, n) != 0);
+    free(want);
+    free(got);
+    fv_scene_free(s);
+}
+
 /* Stereo: the eyes sit IPD/2 either side of the head along its right axis. */
 static void test_stereo_eyes(void **st)
 {
@@ -409,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_thread_determinism),
         cmocka_unit_test(test_fused_pull_matches_pullpush),
         cmocka_unit_test(test_stereo_eyes),
+        cmocka_unit_test(test_stereo_pair_matches_sequential),
     };
     return cmocka_run_group_tests_name("pipeline", tests, NULL, NULL);
 }

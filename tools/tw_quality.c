@@ -94,7 +94,7 @@ int main(int argc, char **argv)
     int w = 1280, h = 1440, right = 0;
     const char *png_dir = NULL;
     double rate = 30.0, hz = 90.0, step_mm = 0.0;
-    int bench = 0;
+    int bench = 0, bench_pixel = 1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--scene") && i + 1 < argc)
             scene_path = argv[++i];
@@ -109,17 +109,20 @@ int main(int argc, char **argv)
             step_mm = fv_arg_float(prog, "--step", argv[++i], -100.0f, 100.0f);
         else if (!strcmp(argv[i], "--bench") && i + 1 < argc)
             bench = (int)fv_arg_long(prog, "--bench", argv[++i], 1, 1000);
+        else if (!strcmp(argv[i], "--no-per-pixel"))
+            bench_pixel = 0;
         else if (!strcmp(argv[i], "--png") && i + 1 < argc)
             png_dir = argv[++i];
         else if (!strcmp(argv[i], "--eye") && i + 1 < argc)
             right = !strcmp(argv[++i], "right");
         else if (!strcmp(argv[i], "--help")) {
             printf("usage: tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] [--step MM]\n"
-                   "                  [--eye left|right] [--png DIR] [--bench N]\n"
+                   "                  [--eye left|right] [--png DIR] [--bench N [--no-per-pixel]]\n"
                    "  --step MM   a sideways head step of MM a refresh besides the turn (default 0)\n"
                    "  --png DIR   DIR/warped_K.png, direct_K.png, error_K.png (the luma error x8)\n"
                    "  --bench N   time the stereo pair one refresh old on this thread, block warp,\n"
-                   "              per-pixel warp and a copy of the pair's bytes, N times each\n");
+                   "              per-pixel warp and a copy of the pair's bytes, N times each\n"
+                   "  --no-per-pixel  --bench leaves the per-pixel warp out (profiling the block warp)\n");
             return 0;
         } else
             fv_usage_error(prog, "usage: tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] "
@@ -211,12 +214,12 @@ int main(int argc, char **argv)
         uint8_t *pair = malloc((size_t)w * h * 6);
         double *t[7];
         for (int j = 0; j < 7; j++)
-            t[j] = malloc((size_t)bench * sizeof(double));
+            t[j] = calloc((size_t)bench, sizeof(double));
         if (!pair || !t[0] || !t[1] || !t[2] || !t[3] || !t[4] || !t[5] || !t[6])
             fv_fail(prog, FV_EXIT_FAIL, "out of memory");
         long hb = 0, hp = 0;
         for (int r = 0; r < bench; r++)
-            for (int v = 0; v < 3; v++) { /* 0 copy, 1 block warp, 2 per-pixel: alternately */
+            for (int v = 0; v < 2 + bench_pixel; v++) { /* 0 copy, 1 block warp, 2 per-pixel: alternately */
                 const double c0 = now_ms(CLOCK_THREAD_CPUTIME_ID), w0 = now_ms(CLOCK_MONOTONIC);
                 for (int e = 0; e < 2; e++) {
                     uint8_t *o = pair + (size_t)e * w * h * 3;
@@ -228,7 +231,7 @@ int main(int argc, char **argv)
                         hp = fv_tw_warp_rows_pixel(&d, o, (ptrdiff_t)w * 3, 0, h, &m[e], &s[e]);
                 }
                 t[v][r] = now_ms(CLOCK_THREAD_CPUTIME_ID) - c0, t[3 + v][r] = now_ms(CLOCK_MONOTONIC) - w0;
-                if (v == 2) { /* the block warp's planning alone */
+                if (v == 1) { /* the block warp's planning alone */
                     const double p0c = now_ms(CLOCK_THREAD_CPUTIME_ID);
                     translated_share(&d, &m[0], &s[0], &f0.tiles[0]), translated_share(&d, &m[1], &s[1], &f0.tiles[1]);
                     t[6][r] = now_ms(CLOCK_THREAD_CPUTIME_ID) - p0c;
@@ -248,8 +251,9 @@ int main(int argc, char **argv)
         printf("    block warp: %.3f / %.3f ms (%.2fx the copy; planning %.3f ms of it; %.1f %% of pixels translated; "
                "%ld disoccluded)\n",
                med[1], med[4], med[1] / med[0], med[6], 100.0 * fast, hb);
-        printf("    per-pixel warp: %.3f / %.3f ms (%.1fx the copy; %ld disoccluded)\n", med[2], med[5],
-               med[2] / med[0], hp);
+        if (bench_pixel)
+            printf("    per-pixel warp: %.3f / %.3f ms (%.1fx the copy; %ld disoccluded)\n", med[2], med[5],
+                   med[2] / med[0], hp);
         for (int j = 0; j < 7; j++)
             free(t[j]);
         free(pair);
