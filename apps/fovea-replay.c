@@ -46,7 +46,9 @@ static void usage(FILE *f)
             "  --reference SPP    render ground-truth depth of field instead: SPP thin-lens rays\n"
             "                     per pixel (every pixel; stage columns empty, total_ms its time)\n"
             "                     (--focus-m and --pupil-mm below set its lens; the default focus\n"
-            "                     is the view depth at the point of regard)\n"
+            "                     is the view depth at the point of regard); with --dof none (the\n"
+            "                     default): SPP pinhole rays spread over each pixel's area, the\n"
+            "                     supersampled (anti-aliased) image\n"
             "  --trace-out FILE   write a Chrome trace-event JSON of the run (Perfetto,\n"
             "                     chrome://tracing): worker, stage and ray-tile tracks, frame markers\n"
             "  --window           also show each frame in a window (SDL2) as it is rendered; closing\n"
@@ -148,6 +150,10 @@ int main(int argc, char **argv)
     const int focus_given = cfg.dof.focus.fixed_m > 0.0f;
     refp.pupil_mm = cfg.dof.pupil_mm;
     refp.focus_m = cfg.dof.focus.fixed_m;
+    if (cfg.dof.preset == FV_DOF_NONE) { /* no depth of field: the jittered pinhole supersampling reference */
+        refp.pupil_mm = 0.0f;
+        refp.pixel_aa = 1;
+    }
     if (refp.spp && vs_full)
         fv_usage_error(prog, "--vs-full and --reference exclude each other");
     if (y4m_path && ((cfg.cam.width & 1) || (cfg.cam.height & 1)))

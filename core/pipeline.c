@@ -28,6 +28,7 @@ typedef struct {
     uint8_t *rgb8;     /* the last frame in the display format: sRGB 8-bit RGB, rows 3 w bytes */
     uint32_t *rows;    /* DoF-driven sampling: the last frame's sample bits per tile (ceiling) */
     int rows_valid;    /* the last frame was thinned: rows holds its bits */
+    uint8_t *aa_n[2];  /* fovea anti-aliasing: per-pixel sample counts, aa_n[cur] the last frame's */
 } eye_state;
 
 struct fv_pipeline {
@@ -42,6 +43,7 @@ struct fv_pipeline {
     const fv_sampler *smp_cur; /* the sampler in force: smp or one of wide */
     int fovea_step;
     int taa;           /* reprojection runs (enabled and foveated) */
+    int aa;            /* anti-aliasing in the fovea (with reprojection; core/reproject_aa.c) */
     int dof;           /* the depth-of-field stages run */
     int dofsamp;       /* DoF-driven sampling thins the rays (DoF and reprojection on) */
     float *dofsamp_map; /* its defocus map (shared by the eyes, rendered one after the other) */
@@ -110,6 +112,13 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         for (int b = 0; b < (p->taa ? 2 : 1); b++)
             if (fv_pyramid_init(&p->eyes[e].pyr[b], cfg->cam.width, cfg->cam.height)) {
                 fv_err(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
+                goto bad;
+            }
+    p->aa = p->taa && cfg->taa.fovea_aa;
+    for (int e = 0; e < 2 && p->aa; e++)
+        for (int b = 0; b < 2; b++)
+            if (!(p->eyes[e].aa_n[b] = calloc((size_t)cfg->cam.width * (size_t)cfg->cam.height, 1))) {
+                fv_err(err, err_len, "out of memory");
                 goto bad;
             }
     for (int e = 0; e < 2; e++)
@@ -203,6 +212,8 @@ void fv_pipeline_destroy(fv_pipeline *p)
         free(p->eyes[e].lca);
         free(p->eyes[e].rgb8);
         free(p->eyes[e].rows);
+        free(p->eyes[e].aa_n[0]);
+        free(p->eyes[e].aa_n[1]);
     }
     fv_dof_work_free(&p->dof_work);
     free(p->dofsamp_map);
@@ -361,6 +372,15 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
         }
     }
     es->rows_valid = opt.dofs != NULL;
+    /* fovea anti-aliasing: this frame's point in the pixels, the counts next to the pyramids */
+    fv_taa_aa_frame aaf;
+    if (p->aa) {
+        aaf.n_prev = es->hist_valid ? es->aa_n[es->cur] : NULL;
+        aaf.n_cur = es->aa_n[dst];
+        aaf.stride = d.width;
+        fv_sampling_jitter((uint32_t)es->frame, &aaf.ox, &aaf.oy);
+        opt.aa = &aaf;
+    }
     double taa_ms = NAN;
     st->samples = fv_tile_pass(p->scene, &es->cam, p->smp_cur, gx, gy, pyr, &p->dsp, p->pool, &opt, &taa_ms);
     const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);

@@ -54,6 +54,12 @@ int fv_raycast_pixels(const uint32_t rows[FV_TILE], int tw, int th, uint8_t px[F
 long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const struct fv_render_dsp *dsp,
                      const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE]);
 
+/* The same with every ray through (ox, oy) inside its pixel instead of the centre (0.5, 0.5 gives
+ * fv_raycast_tile's bits): the fovea's anti-aliasing jitter (fv_sampling_jitter). */
+long fv_raycast_tile_at(const fv_scene *scene, const fv_camera *cam, const struct fv_render_dsp *dsp,
+                        const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], float ox,
+                        float oy);
+
 /* Nanoseconds spent shading in fv_raycast_tile since the program started, summed over all threads
  * and tiles (the packets' fv_scene_shade_packet, not tracing or writing): the bench reads it before
  * and after a frame for the shading share of the ray stage. */

@@ -24,6 +24,7 @@ typedef struct {
     struct fv_prof *prof; /* NULL: no trace recording */
     const struct fv_dofsamp_frame *dofs;
     uint32_t *rows_out;
+    const fv_taa_aa_frame *aa;
 } tile_job;
 
 static void run_tile(void *ctx, int index, int thread_id)
@@ -48,9 +49,21 @@ static void run_tile(void *ctx, int index, int thread_id)
         for (int y = 0; y < FV_TILE; y++)
             j->rows_out[(size_t)index * FV_TILE + y] = y < th ? rows[y] : 0u;
 
+    /* fovea anti-aliasing: a fully sampled tile's rays go through this frame's jittered point */
+    const int aa = j->aa && fv_taa_aa_tile_eligible(j->smp, j->gx, j->gy, x0, y0, tw, th, rows);
     /* writes every weight of the tile: pixels without a sample get 0 */
-    const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
-    if (j->taa) {
+    const long rays = aa ? fv_raycast_tile_at(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows, j->aa->ox, j->aa->oy)
+                         : fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows);
+    if (j->aa && !aa)
+        fv_taa_aa_clear(j->aa, x0, y0, tw, th);
+    if (aa) {
+        const int64_t t0 = fv_time_ns();
+        fv_taa_aa_tile(j->taa, j->aa, l0, x0, y0, tw, th);
+        const int64_t t1 = fv_time_ns();
+        atomic_fetch_add_explicit(&j->taa_ns, t1 - t0, memory_order_relaxed);
+        if (j->prof)
+            fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
+    } else if (j->taa) {
         const int64_t t0 = fv_time_ns();
         fv_taa_tile_run_keep(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th,
                              keep);
@@ -82,6 +95,7 @@ long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler 
         j.prof = opt->prof;
         j.dofs = opt->dofs;
         j.rows_out = opt->rows_out;
+        j.aa = opt->aa;
     }
     j.tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
     j.tiles_y = (cam->height + FV_TILE - 1) / FV_TILE;
@@ -89,6 +103,6 @@ long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler 
     atomic_init(&j.taa_ns, 0);
     fv_pool_run(pool, j.tiles_x * j.tiles_y, run_tile, &j);
     if (taa_ms)
-        *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
+        *taa_ms = j.taa || j.aa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
     return atomic_load(&j.rays);
 }

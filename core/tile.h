@@ -38,6 +38,7 @@ typedef struct fv_tile_opts {
                                           * (core/sampling_dof.h); NULL = off */
     uint32_t *rows_out;           /* NULL, or every tile's final sample bits: tile i's rows at
                                    * rows_out + FV_TILE * i (the bench's ceiling retraces them) */
+    const fv_taa_aa_frame *aa;    /* anti-aliasing in the fovea (core/reproject_aa.c); NULL = off */
 } fv_tile_opts;
 
 /* Runs every tile of the eye image: the sampler's pixels around the point of regard (gx, gy
