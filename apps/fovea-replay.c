@@ -46,8 +46,8 @@ static void usage(FILE *f)
             "  --reference SPP    render ground-truth depth of field instead: SPP thin-lens rays\n"
             "                     per pixel (every pixel; stage columns empty, total_ms its time)\n"
             "                     (--focus-m and --pupil-mm below set its lens; the default focus\n"
-            "                     is the view depth at the point of regard); with --dof none (the\n"
-            "                     default): SPP pinhole rays spread over each pixel's area, the\n"
+            "                     is the view depth at the point of regard); with --dof none given:\n"
+            "                     SPP pinhole rays spread over each pixel's area instead, the\n"
             "                     supersampled (anti-aliased) image\n"
             "  --trace-out FILE   write a Chrome trace-event JSON of the run (Perfetto,\n"
             "                     chrome://tracing): worker, stage and ray-tile tracks, frame markers\n"
@@ -97,7 +97,7 @@ int main(int argc, char **argv)
     fv_pipeline_config_default(&cfg);
     const char *asset_root = NULL; /* --asset-root */
     const char *lens_path = NULL;  /* --lens */
-    int reproject_given = 0;
+    int reproject_given = 0, dof_given = 0, pupil_given = 0;
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0, window = 0, png = 1;
@@ -136,6 +136,8 @@ int main(int argc, char **argv)
         case '?': fv_bad_option(prog, argv);
         default:
             reproject_given |= o == FV_OPT_REPROJECT;
+            dof_given |= o == FV_OPT_DOF;
+            pupil_given |= o == FV_OPT_PUPIL_MM;
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
@@ -150,7 +152,11 @@ int main(int argc, char **argv)
     const int focus_given = cfg.dof.focus.fixed_m > 0.0f;
     refp.pupil_mm = cfg.dof.pupil_mm;
     refp.focus_m = cfg.dof.focus.fixed_m;
-    if (cfg.dof.preset == FV_DOF_NONE) { /* no depth of field: the jittered pinhole supersampling reference */
+    /* --dof none given: the pinhole supersampling reference (rays spread over each pixel), the
+     * anti-aliased image the pipeline without depth of field is compared with */
+    if (refp.spp && dof_given && cfg.dof.preset == FV_DOF_NONE) {
+        if (pupil_given)
+            fv_usage_error(prog, "--pupil-mm: --reference with --dof none is a pinhole (no lens)");
         refp.pupil_mm = 0.0f;
         refp.pixel_aa = 1;
     }

@@ -489,7 +489,8 @@ void fv_pipeline_memory_bytes(const fv_pipeline *p, fv_eye eye, fv_pipeline_memo
     m->pyramids = pyramid_bytes(&es->pyr[0]) + pyramid_bytes(&es->pyr[1]);
     m->image = es->out ? image_bytes(&es->pyr[0].lv[0]) : 0;
     m->display = (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height * 3;
-    m->other = es->rows ? rows_bytes(&p->cfg.cam) : 0;
+    m->other = (es->rows ? rows_bytes(&p->cfg.cam) : 0) +
+               (es->aa_n[0] ? 2 * (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height : 0);
     if (p->dof) {
         const fv_dof_work *wk = &p->dof_work;
         m->shared = (size_t)wk->stride * (size_t)wk->h * (4 * FV_DOF_PLANES4 + FV_DOF_PLANES1) * sizeof(float) +

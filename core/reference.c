@@ -109,7 +109,7 @@ static void ref_tile(void *ctx, int index, int thread_id)
             const int x = x0 + p % tw, y = y0 + p / tw;
             float d[3], o[3] = {cam->eye_pos[0], cam->eye_pos[1], cam->eye_pos[2]};
             float ox = 0.5f, oy = 0.5f;
-            if (s >= 0 && j->prm->pixel_aa && !(j->lens_r_m > 0.0f))
+            if (s >= 0 && j->prm->pixel_aa && !(j->lens_r_m > 0.0f) && j->prm->spp > 1) /* one ray: the centre */
                 pixel_point(j, x, y, s, &ox, &oy);
             fv_camera_ray(cam, (float)x + ox, (float)y + oy, d);
             if (s >= 0 && j->lens_r_m > 0.0f) {

@@ -36,7 +36,8 @@ typedef struct fv_reference_params {
     /* pinhole only (pupil_mm 0): 1 spreads the SPP rays over the pixel's area (a box filter, the
      * same stratified point set as the lens samples, with its own per-pixel shift): the
      * supersampled reference of the fovea's anti-aliasing (`fovea-replay --reference SPP --dof
-     * none`); 0: every ray through the pixel centre, the pinhole image */
+     * none`; SPP 1: the one ray through the centre); 0: every ray through the pixel centre, the
+     * pinhole image */
     int pixel_aa;
 } fv_reference_params;
 

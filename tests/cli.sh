@@ -74,6 +74,7 @@ expect_usage "replay empty trace" 'empty.csv: no samples' $R --scene $SCENE --ou
 expect_usage "replay reference spp 0" '--reference: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 0
 expect_usage "replay bad focus" '--focus-m: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --focus-m 0
 expect_usage "replay bad pupil" '--pupil-mm: 25 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --pupil-mm 25
+expect_usage "replay reference dof none pupil" '--pupil-mm: --reference with --dof none is a pinhole' $R --scene $SCENE --out "$T/o2" --reference 4 --dof none --pupil-mm 3
 expect_usage "replay reference vs-full" '--vs-full and --reference exclude each other' $R --scene $SCENE --out "$T/o2" --reference 4 --vs-full
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
 # values checked at the type they are used in: a head position finite as a double, infinite as a float
@@ -199,8 +200,7 @@ else
     bad "replay --reference failed: $(cat "$T/err")"
 fi
 $R --scene $SCENE --frames 1 --size 64x72 --full --out "$T/pin" --quiet 2>/dev/null
-# (with a depth of field: --dof none makes it the jittered pinhole reference, below)
-$R --scene $SCENE --frames 1 --size 64x72 --reference 1 --pupil-mm 0 --dof weak --out "$T/ref0" --quiet 2>/dev/null
+$R --scene $SCENE --frames 1 --size 64x72 --reference 1 --pupil-mm 0 --out "$T/ref0" --quiet 2>/dev/null
 cmp -s "$T/pin/frame_00000.png" "$T/ref0/frame_00000.png" && ok || bad "reference with a zero pupil differs from --full"
 # --reference SPP --dof none: pinhole rays spread over each pixel (anti-aliased, so not the
 # pixel-centre image), the same bytes for 1 and 2 threads
