@@ -13,7 +13,9 @@
  *      per-texel depth weight as in the periphery's blend: a jittered pixel on an edge holds
  *      either surface's depth from frame to frame, and per-texel rejection would drop exactly
  *      the edges' history.
- *   3. History h: a bilinear tap of level 0 weighted by the texels' confidence, clamped to the
+ *   3. History h: a bilinear tap of level 0 weighted by the texels' confidence (with the head
+ *      moving and the 4x4 texels around all real samples: Catmull-Rom instead, whose sharpness
+ *      keeps the per-frame resampling from blurring the accumulated image), clamped to the
  *      min / max of this frame's samples in the pixel's 3x3 neighbourhood inside the tile (the
  *      usual rectification: what the history holds beyond what the neighbourhood shows now is
  *      a ghost or a disocclusion). Only the tile's own samples: a neighbour tile may not be
@@ -57,6 +59,35 @@ void fv_taa_aa_clear(const fv_taa_aa_frame *a, int x0, int y0, int tw, int th)
 
 static inline float minf(float a, float b) { return a < b ? a : b; }
 static inline float maxf(float a, float b) { return a > b ? a : b; }
+
+/* Catmull-Rom resampling of level 0 at texels i0-1 .. i0+2, j0-1 .. j0+2 (fractions fx, fy), into
+ * h when all 16 texels have weight 1 (else h stays). */
+static void catmull_rom(const fv_pyr_level *H, int i0, int j0, float fx, float fy, float h[3])
+{
+    float wx[4], wy[4];
+    const float t[2] = {fx, fy};
+    float *w[2] = {wx, wy};
+    for (int k = 0; k < 2; k++) {
+        const float q = t[k];
+        w[k][0] = q * (-0.5f + q * (1.0f - 0.5f * q));
+        w[k][1] = 1.0f + q * q * (-2.5f + 1.5f * q);
+        w[k][2] = q * (0.5f + q * (2.0f - 1.5f * q));
+        w[k][3] = q * q * (-0.5f + 0.5f * q);
+    }
+    float acc[3] = {0.0f, 0.0f, 0.0f};
+    for (int j = 0; j < 4; j++) {
+        const ptrdiff_t row = (ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1;
+        for (int i = 0; i < 4; i++) {
+            if (H->wgt[row + i] != 1.0f)
+                return;
+            const float ww = wx[i] * wy[j];
+            for (int c = 0; c < 3; c++)
+                acc[c] += ww * H->rgbd[4 * (row + i) + c];
+        }
+    }
+    for (int c = 0; c < 3; c++)
+        h[c] = acc[c];
+}
 
 void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
                     int th)
@@ -117,6 +148,13 @@ void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_py
                         n = a->n_prev[(ptrdiff_t)(int)v * a->stride + (int)u];
                         for (int c = 0; c < 3; c++)
                             h[c] = acc[c] / accw;
+                        /* moving: Catmull-Rom over the 4x4 texels where all are real samples
+                         * inside the image (the fovea's history), sharper than the bilinear
+                         * tap, whose blur compounds frame after frame; the clamp below takes
+                         * its overshoot */
+                        if (!f->identity && i0 >= 1 && j0 >= 1 && (float)(i0 + 2) < f->prev_w &&
+                            (float)(j0 + 2) < f->prev_h)
+                            catmull_rom(H, i0, j0, fx, fy, h);
                     }
                 }
             }
