@@ -46,7 +46,9 @@ static void usage(FILE *f)
             "  --reference SPP    render ground-truth depth of field instead: SPP thin-lens rays\n"
             "                     per pixel (every pixel; stage columns empty, total_ms its time)\n"
             "                     (--focus-m and --pupil-mm below set its lens; the default focus\n"
-            "                     is the view depth at the point of regard)\n"
+            "                     is the view depth at the point of regard); with --dof none given:\n"
+            "                     SPP pinhole rays spread over each pixel's area instead, the\n"
+            "                     supersampled (anti-aliased) image\n"
             "  --trace-out FILE   write a Chrome trace-event JSON of the run (Perfetto,\n"
             "                     chrome://tracing): worker, stage and ray-tile tracks, frame markers\n"
             "  --window           also show each frame in a window (SDL2) as it is rendered; closing\n"
@@ -96,7 +98,7 @@ int main(int argc, char **argv)
     const char *asset_root = NULL; /* --asset-root */
     int shadows = 0;               /* --shadows */
     const char *lens_path = NULL;  /* --lens */
-    int reproject_given = 0;
+    int reproject_given = 0, dof_given = 0, pupil_given = 0;
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0, window = 0, png = 1;
@@ -136,6 +138,8 @@ int main(int argc, char **argv)
         case '?': fv_bad_option(prog, argv);
         default:
             reproject_given |= o == FV_OPT_REPROJECT;
+            dof_given |= o == FV_OPT_DOF;
+            pupil_given |= o == FV_OPT_PUPIL_MM;
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
@@ -150,6 +154,14 @@ int main(int argc, char **argv)
     const int focus_given = cfg.dof.focus.fixed_m > 0.0f;
     refp.pupil_mm = cfg.dof.pupil_mm;
     refp.focus_m = cfg.dof.focus.fixed_m;
+    /* --dof none given: the pinhole supersampling reference (rays spread over each pixel), the
+     * anti-aliased image the pipeline without depth of field is compared with */
+    if (refp.spp && dof_given && cfg.dof.preset == FV_DOF_NONE) {
+        if (pupil_given)
+            fv_usage_error(prog, "--pupil-mm: --reference with --dof none is a pinhole (no lens)");
+        refp.pupil_mm = 0.0f;
+        refp.pixel_aa = 1;
+    }
     if (refp.spp && vs_full)
         fv_usage_error(prog, "--vs-full and --reference exclude each other");
     if (y4m_path && ((cfg.cam.width & 1) || (cfg.cam.height & 1)))

@@ -28,6 +28,7 @@ typedef struct {
     uint8_t *rgb8;     /* the last frame in the display format: sRGB 8-bit RGB, rows 3 w bytes */
     uint32_t *rows;    /* DoF-driven sampling: the last frame's sample bits per tile (ceiling) */
     int rows_valid;    /* the last frame was thinned: rows holds its bits */
+    uint8_t *aa_n[2];  /* fovea anti-aliasing: per-pixel sample counts, aa_n[cur] the last frame's */
 } eye_state;
 
 struct fv_pipeline {
@@ -42,6 +43,7 @@ struct fv_pipeline {
     const fv_sampler *smp_cur; /* the sampler in force: smp or one of wide */
     int fovea_step;
     int taa;           /* reprojection runs (enabled and foveated) */
+    int aa;            /* anti-aliasing in the fovea (with reprojection; core/reproject_aa.c) */
     int dof;           /* the depth-of-field stages run */
     int dofsamp;       /* DoF-driven sampling thins the rays (DoF and reprojection on) */
     float *dofsamp_map; /* its defocus map (shared by the eyes, rendered one after the other) */
@@ -111,6 +113,13 @@ fv_pipeline *fv_pipeline_create(const fv_scene *scene, const fv_pipeline_config 
         for (int b = 0; b < (p->taa ? 2 : 1); b++)
             if (fv_pyramid_init(&p->eyes[e].pyr[b], cfg->cam.width, cfg->cam.height)) {
                 fv_err(err, err_len, "out of memory for a %dx%d pyramid", cfg->cam.width, cfg->cam.height);
+                goto bad;
+            }
+    p->aa = p->taa && cfg->taa.fovea_aa;
+    for (int e = 0; e < 2 && p->aa; e++)
+        for (int b = 0; b < 2; b++)
+            if (!(p->eyes[e].aa_n[b] = calloc((size_t)cfg->cam.width * (size_t)cfg->cam.height, 1))) {
+                fv_err(err, err_len, "out of memory");
                 goto bad;
             }
     for (int e = 0; e < 2; e++)
@@ -204,6 +213,8 @@ void fv_pipeline_destroy(fv_pipeline *p)
         free(p->eyes[e].lca);
         free(p->eyes[e].rgb8);
         free(p->eyes[e].rows);
+        free(p->eyes[e].aa_n[0]);
+        free(p->eyes[e].aa_n[1]);
     }
     fv_dof_work_free(&p->dof_work);
     free(p->dofsamp_map);
@@ -330,7 +341,8 @@ typedef struct {
     int gx, gy;
     fv_taa_frame tf;
     fv_dofsamp_frame dsf;
-    fv_tile_opts opt; /* points into tf, dsf and shade_ns */
+    fv_taa_aa_frame aaf;
+    fv_tile_opts opt; /* points into tf, dsf, aaf and shade_ns */
     int64_t shade_ns; /* the workers' time shading, when the config asks (time_shading) */
     int64_t t0, tc0;  /* the frame's and the ray stage's span starts (single-eye path) */
 } eye_frame;
@@ -382,6 +394,14 @@ static int eye_begin(fv_pipeline *p, eye_frame *f, fv_eye eye, const fv_pose *he
         }
     }
     es->rows_valid = f->opt.dofs != NULL;
+    /* fovea anti-aliasing: this frame's point in the pixels, the counts next to the pyramids */
+    if (p->aa) {
+        f->aaf.n_prev = es->hist_valid ? es->aa_n[es->cur] : NULL;
+        f->aaf.n_cur = es->aa_n[f->dst];
+        f->aaf.stride = d.width;
+        fv_sampling_jitter((uint32_t)es->frame, &f->aaf.ox, &f->aaf.oy);
+        f->opt.aa = &f->aaf;
+    }
     return 0;
 }
 
@@ -560,7 +580,8 @@ void fv_pipeline_memory_bytes(const fv_pipeline *p, fv_eye eye, fv_pipeline_memo
     m->pyramids = pyramid_bytes(&es->pyr[0]) + pyramid_bytes(&es->pyr[1]);
     m->image = es->out ? image_bytes(&es->pyr[0].lv[0]) : 0;
     m->display = (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height * 3;
-    m->other = es->rows ? rows_bytes(&p->cfg.cam) : 0;
+    m->other = (es->rows ? rows_bytes(&p->cfg.cam) : 0) +
+               (es->aa_n[0] ? 2 * (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height : 0);
     if (p->dof) {
         const fv_dof_work *wk = &p->dof_work;
         m->shared = (size_t)wk->stride * (size_t)wk->h * (4 * FV_DOF_PLANES4 + FV_DOF_PLANES1) * sizeof(float) +

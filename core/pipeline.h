@@ -113,7 +113,8 @@ typedef struct fv_pipeline_memory {
                       * (r, g, b, depth and a weight a texel, every level) */
     size_t image;    /* per eye: the final float image (fv_pipeline_config.keep_image; 0 without) */
     size_t display;  /* per eye: the display-format image */
-    size_t other;    /* per eye: the last frame's sample bits (DoF-driven sampling) */
+    size_t other;    /* per eye: the last frame's sample bits (DoF-driven sampling), the fovea
+                      * anti-aliasing's two sample-count planes (a byte a pixel each) */
     size_t shared;   /* both eyes together: DoF scratch planes, tables and row buffers, the
                       * DoF-driven sampling map */
 } fv_pipeline_memory;

@@ -84,7 +84,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
  * (they were the shading's main cost), and shading, when asked, is timed with two clock reads per tile. */
 #define FV_TILE_PACKETS(N) (FV_TILE * FV_TILE / (N))
 #define DEF_PACKETS(N)                                                                                            \
-    /* Camera rays through the pixel centres px[0 .. N) (as fv_camera_ray computes them) straight into      \
+    /* Camera rays through the pixels px[0 .. N) at (ox, oy) in each (the centres: as fv_camera_ray) into   \
      * the SoA packet, lanes from k on invalid; px holds N copies of its last pixel past the end. The        \
      * pinhole by the ray kernel; a lens lane by lane. */                                                    \
     static void trace_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,             \
@@ -96,8 +96,8 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
         } else {                                                                                              \
             for (int q = 0; q < N; q++) {                                                                     \
                 const int p = px[q];                                                                          \
-                float tx = cam->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * cam->px_tan;                     \
-                float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * cam->px_tan;                      \
+                float tx = cam->tan_left + ((float)(x0 + (p & 15)) + rc->ox) * cam->px_tan;                   \
+                float ty = cam->tan_top - ((float)(y0 + (p >> 4)) + rc->oy) * cam->px_tan;                    \
                 fv_lens_distort(cam->lens_k1, cam->lens_k2, cam->lens_scale, cam->lens_cx, cam->lens_cy, tx, ty, \
                                 &tx, &ty);                                                                    \
                 rh->ray.dir_x[q] = tx * cam->right[0] + ty * cam->up[0] - cam->back[0];                       \
@@ -136,7 +136,8 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
     static _Thread_local float tile_org_##N[3] = {NAN, NAN, NAN};                                            \
     static _Thread_local fv_blend_lane tile_blend_##N[FV_TILE_PACKETS(N)][16]; /* alpha BLEND: blend.c */     \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
-                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n, int64_t *shade_ns) \
+                            const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n, float ox, float oy,  \
+                            int64_t *shade_ns)                                                                \
     {                                                                                                         \
         struct RTCIntersectContext ictx;                                                                      \
         rtcInitIntersectContext(&ictx);                                                                       \
@@ -145,7 +146,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
         _Alignas(64) int valid[N];                                                                            \
         const fv_raygen_cam rc = {cam->tan_left, cam->tan_top, cam->px_tan, {cam->right[0], cam->right[1],    \
                                   cam->right[2]}, {cam->up[0], cam->up[1], cam->up[2]},                       \
-                                  {cam->back[0], cam->back[1], cam->back[2]}};                                \
+                                  {cam->back[0], cam->back[1], cam->back[2]}, ox, oy};                        \
         if (memcmp(tile_org_##N, cam->eye_pos, sizeof tile_org_##N)) { /* what no lane changes: once per eye */ \
             for (int b = 0; b < FV_TILE_PACKETS(N); b++)                                                      \
                 for (int q = 0; q < N; q++) {                                                                 \
@@ -189,6 +190,13 @@ DEF_PACKETS(16)
 long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
                      int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], int64_t *shade_ns)
 {
+    return fv_raycast_tile_at(scene, cam, dsp, l0, x0, y0, tw, th, rows, 0.5f, 0.5f, shade_ns);
+}
+
+long fv_raycast_tile_at(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
+                        int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], float ox, float oy,
+                        int64_t *shade_ns)
+{
     /* every pixel's weight, from the rows' bits (pull-push never reads the colour of a zero-weight
      * pixel, so the others' colours are left alone) */
     for (int y = 0; y < th; y++) {
@@ -214,8 +222,8 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_rende
     for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
         px[q] = px[n - 1];
     if (fv_raycast_packet_width() == 16)
-        packets_16(scene, cam, dsp, l0, x0, y0, px, n, shade_ns);
+        packets_16(scene, cam, dsp, l0, x0, y0, px, n, ox, oy, shade_ns);
     else
-        packets_8(scene, cam, dsp, l0, x0, y0, px, n, shade_ns);
+        packets_8(scene, cam, dsp, l0, x0, y0, px, n, ox, oy, shade_ns);
     return n;
 }

@@ -57,4 +57,10 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const struct f
                      const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE],
                      int64_t *shade_ns);
 
+/* The same with every ray through (ox, oy) inside its pixel instead of the centre (0.5, 0.5 gives
+ * fv_raycast_tile's bits): the fovea's anti-aliasing jitter (fv_sampling_jitter). */
+long fv_raycast_tile_at(const fv_scene *scene, const fv_camera *cam, const struct fv_render_dsp *dsp,
+                        const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], float ox,
+                        float oy, int64_t *shade_ns);
+
 #endif

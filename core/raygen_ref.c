@@ -5,8 +5,8 @@ void fv_camera_rays_c(const fv_raygen_cam *c, const uint8_t *px, int x0, int y0,
 {
     for (int i = 0; i < n; i++) {
         const int p = px[i];
-        const float tx = c->tan_left + ((float)(x0 + (p & 15)) + 0.5f) * c->px_tan;
-        const float ty = c->tan_top - ((float)(y0 + (p >> 4)) + 0.5f) * c->px_tan;
+        const float tx = c->tan_left + ((float)(x0 + (p & 15)) + c->ox) * c->px_tan;
+        const float ty = c->tan_top - ((float)(y0 + (p >> 4)) + c->oy) * c->px_tan;
         dx[i] = tx * c->right[0] + ty * c->up[0] - c->back[0];
         dy[i] = tx * c->right[1] + ty * c->up[1] - c->back[1];
         dz[i] = tx * c->right[2] + ty * c->up[2] - c->back[2];

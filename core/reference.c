@@ -69,6 +69,21 @@ static inline void lens_point(const ref_job *j, int x, int y, int s, float *lx, 
     *ly *= j->lens_r_m;
 }
 
+/* Pixel sample s of pixel (x, y) (pixel_aa): a point of the pixel's area, [0, 1)^2, the same
+ * Hammersley set under a shift of its own. */
+static inline void pixel_point(const ref_job *j, int x, int y, int s, float *px, float *py)
+{
+    const uint32_t h = fv_hash32((uint32_t)x * 0x2c1b3c6du ^ (uint32_t)y * 0x297a2d39u ^ j->prm->seed * 0x68e31da4u ^
+                                 0x5bd1e995u);
+    const float sx = (float)(h >> 8) * (1.0f / 16777216.0f);
+    const float sy = (float)(fv_hash32(h ^ 0x85ebca6bu) >> 8) * (1.0f / 16777216.0f);
+    float u = ((float)s + 0.5f) / (float)j->prm->spp + sx, v = radical_inverse2((uint32_t)s) + sy;
+    u -= u >= 1.0f ? 1.0f : 0.0f;
+    v -= v >= 1.0f ? 1.0f : 0.0f;
+    *px = u;
+    *py = v;
+}
+
 static void ref_tile(void *ctx, int index, int thread_id)
 {
     ref_job *j = ctx;
@@ -95,7 +110,10 @@ static void ref_tile(void *ctx, int index, int thread_id)
             const int p = (int)(r / (spp + 1)), s = (int)(r % (spp + 1)) - 1;
             const int x = x0 + p % tw, y = y0 + p / tw;
             float d[3], o[3] = {cam->eye_pos[0], cam->eye_pos[1], cam->eye_pos[2]};
-            fv_camera_ray(cam, (float)x + 0.5f, (float)y + 0.5f, d);
+            float ox = 0.5f, oy = 0.5f;
+            if (s >= 0 && j->prm->pixel_aa && !(j->lens_r_m > 0.0f) && j->prm->spp > 1) /* one ray: the centre */
+                pixel_point(j, x, y, s, &ox, &oy);
+            fv_camera_ray(cam, (float)x + ox, (float)y + oy, d);
             if (s >= 0 && j->lens_r_m > 0.0f) {
                 /* from the lens point a through the pixel's point on the focus plane, eye + d *
                  * focus; the pinhole ray (else) stays bit for bit the pipeline's */

@@ -33,6 +33,12 @@ typedef struct fv_reference_params {
     float pupil_mm; /* aperture diameter; 0 = pinhole */
     float focus_m;  /* view depth of the focus plane, > 0 */
     uint32_t seed;  /* varies the per-pixel shifts */
+    /* pinhole only (pupil_mm 0): 1 spreads the SPP rays over the pixel's area (a box filter, the
+     * same stratified point set as the lens samples, with its own per-pixel shift): the
+     * supersampled reference of the fovea's anti-aliasing (`fovea-replay --reference SPP --dof
+     * none`; SPP 1: the one ray through the centre); 0: every ray through the pixel centre, the
+     * pinhole image */
+    int pixel_aa;
 } fv_reference_params;
 
 /* Called on the calling thread (pool worker 0) after each of its tiles: tiles done, tiles. */

@@ -15,6 +15,7 @@ void fv_taa_params_default(fv_taa_params *p)
     p->alpha_min = 0.3f;
     p->depth_tol = 0.03f;
     p->fill = 1;
+    p->fovea_aa = 1;
 }
 
 /* ---------------------------------------------------------------- setup */

@@ -28,6 +28,8 @@
 #ifndef FOVEA_REPROJECT_H
 #define FOVEA_REPROJECT_H
 
+#include <stdint.h>
+
 #include "camera.h"
 #include "pullpush.h"
 #include "reproject_dsp.h"
@@ -37,6 +39,7 @@ typedef struct fv_taa_params {
     float alpha_min; /* minimum weight of a new sample per frame of history, default 0.3 */
     float depth_tol; /* relative depth tolerance of history texels, default 0.03 */
     int fill;        /* fill pixels without a sample from valid history, default 1 */
+    int fovea_aa;    /* anti-aliasing in the fovea (jittered rays accumulated), default 1 */
 } fv_taa_params;
 
 void fv_taa_params_default(fv_taa_params *p);
@@ -92,6 +95,33 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
  * read, guessing the tile's motion from the history's depth at coarse_level (the level where the
  * tile is one texel). Call it before the tile's rays are cast, so the lines arrive meanwhile. */
 void fv_taa_prefetch(const fv_taa_frame *f, int coarse_level, int x0, int y0, int tw, int th);
+
+/* ---- anti-aliasing in the fovea (core/reproject_aa.c has the model) ----
+ * Tiles whose every pixel is sampled every frame trace their rays through (ox, oy) inside the
+ * pixels, a new point each frame (fv_sampling_jitter), and accumulate them here instead of
+ * fv_taa_tile_run: history h (reprojected, confidence-weighted bilinear, clamped to the 3x3
+ * neighbourhood of this frame's samples) and the sample s give h + (s - h) / n, n the pixel's
+ * accumulated sample count (1 without history, at most FV_TAA_AA_MAX_N). */
+#define FV_TAA_AA_MAX_N 16
+typedef struct fv_taa_aa_frame {
+    const uint8_t *n_prev; /* the history's sample counts (w x h, stride bytes a row); NULL: none */
+    uint8_t *n_cur;        /* this frame's: written for every tile (0 outside the AA tiles) */
+    ptrdiff_t stride;
+    float ox, oy;          /* this frame's ray position inside the AA tiles' pixels, [0, 1) */
+} fv_taa_aa_frame;
+
+/* 1 when the tile [x0, x0+tw) x [y0, y0+th) takes the anti-aliasing: every pixel has a sample in
+ * rows (this frame's final bits, bit x - x0 of rows[y - y0]) and the acuity model samples every
+ * pixel of it every frame (probability 1 at its corner pixels; gaze at pixel gx, gy). */
+struct fv_sampler;
+int fv_taa_aa_tile_eligible(const struct fv_sampler *smp, int gx, int gy, int x0, int y0, int tw, int th,
+                            const uint32_t *rows);
+/* Accumulates an eligible tile's jittered samples (level 0, all weight 1) with its history;
+ * f NULL (no history yet): the samples stay as traced with count 1. Writes the tile's counts. */
+void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
+                    int th);
+/* Any other tile: its counts are 0. */
+void fv_taa_aa_clear(const fv_taa_aa_frame *a, int x0, int y0, int tw, int th);
 
 /* The mapping itself, for tests and tools: current pixel (px, py) at depth d -> previous pixel
  * (*u, *v); returns the previous view depth (<= 0: behind the previous eye). */

@@ -168,6 +168,16 @@ float fv_sampler_probability(const fv_sampler *s, float dx_px, float dy_px)
     return l > 1.0f ? 1.0f : l < s->prm.p_min ? s->prm.p_min : l;
 }
 
+void fv_sampling_jitter(uint32_t frame, float *ox, float *oy)
+{
+    const double x = 0.5 + halton(frame, 2), y = 0.5 + halton(frame, 3);
+    *ox = (float)(x < 1.0 ? x : x - 1.0);
+    *oy = (float)(y < 1.0 ? y : y - 1.0);
+    /* (float) may round 0.99999999 up to 1: keep the position inside the pixel */
+    *ox = *ox < 1.0f ? *ox : 0.99999994f;
+    *oy = *oy < 1.0f ? *oy : 0.99999994f;
+}
+
 void fv_sampler_free(fv_sampler *s)
 {
     free(s->s_in);

@@ -27,6 +27,7 @@ typedef struct {
     struct fv_prof *prof; /* NULL: no trace recording */
     const struct fv_dofsamp_frame *dofs;
     uint32_t *rows_out;
+    const fv_taa_aa_frame *aa;
 } tile_job;
 
 static void run_tile(void *ctx, int index, int thread_id)
@@ -51,13 +52,25 @@ static void run_tile(void *ctx, int index, int thread_id)
         for (int y = 0; y < FV_TILE; y++)
             j->rows_out[(size_t)index * FV_TILE + y] = y < th ? rows[y] : 0u;
 
+    /* fovea anti-aliasing: a fully sampled tile's rays go through this frame's jittered point */
+    const int aa = j->aa && fv_taa_aa_tile_eligible(j->smp, j->gx, j->gy, x0, y0, tw, th, rows);
     /* writes every weight of the tile: pixels without a sample get 0 */
     int64_t shade_ns = 0;
-    const long rays = fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows,
-                                      j->time_shading ? &shade_ns : NULL);
+    int64_t *sp = j->time_shading ? &shade_ns : NULL;
+    const long rays = aa ? fv_raycast_tile_at(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows, j->aa->ox, j->aa->oy, sp)
+                         : fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows, sp);
     if (shade_ns)
         atomic_fetch_add_explicit(&j->shade_ns, shade_ns, memory_order_relaxed);
-    if (j->taa) {
+    if (j->aa && !aa)
+        fv_taa_aa_clear(j->aa, x0, y0, tw, th);
+    if (aa) {
+        const int64_t t0 = fv_time_ns();
+        fv_taa_aa_tile(j->taa, j->aa, l0, x0, y0, tw, th);
+        const int64_t t1 = fv_time_ns();
+        atomic_fetch_add_explicit(&j->taa_ns, t1 - t0, memory_order_relaxed);
+        if (j->prof)
+            fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
+    } else if (j->taa) {
         const int64_t t0 = fv_time_ns();
         fv_taa_tile_run_keep(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th,
                              keep);
@@ -90,6 +103,7 @@ static void job_init(tile_job *j, const fv_scene *scene, const fv_camera *cam, c
         j->prof = opt->prof;
         j->dofs = opt->dofs;
         j->rows_out = opt->rows_out;
+        j->aa = opt->aa;
         j->time_shading = opt->shade_ns != NULL;
     }
     j->tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;
@@ -122,7 +136,7 @@ long fv_tile_pass(const fv_scene *scene, const fv_camera *cam, const fv_sampler 
     if (j.time_shading)
         *opt->shade_ns = atomic_load(&j.shade_ns);
     if (taa_ms)
-        *taa_ms = j.taa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
+        *taa_ms = j.taa || j.aa ? (double)atomic_load(&j.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
     return atomic_load(&j.rays);
 }
 
@@ -143,7 +157,7 @@ void fv_tile_pass_wait(fv_tile_async *a, fv_pool *pool, fv_tile_eye *eye)
     fv_pool_wait(pool);
     eye->rays = atomic_load(&a->job.rays);
     eye->tile_ms = (double)atomic_load(&a->tile_ns) * 1e-6;
-    eye->taa_ms = a->job.taa ? (double)atomic_load(&a->job.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
+    eye->taa_ms = a->job.taa || a->job.aa ? (double)atomic_load(&a->job.taa_ns) * 1e-6 / fv_pool_threads(pool) : NAN;
     if (a->job.time_shading)
         *eye->opt.shade_ns = atomic_load(&a->job.shade_ns);
     free(a);

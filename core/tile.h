@@ -40,6 +40,7 @@ typedef struct fv_tile_opts {
                                    * rows_out + FV_TILE * i (the bench's ceiling retraces them) */
     int64_t *shade_ns;            /* NULL: shading not timed (no clock reads); else set to the
                                    * workers' summed time shading hits in this pass (ns) */
+    const fv_taa_aa_frame *aa;    /* anti-aliasing in the fovea (core/reproject_aa.c); NULL = off */
 } fv_tile_opts;
 
 /* Runs every tile of the eye image: the sampler's pixels around the point of regard (gx, gy

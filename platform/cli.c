@@ -109,6 +109,9 @@ int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_con
     case FV_OPT_REPROJECT:
         cfg->taa.enabled = fv_arg_onoff(prog, "--reproject", arg);
         return 1;
+    case FV_OPT_FOVEA_AA:
+        cfg->taa.fovea_aa = fv_arg_onoff(prog, "--fovea-aa", arg);
+        return 1;
     case FV_OPT_TAA_FILL:
         cfg->taa.fill = fv_arg_onoff(prog, "--taa-fill", arg);
         return 1;

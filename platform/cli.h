@@ -31,6 +31,7 @@ enum {
     FV_OPT_CONTRAST, FV_OPT_CHROMA,
     FV_OPT_SAMPLING, FV_OPT_LIU_DENSITY,
     FV_OPT_DOF_SAMPLING, FV_OPT_DOF_SAMPLING_KAPPA, /* depth-of-field-driven sampling */
+    FV_OPT_FOVEA_AA, /* anti-aliasing in the fovea */
 };
 #define FV_COMMON_LONGOPTS                                                                     \
     {"size", required_argument, 0, FV_OPT_SIZE}, {"threads", required_argument, 0, FV_OPT_THREADS}, \
@@ -47,7 +48,8 @@ enum {
     {"contrast-gain", required_argument, 0, FV_OPT_CONTRAST}, {"chroma", required_argument, 0, FV_OPT_CHROMA}, \
     {"sampling", required_argument, 0, FV_OPT_SAMPLING}, {"liu-density", required_argument, 0, FV_OPT_LIU_DENSITY}, \
     {"dof-sampling", required_argument, 0, FV_OPT_DOF_SAMPLING},                                 \
-    {"dof-sampling-kappa", required_argument, 0, FV_OPT_DOF_SAMPLING_KAPPA}
+    {"dof-sampling-kappa", required_argument, 0, FV_OPT_DOF_SAMPLING_KAPPA},                     \
+    {"fovea-aa", required_argument, 0, FV_OPT_FOVEA_AA}
 #define FV_COMMON_HELP                                                                             \
     "  --size WxH         eye image size in pixels (default 1280x1440)\n"                          \
     "  --fov DEG          vertical field of view (default 100)\n"                                  \
@@ -60,6 +62,9 @@ enum {
     "  --taa-alpha A      minimum weight of a new sample per frame of history (default 0.3)\n"  \
     "  --taa-depth-tol F  relative depth difference that rejects history (default 0.03)\n"     \
     "  --taa-fill on|off  fill pixels without a sample from valid history (default on)\n"      \
+    "  --fovea-aa on|off  anti-aliasing in the fovea: its rays jittered inside the pixels\n"    \
+    "                     over frames and accumulated by the reprojection (default on;\n"     \
+    "                     needs reprojection)\n"                                              \
     "  --sampling weier|liu  sampling pattern: Weier's S_in/S_out (default) or Liu's polar\n"  \
     "                     acuity grid (eq. 1-3), at Weier's ray count for r0, r1, pmin\n"     \
     "  --liu-density L    liu: samples per pixel where eq. 1 is flat (>= 1; default 0 =\n"      \

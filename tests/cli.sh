@@ -54,6 +54,7 @@ for p in fovea-replay fovea-bench; do
     expect_usage "$p bad reproject" '--reproject: .maybe. is not one of on, off' $B/$p --scene $SCENE $O --reproject maybe
     expect_usage "$p bad taa-alpha" '--taa-alpha: 0 is out of range' $B/$p --scene $SCENE $O --taa-alpha 0
     expect_usage "$p bad taa-fill" '--taa-fill: .yes. is not one of on, off' $B/$p --scene $SCENE $O --taa-fill yes
+    expect_usage "$p bad fovea-aa" '--fovea-aa: .yes. is not one of on, off' $B/$p --scene $SCENE $O --fovea-aa yes
     expect_usage "$p bad pattern" '--pattern: .spiral. is not one of rotate, static' $B/$p --scene $SCENE $O --pattern spiral
     expect_usage "$p bad sampling" '--sampling: .polar. is not one of weier, liu' $B/$p --scene $SCENE $O --sampling polar
     expect_usage "$p bad liu density" '--liu-density 0.5: must be 0' $B/$p --scene $SCENE $O --sampling liu --liu-density 0.5
@@ -75,6 +76,7 @@ expect_usage "replay empty trace" 'empty.csv: no samples' $R --scene $SCENE --ou
 expect_usage "replay reference spp 0" '--reference: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 0
 expect_usage "replay bad focus" '--focus-m: 0 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --focus-m 0
 expect_usage "replay bad pupil" '--pupil-mm: 25 is out of range' $R --scene $SCENE --out "$T/o2" --reference 4 --pupil-mm 25
+expect_usage "replay reference dof none pupil" '--pupil-mm: --reference with --dof none is a pinhole' $R --scene $SCENE --out "$T/o2" --reference 4 --dof none --pupil-mm 3
 expect_usage "replay reference vs-full" '--vs-full and --reference exclude each other' $R --scene $SCENE --out "$T/o2" --reference 4 --vs-full
 [ ! -e "$T/o2" ] && ok || bad "bad trace left output directory behind"
 # values checked at the type they are used in: a head position finite as a double, infinite as a float
@@ -156,6 +158,22 @@ for f in frame_00000.png frame_00001.png frame_00002.png; do
         if cmp -s "$T/d1/$f" "$T/$d/$f"; then ok; else bad "$f differs between d1 and $d"; fi
     done
 done
+# Fovea anti-aliasing (issue 17 item 5): with a fovea of many whole tiles (r0 40 deg) along the
+# trace (head and gaze move), the same bytes for 1, 2 and 5 threads; --fovea-aa off gives other
+# frames after the first (frame 0's rays go through the pixel centres either way)
+for th in 1 2 5; do
+    $R --scene $SCENE --trace assets/gaze_sweep.csv --frames 4 --size 160x180 --r0 40 --r1 50 --threads $th \
+        --out "$T/aa$th" --quiet 2>"$T/err" || bad "replay --r0 40 --threads $th failed: $(cat "$T/err")"
+done
+$R --scene $SCENE --trace assets/gaze_sweep.csv --frames 4 --size 160x180 --r0 40 --r1 50 --fovea-aa off \
+    --out "$T/aaoff" --quiet 2>/dev/null
+for f in frame_00001.png frame_00003.png; do
+    for d in aa2 aa5; do
+        if cmp -s "$T/aa1/$f" "$T/$d/$f"; then ok; else bad "fovea-aa: $f differs between aa1 and $d"; fi
+    done
+done
+cmp -s "$T/aa1/frame_00000.png" "$T/aaoff/frame_00000.png" && ok || bad "fovea-aa: frame 0 differs from --fovea-aa off"
+cmp -s "$T/aa1/frame_00003.png" "$T/aaoff/frame_00003.png" && bad "fovea-aa on and off give the same frame 3" || ok
 # Liu's polar sampler (issue 15 item 3): the same bytes for 1 and 5 threads, not Weier's frames,
 # and the bench names it and its rays agree with the ceiling's
 for th in 1 5; do
@@ -186,6 +204,14 @@ fi
 $R --scene $SCENE --frames 1 --size 64x72 --full --out "$T/pin" --quiet 2>/dev/null
 $R --scene $SCENE --frames 1 --size 64x72 --reference 1 --pupil-mm 0 --out "$T/ref0" --quiet 2>/dev/null
 cmp -s "$T/pin/frame_00000.png" "$T/ref0/frame_00000.png" && ok || bad "reference with a zero pupil differs from --full"
+# --reference SPP --dof none: pinhole rays spread over each pixel (anti-aliased, so not the
+# pixel-centre image), the same bytes for 1 and 2 threads
+for th in 1 2; do
+    $R --scene $SCENE --frames 1 --size 64x72 --reference 8 --dof none --threads $th --out "$T/ra$th" --quiet 2>/dev/null
+done
+[ -e "$T/ra1/frame_00000.png" ] && cmp -s "$T/ra1/frame_00000.png" "$T/ra2/frame_00000.png" && ok \
+    || bad "jittered pinhole reference missing or differs between 1 and 2 threads"
+cmp -s "$T/pin/frame_00000.png" "$T/ra1/frame_00000.png" && bad "jittered pinhole reference equals the pixel-centre image" || ok
 for th in 1 2; do
     $R --scene $SCENE --frames 1 --size 64x72 --reference 6 --focus-m 1.5 --threads $th --out "$T/rt$th" --quiet 2>/dev/null
 done

@@ -255,7 +255,7 @@ static void test_bad_params(void **st)
     fv_scene *s = mixed_scene();
     fv_camera cam = make_cam(16, 16, 60.0f);
     float buf[4 * 16 * 16];
-    fv_reference_params bad[] = {{0, 4.0f, 1.0f, 0}, {4, -1.0f, 1.0f, 0}, {4, 4.0f, 0.0f, 0}, {4, 4.0f, INFINITY, 0}};
+    fv_reference_params bad[] = {{0, 4.0f, 1.0f, 0, 0}, {4, -1.0f, 1.0f, 0, 0}, {4, 4.0f, 0.0f, 0, 0}, {4, 4.0f, INFINITY, 0, 0}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
         assert_int_equal(fv_reference_render(s, &cam, &bad[i], NULL, buf, NULL, NULL), -1);
     /* the focus at the point of regard: one pinhole ray */

@@ -59,6 +59,9 @@ static fv_pipeline *make_pipeline_taa(const fv_scene *s, int w, int h, float fov
     cfg.cam.fov_y_deg = fov;
     cfg.samp.full = full;
     cfg.taa.enabled = taa;
+    /* these tests compare with the pixel-centre full render: the fovea's anti-aliasing (its own
+     * tests: test_fovea_aa.c) converges to the box filter instead */
+    cfg.taa.fovea_aa = 0;
     cfg.threads = 2;
     char err[256];
     fv_pipeline *p = fv_pipeline_create(s, &cfg, err, sizeof err);
@@ -169,9 +172,13 @@ static void test_mapping(void **st)
     fv_pyramid_free(&hist);
 }
 
-/* Where the tile's alpha is 1 (the fovea: every pixel traced every frame), the history has no
- * weight: the samples must come back bit for bit, for every ISA, while the flow sums the fill
- * needs are still taken. The history here is far brighter than the samples on the same surface,
+/* Where the tile's alpha is 1 (the fovea: every pixel traced every frame), the blend gives the
+ * history no weight: the samples must come back bit for bit, for every ISA, while the flow sums
+ * the fill needs are still taken. This is the fovea's path with --fovea-aa off, and with it on for
+ * the tiles that are not wholly fully sampled (the fovea's rim, the saturated transition); the
+ * whole tiles of the fovea then accumulate jittered samples instead (core/reproject_aa.c,
+ * tests/test_fovea_aa.c, which also checks that with it off the pipeline's fovea is exactly the
+ * pixel-centre full render). The history here is far brighter than the samples on the same surface,
  * so blending with a weight of 1 and rounding (h + 1 (px - h)) would show: 1000.3 + (0.1 - 1000.3)
  * is 0.1000366 in float, not 0.1. */
 static void test_fovea_samples_untouched(void **st)

@@ -54,8 +54,8 @@ static void FV_X86_FN(camera_rays)(const fv_raygen_cam *c, const uint8_t *px, in
     for (int i = 0; i < n; i += FV_X86_W) {
         const VI p = load_px(px + i);
         const V fx = VCVT(IADD(IAND(p, 15), x0)), fy = VCVT(IADD(ISHR(p, 4), y0));
-        const V tx = VADD(VS(c->tan_left), VMUL(VADD(fx, VS(0.5f)), VS(c->px_tan)));
-        const V ty = VSUB(VS(c->tan_top), VMUL(VADD(fy, VS(0.5f)), VS(c->px_tan)));
+        const V tx = VADD(VS(c->tan_left), VMUL(VADD(fx, VS(c->ox)), VS(c->px_tan)));
+        const V ty = VSUB(VS(c->tan_top), VMUL(VADD(fy, VS(c->oy)), VS(c->px_tan)));
         float *d[3] = {dx, dy, dz};
         for (int k = 0; k < 3; k++)
             VST(d[k] + i, VSUB(VADD(VMUL(tx, VS(c->right[k])), VMUL(ty, VS(c->up[k]))), VS(c->back[k])));

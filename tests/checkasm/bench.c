@@ -575,7 +575,7 @@ static volatile float ray_sink;
 static void ray_run(void *st, const checkasm_dsp *d, int row0, int rows)
 {
     ray_st *t = st;
-    const fv_raygen_cam c = {-1.19f, 1.19f, 0.00186f, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const fv_raygen_cam c = {-1.19f, 1.19f, 0.00186f, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 0.5f, 0.5f};
     for (int k = 0; k < rows; k++) {
         const int p = (row0 + k) % (W * H / 16), tile = p / 16;
         d->ray.camera_rays(&c, t->px + 16 * (p % 16), tile % (W / 16) * 16, tile / (W / 16) * 16, t->d[0], t->d[1],

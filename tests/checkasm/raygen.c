@@ -1,6 +1,6 @@
 /* fovea checkasm: the ray-generation kernel (raygen_dsp.h), every ISA version against the C
  * reference, bit for bit: random cameras (also huge and tiny pixel angles, negative axes), random
- * pixel lists of both packet widths, tiles anywhere up to 16384 px. Outputs are canaried. */
+ * pixel lists of both packet widths, sample positions anywhere in the pixel (centre, edges, random), tiles anywhere up to 16384 px. Outputs are canaried. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -39,7 +39,10 @@ static void test_camera_rays(void **state)
             const int n = r & 1 ? 16 : 8;
             static const float scale[] = {1e-3f, 1.0f, 1e-30f, 1e20f};
             const float s = scale[r % 4];
-            fv_raygen_cam c = {rnd(-2, 0) * s, rnd(0, 2) * s, rnd(0, 0.01f) * s, {0}, {0}, {0}};
+            /* the pixel centre, and (fovea anti-aliasing) anywhere in the pixel, its edges too */
+            static const float edge[] = {0.0f, 0.99999994f, 0.5f};
+            const float ox = r % 5 < 3 ? edge[r % 5] : checkasm_randf(), oy = r % 7 < 3 ? edge[r % 7] : checkasm_randf();
+            fv_raygen_cam c = {rnd(-2, 0) * s, rnd(0, 2) * s, rnd(0, 0.01f) * s, {0}, {0}, {0}, ox, oy};
             for (int i = 0; i < 3; i++)
                 c.right[i] = rnd(-1, 1), c.up[i] = rnd(-1, 1), c.back[i] = rnd(-1, 1) * s;
             uint8_t px[16];

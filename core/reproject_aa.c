@@ -1,0 +1,187 @@
+/* fovea: anti-aliasing in the fovea (reproject.h, fv_taa_aa_*): the fully sampled tiles' rays
+ * go through a different point of their pixels every frame (fv_sampling_jitter) and each pixel
+ * accumulates them in its history, so a still view converges to the pixel's box-filtered
+ * value. Plain C: it runs on the fovea's tiles only (about 140 of 7200 at 1280x1440).
+ *
+ * Per pixel of an AA tile (every pixel has this frame's sample s, depth d):
+ *   1. The pixel centre's place in the previous frame: the sample's world point (its ray through
+ *      (x + ox, y + oy) at depth d) projected into the previous camera, moved back by the jitter
+ *      (ox - 1/2, oy - 1/2) (exact for a translation of the image; with the head still, the
+ *      centre itself).
+ *   2. Disocclusion: the history counts only if one of the 3x3 history texels around that place
+ *      has a depth within the reprojection's tolerance of the sample's previous view depth. Not a
+ *      per-texel depth weight as in the periphery's blend: a jittered pixel on an edge holds
+ *      either surface's depth from frame to frame, and per-texel rejection would drop exactly
+ *      the edges' history.
+ *   3. History h: a bilinear tap of level 0 weighted by the texels' confidence (with the head
+ *      moving and the 4x4 texels around all real samples: Catmull-Rom instead, whose sharpness
+ *      keeps the per-frame resampling from blurring the accumulated image), clamped to the
+ *      min / max of this frame's samples in the pixel's 3x3 neighbourhood inside the tile (the
+ *      usual rectification: what the history holds beyond what the neighbourhood shows now is
+ *      a ghost or a disocclusion). Only the tile's own samples: a neighbour tile may not be
+ *      traced yet, and reading it would make the image depend on the thread count.
+ *   4. Weight: n = the history's sample count at the nearest texel (0 without history) + 1,
+ *      capped at FV_TAA_AA_MAX_N; out = h + (s - h) / n. A still view is the plain mean of its
+ *      first FV_TAA_AA_MAX_N jittered samples, then an exponential window of that length.
+ * The depth stays the sample's. Counts live in a plane of their own (one byte a pixel, two per
+ * eye, swapped with the pyramids); every other tile writes 0 there, so a pixel that joins the
+ * fovea starts afresh from its first jittered sample (today's behaviour) and counts never go
+ * stale. */
+#include <math.h>
+#include <string.h>
+
+#include "reproject.h"
+#include "sampling.h"
+
+int fv_taa_aa_tile_eligible(const struct fv_sampler *smp, int gx, int gy, int x0, int y0, int tw, int th,
+                            const uint32_t *rows)
+{
+    const uint32_t full = tw >= 32 ? ~0u : (1u << tw) - 1u;
+    for (int y = 0; y < th; y++)
+        if ((rows[y] & full) != full)
+            return 0;
+    /* every pixel sampled every frame: the acuity model's probability 1 at the pixel centres of
+     * the tile's corners (the region is a disc around the gaze, so convex) */
+    const float xs[2] = {(float)x0 + 0.5f - (float)gx, (float)(x0 + tw - 1) + 0.5f - (float)gx};
+    const float ys[2] = {(float)y0 + 0.5f - (float)gy, (float)(y0 + th - 1) + 0.5f - (float)gy};
+    for (int i = 0; i < 2; i++)
+        for (int k = 0; k < 2; k++)
+            if (!(fv_sampler_probability(smp, xs[i], ys[k]) >= 1.0f))
+                return 0;
+    return 1;
+}
+
+void fv_taa_aa_clear(const fv_taa_aa_frame *a, int x0, int y0, int tw, int th)
+{
+    for (int y = 0; y < th; y++)
+        memset(a->n_cur + (ptrdiff_t)(y0 + y) * a->stride + x0, 0, (size_t)tw);
+}
+
+static inline float minf(float a, float b) { return a < b ? a : b; }
+static inline float maxf(float a, float b) { return a > b ? a : b; }
+
+/* Catmull-Rom resampling of level 0 at texels i0-1 .. i0+2, j0-1 .. j0+2 (fractions fx, fy), into
+ * h when all 16 texels have weight 1 (else h stays). */
+static void catmull_rom(const fv_pyr_level *H, int i0, int j0, float fx, float fy, float h[3])
+{
+    float wx[4], wy[4];
+    const float t[2] = {fx, fy};
+    float *w[2] = {wx, wy};
+    for (int k = 0; k < 2; k++) {
+        const float q = t[k];
+        w[k][0] = q * (-0.5f + q * (1.0f - 0.5f * q));
+        w[k][1] = 1.0f + q * q * (-2.5f + 1.5f * q);
+        w[k][2] = q * (0.5f + q * (2.0f - 1.5f * q));
+        w[k][3] = q * q * (-0.5f + 0.5f * q);
+    }
+    float acc[3] = {0.0f, 0.0f, 0.0f};
+    for (int j = 0; j < 4; j++) {
+        const ptrdiff_t row = (ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1;
+        for (int i = 0; i < 4; i++) {
+            if (H->wgt[row + i] != 1.0f)
+                return;
+            const float ww = wx[i] * wy[j];
+            for (int c = 0; c < 3; c++)
+                acc[c] += ww * H->rgbd[4 * (row + i) + c];
+        }
+    }
+    for (int c = 0; c < 3; c++)
+        h[c] = acc[c];
+}
+
+void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
+                    int th)
+{
+    enum { T = 16 };
+    /* the tile's samples before any is changed: the neighbourhoods read this frame's samples only */
+    float s[T][T][4];
+    for (int y = 0; y < th; y++)
+        memcpy(s[y], l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0), (size_t)tw * 4 * sizeof(float));
+    const int hist = f && a->n_prev;
+    const fv_pyr_level *H = hist ? &f->hist->lv[0] : NULL;
+    const float jx = a->ox - 0.5f, jy = a->oy - 0.5f;
+    for (int y = 0; y < th; y++) {
+        uint8_t *ncur = a->n_cur + (ptrdiff_t)(y0 + y) * a->stride + x0;
+        for (int x = 0; x < tw; x++) {
+            float *px = l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0 + x);
+            int n = 0;
+            float h[3] = {0.0f, 0.0f, 0.0f};
+            if (hist) {
+                const float d = s[y][x][3];
+                float u, v, z;
+                if (f->identity) {
+                    u = (float)(x0 + x) + 0.5f;
+                    v = (float)(y0 + y) + 0.5f;
+                    z = d;
+                } else {
+                    z = fv_taa_project(f, (float)(x0 + x) + a->ox, (float)(y0 + y) + a->oy, d, &u, &v);
+                    u -= jx;
+                    v -= jy;
+                }
+                if (z > 1e-4f && u >= 0.0f && u < f->prev_w && v >= 0.0f && v < f->prev_h) {
+                    /* 2. some history texel near the place is on the sample's surface */
+                    const int ni = (int)u, nj = (int)v; /* u, v >= 0: truncation is floor */
+                    const float tol = z / f->inv_depth_tol;
+                    int near = 0;
+                    for (int j = nj - 1; j <= nj + 1 && !near; j++)
+                        for (int i = ni - 1; i <= ni + 1; i++) {
+                            const ptrdiff_t o = (ptrdiff_t)j * H->stride + i;
+                            if (H->wgt[o] > 0.0f && fabsf(H->rgbd[4 * o + 3] - z) <= tol) {
+                                near = 1;
+                                break;
+                            }
+                        }
+                    /* 3. bilinear history, weighted by confidence */
+                    const float sx = u - 0.5f, sy = v - 0.5f, fx0 = floorf(sx), fy0 = floorf(sy);
+                    const int i0 = (int)fx0, j0 = (int)fy0;
+                    const float fx = sx - fx0, fy = sy - fy0;
+                    const float b[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
+                    float acc[3] = {0.0f, 0.0f, 0.0f}, accw = 0.0f;
+                    for (int k = 0; k < 4; k++) {
+                        const ptrdiff_t o = (ptrdiff_t)(j0 + (k >> 1)) * H->stride + i0 + (k & 1);
+                        const float w = b[k] * H->wgt[o];
+                        for (int c = 0; c < 3; c++)
+                            acc[c] += w * H->rgbd[4 * o + c];
+                        accw += w;
+                    }
+                    if (near && accw > 1e-6f) {
+                        n = a->n_prev[(ptrdiff_t)(int)v * a->stride + (int)u];
+                        for (int c = 0; c < 3; c++)
+                            h[c] = acc[c] / accw;
+                        /* moving: Catmull-Rom over the 4x4 texels where all are real samples
+                         * inside the image (the fovea's history), sharper than the bilinear
+                         * tap, whose blur compounds frame after frame; the clamp below takes
+                         * its overshoot */
+                        if (!f->identity && i0 >= 1 && j0 >= 1 && (float)(i0 + 2) < f->prev_w &&
+                            (float)(j0 + 2) < f->prev_h)
+                            catmull_rom(H, i0, j0, fx, fy, h);
+                    }
+                }
+            }
+            n = n + 1 < FV_TAA_AA_MAX_N ? n + 1 : FV_TAA_AA_MAX_N;
+            ncur[x] = (uint8_t)n;
+            if (n == 1)
+                continue; /* no history: the sample as traced */
+            const float alpha = 1.0f / (float)n;
+            if (f->identity) { /* head still, scene static: the history is exact, nothing to rectify */
+                for (int c = 0; c < 3; c++)
+                    px[c] = h[c] + alpha * (s[y][x][c] - h[c]);
+                continue;
+            }
+            /* rectification: the 3x3 neighbourhood of this frame's samples, inside the tile */
+            float lo[3], hi[3];
+            for (int c = 0; c < 3; c++)
+                lo[c] = hi[c] = s[y][x][c];
+            for (int j = y > 0 ? y - 1 : 0; j <= (y + 1 < th ? y + 1 : th - 1); j++)
+                for (int i = x > 0 ? x - 1 : 0; i <= (x + 1 < tw ? x + 1 : tw - 1); i++)
+                    for (int c = 0; c < 3; c++) {
+                        lo[c] = minf(lo[c], s[j][i][c]);
+                        hi[c] = maxf(hi[c], s[j][i][c]);
+                    }
+            for (int c = 0; c < 3; c++) {
+                const float hc = minf(maxf(h[c], lo[c]), hi[c]);
+                px[c] = hc + alpha * (s[y][x][c] - hc);
+            }
+        }
+    }
+}
