@@ -29,6 +29,8 @@ struct fv_pool {
      * to check in, only for the job's items (done) */
     _Atomic uint64_t claim;
     atomic_int done;          /* items of the current job finished */
+    atomic_int inflight;      /* threads inside drain: the caller waits for them too, since a
+                               * worker that ran items still writes its span after its last */
     fv_prof *prof;            /* trace recorder (NULL: off), published under mu with the job */
     /* the background job (fv_pool_post): items claimed under mu, by idle workers between the
      * foreground jobs' items and by the caller in fv_pool_wait */
@@ -73,9 +75,12 @@ static int claim(fv_pool *p, uint32_t gen, int count)
 
 static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, uint32_t gen, int id, fv_prof *prof)
 {
+    atomic_fetch_add_explicit(&p->inflight, 1, memory_order_acq_rel); /* before any claim */
     const int64_t t0 = prof ? fv_time_ns() : 0;
+    int ran = 0;
     for (int i; (i = claim(p, gen, count)) >= 0;) {
         fn(ctx, i, id);
+        ran = 1;
         /* release: the item's writes happen before the caller sees the job done */
         if (atomic_fetch_add_explicit(&p->done, 1, memory_order_acq_rel) + 1 == count) {
             pthread_mutex_lock(&p->mu);
@@ -83,8 +88,15 @@ static void drain(fv_pool *p, fv_task_fn fn, void *ctx, int count, uint32_t gen,
             pthread_mutex_unlock(&p->mu);
         }
     }
-    if (prof) /* this worker's share of the job, on its own track */
+    /* this worker's share of the job, on its own track; a worker that woke too late to claim
+     * anything touches neither the job nor prof (both may be gone by then) */
+    if (prof && ran)
         fv_prof_span(prof, id, id, "pool job", t0, fv_time_ns(), count);
+    if (atomic_fetch_sub_explicit(&p->inflight, 1, memory_order_acq_rel) == 1) {
+        pthread_mutex_lock(&p->mu);
+        pthread_cond_signal(&p->done_cv);
+        pthread_mutex_unlock(&p->mu);
+    }
 }
 
 static void *worker_main(void *arg)
@@ -134,6 +146,7 @@ fv_pool *fv_pool_create(int threads)
     p->threads = threads;
     atomic_init(&p->claim, 0);
     atomic_init(&p->done, 0);
+    atomic_init(&p->inflight, 0);
     pthread_mutex_init(&p->mu, NULL);
     pthread_cond_init(&p->start_cv, NULL);
     pthread_cond_init(&p->done_cv, NULL);
@@ -201,10 +214,11 @@ void fv_pool_run(fv_pool *p, int count, fv_task_fn fn, void *ctx)
     pthread_mutex_unlock(&p->mu);
     fv_prof *prof = p->prof; /* only the caller writes it (fv_pool_set_prof) */
     drain(p, fn, ctx, count, gen, 0, prof);
-    /* done when every item is: a worker still in a background item, or not yet awake, holds
-     * nothing of this job */
+    /* done when every item is and the threads that ran them are out of drain: a worker still in
+     * a background item, or not yet awake, holds nothing of this job */
     pthread_mutex_lock(&p->mu);
-    while (atomic_load_explicit(&p->done, memory_order_acquire) < count)
+    while (atomic_load_explicit(&p->done, memory_order_acquire) < count ||
+           atomic_load_explicit(&p->inflight, memory_order_acquire) > 0)
         pthread_cond_wait(&p->done_cv, &p->mu);
     pthread_mutex_unlock(&p->mu);
 }
