@@ -51,8 +51,8 @@ void fv_blend_record(unsigned ray_id, unsigned geom, unsigned prim, float u, flo
 }
 
 void fv_blend_composite(const fv_scene *s, const fv_blend_lane lanes[16], unsigned *geom, float *tfar,
-                        const float *const dir[3], int n, float px_tan, const float eye[3], const float background[3],
-                        float rgb[3][16])
+                        const float *const org[3], const float *const dir[3], int n, float px_tan, const float eye[3],
+                        const float background[3], float rgb[3][16])
 {
     for (int q = 0; q < n; q++) {
         const fv_blend_lane *l = &lanes[q];
@@ -72,13 +72,14 @@ void fv_blend_composite(const fv_scene *s, const fv_blend_lane lanes[16], unsign
         }
         if (!m) continue;
         const float d[3] = {dir[0][q], dir[1][q], dir[2][q]};
+        const float o[3] = {org ? org[0][q] : eye[0], org ? org[1][q] : eye[1], org ? org[2][q] : eye[2]};
         const float fp = px_tan / sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         float acc[3] = {0, 0, 0}, trans = 1.0f;
         for (unsigned i = 0; i < m; i++) {
             const unsigned k = order[i];
             const float a = fv_scene_alpha(s, l->geom[k], l->prim[k], l->u[k], l->v[k]);
             float c[3];
-            fv_scene_shade(s, l->geom[k], l->prim[k], l->u[k], l->v[k], eye, d, l->t[k], fp, eye, c);
+            fv_scene_shade(s, l->geom[k], l->prim[k], l->u[k], l->v[k], o, d, l->t[k], fp, eye, c);
             for (int ch = 0; ch < 3; ch++) acc[ch] += trans * a * c[ch];
             trans *= 1.0f - a;
         }

@@ -26,12 +26,13 @@ void fv_blend_begin(fv_blend_lane lanes[16]);
 void fv_blend_end(void);
 /* (the scene's intersect filter) a blended hit of the ray with this id at distance t */
 void fv_blend_record(unsigned ray_id, unsigned geom, unsigned prim, float u, float v, float t);
-/* Lays lane q's blended layers (those nearer than tfar[q]) over rgb[.][q], for q < n: camera
- * rays from eye with direction dir and pixel angle px_tan / |dir|. A lane whose ray missed
+/* Lays lane q's blended layers (those nearer than tfar[q]) over rgb[.][q], for q < n: rays from
+ * org[.][q] (NULL: all from eye; the thin-lens reference's start on the lens) with direction dir
+ * and pixel angle px_tan / |dir|, seen from eye. A lane whose ray missed
  * (geom RTC_INVALID_GEOMETRY_ID) is laid over background and becomes a hit of its nearest layer
  * (geom and tfar rewritten), so the ray stage writes its colour and that layer's depth. */
 void fv_blend_composite(const fv_scene *s, const fv_blend_lane lanes[16], unsigned *geom, float *tfar,
-                        const float *const dir[3], int n, float px_tan, const float eye[3], const float background[3],
-                        float rgb[3][16]);
+                        const float *const org[3], const float *const dir[3], int n, float px_tan, const float eye[3],
+                        const float background[3], float rgb[3][16]);
 
 #endif

@@ -173,7 +173,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
                                   cam->eye_pos, tile_rgb_##N[b]);                                             \
             if (blend) { /* blended layers over the shaded hits (misses become the nearest layer's hits) */    \
                 const float *const dirs[3] = {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z};             \
-                fv_blend_composite(scene, tile_blend_##N[b], rh[b].hit.geomID, rh[b].ray.tfar, dirs,           \
+                fv_blend_composite(scene, tile_blend_##N[b], rh[b].hit.geomID, rh[b].ray.tfar, NULL, dirs,     \
                                    n - b * N < N ? n - b * N : N, cam->px_tan, cam->eye_pos, fv_background_rgb, \
                                    tile_rgb_##N[b]);                                                          \
             }                                                                                                 \

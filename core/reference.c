@@ -1,10 +1,12 @@
 #include "reference.h"
 
+#include "blend.h"
 #include "output_convert.h"
 
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "base/util.h"
 #include "raycast.h" /* FV_TILE, FV_DEPTH_MISS_M, fv_background_rgb */
@@ -100,6 +102,9 @@ static void ref_tile(void *ctx, int index, int thread_id)
     ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     struct RTCRayHit8 rh;
     int valid[8], lane_px[8], lane_s[8];
+    /* alpha BLEND as the ray stage does it (core/blend.h), from each ray's own origin */
+    const int blend = fv_scene_has_blend(j->scene);
+    fv_blend_lane bl[16];
     int k = 0;
     long rays = 0;
     /* per pixel: ray -1 is the pinhole ray (depth), 0..spp-1 the lens samples, in this order,
@@ -136,26 +141,47 @@ static void ref_tile(void *ctx, int index, int thread_id)
             break;
         for (int q = k; q < 8; q++)
             valid[q] = 0;
+        if (blend)
+            fv_blend_begin(bl);
         fv_scene_intersect8(j->scene, valid, &ictx, &rh);
+        if (blend)
+            fv_blend_end();
+        float rgb[3][16];
         for (int q = 0; q < k; q++) {
-            const int p = lane_px[q];
             const int hit = rh.hit.geomID[q] != RTC_INVALID_GEOMETRY_ID;
             const float t = rh.ray.tfar[q];
-            if (lane_s[q] < 0) {
-                j->rgbd[4 * ((size_t)(y0 + p / tw) * cam->width + x0 + p % tw) + 3] =
-                    hit && t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;
-                continue;
-            }
-            float rgb[3] = {fv_background_rgb[0], fv_background_rgb[1], fv_background_rgb[2]};
+            for (int c = 0; c < 3; c++)
+                rgb[c][q] = fv_background_rgb[c];
+            if (lane_s[q] < 0)
+                continue; /* the depth ray: below, after the blended layers */
             if (hit) {
                 const float org[3] = {rh.ray.org_x[q], rh.ray.org_y[q], rh.ray.org_z[q]};
                 const float dir[3] = {rh.ray.dir_x[q], rh.ray.dir_y[q], rh.ray.dir_z[q]};
                 const float len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+                float c3[3];
                 fv_scene_shade(j->scene, rh.hit.geomID[q], rh.hit.primID[q], rh.hit.u[q], rh.hit.v[q], org, dir, t,
-                               cam->px_tan / len, cam->eye_pos, rgb);
+                               cam->px_tan / len, cam->eye_pos, c3);
+                for (int c = 0; c < 3; c++)
+                    rgb[c][q] = c3[c];
+            }
+        }
+        /* the depth lanes' colours are composited too, and not used; a miss behind a blended
+         * layer takes the layer's depth, as in the ray stage */
+        if (blend) {
+            const float *const orgs[3] = {rh.ray.org_x, rh.ray.org_y, rh.ray.org_z};
+            const float *const dirs[3] = {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
+            fv_blend_composite(j->scene, bl, rh.hit.geomID, rh.ray.tfar, orgs, dirs, k, cam->px_tan, cam->eye_pos,
+                               fv_background_rgb, rgb);
+        }
+        for (int q = 0; q < k; q++) {
+            if (lane_s[q] < 0) {
+                const float t = rh.ray.tfar[q];
+                j->rgbd[4 * ((size_t)(y0 + lane_px[q] / tw) * cam->width + x0 + lane_px[q] % tw) + 3] =
+                    rh.hit.geomID[q] != RTC_INVALID_GEOMETRY_ID && t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;
+                continue;
             }
             for (int c = 0; c < 3; c++)
-                acc[p][c] += rgb[c];
+                acc[lane_px[q]][c] += rgb[c][q];
         }
         rays += k;
         k = 0;

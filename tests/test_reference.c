@@ -39,6 +39,27 @@ static fv_scene *mixed_scene(void)
 
 static const fv_pose origin = {{0, 0, 0}, {0, 0, 0, 1}};
 
+/* mixed_scene with a half-transparent alpha BLEND pane at 0.8 m over the card's left half */
+static fv_scene *blend_scene(void)
+{
+    fv_scene *s = fv_scene_create();
+    add_quad(s, -10.0f, -10.0f, 0.5f, 10.0f, -3.0f, 0.6f);
+    add_quad(s, -0.3f, -0.2f, 0.1f, 0.25f, -1.0f, 0.3f);
+    float pos[] = {-0.35f, -0.25f, -0.8f, -0.1f, -0.25f, -0.8f, -0.1f, 0.3f, -0.8f, -0.35f, 0.3f, -0.8f};
+    float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    fv_mesh_desc m;
+    memset(&m, 0, sizeof m);
+    m.positions = pos, m.normals = nrm, m.indices = idx, m.vertex_count = 4, m.index_count = 6;
+    m.base_color[0] = 0.9f, m.base_color[1] = 0.2f, m.base_color[2] = 0.1f, m.base_color[3] = 0.5f;
+    m.texture = -1;
+    m.alpha_blend = 1;
+    char err[256];
+    assert_int_equal(fv_scene_add_mesh(s, &m, err, sizeof err), 0);
+    return commit(s);
+}
+
+
 static fv_camera make_cam(int w, int h, float fov_deg)
 {
     fv_camera_desc d;
@@ -82,7 +103,9 @@ static void test_zero_pupil_is_pinhole(void **st)
 {
     (void)st;
     const int W = 48, H = 40;
-    fv_scene *s = mixed_scene();
+    for (int with_blend = 0; with_blend < 2; with_blend++) {
+    /* with a blended pane: the reference composites it as the ray stage does */
+    fv_scene *s = with_blend ? blend_scene() : mixed_scene();
     fv_camera cam = make_cam(W, H, 60.0f);
     uint8_t a8[W * H * 3], b8[W * H * 3];
     float *pin = pinhole(s, W, H, 60.0f, a8);
@@ -98,6 +121,7 @@ static void test_zero_pupil_is_pinhole(void **st)
     free(pin);
     free(ref);
     fv_scene_free(s);
+    }
 }
 
 /* A plane at the focus distance: every lens ray of a pixel meets the plane at the pixel's
