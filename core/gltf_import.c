@@ -42,21 +42,26 @@ static void matrix_quat(const double wm[16], float q[4])
     q[0] = (float)x, q[1] = (float)y, q[2] = (float)z, q[3] = (float)w;
 }
 
-/* The scene texture of image img, decoded once per colour space and pair of wrap modes
- * (tex[18 * img + 9 * linear + 3 * wrap_s + wrap_t]); -1 for none (no image, or no uvs to
- * sample it with); -2 on failure. */
+/* Textures an image may become: 2 colour spaces x 9 pairs of wrap modes x 12 filter settings */
+#define TEX_VARIANTS (2 * 9 * 12)
+
+/* The scene texture of image img, decoded once per colour space, pair of wrap modes and filter
+ * setting (tex[TEX_VARIANTS * img + ...]); -1 for none (no image, or no uvs to sample it with);
+ * -2 on failure. */
 static int image_texture(fv_scene *s, const fv_gltf_model *g, int *tex, int img, int linear, const int wrap[2],
-                         const float *uvs)
+                         const int filter[3], const float *uvs)
 {
     if (img < 0 || !uvs || !g->images[img].rgba8) return -1;
     const int ws = wrap[0] >= 0 && wrap[0] <= 2 ? wrap[0] : 0, wt = wrap[1] >= 0 && wrap[1] <= 2 ? wrap[1] : 0;
-    int *t = &tex[18 * img + 9 * linear + 3 * ws + wt];
+    const int mag = filter[0] != 0, min = filter[1] != 0, mip = filter[2] >= 0 && filter[2] <= 2 ? filter[2] : 0;
+    int *t = &tex[TEX_VARIANTS * img + ((linear * 9 + 3 * ws + wt) * 2 + mag) * 6 + min * 3 + mip];
     if (*t < 0) {
         const fv_gltf_image *im = &g->images[img];
         *t = linear ? fv_scene_add_texture_linear(s, im->rgba8, im->width, im->height)
                     : fv_scene_add_texture(s, im->rgba8, im->width, im->height);
         if (*t < 0) return -2;
         fv_scene_set_texture_wrap(s, *t, (fv_wrap)ws, (fv_wrap)wt);
+        fv_scene_set_texture_filter(s, *t, mag, min, (fv_mip)mip);
     }
     return *t;
 }
@@ -66,12 +71,12 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
 {
     int *tex_of_image = NULL;
     if (g->image_count) {
-        tex_of_image = malloc(18 * g->image_count * sizeof *tex_of_image);
+        tex_of_image = malloc(TEX_VARIANTS * g->image_count * sizeof *tex_of_image);
         if (!tex_of_image) {
             fv_err(err, err_len, "out of memory");
             return -1;
         }
-        for (size_t i = 0; i < 18 * g->image_count; i++) tex_of_image[i] = -1;
+        for (size_t i = 0; i < TEX_VARIANTS * g->image_count; i++) tex_of_image[i] = -1;
     }
     int have_camera = 0, rc = 0;
     for (size_t ni = 0; ni < g->node_count && rc == 0; ni++) {
@@ -103,7 +108,8 @@ static int add_gltf(fv_scene *s, const fv_gltf_model *g, char *err, size_t err_l
                                         mat->normal_image};
                     int tx[5];
                     for (int j = 0; j < 5 && rc == 0; j++) { /* data maps (MR, occlusion, normal) are linear */
-                        tx[j] = image_texture(s, g, tex_of_image, img[j], j == 1 || j == 2 || j == 4, mat->wrap[j], p->uvs);
+                        tx[j] = image_texture(s, g, tex_of_image, img[j], j == 1 || j == 2 || j == 4, mat->wrap[j],
+                                              mat->filter[j], p->uvs);
                         if (tx[j] == -2) {
                             fv_err(err, err_len, "image %d: cannot add texture", img[j]);
                             rc = -1;

@@ -569,6 +569,12 @@ void convert_materials(const tinygltf::Model &m, Holder &h, std::vector<char> *i
             if (si >= 0 && size_t(si) < m.samplers.size()) {
                 mat.wrap[slot][0] = wrap_of(m.samplers[size_t(si)].wrapS);
                 mat.wrap[slot][1] = wrap_of(m.samplers[size_t(si)].wrapT);
+                const int mag = m.samplers[size_t(si)].magFilter, min = m.samplers[size_t(si)].minFilter;
+                mat.filter[slot][0] = mag == 9728; // NEAREST (9729 LINEAR, or none: linear)
+                // minFilter: 9728 NEAREST, 9729 LINEAR (no mipmaps), 9984 NEAREST_MIPMAP_NEAREST,
+                // 9985 LINEAR_MIPMAP_NEAREST, 9986 NEAREST_MIPMAP_LINEAR, 9987 LINEAR_MIPMAP_LINEAR
+                mat.filter[slot][1] = min == 9728 || min == 9984 || min == 9986;
+                mat.filter[slot][2] = min == 9728 || min == 9729 ? 2 : min == 9984 || min == 9985 ? 1 : 0;
             }
         };
         texture(0, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions, "base colour", &mat.image);

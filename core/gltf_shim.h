@@ -51,6 +51,9 @@ typedef struct fv_gltf_material {
     float alpha_cutoff;  /* alphaMode MASK: alphaCutoff (default 0.5); OPAQUE and BLEND: 0 */
     int wrap[5][2];      /* base colour, metallic-roughness, occlusion, emissive, normal textures' sampler
                           * wrapS, wrapT: 0 REPEAT, 1 CLAMP_TO_EDGE, 2 MIRRORED_REPEAT (fv_wrap) */
+    int filter[5][3];    /* per texture as wrap[]: the sampler's magFilter NEAREST (1) or LINEAR (0),
+                          * minFilter's within-level NEAREST (1) or LINEAR (0), and its mipmaps
+                          * (fv_mip: 0 LINEAR, 1 NEAREST, 2 none); zeros: trilinear (no filter given) */
     int has_uvx;         /* some texture has KHR_texture_transform: */
     float uvx[5][6];     /* per texture as wrap[]: u' = [0] u + [1] v + [2], v' = [3] u + [4] v + [5] */
     int double_sided;    /* doubleSided (default false: back faces culled) */

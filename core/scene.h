@@ -19,8 +19,8 @@ typedef struct fv_scene fv_scene;
  * extension, no triangles at all, ...). Never crashes. Meshes of all TRIANGLES primitives
  * reachable from the default scene (or all root nodes) are flattened with their world
  * transforms. Materials as docs/materials.md says: metallic-roughness with base colour,
- * metallic-roughness, occlusion, emissive and normal maps, vertex colours, alpha MASK, doubleSided,
- * sampler wrap modes and KHR_texture_transform (BLEND and filter modes are not read yet). Skins,
+ * metallic-roughness, occlusion, emissive and normal maps, vertex colours, alpha MASK and BLEND,
+ * doubleSided, sampler wrap and filter modes and KHR_texture_transform. Skins,
  * morph targets and animations are ignored. The first perspective camera in depth-first node
  * order becomes the default view. */
 fv_scene *fv_scene_load(const char *path, char *err, size_t err_len);
@@ -85,6 +85,12 @@ int fv_scene_add_texture_linear(fv_scene *s, const uint8_t *rgba8, int w, int h)
 typedef enum { FV_WRAP_REPEAT, FV_WRAP_CLAMP, FV_WRAP_MIRROR } fv_wrap;
 /* Sets texture tex's wrap modes; 0, or -1 if tex does not exist. */
 int fv_scene_set_texture_wrap(fv_scene *s, int tex, fv_wrap wrap_s, fv_wrap wrap_t);
+/* Texture filtering (glTF sampler magFilter / minFilter): the texel nearest the point instead of
+ * the bilinear blend when magnifying (lod <= 0: mag_nearest) or minifying (min_nearest), and the
+ * mip levels blended (FV_MIP_LINEAR, a new texture's: trilinear), the nearest level taken
+ * (FV_MIP_NEAREST) or level 0 only (FV_MIP_NONE). 0, or -1 if tex does not exist. */
+typedef enum { FV_MIP_LINEAR, FV_MIP_NEAREST, FV_MIP_NONE } fv_mip;
+int fv_scene_set_texture_filter(fv_scene *s, int tex, int mag_nearest, int min_nearest, fv_mip mip);
 /* Validates (indices < vertex_count, counts multiple of 3, finite data, texture index) and
  * flattens the mesh to world space. Returns 0, or -1 with err (the scene is unchanged).
  * Meshes get Embree geometry IDs 0, 1, 2, ... in the order they were added successfully. */

@@ -22,6 +22,8 @@ typedef struct fv_texture {
     const float *level[FV_TEX_MAX_LEVELS]; /* linear RGBA, rows top to bottom, into data */
     float *data;
     fv_wrap wrap_s, wrap_t; /* addressing along u and v */
+    unsigned char mag_nearest, min_nearest; /* fv_scene_set_texture_filter */
+    unsigned char mip;                      /* fv_mip */
 } fv_texture;
 
 /* A triangle's shading inputs, one cache line: its corners' normals (world, unit or zero if

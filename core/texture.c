@@ -87,6 +87,14 @@ int fv_scene_set_texture_wrap(fv_scene *s, int tex, fv_wrap wrap_s, fv_wrap wrap
     return 0;
 }
 
+int fv_scene_set_texture_filter(fv_scene *s, int tex, int mag_nearest, int min_nearest, fv_mip mip)
+{
+    if (!s || tex < 0 || tex >= s->texture_count || mip < FV_MIP_LINEAR || mip > FV_MIP_NONE) return -1;
+    fv_texture *t = &s->textures[tex];
+    t->mag_nearest = mag_nearest != 0, t->min_nearest = min_nearest != 0, t->mip = (unsigned char)mip;
+    return 0;
+}
+
 void fv_texture_taps(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp) { fv_tex_taps_at(t, u, v, lod, tp); }
 void fv_texture_taps_prefetch(const fv_tex_taps *tp) { fv_tex_taps_prefetch(tp); }
 void fv_texture_blend(const fv_tex_taps *tp, float out[4]) { fv_tex_blend(tp, out); }

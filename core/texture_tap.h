@@ -32,8 +32,9 @@ static inline int fv_tex_wrap_index(int i, int side, fv_wrap mode)
 }
 
 /* Bilinear with the texture's wrap modes; uv (0,0) is the first texel of the first row (glTF).
- * A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. */
-static inline void fv_tex_tap_at(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp)
+ * A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. nearest: the texel holding
+ * the point, as all four with fractions 0 (the blend then gives its bits exactly). */
+static inline void fv_tex_tap_at(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp, int nearest)
 {
     const int w = t->w[l], h = t->h[l];
     const float *px = t->level[l];
@@ -42,6 +43,13 @@ static inline void fv_tex_tap_at(const fv_texture *t, int l, float u, float v, f
     const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
     const float xf = floorf(x), yf = floorf(y);
     tp->fx = x - xf, tp->fy = y - yf;
+    if (nearest) { /* x - xf >= 0.5: the point lies in texel xf + 1 */
+        const int xn = fv_tex_wrap_index((int)xf + (tp->fx >= 0.5f), w, t->wrap_s);
+        const int yn = fv_tex_wrap_index((int)yf + (tp->fy >= 0.5f), h, t->wrap_t);
+        tp->p[0] = tp->p[1] = tp->p[2] = tp->p[3] = px + ((size_t)yn * (size_t)w + (size_t)xn) * 4;
+        tp->fx = tp->fy = 0.0f;
+        return;
+    }
     const int x0 = fv_tex_wrap_index((int)xf, w, t->wrap_s), y0 = fv_tex_wrap_index((int)yf, h, t->wrap_t);
     const int x1 = fv_tex_wrap_index((int)xf + 1, w, t->wrap_s), y1 = fv_tex_wrap_index((int)yf + 1, h, t->wrap_t);
     tp->p[0] = px + ((size_t)y0 * (size_t)w + (size_t)x0) * 4, tp->p[1] = px + ((size_t)y0 * (size_t)w + (size_t)x1) * 4;
@@ -62,28 +70,33 @@ static inline void fv_tex_blend1(const fv_tex_tap *tp, float out[4])
     memcpy(out, o, sizeof o);
 }
 
-/* fv_texture_taps (scene_impl.h): the taps of the one or two mip levels around lod. */
+/* fv_texture_taps (scene_impl.h): the taps of the one or two mip levels around lod, as the
+ * texture's filters say (lod <= 0 magnifies: level 0, mag_nearest; else min_nearest and mip). */
 static inline void fv_tex_taps_at(const fv_texture *t, float u, float v, float lod, fv_tex_taps *tp)
 {
     if (!(lod > 0.0f)) lod = 0.0f; /* also NaN */
+    const int nearest = lod > 0.0f ? t->min_nearest : t->mag_nearest;
     const float top = (float)(t->levels - 1);
     tp->f = 0.0f;
+    if (t->mip == FV_MIP_NONE) lod = 0.0f;
+    else if (t->mip == FV_MIP_NEAREST) lod = floorf(lod + 0.5f);
     if (lod >= top) {
-        fv_tex_tap_at(t, t->levels - 1, u, v, &tp->tap[0]);
+        fv_tex_tap_at(t, t->levels - 1, u, v, &tp->tap[0], nearest);
         return;
     }
     const int l0 = (int)lod;
     tp->f = lod - (float)l0;
-    fv_tex_tap_at(t, l0, u, v, &tp->tap[0]);
+    fv_tex_tap_at(t, l0, u, v, &tp->tap[0], nearest);
     if (tp->f > 0.0f)
-        fv_tex_tap_at(t, l0 + 1, u, v, &tp->tap[1]);
+        fv_tex_tap_at(t, l0 + 1, u, v, &tp->tap[1], nearest);
 }
 
-/* Textures of the same size and wrap modes: fv_tex_taps_at of one at (u, v, lod) is the other's
- * at the same coordinates moved to its texels (fv_tex_taps_rebase). */
+/* Textures of the same size, wrap modes and filters: fv_tex_taps_at of one at (u, v, lod) is the
+ * other's at the same coordinates moved to its texels (fv_tex_taps_rebase). */
 static inline int fv_tex_same_layout(const fv_texture *a, const fv_texture *b)
 {
-    return a->w[0] == b->w[0] && a->h[0] == b->h[0] && a->wrap_s == b->wrap_s && a->wrap_t == b->wrap_t;
+    return a->w[0] == b->w[0] && a->h[0] == b->h[0] && a->wrap_s == b->wrap_s && a->wrap_t == b->wrap_t &&
+           a->mag_nearest == b->mag_nearest && a->min_nearest == b->min_nearest && a->mip == b->mip;
 }
 
 /* The taps fv_tex_taps_at(to, u, v, lod) gives, from src = fv_tex_taps_at(from, u, v, lod) with

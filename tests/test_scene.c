@@ -1570,6 +1570,83 @@ static void test_gltf_sampler_wrap(void **state)
     tmpdir_remove(dir);
 }
 
+/* Sampler filters (glTF magFilter / minFilter), on a 4x1 linear texture whose red texels are
+ * 0, 64, 128, 255 (/255): magnified (lod 0) at u = 0.3 the bilinear tap blends texels 0 and 1
+ * (x = 0.7), NEAREST gives texel 1 (u w = 1.2) exactly; minified, no mipmaps: level 0 whatever
+ * the lod; NEAREST mipmap: the nearest level (lod 0.7 -> 1, 0.4 -> 0) at its texel centre
+ * (u = 0.25 on level 1, 0.375 on level 0) exactly; NEAREST within levels blended linearly:
+ * texel 1 of level 0 and texel 0 of level 1 (u 2 = 0.6), half each at lod 0.5. Then the glTF
+ * sampler: the wrap test's quad with magFilter NEAREST gives white (texel 1) where the
+ * bilinear tap gave 0.9. */
+static void test_texture_filters(void **state)
+{
+    (void)state;
+    fv_scene *s = fv_scene_create();
+    const uint8_t px[16] = {0, 0, 0, 255, 64, 64, 64, 255, 128, 128, 128, 255, 255, 255, 255, 255};
+    const int id = fv_scene_add_texture_linear(s, px, 4, 1);
+    assert_true(id >= 0);
+    const fv_texture *t = &s->textures[id];
+    const float *l0 = t->level[0], *l1 = t->level[1];
+    float o[4];
+    fv_texture_sample(t, 0.3f, 0.5f, 0.0f, o); /* trilinear: a blend */
+    assert_true(o[0] > l0[0] && o[0] < l0[4]);
+    assert_int_equal(fv_scene_set_texture_filter(s, id, 1, 0, FV_MIP_LINEAR), 0);
+    fv_texture_sample(t, 0.3f, 0.5f, 0.0f, o);
+    assert_true(o[0] == l0[4]);
+    assert_int_equal(fv_scene_set_texture_filter(s, id, 0, 1, FV_MIP_NONE), 0);
+    fv_texture_sample(t, 0.3f, 0.5f, 1.3f, o);
+    assert_true(o[0] == l0[4]);
+    assert_int_equal(fv_scene_set_texture_filter(s, id, 0, 0, FV_MIP_NEAREST), 0);
+    fv_texture_sample(t, 0.25f, 0.5f, 0.7f, o);
+    assert_true(o[0] == l1[0]);
+    fv_texture_sample(t, 0.375f, 0.5f, 0.4f, o);
+    assert_true(o[0] == l0[4]);
+    assert_int_equal(fv_scene_set_texture_filter(s, id, 0, 1, FV_MIP_LINEAR), 0);
+    fv_texture_sample(t, 0.3f, 0.5f, 0.5f, o);
+    assert_true(o[0] == l0[4] + (l1[0] - l0[4]) * 0.5f);
+    assert_int_equal(fv_scene_set_texture_filter(s, id + 1, 0, 0, FV_MIP_LINEAR), -1);
+    fv_scene_free(s);
+
+    char *dir = tmpdir_make(), p[512], err[512];
+    const unsigned char bw[8] = {0, 0, 0, 255, 255, 255, 255, 255};
+    path_join(p, sizeof p, dir, "bw.png");
+    assert_true(stbi_write_png(p, 2, 1, 4, bw, 8) != 0);
+    unsigned char bin[92];
+    static const float uv[8] = {-1, 0.5f, 2, 0.5f, 2, 0.5f, -1, 0.5f};
+    quad_buffer(bin, uv);
+    const char *json =
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+        "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+        "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"images\":[{\"uri\":\"bw.png\"}],\"samplers\":[{\"magFilter\":9728,\"minFilter\":9984}],"
+        "\"textures\":[{\"source\":0,\"sampler\":0}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0},"
+        "\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0";
+    path_join(p, sizeof p, dir, "filter.gltf");
+    write_gltf(p, bin, sizeof bin, json);
+    s = fv_scene_load(p, err, sizeof err);
+    if (!s) print_error("%s\n", err);
+    assert_non_null(s);
+    assert_int_equal(s->textures[0].mag_nearest, 1);
+    assert_int_equal(s->textures[0].min_nearest, 1);
+    assert_int_equal(s->textures[0].mip, FV_MIP_NEAREST);
+    const float d[3] = {0, 0, -1}, xs[2] = {-8.0f / 15.0f, 0.8f};
+    for (int i = 0; i < 2; i++) {
+        const float org[3] = {xs[i], 0.3f, 5};
+        hit h;
+        float rgb[3];
+        cast_shade(s, org, d, 0, &h, rgb);
+        assert_near(rgb[1], 1.15f * 1.0f, 1e-4f);
+    }
+    check_packets(s, 31);
+    fv_scene_free(s);
+    tmpdir_remove(dir);
+}
+
 /* KHR_texture_transform on the base colour: a quad [-1,1]^2 with u = (x + 1)/2, v = 0.5 and the
  * 2x1 black | white texture (REPEAT), matte, head-on (rgb = 1.15 x texel). At x = -0.5 and 0.5
  * (u = 0.25 and 0.75, the texel centres):
@@ -2101,6 +2178,7 @@ int main(void)
         cmocka_unit_test(test_gltf_alpha_blend),
         cmocka_unit_test(test_gltf_vertex_colours),
         cmocka_unit_test(test_gltf_sampler_wrap),
+        cmocka_unit_test(test_texture_filters),
         cmocka_unit_test(test_gltf_texture_transform),
         cmocka_unit_test(test_load_flight_helmet),
         cmocka_unit_test(test_load_damaged_helmet),
