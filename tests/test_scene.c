@@ -1083,6 +1083,26 @@ static void test_gltf_material_maps(void **state)
     tmpdir_remove(dir);
 }
 
+/* Casts 16 rays (lane q: origin o[q % 4], direction d) through fv_scene_intersect16 and writes their
+ * hit distances (INFINITY for a miss). */
+static void cast16(const fv_scene *s, const float o[4][3], const float d[3], float t[16])
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    _Alignas(64) struct RTCRayHit16 rh;
+    memset(&rh, 0, sizeof rh);
+    _Alignas(64) int valid[16];
+    for (int q = 0; q < 16; q++) {
+        valid[q] = -1;
+        rh.ray.org_x[q] = o[q % 4][0], rh.ray.org_y[q] = o[q % 4][1], rh.ray.org_z[q] = o[q % 4][2];
+        rh.ray.dir_x[q] = d[0], rh.ray.dir_y[q] = d[1], rh.ray.dir_z[q] = d[2];
+        rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
+        rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
+    }
+    fv_scene_intersect16(s, valid, &ctx, &rh);
+    for (int q = 0; q < 16; q++) t[q] = rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar[q];
+}
+
 /* Alpha MASK (cutoff 0.6) in the ray query: a quad at z = 0 whose 2x1 base colour texture has
  * alpha 0 on the left half and 1 on the right, in front of a wall at z = -2 (the same quad,
  * opaque). From z = 5 straight down, a ray through the left half passes the cut-out and reaches
@@ -1132,19 +1152,10 @@ static void test_gltf_alpha_mask(void **state)
             assert_near(h.t, want_t[blend][i], 1e-5f);
         }
         /* the same rays as one packet of 16 (4 copies each) */
-        struct RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        _Alignas(64) struct RTCRayHit16 rh;
-        memset(&rh, 0, sizeof rh);
-        _Alignas(64) int valid[16];
-        for (int q = 0; q < 16; q++) {
-            valid[q] = -1;
-            rh.ray.org_x[q] = xs[q % 4], rh.ray.org_y[q] = 0.1f, rh.ray.org_z[q] = 5;
-            rh.ray.dir_z[q] = -1, rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
-            rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
-        }
-        fv_scene_intersect16(s, valid, &ctx, &rh);
-        for (int q = 0; q < 16; q++) assert_near(rh.ray.tfar[q], want_t[blend][q % 4], 1e-5f);
+        const float o4[4][3] = {{xs[0], 0.1f, 5}, {xs[1], 0.1f, 5}, {xs[2], 0.1f, 5}, {xs[3], 0.1f, 5}};
+        float t16[16];
+        cast16(s, o4, d, t16);
+        for (int q = 0; q < 16; q++) assert_near(t16[q], want_t[blend][q % 4], 1e-5f);
         fv_scene_free(s);
     }
     /* a cutoff out of range is refused */
@@ -1155,25 +1166,6 @@ static void test_gltf_alpha_mask(void **state)
     tmpdir_remove(dir);
 }
 
-/* Casts 16 rays (lane q: origin o[q % 4], direction d) through rtcIntersect16 and writes their
- * hit distances (INFINITY for a miss). */
-static void cast16(const fv_scene *s, const float o[4][3], const float d[3], float t[16])
-{
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    _Alignas(64) struct RTCRayHit16 rh;
-    memset(&rh, 0, sizeof rh);
-    _Alignas(64) int valid[16];
-    for (int q = 0; q < 16; q++) {
-        valid[q] = -1;
-        rh.ray.org_x[q] = o[q % 4][0], rh.ray.org_y[q] = o[q % 4][1], rh.ray.org_z[q] = o[q % 4][2];
-        rh.ray.dir_x[q] = d[0], rh.ray.dir_y[q] = d[1], rh.ray.dir_z[q] = d[2];
-        rh.ray.tfar[q] = INFINITY, rh.ray.mask[q] = 0xFFFFFFFFu;
-        rh.hit.geomID[q] = RTC_INVALID_GEOMETRY_ID;
-    }
-    fv_scene_intersect16(s, valid, &ctx, &rh);
-    for (int q = 0; q < 16; q++) t[q] = rh.hit.geomID[q] == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar[q];
-}
 
 /* doubleSided: the quad [-1,1]^2 at z = 0 (corners counter-clockwise seen from +z: its front
  * faces +z) as a default (single-sided) material at x = 0 and as a doubleSided one at x = 3,
