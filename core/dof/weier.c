@@ -133,7 +133,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
     const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 2 * lh + 3 * (size_t)th +
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 3 * (size_t)th +
                        4 * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
@@ -189,6 +189,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_hw = a, a += nl;
     x->l_v = a, a += 4 * nl;
     x->l_span = (int32_t *)(void *)a, a += 2 * x->lh; /* int32 and float have the same size */
+    x->l_nn = (int32_t *)(void *)a, a += 2 * x->lh;
     x->band_ms = a, a += 3 * x->th;
     x->hw = half_w(x->w), x->hh = half_w(x->h);
     x->hblur = a, a += 4 * (ptrdiff_t)x->hw * x->hh;

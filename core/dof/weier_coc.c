@@ -14,21 +14,27 @@ void fvw_coc_band(void *ctx, int band, int tid)
     const fv_pyr_level *l0 = &x->v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
     const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
-    for (int y = y0; y < y1; y++)
-        x->dsp->dof_coc_row(x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w, x->K, x->dn, x->df);
-    /* the tile statistics and the quarter-resolution near source in one kernel sweep per row: per
-     * 4x4 block the near pixels' colour sum and count (dof_nearblk_row), the smallest and largest
-     * c (ext: the largest near radius, the largest far c) */
+    /* per row the CoC and, while the row is in L1, the tile statistics and the quarter-resolution
+     * near source in one kernel sweep: per 4x4 block the near pixels' colour sum and count
+     * (dof_nearblk_row), the smallest and largest c (ext: the largest near radius, the largest
+     * far c) */
     const float inv_blk = 1.0f / (LOW * LOW);
     float *ext = fvw_slot(x, tid, 0);
     for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
         float *src = x->l_src + 4 * (ptrdiff_t)by * x->lw;
         memset(src, 0, (size_t)x->lw * 4 * sizeof(float));
         memset(ext, 0, (size_t)x->lw * 2 * sizeof(float));
-        for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++)
-            x->dsp->dof_nearblk_row(src, ext, x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w);
+        for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++) {
+            const float *rgbd = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
+            x->dsp->dof_coc_row(x->wk->p1[0] + y * st, rgbd, x->w, x->K, x->dn, x->df);
+            x->dsp->dof_nearblk_row(src, ext, x->wk->p1[0] + y * st, rgbd, x->w);
+        }
+        const float full_h = (float)(fv_mini(by * LOW + LOW, x->h) - by * LOW);
+        int nlo = x->lw, nhi = 0; /* the blocks with a pixel that is not near */
         for (int i = 0; i < x->lw; i++) {
             const int xa = i * LOW;
+            if (src[4 * i + 3] < full_h * (float)(fv_mini(xa + LOW, x->w) - xa))
+                nlo = nlo < i ? nlo : i, nhi = i + 1;
             float r = floorf(-ext[2 * i] * 0.5f); /* the largest near radius in pixels, capped */
             r = r < (float)FV_DOF_RMAX ? r : (float)FV_DOF_RMAX;
             /* the tile's largest near radius and far c (first block of the tile in the band: reset) */
@@ -44,6 +50,7 @@ void fvw_coc_band(void *ctx, int band, int tid)
             for (int k = 0; k < 4; k++)
                 src[4 * i + k] *= inv_blk;
         }
+        x->l_nn[2 * by] = nlo, x->l_nn[2 * by + 1] = nhi;
     }
     for (int tx = 0; tx < x->tw; tx++) /* far c -> sigma */
         x->t_fsig_own[band * x->tw + tx] *= 0.25f;

@@ -68,7 +68,6 @@ static void near_box_col(float *restrict out, const float *src, ptrdiff_t step, 
  * the centre rectangle, and the band's quarter-resolution rows. */
 void fvw_hpass_band(void *ctx, int band, int tid)
 {
-    (void)tid;
     fvw_ctx *x = ctx;
     const fv_pyr_level *l0 = &x->v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
@@ -92,10 +91,11 @@ void fvw_hpass_band(void *ctx, int band, int tid)
             }
             x->dsp->dof_hgauss_row(fh, rgbd, coc, x->w, xs, n, sig, x->tab);
         }
-        /* near sources of the row: premultiplied colour, radius (-1: not near), box weight
-         * (p4[0]'s row is free until the fused pass) */
-        float *s4 = x->wk->p4[0] + 4 * y * st, *sr = x->wk->p1[1] + y * st, *sw = x->wk->p1[2] + y * st;
-        float *nh = x->wk->p4[3] + 4 * y * st, *nr = x->wk->p4[2] + 4 * y * st, *nw = nr + st;
+        /* near sources of the row: premultiplied colour, radius (-1: not near), box weight, in
+         * the thread's row buffers (only this row reads them); the horizontal result's radius and
+         * weight go straight to p1[1] / p1[2] for the vertical pass */
+        float *s4 = fvw_slot(x, tid, 0), *sr = fvw_slot(x, tid, 1), *sw = sr + x->w;
+        float *nh = x->wk->p4[3] + 4 * y * st, *nr = x->wk->p1[1] + y * st, *nw = x->wk->p1[2] + y * st;
         int prepped = 0;
         for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
             const int reach = (int)x->t_near[band * x->tw + tx];
@@ -118,15 +118,6 @@ void fvw_hpass_band(void *ctx, int band, int tid)
             const int i0 = tx * TILE > x->cx0 ? tx * TILE : x->cx0, i1 = fv_mini((tx + 1) * TILE, x->cx1);
             x->dsp->dof_nearbox_row(nh, nr, nw, s4, sr, sw, x->w, i0, i1 - i0, reach);
         }
-        /* near radius / weight of the horizontal result moved into p1[1] / p1[2] for the
-         * vertical pass (the per-sample arrays are no longer needed) */
-        if (prepped)
-            for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
-                if (!(x->t_near[band * x->tw + tx] > 0.0f))
-                    continue;
-                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++)
-                    sr[i] = nr[i], sw[i] = nw[i];
-            }
     }
     /* the quarter-resolution rows of this band */
     if (x->l_reach >= 0)
@@ -160,7 +151,7 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
  * start): only over the columns whose texels are not all 0 (most of the image has no near
  * field), the rest of the row kept at 0 from the last row's dirty span [*da, *db). The same
  * values as up-sampling the whole row (0 + a (0 - 0) is 0). */
-static void near_upsample_row(const fvw_ctx *x, int tid, int y, float *restrict lup, int *da, int *db)
+static void near_upsample_row(const fvw_ctx *x, int tid, int y, float *restrict lup, int *da, int *db, int na, int nb)
 {
     const float v = ((float)y + 0.5f) * (1.0f / LOW) - 0.5f, fv = floorf(v);
     const int r0 = fv_clampi((int)fv, 0, x->lh - 1), r1 = fv_clampi((int)fv + 1, 0, x->lh - 1);
@@ -172,6 +163,10 @@ static void near_upsample_row(const fvw_ctx *x, int tid, int y, float *restrict 
         xa = fv_clampi(LOW * lo - LOW, 0, x->w);
         xb = fv_clampi(LOW * hi + LOW, 0, x->w);
     }
+    /* and only where it is read: [na, nb) (beyond it the row keeps its 0s or stale values) */
+    xa = xa > na ? xa : na, xb = xb < nb ? xb : nb;
+    if (xa >= xb)
+        xa = xb = x->w;
     /* zero what the last row left outside [xa, xb) */
     if (*da < *db) {
         const int za = *da, zb = fv_mini(*db, xa);
@@ -304,6 +299,27 @@ static void periphery_row(const fvw_ctx *x, int tid, int y, const float *coc, co
     x->dsp->dof_pyrblur_row(blur, &pa, xa, xb - xa);
 }
 
+/* Row y of the half-resolution blur up-sampled vertically (fixed taps 0.25 / 0.75) into h over the
+ * texels that the pixels [0, a) and [b, w) read (dof_periph_row: x / 2 and its neighbours), with
+ * h[-1] = h[0] and h[hw] = h[hw - 1] (the borders clamp). */
+static void half_row(const fvw_ctx *x, int y, float *restrict h, int a0, int a, int b)
+{
+    const float v = ((float)y + 0.5f) * 0.5f - 0.5f, fv = floorf(v), ay = v - fv;
+    const float *ra = x->hblur + 4 * (ptrdiff_t)fv_clampi((int)fv, 0, x->hh - 1) * x->hw;
+    const float *rb = x->hblur + 4 * (ptrdiff_t)fv_clampi((int)fv + 1, 0, x->hh - 1) * x->hw;
+    const int seg[2][2] = {{a0, a}, {b, x->w}};
+    for (int k = 0; k < 2; k++) {
+        if (seg[k][0] >= seg[k][1])
+            continue;
+        const int ka = fv_maxi((seg[k][0] >> 1) - 1, 0), kb = fv_mini(((seg[k][1] - 1) >> 1) + 2, x->hw);
+        vlerp(h + 4 * ka, ra + 4 * ka, rb + 4 * ka, ay, 4 * (kb - ka));
+        if (ka == 0)
+            memcpy(h - 4, h, 4 * sizeof(float));
+        if (kb == x->hw)
+            memcpy(h + 4 * x->hw, h + 4 * (x->hw - 1), 4 * sizeof(float));
+    }
+}
+
 /* The fused vertical pass and combine of one band. */
 void fvw_vcombine_band(void *ctx, int band, int tid)
 {
@@ -319,6 +335,11 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
      * quarter-resolution near layer up-sampled (14) */
     float *far = fvw_slot(x, tid, 0), *near = fvw_slot(x, tid, 1), *trow = fvw_slot(x, tid, 8);
     float *enh = x->enh_on ? fvw_slot(x, tid, 10) : NULL;
+    /* beyond the disc (t = 1) one kernel (dof_periph_row) blurs and combines from the half-
+     * resolution blur's row (slot 9, a texel of clamped border each side); with contrast
+     * enhancement the chain of kernels */
+    const int fused = x->half_on && !enh && !v->prm->chain_periphery;
+    float *hrow = fvw_slot(x, tid, 9) + 4;
     uint8_t sig[TILE * 8];
     double filter_ns = 0.0, combine_ns = 0.0, output_ns = 0.0;
     /* t is 1 outside the disc of radius r1: the row holds 1 except across the disc's span, which
@@ -353,12 +374,16 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
                     for (int k = 0; k < 3; k++)
                         far[4 * i + k] /= far[4 * i + 3];
         }
-        if (x->half_on) {
+        if (fused) /* beyond the disc the combine's kernel reads the half-resolution blur itself */
+            half_row(x, y, hrow, 0, tx0, tx1);
+        else if (x->half_on) {
             periphery_row(x, tid, y, coc, trow, sharp, far, 0, tx0);
             periphery_row(x, tid, y, coc, trow, sharp, far, tx1, x->w);
             blur_periphery(x, tid, y, coc, trow, sharp, far, tx0, tx1);
         } else
             blur_periphery(x, tid, y, coc, trow, sharp, far, 0, x->w);
+        if (fused)
+            blur_periphery(x, tid, y, coc, trow, sharp, far, tx0, tx1);
         /* near: full resolution in the centre rectangle (pixels with t < 1); the quarter-
          * resolution layer up-sampled is blended in by t in the combine */
         float *nfull = NULL;
@@ -396,14 +421,28 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         float *lup = NULL;
         if (x->l_reach >= 0) {
             lup = fvw_slot(x, tid, 14);
-            near_upsample_row(x, tid, y, lup, &lup_da, &lup_db);
+            /* read only by pixels that are not near (c >= 0: the blocks l_nn spans) and, by the
+             * chain's combine, across the disc */
+            int na = 0, nb = x->w;
+            if (fused) {
+                const int32_t *nn = x->l_nn + 2 * (y / LOW);
+                na = nn[0] < nn[1] ? LOW * nn[0] : x->w, nb = nn[0] < nn[1] ? fv_mini(LOW * nn[1], x->w) : 0;
+                if (tx0 < tx1)
+                    na = na < tx0 ? na : tx0, nb = nb > tx1 ? nb : tx1;
+            }
+            near_upsample_row(x, tid, y, lup, &lup_da, &lup_db, na, nb);
         }
         if (enh)
             fvw_enhance_row(x, tid, y, sharp, trow, enh);
         const int64_t tb = fv_time_ns();
         /* without a float image the row lives in slot 13 only, converted while in cache */
         float *orow = x->out ? x->out + 4 * (ptrdiff_t)y * x->out_stride : fvw_slot(x, tid, 13);
-        fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh);
+        if (fused) {
+            fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh, tx0, tx1);
+            x->dsp->dof_periph_row(orow, sharp, coc, hrow, lup, 0, tx0);
+            x->dsp->dof_periph_row(orow, sharp, coc, hrow, lup, tx1, x->w - tx1);
+        } else
+            fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh, 0, x->w);
         const int64_t tc = fv_time_ns();
         if (v->conv) /* the output stage on the row just written, while it is in cache */
             fv_output_convert(v->conv, orow, x->out_stride, x->w, 1, NULL, NULL, v->rgb8 + (ptrdiff_t)y * v->rgb8_stride,

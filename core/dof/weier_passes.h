@@ -53,6 +53,7 @@ typedef struct {
     float *l_src, *l_r, *l_w;  /* source: premultiplied (rgb, coverage) / radius / box weight */
     float *l_h, *l_hr, *l_hw;  /* after the horizontal pass */
     float *l_v;                /* after the vertical pass */
+    int32_t *l_nn;             /* per block row: the blocks [l_nn[2 by], l_nn[2 by + 1]) holding a pixel that is not near */
     int32_t *l_span;           /* per row of l_v: its texels [l_span[2 by], l_span[2 by + 1]) that are not all 0 */
     int l_reach;               /* the largest radius there */
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
@@ -117,6 +118,6 @@ void fvw_vcombine_band(void *ctx, int band, int tid);
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
 void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
-                     const float *lnear, const float *trow, const float *enh);
+                     const float *lnear, const float *trow, const float *enh, int xa, int xb);
 
 #endif
