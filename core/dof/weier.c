@@ -152,7 +152,9 @@ static int ensure_aux(fv_dof_work *wk, int threads)
         for (int L = 1; L < MAX_UP_LEVEL; L++) /* level L + 1 onto the level 1 grid */
             fvw_xtaps_init(&xh[L], L, half_w(w), (half_w(w) + (1 << L) - 1) >> L);
     }
-    const size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
+    size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
+    if (rows < 8 * (size_t)w + (size_t)tw * th) /* the tile dilation's temporary after slots 0, 1 */
+        rows = 8 * (size_t)w + (size_t)tw * th;
     if (wk->rows_len < rows) {
         free(wk->rows);
         if (!(wk->rows = malloc(rows * sizeof(float))))

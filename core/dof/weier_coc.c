@@ -56,27 +56,37 @@ void fvw_coc_band(void *ctx, int band, int tid)
         x->t_fsig_own[band * x->tw + tx] *= 0.25f;
 }
 
-/* Each tile learns the largest near radius / far sigma of the tiles within reach. */
+/* max over the (2 r + 1)^2 tiles around each tile of src into dst (borders: the tiles that
+ * exist), separably: rows into tmp, then columns */
+static void tile_max(float *restrict dst, const float *src, float *restrict tmp, int tw, int th, int r)
+{
+    for (int ty = 0; ty < th; ty++)
+        for (int tx = 0; tx < tw; tx++) {
+            float m = 0.0f;
+            for (int i = fv_maxi(tx - r, 0); i <= fv_mini(tx + r, tw - 1); i++)
+                m = src[ty * tw + i] > m ? src[ty * tw + i] : m;
+            tmp[ty * tw + tx] = m;
+        }
+    for (int ty = 0; ty < th; ty++)
+        for (int tx = 0; tx < tw; tx++) {
+            float m = 0.0f;
+            for (int j = fv_maxi(ty - r, 0); j <= fv_mini(ty + r, th - 1); j++)
+                m = tmp[j * tw + tx] > m ? tmp[j * tw + tx] : m;
+            dst[ty * tw + tx] = m;
+        }
+}
+
+/* Each tile learns the largest near radius / far sigma of the tiles within reach (a max is
+ * separable: the same values as the square window). */
 void fvw_dilate_tiles(fvw_ctx *x)
 {
     float rmax = 0.0f;
     for (int i = 0; i < x->tw * x->th; i++)
         rmax = x->t_near_own[i] > rmax ? x->t_near_own[i] : rmax;
     const int dn = (int)ceilf(rmax / TILE), df = (FV_DOF_RMAX + TILE - 1) / TILE;
-    for (int ty = 0; ty < x->th; ty++)
-        for (int tx = 0; tx < x->tw; tx++) {
-            float n = 0.0f, f = 0.0f;
-            for (int j = ty - dn; j <= ty + dn; j++)
-                for (int i = tx - dn; i <= tx + dn; i++)
-                    if (j >= 0 && j < x->th && i >= 0 && i < x->tw && x->t_near_own[j * x->tw + i] > n)
-                        n = x->t_near_own[j * x->tw + i];
-            for (int j = ty - df; j <= ty + df; j++)
-                for (int i = tx - df; i <= tx + df; i++)
-                    if (j >= 0 && j < x->th && i >= 0 && i < x->tw && x->t_fsig_own[j * x->tw + i] > f)
-                        f = x->t_fsig_own[j * x->tw + i];
-            x->t_near[ty * x->tw + tx] = n;
-            x->t_fsig[ty * x->tw + tx] = f;
-        }
+    float *tmp = fvw_slot(x, 0, 2); /* thread 0's row buffers 2.. (free between the passes) */
+    tile_max(x->t_near, x->t_near_own, tmp, x->tw, x->th, dn);
+    tile_max(x->t_fsig, x->t_fsig_own, tmp, x->tw, x->th, df);
     int lr = -1; /* -1: no near block at all */
     for (ptrdiff_t i = 0; i < (ptrdiff_t)x->lw * x->lh; i++)
         lr = x->l_r[i] > (float)lr ? (int)x->l_r[i] : lr;

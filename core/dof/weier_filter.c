@@ -46,22 +46,40 @@ void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps
     dsp->dof_upsample_row(dst + 4 * xa, tmp, xt->i0 + xa, xt->i1 + xa, xt->ax + xa, xb - xa);
 }
 
-/* The scatter-as-gather box down a column (the horizontal one is the kernel dof_nearbox_row):
- * out = sum over samples s within `reach` whose radius r[s] >= |i - s| of wgt[s] * src[s]. */
-static void near_box_col(float *restrict out, const float *src, ptrdiff_t step, const float *r, const float *wgt,
-                         ptrdiff_t rstep, int i, int n, int reach)
+/* One tap row of the scatter-as-gather box down the columns (the horizontal one is the kernel
+ * dof_nearbox_row): out[i] += wgt[i] src[i] for the n columns whose radius r[i] >= aj (the tap's
+ * |offset|). Row by row in the reference's order of taps; a tap that does not reach adds +0
+ * (0 times a finite value) to a sum that started at +0, which leaves its bits as skipping it
+ * did, so the loop has no branch and the compiler can vectorise it. */
+static void near_box_tap(float *restrict out, const float *restrict src, const float *restrict r,
+                         const float *restrict wgt, float aj, int n)
 {
-    float acc[4] = {0, 0, 0, 0};
-    const int jlo = i - reach > 0 ? -reach : -i, jhi = i + reach < n ? reach : n - 1 - i;
-    for (int j = jlo; j <= jhi; j++) {
-        const float rs = r[(i + j) * rstep];
-        if (rs < (float)(j < 0 ? -j : j)) /* not near (-1), or does not reach */
-            continue;
-        const float ws = wgt[(i + j) * rstep], *p = src + (i + j) * step;
+    for (int i = 0; i < n; i++) {
+        const float m = r[i] < aj ? 0.0f : wgt[i];
         for (int c = 0; c < 4; c++)
-            acc[c] += ws * p[c];
+            out[4 * i + c] += m * src[4 * i + c];
     }
-    memcpy(out, acc, sizeof acc);
+}
+
+/* The near sources of columns [lo, hi): radius r = min(floor(-c / 2), FV_DOF_RMAX) for c < 0,
+ * else -1; box weight 1 / (2 max(r, 0) + 1); colour with coverage 1. floor is the truncation of
+ * the clamped, non-negative half CoC, so the loop vectorises (SSE2 conversions). */
+static void near_sources(float *restrict s4, float *restrict sr, float *restrict sw, const float *restrict rgbd,
+                         const float *restrict coc, int lo, int hi)
+{
+    for (int i = lo; i < hi; i++) {
+        const float c = coc[i], h = -c * 0.5f;
+        const float hc = h < (float)FV_DOF_RMAX ? (h > 0.0f ? h : 0.0f) : (float)FV_DOF_RMAX;
+        const float r = c < 0.0f ? (float)(int)hc : -1.0f;
+        sr[i] = r;
+        sw[i] = 1.0f / (2.0f * (r > 0.0f ? r : 0.0f) + 1.0f);
+    }
+    for (int i = lo; i < hi; i++) {
+        s4[4 * i + 0] = rgbd[4 * i + 0];
+        s4[4 * i + 1] = rgbd[4 * i + 1];
+        s4[4 * i + 2] = rgbd[4 * i + 2];
+        s4[4 * i + 3] = 1.0f;
+    }
 }
 
 /* Horizontal pass of one band: far_h (p4[1]) and near_h (p4[3], radius p1[2], weight p1[1]) in
@@ -104,15 +122,7 @@ void fvw_hpass_band(void *ctx, int band, int tid)
             if (!prepped) {
                 const int lo = x->cx0 - FV_DOF_RMAX > 0 ? x->cx0 - FV_DOF_RMAX : 0;
                 const int hi = fv_mini(x->cx1 + FV_DOF_RMAX, x->w);
-                for (int i = lo; i < hi; i++) {
-                    const float rc = floorf(-coc[i] * 0.5f);
-                    const float r = coc[i] < 0.0f ? (rc < (float)FV_DOF_RMAX ? rc : (float)FV_DOF_RMAX) : -1.0f;
-                    sr[i] = r;
-                    sw[i] = 1.0f / (2.0f * (r > 0.0f ? r : 0.0f) + 1.0f);
-                    for (int c = 0; c < 3; c++)
-                        s4[4 * i + c] = rgbd[4 * i + c];
-                    s4[4 * i + 3] = 1.0f;
-                }
+                near_sources(s4, sr, sw, rgbd, coc, lo, hi);
                 prepped = 1;
             }
             const int i0 = tx * TILE > x->cx0 ? tx * TILE : x->cx0, i1 = fv_mini((tx + 1) * TILE, x->cx1);
@@ -135,13 +145,16 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
     fvw_ctx *x = ctx;
     for (int by = band * (TILE / LOW); by < fv_mini((band + 1) * (TILE / LOW), x->lh); by++) {
         int lo = x->lw, hi = 0;
-        for (int i = 0; i < x->lw; i++) {
-            float *o = x->l_v + 4 * ((ptrdiff_t)by * x->lw + i);
-            near_box_col(o, x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw, x->l_hr + i, x->l_hw + i, x->lw, by, x->lh,
-                         x->l_reach);
-            if (o[0] != 0.0f || o[1] != 0.0f || o[2] != 0.0f || o[3] != 0.0f)
-                lo = lo < i ? lo : i, hi = i + 1;
+        float *o = x->l_v + 4 * (ptrdiff_t)by * x->lw;
+        memset(o, 0, (size_t)x->lw * 4 * sizeof(float));
+        const int reach = x->l_reach, jlo = by - reach > 0 ? -reach : -by, jhi = by + reach < x->lh ? reach : x->lh - 1 - by;
+        for (int j = jlo; j <= jhi; j++) {
+            const ptrdiff_t q = (ptrdiff_t)(by + j) * x->lw;
+            near_box_tap(o, x->l_h + 4 * q, x->l_hr + q, x->l_hw + q, (float)(j < 0 ? -j : j), x->lw);
         }
+        for (int i = 0; i < x->lw; i++)
+            if (o[4 * i] != 0.0f || o[4 * i + 1] != 0.0f || o[4 * i + 2] != 0.0f || o[4 * i + 3] != 0.0f)
+                lo = lo < i ? lo : i, hi = i + 1;
         x->l_span[2 * by] = lo < hi ? lo : 0;
         x->l_span[2 * by + 1] = lo < hi ? hi : 0;
     }
@@ -262,12 +275,25 @@ void fvw_hblur_band(void *ctx, int band, int tid)
             const int a = seg[k][0], b = seg[k][1];
             if (a >= b)
                 continue;
-            for (int u = a; u < b; u++) {
+            /* the 2x2 mean |c| (the last column of an odd width clamps) and its largest value */
+            const int bb = 2 * b <= x->w ? b : b - 1;
+            float amax = 0.0f;
+            for (int u = a; u < bb; u++) {
+                const float m = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
+                ch[u] = m;
+                amax = m > amax ? m : amax;
+            }
+            for (int u = bb; u < b; u++) {
                 const int i0 = 2 * u, i1 = fv_mini(2 * u + 1, x->w - 1);
                 ch[u] = 0.25f * ((fabsf(ca[i0]) + fabsf(ca[i1])) + (fabsf(cb[i0]) + fabsf(cb[i1])));
+                amax = ch[u] > amax ? ch[u] : amax;
             }
             memcpy(blur + 4 * a, sharp + 4 * a, (size_t)(b - a) * 4 * sizeof(float));
-            const int need = fv_mini(levels_needed(x->lambda_h, ch, ones, a, b), x->up_levels - 1);
+            int need = 0; /* levels_needed's: the deepest level the largest |c| reads */
+            if (amax > 0.0f) {
+                const float l = x->lambda_h[fv_mini((int)(amax * LAMBDA_STEPS), (LAMBDA_N - 1))];
+                need = fv_mini((int)l + (l > (float)(int)l), x->up_levels - 1);
+            }
             float *up[MAX_UP_LEVEL];
             up[0] = (float *)sharp;
             for (int L = 1; L <= need; L++) {
@@ -389,7 +415,12 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         float *nfull = NULL;
         if (centre_row) {
             nfull = near;
-            memset(near, 0, (size_t)x->w * 4 * sizeof(float));
+            /* the near loop writes only pixels with t < 1 (the disc's span), which is all the
+             * fused path's combine reads */
+            if (fused)
+                memset(near + 4 * tx0, 0, (size_t)(tx1 - tx0) * 4 * sizeof(float));
+            else
+                memset(near, 0, (size_t)x->w * 4 * sizeof(float));
             for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
                 const int reach = (int)x->t_near[(y / TILE) * x->tw + tx];
                 if (reach <= 0)
