@@ -134,7 +134,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
     const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 3 * (size_t)th +
-                       4 * (size_t)half_w(w) * (size_t)half_w(h);
+                       5 * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
         if (!(wk->aux = malloc(aux * sizeof(float))))
@@ -195,6 +195,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->band_ms = a, a += 3 * x->th;
     x->hw = half_w(x->w), x->hh = half_w(x->h);
     x->hblur = a, a += 4 * (ptrdiff_t)x->hw * x->hh;
+    x->hcoc = a, a += (ptrdiff_t)x->hw * x->hh;
     /* the centre rectangle: the transition disc plus the kernels' reach */
     const float reach = v->r1_px + 2.0f * FV_DOF_RMAX;
     x->cx0 = fv_clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = fv_clampi((int)ceilf(v->gaze_x + reach), 0, x->w);

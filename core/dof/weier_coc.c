@@ -51,6 +51,17 @@ void fvw_coc_band(void *ctx, int band, int tid)
                 src[4 * i + k] *= inv_blk;
         }
         x->l_nn[2 * by] = nlo, x->l_nn[2 * by + 1] = nhi;
+        /* the half-resolution periphery's CoC while the block row is in cache: per level-1 texel
+         * the mean |c| of its 2x2 pixels (the last column / row of an odd size clamps) */
+        for (int vy = 2 * by; x->half_on && vy < fv_mini(2 * by + 2, x->hh); vy++) {
+            const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
+            float *ch = x->hcoc + (ptrdiff_t)vy * x->hw;
+            const int uw = x->w / 2; /* texels with two columns */
+            for (int u = 0; u < uw; u++)
+                ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
+            for (int u = uw; u < x->hw; u++)
+                ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u])));
+        }
     }
     for (int tx = 0; tx < x->tw; tx++) /* far c -> sigma */
         x->t_fsig_own[band * x->tw + tx] *= 0.25f;

@@ -250,8 +250,7 @@ void fvw_hblur_band(void *ctx, int band, int tid)
         return;
     const fv_dof_view *v = x->v;
     const fv_pyr_level *l1 = &v->pyr->lv[1];
-    const ptrdiff_t st = x->wk->stride;
-    float *ch = fvw_slot(x, tid, 1), *tmp = fvw_slot(x, tid, 2), *ones = fvw_slot(x, tid, 8);
+    float *tmp = fvw_slot(x, tid, 2), *ones = fvw_slot(x, tid, 8);
     for (int i = 0; i < x->hw; i++)
         ones[i] = 1.0f;
     /* a texel's centre is within 2 px per axis of every pixel it feeds, pixels outside the disc
@@ -267,7 +266,7 @@ void fvw_hblur_band(void *ctx, int band, int tid)
             if (u1 <= u0)
                 u0 = u1 = x->hw;
         }
-        const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
+        const float *ch = x->hcoc + (ptrdiff_t)vy * x->hw; /* the 2x2-mean |c| (the CoC pass) */
         const float *sharp = l1->rgbd + 4 * (ptrdiff_t)vy * l1->stride;
         float *blur = x->hblur + 4 * (ptrdiff_t)vy * x->hw;
         const int seg[2][2] = {{0, u0}, {u1, x->hw}};
@@ -275,19 +274,9 @@ void fvw_hblur_band(void *ctx, int band, int tid)
             const int a = seg[k][0], b = seg[k][1];
             if (a >= b)
                 continue;
-            /* the 2x2 mean |c| (the last column of an odd width clamps) and its largest value */
-            const int bb = 2 * b <= x->w ? b : b - 1;
             float amax = 0.0f;
-            for (int u = a; u < bb; u++) {
-                const float m = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
-                ch[u] = m;
-                amax = m > amax ? m : amax;
-            }
-            for (int u = bb; u < b; u++) {
-                const int i0 = 2 * u, i1 = fv_mini(2 * u + 1, x->w - 1);
-                ch[u] = 0.25f * ((fabsf(ca[i0]) + fabsf(ca[i1])) + (fabsf(cb[i0]) + fabsf(cb[i1])));
+            for (int u = a; u < b; u++)
                 amax = ch[u] > amax ? ch[u] : amax;
-            }
             memcpy(blur + 4 * a, sharp + 4 * a, (size_t)(b - a) * 4 * sizeof(float));
             int need = 0; /* levels_needed's: the deepest level the largest |c| reads */
             if (amax > 0.0f) {

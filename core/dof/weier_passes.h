@@ -65,6 +65,7 @@ typedef struct {
     int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
     int hw, hh;                /* level 1's size */
     float *hblur;              /* hw x hh x 4: level 1 blurred by the half-resolution CoC */
+    float *hcoc;               /* hw x hh: that CoC, the 2x2 mean of |c| (written by the CoC pass) */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
     xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
 } fvw_ctx;
