@@ -21,7 +21,10 @@
  *        Beyond the transition disc (one ray per ~5 pixels there) the levels >= 1 part runs on
  *        the level 1 grid with a 2x2-mean |c| (fvw_hblur_band) and each row reads it up-sampled as
  *        its level 1, so a pixel below level 1 still mixes its own sharp colour at full resolution
- *        (tests/test_dof.c bounds the difference to the full-resolution path).
+ *        (tests/test_dof.c bounds the difference to the full-resolution path). There (t = 1) one
+ *        kernel, dof_periph_row, does it all per pixel: the half-resolution row up-sampled by 2
+ *        with fixed taps, the own-blur weight min(|c|, 1) min(3 c^2 / 44, 1) in closed form (the
+ *        combine's min(1, |c|) times the level-0..1 interpolation), the near layer, the combine.
  *   near (c < 0): scatter-as-gather box: a near sample of radius r = min(floor(|c| / 2), 24)
  *        covers 2r + 1 pixels with weight 1 / (2r + 1) each, so it spreads over whatever lies
  *        around it (the focused background included) and the sum of the weights is the layer's
@@ -39,9 +42,10 @@
  *
  * The filter's vertical pass and the combine run fused per row (the layers never go to memory
  * as full images); their times are the workers' time in each, scaled to the pass's wall time.
- * Pass order: CoC (+ per-block statistics, kernel dof_nearblk_row) -> horizontal pass (centre
- * rectangle; near boxes by dof_nearbox_row) -> quarter-resolution vertical pass -> the
- * periphery's half-resolution blur -> fused vertical pass + combine.
+ * Pass order: CoC (+ per-block statistics, kernel dof_nearblk_row, and the half-resolution
+ * periphery's 2x2-mean CoC) -> horizontal pass (centre rectangle; near boxes by dof_nearbox_row)
+ * -> quarter-resolution vertical pass -> the periphery's half-resolution blur -> fused vertical
+ * pass + combine (dof_periph_row beyond the disc).
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *

@@ -410,32 +410,29 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
                 memset(near + 4 * tx0, 0, (size_t)(tx1 - tx0) * 4 * sizeof(float));
             else
                 memset(near, 0, (size_t)x->w * 4 * sizeof(float));
+            /* the vertical scatter-as-gather box over the tile's columns, a tap row at a time
+             * (near_box_tap: in the reference's order of taps, +0 where a tap does not reach; a
+             * horizontal result with no sample, w = 0, is all +0 and adds nothing), only over
+             * pixels with t < 1, i.e. within the disc's span; rows of the column outside the
+             * rectangle or in tiles no near sample reaches hold no near_h: stay within
+             * [cy0, cy1) and skip those tiles */
             for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
                 const int reach = (int)x->t_near[(y / TILE) * x->tw + tx];
-                if (reach <= 0)
+                const int ia = fv_maxi(fv_maxi(tx * TILE, x->cx0), tx0), ib = fv_mini(fv_mini((tx + 1) * TILE, x->cx1), tx1);
+                if (reach <= 0 || ia >= ib)
                     continue;
-                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++) {
-                    if (!(trow[i] < 1.0f))
+                const int jlo = y - reach > x->cy0 ? -reach : x->cy0 - y;
+                const int jhi = y + reach < x->cy1 ? reach : x->cy1 - 1 - y;
+                for (int j = jlo; j <= jhi; j++) {
+                    const int s = y + j;
+                    if (!(x->t_near[(s / TILE) * x->tw + tx] > 0.0f))
                         continue;
-                    /* rows of the column outside the rectangle or in tiles no near sample
-                     * reaches hold no near_h: stay within [cy0, cy1) and skip those tiles */
-                    float acc[4] = {0, 0, 0, 0};
-                    const int jlo = y - reach > x->cy0 ? -reach : x->cy0 - y;
-                    const int jhi = y + reach < x->cy1 ? reach : x->cy1 - 1 - y;
-                    for (int j = jlo; j <= jhi; j++) {
-                        const int s = y + j;
-                        if (!(x->t_near[(s / TILE) * x->tw + tx] > 0.0f))
-                            continue;
-                        const float *nh = x->wk->p4[3] + 4 * (s * st + i);
-                        const float r = x->wk->p1[1][s * st + i];
-                        if (!(nh[3] > 0.0f) || r < (float)(j < 0 ? -j : j))
-                            continue;
-                        const float wgt = x->wk->p1[2][s * st + i];
-                        for (int c = 0; c < 4; c++)
-                            acc[c] += wgt * nh[c];
-                    }
-                    memcpy(near + 4 * i, acc, sizeof acc);
+                    near_box_tap(near + 4 * ia, x->wk->p4[3] + 4 * (s * st + ia), x->wk->p1[1] + s * st + ia,
+                                 x->wk->p1[2] + s * st + ia, (float)(j < 0 ? -j : j), ib - ia);
                 }
+                for (int i = ia; i < ib; i++)
+                    if (!(trow[i] < 1.0f))
+                        memset(near + 4 * i, 0, 4 * sizeof(float));
             }
         }
         float *lup = NULL;
