@@ -8,6 +8,7 @@
 #include "dof/dof.h"
 #include "dof/weier_impl.h"
 #include "render_dsp.h"
+#include "base/util.h"
 
 #define W 200
 #define H 160
@@ -337,6 +338,135 @@ static void test_half_res_periphery(void **st)
     rig_free(&b);
 }
 
+/* Beyond the transition disc one kernel (dof_periph_row) blends the sharp row towards the
+ * half-resolution blur up-sampled by 2, with the own-blur weight in closed form: w = min(|c|, 1)
+ * min(|c|^2 3 / 44, 1) (the level-0..1 interpolation of the disc's variance, which the level table
+ * held in steps of 1/8 px). A far plane with c = 2.06 px (off the table's grid; its 2x2-mean CoC
+ * selects level 1 itself on the half grid): every peripheral pixel is s + w (U - s), U level 1
+ * up-sampled bilinearly (computed here in double), within 2e-6. The table's w (c taken as 2.0)
+ * is 0.0166 lower: the chain of kernels fails this (max 6.3e-3). */
+static void busy(int x, int y, float px[4]);
+#define C206_FOCUS 1.0f
+static float c206_depth(void)
+{
+    const double K = 4.49e-3 * FOCAL * fv_dof_presets[FV_DOF_MEDIUM].e_scale, df = C206_FOCUS + 0.2;
+    return (float)(1.0 / (1.0 / df - 2.06 / K));
+}
+static void plane_c206(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = c206_depth();
+}
+
+static void test_periph_closed_form(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, plane_c206, FV_DOF_MEDIUM, C206_FOCUS, 40.0f, 40.0f);
+    assert_float_equal(r.prm.pupil_mm, 4.49f, 0.0f);
+    rig_run(&r, NULL, ~0u);
+    const double K = 4.49e-3 * FOCAL * r.v.blur_scale;
+    const double c = K * (1.0 / (C206_FOCUS + 0.2) - 1.0 / (double)c206_depth());
+    const double w = fmin(c, 1.0) * fmin(c * c * 3.0 / 44.0, 1.0);
+    const fv_pyr_level *l1 = &r.pyr.lv[1];
+    double mx = 0.0, dmax = 0.0;
+    int n = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const float dx = (float)x + 0.5f - 40.0f, dy = (float)y + 0.5f - 40.0f;
+            if (dx * dx + dy * dy < 62.0f * 62.0f)
+                continue;
+            const double u = ((double)x + 0.5) * 0.5 - 0.5, v = ((double)y + 0.5) * 0.5 - 0.5;
+            const int u0 = (int)floor(u), v0 = (int)floor(v);
+            const double au = u - u0, av = v - v0;
+            for (int k = 0; k < 3; k++) {
+                double t[2];
+                for (int j = 0; j < 2; j++) {
+                    const int yy = fv_clampi(v0 + j, 0, l1->h - 1);
+                    const float *row = l1->rgbd + 4 * (ptrdiff_t)yy * l1->stride;
+                    const double a = row[4 * fv_clampi(u0, 0, l1->w - 1) + k], b = row[4 * fv_clampi(u0 + 1, 0, l1->w - 1) + k];
+                    t[j] = a + au * (b - a);
+                }
+                const double U = t[0] + av * (t[1] - t[0]), s = in_px(&r, x, y)[k];
+                const double e = s + w * (U - s), d = fabs((double)out_px(&r, x, y)[k] - e);
+                mx = d > mx ? d : mx, n++;
+                dmax = fabs(U - s) > dmax ? fabs(U - s) : dmax;
+            }
+            assert_memory_equal(&out_px(&r, x, y)[3], &in_px(&r, x, y)[3], sizeof(float));
+        }
+    print_message("periphery closed form: c %.4f px, w %.5f, max |out - expected| %.2e over %d values (max |U - s| %.3f)\n",
+                  c, w, mx, n, dmax);
+    assert_true(n > 10000 && dmax > 0.3);
+    assert_true(mx <= 2e-6);
+    rig_free(&r);
+}
+
+/* The fused periphery against the chain of kernels it replaced (up-sampling, pyramid blend,
+ * combine; prm.chain_periphery) on the receding floor (every CoC 0..~60 px, strong): the fovea
+ * and transition ring bit for bit; beyond them they differ only by the level table's steps of
+ * 1/8 px: |w - w_table| <= 3/44 (c^2 - (c - 1/8)^2) < 3/44 * 2 * 3.83 / 8 = 0.066 below the
+ * knee (|c| = 3.83, where both reach 1) times |U - s| <= 0.8: max <= 0.053, and on average far
+ * less (measured: see the message). */
+static void test_fused_periphery_vs_chain(void **st)
+{
+    (void)st;
+    rig a, b;
+    rig_init(&a, receding_floor, FV_DOF_STRONG, 1.5f, 100.0f, 80.0f);
+    rig_init(&b, receding_floor, FV_DOF_STRONG, 1.5f, 100.0f, 80.0f);
+    b.prm.chain_periphery = 1;
+    rig_run(&a, NULL, ~0u);
+    rig_run(&b, NULL, ~0u);
+    double sum = 0.0, mx = 0.0;
+    int n = 0, diff = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const float dx = (float)x + 0.5f - 100.0f, dy = (float)y + 0.5f - 80.0f;
+            if (dx * dx + dy * dy < 59.0f * 59.0f) {
+                assert_memory_equal(out_px(&a, x, y), out_px(&b, x, y), 4 * sizeof(float));
+                continue;
+            }
+            assert_memory_equal(&out_px(&a, x, y)[3], &out_px(&b, x, y)[3], sizeof(float));
+            for (int c = 0; c < 3; c++) {
+                const double d = fabs((double)out_px(&a, x, y)[c] - out_px(&b, x, y)[c]);
+                sum += d, mx = d > mx ? d : mx, n++, diff += d > 0.0;
+            }
+        }
+    print_message("fused periphery vs chain: mean |diff| %.5f, max %.4f, %d of %d values differ\n", sum / n, mx, diff, n);
+    assert_true(mx <= 0.053);
+    assert_true(sum / n <= 0.005);
+    rig_free(&a);
+    rig_free(&b);
+}
+
+/* The fused periphery path (contrast enhancement off) gives the same bits for 1, 2 and 5 threads
+ * and for the C kernels and the best ISA's. */
+static void test_fused_threads_and_isas_identical(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, busy, FV_DOF_MEDIUM, 1.0f, 70.0f, 60.0f);
+    const size_t n = (size_t)r.pyr.lv[0].stride * H * 4;
+    float *ref = malloc(n * sizeof(float));
+    assert_non_null(ref);
+    rig_run(&r, NULL, FV_ISA_C);
+    memcpy(ref, r.out, n * sizeof(float));
+    const int threads[] = {1, 2, 5};
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 2; i++) {
+            fv_pool *pool = fv_pool_create(threads[k]);
+            assert_non_null(pool);
+            memset(r.out, 0, n * sizeof(float));
+            rig_run(&r, pool, i ? ~0u : FV_ISA_C);
+            for (int y = 0; y < H; y++)
+                assert_memory_equal(r.out + 4 * (size_t)y * r.pyr.lv[0].stride, ref + 4 * (size_t)y * r.pyr.lv[0].stride,
+                                    W * 4 * sizeof(float));
+            fv_pool_destroy(pool);
+        }
+    free(ref);
+    rig_free(&r);
+}
+
 /* The CoC row kernel against eq. (3) in double (core/dof/coc.c), every ISA. */
 static void test_coc_row_matches_eq3(void **st)
 {
@@ -414,6 +544,9 @@ int main(void)
         cmocka_unit_test(test_contrast_enhancement),
         cmocka_unit_test(test_coc_row_matches_eq3),
         cmocka_unit_test(test_threads_and_isas_identical),
+        cmocka_unit_test(test_periph_closed_form),
+        cmocka_unit_test(test_fused_periphery_vs_chain),
+        cmocka_unit_test(test_fused_threads_and_isas_identical),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -359,8 +359,48 @@ static void nearbox_row_neon(float *restrict out, float *restrict out_r, float *
     }
 }
 
+/* 4 pixels a step from an even x, deinterleaved (vld4q: one vector a channel, a lane a pixel), so
+ * the per-pixel scalars need no broadcasts: the texels k - 1 .. k + 2 (k = x / 2) as H = (a, b, c,
+ * d) give the pixels' main taps (b, b, c, c) and their neighbours (a, c, b, d) */
+static void periph_row_neon(float *restrict out, const float *sharp, const float *coc, const float *half,
+                            const float *lnear, int x0, int n)
+{
+    const float32x4_t one = vdupq_n_f32(1.0f), zero = vdupq_n_f32(0.0f), slope = vdupq_n_f32(FV_DOF_L1_SLOPE);
+    const float32x4_t q75 = vdupq_n_f32(0.75f), q25 = vdupq_n_f32(0.25f);
+    int x = x0;
+    if (x & 1) {
+        fv_dof_periph_row_c(out, sharp, coc, half, lnear, x, 1);
+        x++;
+    }
+    for (; x + 4 <= x0 + n; x += 4) {
+        const float32x4_t c = vld1q_f32(coc + x), m = vabsq_f32(c);
+        const float32x4_t w = vmulq_f32(vminq_f32(m, one), vminq_f32(vmulq_f32(vmulq_f32(m, m), slope), one));
+        const uint32x4_t wpos = vcgtq_f32(w, zero), nn = vcgeq_f32(c, zero);
+        const float32x4x4_t h = vld4q_f32(half + 2 * (ptrdiff_t)x - 4), sv = vld4q_f32(sharp + 4 * (ptrdiff_t)x);
+        float32x4x4_t o;
+        for (int k = 0; k < 3; k++) {
+            const float32x4_t e = vextq_f32(h.val[k], h.val[k], 1), f = vextq_f32(h.val[k], h.val[k], 2);
+            const float32x4_t u = vaddq_f32(vmulq_f32(q75, vzip1q_f32(e, e)), vmulq_f32(q25, vzip1q_f32(h.val[k], f)));
+            o.val[k] = sel(wpos, vaddq_f32(sv.val[k], vmulq_f32(w, vsubq_f32(u, sv.val[k]))), sv.val[k]);
+        }
+        if (lnear && vmaxvq_u32(nn)) {
+            const float32x4x4_t q = vld4q_f32(lnear + 4 * (ptrdiff_t)x);
+            const uint32x4_t pos = vandq_u32(vcgtq_f32(q.val[3], zero), nn);
+            const float32x4_t cov = vminq_f32(q.val[3], one);
+            for (int k = 0; k < 3; k++)
+                o.val[k] = sel(pos, vaddq_f32(o.val[k], vmulq_f32(cov, vsubq_f32(vdivq_f32(q.val[k], q.val[3]), o.val[k]))),
+                               o.val[k]);
+        }
+        o.val[3] = sv.val[3];
+        vst4q_f32(out + 4 * (ptrdiff_t)x, o);
+    }
+    if (x < x0 + n)
+        fv_dof_periph_row_c(out, sharp, coc, half, lnear, x, x0 + n - x);
+}
+
 void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
+    d->dof_periph_row = periph_row_neon;
     d->dof_nearbox_row = nearbox_row_neon;
     d->dof_nearblk_row = nearblk_row_neon;
     d->dof_upsample_row = upsample_row_neon;

@@ -43,14 +43,15 @@ void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const
     x->dsp->dof_pyrblur_row(enh, &ea, 0, x->w);
 }
 
-/* An output row into dst: the sharp row blended with the far layer by the CoC, the near layers by
+/* Columns [xa, xb) of an output row into dst: the sharp row blended with the far layer by the CoC, the near layers by
  * their coverage (the full-resolution one in the centre, the quarter-resolution one faded in by
  * t), and the enhancement (enh, NULL = off); the dsp kernel dof_combine_row has the formula. */
 void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
-                     const float *lnear, const float *trow, const float *enh)
+                     const float *lnear, const float *trow, const float *enh, int xa, int xb)
 {
     const fv_dof_view *v = x->v;
     fv_dof_combine_args a = {.sharp = sharp, .coc = coc, .far = far, .near = near, .lnear = lnear, .t = trow,
                              .enh = enh, .gain = v->prm->contrast_gain};
-    x->dsp->dof_combine_row(dst, &a, 0, x->w);
+    if (xa < xb)
+        x->dsp->dof_combine_row(dst, &a, xa, xb - xa);
 }

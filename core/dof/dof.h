@@ -41,6 +41,8 @@ typedef struct fv_dof_params {
     int chroma;            /* liu: longitudinal chromatic aberration (Liu sec. 3.3.2), default 0 */
     int full_res_periphery; /* weier: 1 = the periphery's pyramid blur at full resolution (the path
                              * the half-resolution one replaced; tests compare them), default 0 */
+    int chain_periphery;   /* weier: 1 = beyond the transition disc the chain of kernels (up-sampling,
+                            * level blend, combine) that dof_periph_row replaced; tests compare them */
     fv_focus_params focus; /* focus estimation; focus.fixed_m > 0 fixes it */
 } fv_dof_params;
 void fv_dof_params_default(fv_dof_params *p);

@@ -47,6 +47,19 @@ struct fv_dof_pyrblur_args;
  *   its coc < 0, else +0 (also for pixels past n); ext[2b] = min(ext[2b], the block's coc) + 0,
  *   ext[2b + 1] = max(ext[2b + 1], the block's coc) + 0 (+ 0: a zero result is +0 whatever the
  *   ISA's min of signed zeros gives). coc and ext finite. */
+/* dof_periph_row: the periphery beyond the transition disc (t = 1, no contrast enhancement) in one
+ *   pass: for x in [x0, x0+n), s = sharp[x], c = coc[x], m = |c|, k = x >> 1, h = the half-resolution
+ *   blur row up-sampled by 2 with fixed taps: U = 0.75 half[k] + 0.25 half[x odd ? k + 1 : k - 1]
+ *   (mul, mul, add; half[-1] and half[hw] are the caller's clamped copies), the own-blur weight
+ *   w = min(m, 1) min(m m FV_DOF_L1_SLOPE, 1) (the combine's min(1, |c|) times the level-0..1
+ *   interpolation of the periphery's blur, in closed form), o = w > 0 ? s + w (U - s) : s; then
+ *   where lnear != NULL and !(c < 0): q = lnear[x], where q.w > 0 o = o + min(q.w, 1) (q.rgb / q.w - o);
+ *   out[x] = (o, s.w). coc finite; half finite over the texels read. The ISA versions compute
+ *   several pixels at once and keep each by selects on these conditions (they may read, never use,
+ *   lnear at near pixels): same bits. */
+#define FV_DOF_L1_SLOPE (3.0f / 44.0f)
+typedef void (*fv_dof_periph_row_fn)(float *restrict out, const float *sharp, const float *coc, const float *half,
+                                     const float *lnear, int x0, int n);
 typedef void (*fv_dof_nearblk_row_fn)(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd,
                                       int n);
 /* dof_nearbox_row: the near layer's horizontal scatter-as-gather box, for i in [x0, x0+n):
@@ -77,6 +90,7 @@ typedef struct fv_dof_dsp {
     fv_dof_pyrblur_row_fn dof_pyrblur_row;
     fv_dof_nearblk_row_fn dof_nearblk_row;
     fv_dof_nearbox_row_fn dof_nearbox_row;
+    fv_dof_periph_row_fn dof_periph_row;
 } fv_dof_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -96,6 +110,8 @@ void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args
 void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n);
 void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,
                           const float *r, const float *wgt, int w, int x0, int n, int reach);
+void fv_dof_periph_row_c(float *restrict out, const float *sharp, const float *coc, const float *half,
+                         const float *lnear, int x0, int n);
 #if defined(__x86_64__)
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d);
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d);

@@ -192,6 +192,33 @@ void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *res
     }
 }
 
+void fv_dof_periph_row_c(float *restrict out, const float *sharp, const float *coc, const float *half,
+                         const float *lnear, int x0, int n)
+{
+    for (int x = x0; x < x0 + n; x++) {
+        const float *s = sharp + 4 * (ptrdiff_t)x, c = coc[x], m = c < 0.0f ? -c : c;
+        const float *h0 = half + 4 * (ptrdiff_t)(x >> 1), *h1 = h0 + ((x & 1) ? 4 : -4);
+        const float ab = m < 1.0f ? m : 1.0f, l = m * m * FV_DOF_L1_SLOPE, w = ab * (l < 1.0f ? l : 1.0f);
+        float o[3];
+        for (int k = 0; k < 3; k++) {
+            const float u = 0.75f * h0[k] + 0.25f * h1[k];
+            o[k] = w > 0.0f ? s[k] + w * (u - s[k]) : s[k];
+        }
+        if (lnear && !(c < 0.0f)) {
+            const float *q = lnear + 4 * (ptrdiff_t)x;
+            if (q[3] > 0.0f) {
+                const float cov = q[3] < 1.0f ? q[3] : 1.0f;
+                for (int k = 0; k < 3; k++)
+                    o[k] = o[k] + cov * (q[k] / q[3] - o[k]);
+            }
+        }
+        out[4 * (ptrdiff_t)x + 0] = o[0];
+        out[4 * (ptrdiff_t)x + 1] = o[1];
+        out[4 * (ptrdiff_t)x + 2] = o[2];
+        out[4 * (ptrdiff_t)x + 3] = s[3];
+    }
+}
+
 void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
 {
     const unsigned isas = isa_mask & fv_cpu_isas();
@@ -203,6 +230,7 @@ void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
     d->dof_combine_row = fv_dof_combine_row_c;
     d->dof_nearblk_row = fv_dof_nearblk_row_c;
     d->dof_nearbox_row = fv_dof_nearbox_row_c;
+    d->dof_periph_row = fv_dof_periph_row_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_dof_dsp_init_sse41(d);

@@ -21,7 +21,10 @@
  *        Beyond the transition disc (one ray per ~5 pixels there) the levels >= 1 part runs on
  *        the level 1 grid with a 2x2-mean |c| (fvw_hblur_band) and each row reads it up-sampled as
  *        its level 1, so a pixel below level 1 still mixes its own sharp colour at full resolution
- *        (tests/test_dof.c bounds the difference to the full-resolution path).
+ *        (tests/test_dof.c bounds the difference to the full-resolution path). There (t = 1) one
+ *        kernel, dof_periph_row, does it all per pixel: the half-resolution row up-sampled by 2
+ *        with fixed taps, the own-blur weight min(|c|, 1) min(3 c^2 / 44, 1) in closed form (the
+ *        combine's min(1, |c|) times the level-0..1 interpolation), the near layer, the combine.
  *   near (c < 0): scatter-as-gather box: a near sample of radius r = min(floor(|c| / 2), 24)
  *        covers 2r + 1 pixels with weight 1 / (2r + 1) each, so it spreads over whatever lies
  *        around it (the focused background included) and the sum of the weights is the layer's
@@ -39,9 +42,10 @@
  *
  * The filter's vertical pass and the combine run fused per row (the layers never go to memory
  * as full images); their times are the workers' time in each, scaled to the pass's wall time.
- * Pass order: CoC (+ per-block statistics, kernel dof_nearblk_row) -> horizontal pass (centre
- * rectangle; near boxes by dof_nearbox_row) -> quarter-resolution vertical pass -> the
- * periphery's half-resolution blur -> fused vertical pass + combine.
+ * Pass order: CoC (+ per-block statistics, kernel dof_nearblk_row, and the half-resolution
+ * periphery's 2x2-mean CoC) -> horizontal pass (centre rectangle; near boxes by dof_nearbox_row)
+ * -> quarter-resolution vertical pass -> the periphery's half-resolution blur -> fused vertical
+ * pass + combine (dof_periph_row beyond the disc).
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *
@@ -133,8 +137,8 @@ static int ensure_aux(fv_dof_work *wk, int threads)
     const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 2 * lh + 3 * (size_t)th +
-                       4 * (size_t)half_w(w) * (size_t)half_w(h);
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 3 * (size_t)th +
+                       5 * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
         if (!(wk->aux = malloc(aux * sizeof(float))))
@@ -152,7 +156,9 @@ static int ensure_aux(fv_dof_work *wk, int threads)
         for (int L = 1; L < MAX_UP_LEVEL; L++) /* level L + 1 onto the level 1 grid */
             fvw_xtaps_init(&xh[L], L, half_w(w), (half_w(w) + (1 << L) - 1) >> L);
     }
-    const size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
+    size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
+    if (rows < 8 * (size_t)w + (size_t)tw * th) /* the tile dilation's temporary after slots 0, 1 */
+        rows = 8 * (size_t)w + (size_t)tw * th;
     if (wk->rows_len < rows) {
         free(wk->rows);
         if (!(wk->rows = malloc(rows * sizeof(float))))
@@ -189,9 +195,11 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_hw = a, a += nl;
     x->l_v = a, a += 4 * nl;
     x->l_span = (int32_t *)(void *)a, a += 2 * x->lh; /* int32 and float have the same size */
+    x->l_nn = (int32_t *)(void *)a, a += 2 * x->lh;
     x->band_ms = a, a += 3 * x->th;
     x->hw = half_w(x->w), x->hh = half_w(x->h);
     x->hblur = a, a += 4 * (ptrdiff_t)x->hw * x->hh;
+    x->hcoc = a, a += (ptrdiff_t)x->hw * x->hh;
     /* the centre rectangle: the transition disc plus the kernels' reach */
     const float reach = v->r1_px + 2.0f * FV_DOF_RMAX;
     x->cx0 = fv_clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = fv_clampi((int)ceilf(v->gaze_x + reach), 0, x->w);

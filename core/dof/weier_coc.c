@@ -14,21 +14,27 @@ void fvw_coc_band(void *ctx, int band, int tid)
     const fv_pyr_level *l0 = &x->v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
     const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
-    for (int y = y0; y < y1; y++)
-        x->dsp->dof_coc_row(x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w, x->K, x->dn, x->df);
-    /* the tile statistics and the quarter-resolution near source in one kernel sweep per row: per
-     * 4x4 block the near pixels' colour sum and count (dof_nearblk_row), the smallest and largest
-     * c (ext: the largest near radius, the largest far c) */
+    /* per row the CoC and, while the row is in L1, the tile statistics and the quarter-resolution
+     * near source in one kernel sweep: per 4x4 block the near pixels' colour sum and count
+     * (dof_nearblk_row), the smallest and largest c (ext: the largest near radius, the largest
+     * far c) */
     const float inv_blk = 1.0f / (LOW * LOW);
     float *ext = fvw_slot(x, tid, 0);
     for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
         float *src = x->l_src + 4 * (ptrdiff_t)by * x->lw;
         memset(src, 0, (size_t)x->lw * 4 * sizeof(float));
         memset(ext, 0, (size_t)x->lw * 2 * sizeof(float));
-        for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++)
-            x->dsp->dof_nearblk_row(src, ext, x->wk->p1[0] + y * st, l0->rgbd + 4 * (ptrdiff_t)y * l0->stride, x->w);
+        for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++) {
+            const float *rgbd = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
+            x->dsp->dof_coc_row(x->wk->p1[0] + y * st, rgbd, x->w, x->K, x->dn, x->df);
+            x->dsp->dof_nearblk_row(src, ext, x->wk->p1[0] + y * st, rgbd, x->w);
+        }
+        const float full_h = (float)(fv_mini(by * LOW + LOW, x->h) - by * LOW);
+        int nlo = x->lw, nhi = 0; /* the blocks with a pixel that is not near */
         for (int i = 0; i < x->lw; i++) {
             const int xa = i * LOW;
+            if (src[4 * i + 3] < full_h * (float)(fv_mini(xa + LOW, x->w) - xa))
+                nlo = nlo < i ? nlo : i, nhi = i + 1;
             float r = floorf(-ext[2 * i] * 0.5f); /* the largest near radius in pixels, capped */
             r = r < (float)FV_DOF_RMAX ? r : (float)FV_DOF_RMAX;
             /* the tile's largest near radius and far c (first block of the tile in the band: reset) */
@@ -44,32 +50,54 @@ void fvw_coc_band(void *ctx, int band, int tid)
             for (int k = 0; k < 4; k++)
                 src[4 * i + k] *= inv_blk;
         }
+        x->l_nn[2 * by] = nlo, x->l_nn[2 * by + 1] = nhi;
+        /* the half-resolution periphery's CoC while the block row is in cache: per level-1 texel
+         * the mean |c| of its 2x2 pixels (the last column / row of an odd size clamps) */
+        for (int vy = 2 * by; x->half_on && vy < fv_mini(2 * by + 2, x->hh); vy++) {
+            const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
+            float *ch = x->hcoc + (ptrdiff_t)vy * x->hw;
+            const int uw = x->w / 2; /* texels with two columns */
+            for (int u = 0; u < uw; u++)
+                ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
+            for (int u = uw; u < x->hw; u++)
+                ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u])));
+        }
     }
     for (int tx = 0; tx < x->tw; tx++) /* far c -> sigma */
         x->t_fsig_own[band * x->tw + tx] *= 0.25f;
 }
 
-/* Each tile learns the largest near radius / far sigma of the tiles within reach. */
+/* max over the (2 r + 1)^2 tiles around each tile of src into dst (borders: the tiles that
+ * exist), separably: rows into tmp, then columns */
+static void tile_max(float *restrict dst, const float *src, float *restrict tmp, int tw, int th, int r)
+{
+    for (int ty = 0; ty < th; ty++)
+        for (int tx = 0; tx < tw; tx++) {
+            float m = 0.0f;
+            for (int i = fv_maxi(tx - r, 0); i <= fv_mini(tx + r, tw - 1); i++)
+                m = src[ty * tw + i] > m ? src[ty * tw + i] : m;
+            tmp[ty * tw + tx] = m;
+        }
+    for (int ty = 0; ty < th; ty++)
+        for (int tx = 0; tx < tw; tx++) {
+            float m = 0.0f;
+            for (int j = fv_maxi(ty - r, 0); j <= fv_mini(ty + r, th - 1); j++)
+                m = tmp[j * tw + tx] > m ? tmp[j * tw + tx] : m;
+            dst[ty * tw + tx] = m;
+        }
+}
+
+/* Each tile learns the largest near radius / far sigma of the tiles within reach (a max is
+ * separable: the same values as the square window). */
 void fvw_dilate_tiles(fvw_ctx *x)
 {
     float rmax = 0.0f;
     for (int i = 0; i < x->tw * x->th; i++)
         rmax = x->t_near_own[i] > rmax ? x->t_near_own[i] : rmax;
     const int dn = (int)ceilf(rmax / TILE), df = (FV_DOF_RMAX + TILE - 1) / TILE;
-    for (int ty = 0; ty < x->th; ty++)
-        for (int tx = 0; tx < x->tw; tx++) {
-            float n = 0.0f, f = 0.0f;
-            for (int j = ty - dn; j <= ty + dn; j++)
-                for (int i = tx - dn; i <= tx + dn; i++)
-                    if (j >= 0 && j < x->th && i >= 0 && i < x->tw && x->t_near_own[j * x->tw + i] > n)
-                        n = x->t_near_own[j * x->tw + i];
-            for (int j = ty - df; j <= ty + df; j++)
-                for (int i = tx - df; i <= tx + df; i++)
-                    if (j >= 0 && j < x->th && i >= 0 && i < x->tw && x->t_fsig_own[j * x->tw + i] > f)
-                        f = x->t_fsig_own[j * x->tw + i];
-            x->t_near[ty * x->tw + tx] = n;
-            x->t_fsig[ty * x->tw + tx] = f;
-        }
+    float *tmp = fvw_slot(x, 0, 2); /* thread 0's row buffers 2.. (free between the passes) */
+    tile_max(x->t_near, x->t_near_own, tmp, x->tw, x->th, dn);
+    tile_max(x->t_fsig, x->t_fsig_own, tmp, x->tw, x->th, df);
     int lr = -1; /* -1: no near block at all */
     for (ptrdiff_t i = 0; i < (ptrdiff_t)x->lw * x->lh; i++)
         lr = x->l_r[i] > (float)lr ? (int)x->l_r[i] : lr;

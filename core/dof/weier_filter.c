@@ -46,29 +46,46 @@ void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps
     dsp->dof_upsample_row(dst + 4 * xa, tmp, xt->i0 + xa, xt->i1 + xa, xt->ax + xa, xb - xa);
 }
 
-/* The scatter-as-gather box down a column (the horizontal one is the kernel dof_nearbox_row):
- * out = sum over samples s within `reach` whose radius r[s] >= |i - s| of wgt[s] * src[s]. */
-static void near_box_col(float *restrict out, const float *src, ptrdiff_t step, const float *r, const float *wgt,
-                         ptrdiff_t rstep, int i, int n, int reach)
+/* One tap row of the scatter-as-gather box down the columns (the horizontal one is the kernel
+ * dof_nearbox_row): out[i] += wgt[i] src[i] for the n columns whose radius r[i] >= aj (the tap's
+ * |offset|). Row by row in the reference's order of taps; a tap that does not reach adds +0
+ * (0 times a finite value) to a sum that started at +0, which leaves its bits as skipping it
+ * did, so the loop has no branch and the compiler can vectorise it. */
+static void near_box_tap(float *restrict out, const float *restrict src, const float *restrict r,
+                         const float *restrict wgt, float aj, int n)
 {
-    float acc[4] = {0, 0, 0, 0};
-    const int jlo = i - reach > 0 ? -reach : -i, jhi = i + reach < n ? reach : n - 1 - i;
-    for (int j = jlo; j <= jhi; j++) {
-        const float rs = r[(i + j) * rstep];
-        if (rs < (float)(j < 0 ? -j : j)) /* not near (-1), or does not reach */
-            continue;
-        const float ws = wgt[(i + j) * rstep], *p = src + (i + j) * step;
+    for (int i = 0; i < n; i++) {
+        const float m = r[i] < aj ? 0.0f : wgt[i];
         for (int c = 0; c < 4; c++)
-            acc[c] += ws * p[c];
+            out[4 * i + c] += m * src[4 * i + c];
     }
-    memcpy(out, acc, sizeof acc);
+}
+
+/* The near sources of columns [lo, hi): radius r = min(floor(-c / 2), FV_DOF_RMAX) for c < 0,
+ * else -1; box weight 1 / (2 max(r, 0) + 1); colour with coverage 1. floor is the truncation of
+ * the clamped, non-negative half CoC, so the loop vectorises (SSE2 conversions). */
+static void near_sources(float *restrict s4, float *restrict sr, float *restrict sw, const float *restrict rgbd,
+                         const float *restrict coc, int lo, int hi)
+{
+    for (int i = lo; i < hi; i++) {
+        const float c = coc[i], h = -c * 0.5f;
+        const float hc = h < (float)FV_DOF_RMAX ? (h > 0.0f ? h : 0.0f) : (float)FV_DOF_RMAX;
+        const float r = c < 0.0f ? (float)(int)hc : -1.0f;
+        sr[i] = r;
+        sw[i] = 1.0f / (2.0f * (r > 0.0f ? r : 0.0f) + 1.0f);
+    }
+    for (int i = lo; i < hi; i++) {
+        s4[4 * i + 0] = rgbd[4 * i + 0];
+        s4[4 * i + 1] = rgbd[4 * i + 1];
+        s4[4 * i + 2] = rgbd[4 * i + 2];
+        s4[4 * i + 3] = 1.0f;
+    }
 }
 
 /* Horizontal pass of one band: far_h (p4[1]) and near_h (p4[3], radius p1[2], weight p1[1]) in
  * the centre rectangle, and the band's quarter-resolution rows. */
 void fvw_hpass_band(void *ctx, int band, int tid)
 {
-    (void)tid;
     fvw_ctx *x = ctx;
     const fv_pyr_level *l0 = &x->v->pyr->lv[0];
     const ptrdiff_t st = x->wk->stride;
@@ -92,10 +109,11 @@ void fvw_hpass_band(void *ctx, int band, int tid)
             }
             x->dsp->dof_hgauss_row(fh, rgbd, coc, x->w, xs, n, sig, x->tab);
         }
-        /* near sources of the row: premultiplied colour, radius (-1: not near), box weight
-         * (p4[0]'s row is free until the fused pass) */
-        float *s4 = x->wk->p4[0] + 4 * y * st, *sr = x->wk->p1[1] + y * st, *sw = x->wk->p1[2] + y * st;
-        float *nh = x->wk->p4[3] + 4 * y * st, *nr = x->wk->p4[2] + 4 * y * st, *nw = nr + st;
+        /* near sources of the row: premultiplied colour, radius (-1: not near), box weight, in
+         * the thread's row buffers (only this row reads them); the horizontal result's radius and
+         * weight go straight to p1[1] / p1[2] for the vertical pass */
+        float *s4 = fvw_slot(x, tid, 0), *sr = fvw_slot(x, tid, 1), *sw = sr + x->w;
+        float *nh = x->wk->p4[3] + 4 * y * st, *nr = x->wk->p1[1] + y * st, *nw = x->wk->p1[2] + y * st;
         int prepped = 0;
         for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
             const int reach = (int)x->t_near[band * x->tw + tx];
@@ -104,29 +122,12 @@ void fvw_hpass_band(void *ctx, int band, int tid)
             if (!prepped) {
                 const int lo = x->cx0 - FV_DOF_RMAX > 0 ? x->cx0 - FV_DOF_RMAX : 0;
                 const int hi = fv_mini(x->cx1 + FV_DOF_RMAX, x->w);
-                for (int i = lo; i < hi; i++) {
-                    const float rc = floorf(-coc[i] * 0.5f);
-                    const float r = coc[i] < 0.0f ? (rc < (float)FV_DOF_RMAX ? rc : (float)FV_DOF_RMAX) : -1.0f;
-                    sr[i] = r;
-                    sw[i] = 1.0f / (2.0f * (r > 0.0f ? r : 0.0f) + 1.0f);
-                    for (int c = 0; c < 3; c++)
-                        s4[4 * i + c] = rgbd[4 * i + c];
-                    s4[4 * i + 3] = 1.0f;
-                }
+                near_sources(s4, sr, sw, rgbd, coc, lo, hi);
                 prepped = 1;
             }
             const int i0 = tx * TILE > x->cx0 ? tx * TILE : x->cx0, i1 = fv_mini((tx + 1) * TILE, x->cx1);
             x->dsp->dof_nearbox_row(nh, nr, nw, s4, sr, sw, x->w, i0, i1 - i0, reach);
         }
-        /* near radius / weight of the horizontal result moved into p1[1] / p1[2] for the
-         * vertical pass (the per-sample arrays are no longer needed) */
-        if (prepped)
-            for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
-                if (!(x->t_near[band * x->tw + tx] > 0.0f))
-                    continue;
-                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++)
-                    sr[i] = nr[i], sw[i] = nw[i];
-            }
     }
     /* the quarter-resolution rows of this band */
     if (x->l_reach >= 0)
@@ -144,13 +145,16 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
     fvw_ctx *x = ctx;
     for (int by = band * (TILE / LOW); by < fv_mini((band + 1) * (TILE / LOW), x->lh); by++) {
         int lo = x->lw, hi = 0;
-        for (int i = 0; i < x->lw; i++) {
-            float *o = x->l_v + 4 * ((ptrdiff_t)by * x->lw + i);
-            near_box_col(o, x->l_h + 4 * i, 4 * (ptrdiff_t)x->lw, x->l_hr + i, x->l_hw + i, x->lw, by, x->lh,
-                         x->l_reach);
-            if (o[0] != 0.0f || o[1] != 0.0f || o[2] != 0.0f || o[3] != 0.0f)
-                lo = lo < i ? lo : i, hi = i + 1;
+        float *o = x->l_v + 4 * (ptrdiff_t)by * x->lw;
+        memset(o, 0, (size_t)x->lw * 4 * sizeof(float));
+        const int reach = x->l_reach, jlo = by - reach > 0 ? -reach : -by, jhi = by + reach < x->lh ? reach : x->lh - 1 - by;
+        for (int j = jlo; j <= jhi; j++) {
+            const ptrdiff_t q = (ptrdiff_t)(by + j) * x->lw;
+            near_box_tap(o, x->l_h + 4 * q, x->l_hr + q, x->l_hw + q, (float)(j < 0 ? -j : j), x->lw);
         }
+        for (int i = 0; i < x->lw; i++)
+            if (o[4 * i] != 0.0f || o[4 * i + 1] != 0.0f || o[4 * i + 2] != 0.0f || o[4 * i + 3] != 0.0f)
+                lo = lo < i ? lo : i, hi = i + 1;
         x->l_span[2 * by] = lo < hi ? lo : 0;
         x->l_span[2 * by + 1] = lo < hi ? hi : 0;
     }
@@ -160,7 +164,7 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
  * start): only over the columns whose texels are not all 0 (most of the image has no near
  * field), the rest of the row kept at 0 from the last row's dirty span [*da, *db). The same
  * values as up-sampling the whole row (0 + a (0 - 0) is 0). */
-static void near_upsample_row(const fvw_ctx *x, int tid, int y, float *restrict lup, int *da, int *db)
+static void near_upsample_row(const fvw_ctx *x, int tid, int y, float *restrict lup, int *da, int *db, int na, int nb)
 {
     const float v = ((float)y + 0.5f) * (1.0f / LOW) - 0.5f, fv = floorf(v);
     const int r0 = fv_clampi((int)fv, 0, x->lh - 1), r1 = fv_clampi((int)fv + 1, 0, x->lh - 1);
@@ -172,6 +176,10 @@ static void near_upsample_row(const fvw_ctx *x, int tid, int y, float *restrict 
         xa = fv_clampi(LOW * lo - LOW, 0, x->w);
         xb = fv_clampi(LOW * hi + LOW, 0, x->w);
     }
+    /* and only where it is read: [na, nb) (beyond it the row keeps its 0s or stale values) */
+    xa = xa > na ? xa : na, xb = xb < nb ? xb : nb;
+    if (xa >= xb)
+        xa = xb = x->w;
     /* zero what the last row left outside [xa, xb) */
     if (*da < *db) {
         const int za = *da, zb = fv_mini(*db, xa);
@@ -242,8 +250,7 @@ void fvw_hblur_band(void *ctx, int band, int tid)
         return;
     const fv_dof_view *v = x->v;
     const fv_pyr_level *l1 = &v->pyr->lv[1];
-    const ptrdiff_t st = x->wk->stride;
-    float *ch = fvw_slot(x, tid, 1), *tmp = fvw_slot(x, tid, 2), *ones = fvw_slot(x, tid, 8);
+    float *tmp = fvw_slot(x, tid, 2), *ones = fvw_slot(x, tid, 8);
     for (int i = 0; i < x->hw; i++)
         ones[i] = 1.0f;
     /* a texel's centre is within 2 px per axis of every pixel it feeds, pixels outside the disc
@@ -259,7 +266,7 @@ void fvw_hblur_band(void *ctx, int band, int tid)
             if (u1 <= u0)
                 u0 = u1 = x->hw;
         }
-        const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
+        const float *ch = x->hcoc + (ptrdiff_t)vy * x->hw; /* the 2x2-mean |c| (the CoC pass) */
         const float *sharp = l1->rgbd + 4 * (ptrdiff_t)vy * l1->stride;
         float *blur = x->hblur + 4 * (ptrdiff_t)vy * x->hw;
         const int seg[2][2] = {{0, u0}, {u1, x->hw}};
@@ -267,12 +274,15 @@ void fvw_hblur_band(void *ctx, int band, int tid)
             const int a = seg[k][0], b = seg[k][1];
             if (a >= b)
                 continue;
-            for (int u = a; u < b; u++) {
-                const int i0 = 2 * u, i1 = fv_mini(2 * u + 1, x->w - 1);
-                ch[u] = 0.25f * ((fabsf(ca[i0]) + fabsf(ca[i1])) + (fabsf(cb[i0]) + fabsf(cb[i1])));
-            }
+            float amax = 0.0f;
+            for (int u = a; u < b; u++)
+                amax = ch[u] > amax ? ch[u] : amax;
             memcpy(blur + 4 * a, sharp + 4 * a, (size_t)(b - a) * 4 * sizeof(float));
-            const int need = fv_mini(levels_needed(x->lambda_h, ch, ones, a, b), x->up_levels - 1);
+            int need = 0; /* levels_needed's: the deepest level the largest |c| reads */
+            if (amax > 0.0f) {
+                const float l = x->lambda_h[fv_mini((int)(amax * LAMBDA_STEPS), (LAMBDA_N - 1))];
+                need = fv_mini((int)l + (l > (float)(int)l), x->up_levels - 1);
+            }
             float *up[MAX_UP_LEVEL];
             up[0] = (float *)sharp;
             for (int L = 1; L <= need; L++) {
@@ -304,6 +314,27 @@ static void periphery_row(const fvw_ctx *x, int tid, int y, const float *coc, co
     x->dsp->dof_pyrblur_row(blur, &pa, xa, xb - xa);
 }
 
+/* Row y of the half-resolution blur up-sampled vertically (fixed taps 0.25 / 0.75) into h over the
+ * texels that the pixels [0, a) and [b, w) read (dof_periph_row: x / 2 and its neighbours), with
+ * h[-1] = h[0] and h[hw] = h[hw - 1] (the borders clamp). */
+static void half_row(const fvw_ctx *x, int y, float *restrict h, int a0, int a, int b)
+{
+    const float v = ((float)y + 0.5f) * 0.5f - 0.5f, fv = floorf(v), ay = v - fv;
+    const float *ra = x->hblur + 4 * (ptrdiff_t)fv_clampi((int)fv, 0, x->hh - 1) * x->hw;
+    const float *rb = x->hblur + 4 * (ptrdiff_t)fv_clampi((int)fv + 1, 0, x->hh - 1) * x->hw;
+    const int seg[2][2] = {{a0, a}, {b, x->w}};
+    for (int k = 0; k < 2; k++) {
+        if (seg[k][0] >= seg[k][1])
+            continue;
+        const int ka = fv_maxi((seg[k][0] >> 1) - 1, 0), kb = fv_mini(((seg[k][1] - 1) >> 1) + 2, x->hw);
+        vlerp(h + 4 * ka, ra + 4 * ka, rb + 4 * ka, ay, 4 * (kb - ka));
+        if (ka == 0)
+            memcpy(h - 4, h, 4 * sizeof(float));
+        if (kb == x->hw)
+            memcpy(h + 4 * x->hw, h + 4 * (x->hw - 1), 4 * sizeof(float));
+    }
+}
+
 /* The fused vertical pass and combine of one band. */
 void fvw_vcombine_band(void *ctx, int band, int tid)
 {
@@ -319,6 +350,11 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
      * quarter-resolution near layer up-sampled (14) */
     float *far = fvw_slot(x, tid, 0), *near = fvw_slot(x, tid, 1), *trow = fvw_slot(x, tid, 8);
     float *enh = x->enh_on ? fvw_slot(x, tid, 10) : NULL;
+    /* beyond the disc (t = 1) one kernel (dof_periph_row) blurs and combines from the half-
+     * resolution blur's row (slot 9, a texel of clamped border each side); with contrast
+     * enhancement the chain of kernels */
+    const int fused = x->half_on && !enh && !v->prm->chain_periphery;
+    float *hrow = fvw_slot(x, tid, 9) + 4;
     uint8_t sig[TILE * 8];
     double filter_ns = 0.0, combine_ns = 0.0, output_ns = 0.0;
     /* t is 1 outside the disc of radius r1: the row holds 1 except across the disc's span, which
@@ -353,57 +389,77 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
                     for (int k = 0; k < 3; k++)
                         far[4 * i + k] /= far[4 * i + 3];
         }
-        if (x->half_on) {
+        if (fused) /* beyond the disc the combine's kernel reads the half-resolution blur itself */
+            half_row(x, y, hrow, 0, tx0, tx1);
+        else if (x->half_on) {
             periphery_row(x, tid, y, coc, trow, sharp, far, 0, tx0);
             periphery_row(x, tid, y, coc, trow, sharp, far, tx1, x->w);
             blur_periphery(x, tid, y, coc, trow, sharp, far, tx0, tx1);
         } else
             blur_periphery(x, tid, y, coc, trow, sharp, far, 0, x->w);
+        if (fused)
+            blur_periphery(x, tid, y, coc, trow, sharp, far, tx0, tx1);
         /* near: full resolution in the centre rectangle (pixels with t < 1); the quarter-
          * resolution layer up-sampled is blended in by t in the combine */
         float *nfull = NULL;
         if (centre_row) {
             nfull = near;
-            memset(near, 0, (size_t)x->w * 4 * sizeof(float));
+            /* the near loop writes only pixels with t < 1 (the disc's span), which is all the
+             * fused path's combine reads */
+            if (fused)
+                memset(near + 4 * tx0, 0, (size_t)(tx1 - tx0) * 4 * sizeof(float));
+            else
+                memset(near, 0, (size_t)x->w * 4 * sizeof(float));
+            /* the vertical scatter-as-gather box over the tile's columns, a tap row at a time
+             * (near_box_tap: in the reference's order of taps, +0 where a tap does not reach; a
+             * horizontal result with no sample, w = 0, is all +0 and adds nothing), only over
+             * pixels with t < 1, i.e. within the disc's span; rows of the column outside the
+             * rectangle or in tiles no near sample reaches hold no near_h: stay within
+             * [cy0, cy1) and skip those tiles */
             for (int tx = x->cx0 / TILE; tx * TILE < x->cx1; tx++) {
                 const int reach = (int)x->t_near[(y / TILE) * x->tw + tx];
-                if (reach <= 0)
+                const int ia = fv_maxi(fv_maxi(tx * TILE, x->cx0), tx0), ib = fv_mini(fv_mini((tx + 1) * TILE, x->cx1), tx1);
+                if (reach <= 0 || ia >= ib)
                     continue;
-                for (int i = tx * TILE > x->cx0 ? tx * TILE : x->cx0; i < fv_mini((tx + 1) * TILE, x->cx1); i++) {
-                    if (!(trow[i] < 1.0f))
+                const int jlo = y - reach > x->cy0 ? -reach : x->cy0 - y;
+                const int jhi = y + reach < x->cy1 ? reach : x->cy1 - 1 - y;
+                for (int j = jlo; j <= jhi; j++) {
+                    const int s = y + j;
+                    if (!(x->t_near[(s / TILE) * x->tw + tx] > 0.0f))
                         continue;
-                    /* rows of the column outside the rectangle or in tiles no near sample
-                     * reaches hold no near_h: stay within [cy0, cy1) and skip those tiles */
-                    float acc[4] = {0, 0, 0, 0};
-                    const int jlo = y - reach > x->cy0 ? -reach : x->cy0 - y;
-                    const int jhi = y + reach < x->cy1 ? reach : x->cy1 - 1 - y;
-                    for (int j = jlo; j <= jhi; j++) {
-                        const int s = y + j;
-                        if (!(x->t_near[(s / TILE) * x->tw + tx] > 0.0f))
-                            continue;
-                        const float *nh = x->wk->p4[3] + 4 * (s * st + i);
-                        const float r = x->wk->p1[1][s * st + i];
-                        if (!(nh[3] > 0.0f) || r < (float)(j < 0 ? -j : j))
-                            continue;
-                        const float wgt = x->wk->p1[2][s * st + i];
-                        for (int c = 0; c < 4; c++)
-                            acc[c] += wgt * nh[c];
-                    }
-                    memcpy(near + 4 * i, acc, sizeof acc);
+                    near_box_tap(near + 4 * ia, x->wk->p4[3] + 4 * (s * st + ia), x->wk->p1[1] + s * st + ia,
+                                 x->wk->p1[2] + s * st + ia, (float)(j < 0 ? -j : j), ib - ia);
                 }
+                for (int i = ia; i < ib; i++)
+                    if (!(trow[i] < 1.0f))
+                        memset(near + 4 * i, 0, 4 * sizeof(float));
             }
         }
         float *lup = NULL;
         if (x->l_reach >= 0) {
             lup = fvw_slot(x, tid, 14);
-            near_upsample_row(x, tid, y, lup, &lup_da, &lup_db);
+            /* read only by pixels that are not near (c >= 0: the blocks l_nn spans) and, by the
+             * chain's combine, across the disc */
+            int na = 0, nb = x->w;
+            if (fused) {
+                const int32_t *nn = x->l_nn + 2 * (y / LOW);
+                na = nn[0] < nn[1] ? LOW * nn[0] : x->w, nb = nn[0] < nn[1] ? fv_mini(LOW * nn[1], x->w) : 0;
+                if (tx0 < tx1)
+                    na = na < tx0 ? na : tx0, nb = nb > tx1 ? nb : tx1;
+            }
+            near_upsample_row(x, tid, y, lup, &lup_da, &lup_db, na, nb);
         }
         if (enh)
             fvw_enhance_row(x, tid, y, sharp, trow, enh);
         const int64_t tb = fv_time_ns();
         /* without a float image the row lives in slot 13 only, converted while in cache */
         float *orow = x->out ? x->out + 4 * (ptrdiff_t)y * x->out_stride : fvw_slot(x, tid, 13);
-        fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh);
+        if (fused) {
+            fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh, tx0, tx1);
+            x->dsp->dof_periph_row(orow, sharp, coc, hrow, lup, 0, tx0);
+            x->dsp->dof_periph_row(orow, sharp, coc, hrow, lup, tx1, x->w - tx1);
+        } else
+            fvw_combine_row(x, orow, sharp, coc, far, nfull, lup, trow, enh, 0, x->w);
         const int64_t tc = fv_time_ns();
         if (v->conv) /* the output stage on the row just written, while it is in cache */
             fv_output_convert(v->conv, orow, x->out_stride, x->w, 1, NULL, NULL, v->rgb8 + (ptrdiff_t)y * v->rgb8_stride,

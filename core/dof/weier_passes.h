@@ -53,6 +53,7 @@ typedef struct {
     float *l_src, *l_r, *l_w;  /* source: premultiplied (rgb, coverage) / radius / box weight */
     float *l_h, *l_hr, *l_hw;  /* after the horizontal pass */
     float *l_v;                /* after the vertical pass */
+    int32_t *l_nn;             /* per block row: the blocks [l_nn[2 by], l_nn[2 by + 1]) holding a pixel that is not near */
     int32_t *l_span;           /* per row of l_v: its texels [l_span[2 by], l_span[2 by + 1]) that are not all 0 */
     int l_reach;               /* the largest radius there */
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
@@ -64,6 +65,7 @@ typedef struct {
     int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
     int hw, hh;                /* level 1's size */
     float *hblur;              /* hw x hh x 4: level 1 blurred by the half-resolution CoC */
+    float *hcoc;               /* hw x hh: that CoC, the 2x2 mean of |c| (written by the CoC pass) */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
     xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
 } fvw_ctx;
@@ -117,6 +119,6 @@ void fvw_vcombine_band(void *ctx, int band, int tid);
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
 void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
-                     const float *lnear, const float *trow, const float *enh);
+                     const float *lnear, const float *trow, const float *enh, int xa, int xb);
 
 #endif

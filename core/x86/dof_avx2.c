@@ -382,6 +382,51 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
 }
 
+/* 8 pixels at a time from an even x: their scalars as 8 lanes, then 4 pairs (2k, 2k + 1), whose
+ * up-sampling taps are (half[k - 1], half[k + 1]) and half[k] twice: two loads and two blends */
+static void periph_row_avx2(float *restrict out, const float *sharp, const float *coc, const float *half,
+                            const float *lnear, int x0, int n)
+{
+    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps(), msign = _mm256_set1_ps(-0.0f);
+    const __m256 slope = _mm256_set1_ps(FV_DOF_L1_SLOPE), q75 = _mm256_set1_ps(0.75f), q25 = _mm256_set1_ps(0.25f);
+    int x = x0;
+    if (x & 1) {
+        fv_dof_periph_row_c(out, sharp, coc, half, lnear, x, 1);
+        x++;
+    }
+    for (; x + 8 <= x0 + n; x += 8) {
+        const __m256 c = _mm256_loadu_ps(coc + x), m = _mm256_andnot_ps(msign, c);
+        const __m256 w = _mm256_mul_ps(_mm256_min_ps(m, one), _mm256_min_ps(_mm256_mul_ps(_mm256_mul_ps(m, m), slope), one));
+        const __m256 wpos = _mm256_cmp_ps(w, zero, _CMP_GT_OQ);
+        const __m256 nn = _mm256_cmp_ps(c, zero, _CMP_GE_OQ);
+        const int anyn = lnear && _mm256_movemask_ps(nn);
+        const float *hk = half + 2 * (ptrdiff_t)x; /* texel x / 2 */
+#define PR_PAIR(p)                                                                                                   \
+    do {                                                                                                             \
+        const ptrdiff_t o4 = 4 * (ptrdiff_t)(x + 2 * (p));                                                           \
+        const __m256 a = _mm256_loadu_ps(hk + 4 * (p) - 4), b = _mm256_loadu_ps(hk + 4 * (p));                      \
+        const __m256 u = _mm256_add_ps(_mm256_mul_ps(q75, _mm256_blend_ps(b, a, 0xf0)),                              \
+                                       _mm256_mul_ps(q25, _mm256_blend_ps(a, b, 0xf0)));                             \
+        const __m256 sv = _mm256_loadu_ps(sharp + o4);                                                               \
+        __m256 o = _mm256_blendv_ps(sv, _mm256_add_ps(sv, _mm256_mul_ps(PAIR(w, p), _mm256_sub_ps(u, sv))),          \
+                                    PAIR(wpos, p));                                                                  \
+        if (anyn) {                                                                                                  \
+            const __m256 q = _mm256_loadu_ps(lnear + o4), q3 = _mm256_permute_ps(q, _MM_SHUFFLE(3, 3, 3, 3));       \
+            const __m256 pos = _mm256_and_ps(_mm256_cmp_ps(q3, zero, _CMP_GT_OQ), PAIR(nn, p));                      \
+            o = _mm256_blendv_ps(o, _mm256_add_ps(o, _mm256_mul_ps(_mm256_min_ps(q3, one), _mm256_sub_ps(_mm256_div_ps(q, q3), o))), pos); \
+        }                                                                                                            \
+        _mm256_storeu_ps(out + o4, _mm256_blend_ps(o, sv, 0x88));                                                   \
+    } while (0)
+        PR_PAIR(0);
+        PR_PAIR(1);
+        PR_PAIR(2);
+        PR_PAIR(3);
+#undef PR_PAIR
+    }
+    if (x < x0 + n)
+        dof_periph_row_x86(out, sharp, coc, half, lnear, x, x0 + n - x);
+}
+
 /* two blocks (8 pixels): pixel pairs as vectors, the pairs of a block added crosswise so that
  * each half holds (q0 + q2) / (q1 + q3) as the reference; min / max within each 128-bit half */
 static void nearblk_row_avx2(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n)
@@ -447,6 +492,7 @@ static void nearbox_row_avx2(float *restrict out, float *restrict out_r, float *
 
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d)
 {
+    d->dof_periph_row = periph_row_avx2;
     d->dof_nearbox_row = nearbox_row_avx2;
     d->dof_nearblk_row = nearblk_row_avx2;
     d->dof_upsample_row = upsample_row_avx2;

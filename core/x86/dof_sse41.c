@@ -52,8 +52,15 @@ static void nearbox_row_sse41(float *restrict out, float *restrict out_r, float 
             fv_dof_nearbox_row_c(out, out_r, out_w, src, r, wgt, w, i, 1, reach), i++;
 }
 
+static void periph_row_sse41(float *restrict out, const float *sharp, const float *coc, const float *half,
+                             const float *lnear, int x0, int n)
+{
+    dof_periph_row_x86(out, sharp, coc, half, lnear, x0, n);
+}
+
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d)
 {
+    d->dof_periph_row = periph_row_sse41;
     d->dof_nearbox_row = nearbox_row_sse41;
     d->dof_nearblk_row = nearblk_row_sse41;
     d->dof_upsample_row = upsample_row_sse41;

@@ -240,6 +240,50 @@ static inline void dof_combine_row_x86(float *restrict out, const fv_dof_combine
     }
 }
 
+/* ---- periph_row: 4 pixels' scalars (w, the masks) as 4 lanes, then one pixel a vector ---- */
+#define DOF_BCK(v, k) _mm_shuffle_ps(v, v, _MM_SHUFFLE(k, k, k, k))
+static inline void dof_periph4(float *out, const float *sharp, const float *coc, const float *half, const float *lnear,
+                               int x)
+{
+    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps(), c4 = _mm_loadu_ps(coc + x);
+    const __m128 m = _mm_andnot_ps(_mm_set1_ps(-0.0f), c4);
+    const __m128 w4 = _mm_mul_ps(_mm_min_ps(m, one), _mm_min_ps(_mm_mul_ps(_mm_mul_ps(m, m), _mm_set1_ps(FV_DOF_L1_SLOPE)), one));
+    const __m128 wpos = _mm_cmpgt_ps(w4, zero);
+    const __m128 nn = _mm_cmpge_ps(c4, zero); /* !(c < 0), c finite */
+    const __m128 q75 = _mm_set1_ps(0.75f), q25 = _mm_set1_ps(0.25f);
+#define DOF_PX(k)                                                                                                    \
+    do {                                                                                                             \
+        const int xi = x + (k);                                                                                      \
+        const float *h0 = half + 4 * (ptrdiff_t)(xi >> 1), *h1 = h0 + ((xi & 1) ? 4 : -4);                          \
+        const __m128 sv = _mm_loadu_ps(sharp + 4 * (ptrdiff_t)xi);                                                   \
+        const __m128 u = _mm_add_ps(_mm_mul_ps(q75, _mm_loadu_ps(h0)), _mm_mul_ps(q25, _mm_loadu_ps(h1)));            \
+        const __m128 wk = DOF_BCK(w4, k);                                                                            \
+        __m128 o = _mm_blendv_ps(sv, _mm_add_ps(sv, _mm_mul_ps(wk, _mm_sub_ps(u, sv))), DOF_BCK(wpos, k));          \
+        if (lnear && _mm_movemask_ps(nn) >> (k) & 1) {                                                               \
+            const __m128 q = _mm_loadu_ps(lnear + 4 * (ptrdiff_t)xi), q3 = dof_bcast3(q);                            \
+            const __m128 pos = _mm_cmpgt_ps(q3, zero);                                                               \
+            o = _mm_blendv_ps(o, _mm_add_ps(o, _mm_mul_ps(_mm_min_ps(q3, one), _mm_sub_ps(_mm_div_ps(q, q3), o))), pos); \
+        }                                                                                                            \
+        _mm_storeu_ps(out + 4 * (ptrdiff_t)xi, _mm_blend_ps(o, sv, 8));                                              \
+    } while (0)
+    DOF_PX(0);
+    DOF_PX(1);
+    DOF_PX(2);
+    DOF_PX(3);
+#undef DOF_PX
+}
+#undef DOF_BCK
+
+static inline void dof_periph_row_x86(float *restrict out, const float *sharp, const float *coc, const float *half,
+                                      const float *lnear, int x0, int n)
+{
+    int x = x0;
+    for (; x + 4 <= x0 + n; x += 4)
+        dof_periph4(out, sharp, coc, half, lnear, x);
+    if (x < x0 + n)
+        fv_dof_periph_row_c(out, sharp, coc, half, lnear, x, x0 + n - x);
+}
+
 /* ---- upsample_row, one pixel a vector: dst = p0 + a (p1 - p0), the reference's per-channel
  * operations (the SSE4.1 version; the AVX2 one's tail) ---- */
 

@@ -325,6 +325,18 @@ static void pyrblur_run(void *st, const checkasm_dsp *d, int row0, int rows)
         d->dof.dof_pyrblur_row(t->out + 4 * y * W, &a, 0, W);
     }
 }
+/* the periphery beyond the disc: half-resolution blur row (with its clamped texel before it), near
+ * layer, combine (coc +-6 px: both signs, every weight) */
+static void periph_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const size_t y = (size_t)((row0 + k) % H);
+        d->dof.dof_periph_row(t->out + 4 * y * W, t->rgbd + 4 * y * W, t->coc + y * W, t->a4 + 4 * y * W + 4,
+                              t->c4 + 4 * y * W, 0, W);
+    }
+}
+
 static void combine_run(void *st, const checkasm_dsp *d, int row0, int rows)
 {
     dof_st *t = st;
@@ -610,6 +622,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"dof_pyrblur_row", "1280x1440, 1440 rows, 5 levels", {F(dof.dof_pyrblur_row), 0}, H, dof_setup, NULL, pyrblur_run,
      dof_free},
     {"dof_combine_row", "1280x1440, 1440 rows, all layers", {F(dof.dof_combine_row), 0}, H, dof_setup, NULL, combine_run,
+     dof_free},
+    {"dof_periph_row", "1280x1440, 1440 rows, near layer on", {F(dof.dof_periph_row), 0}, H, dof_setup, NULL, periph_run,
      dof_free},
     {"et_down2_row", "640x480 -> 320x240, 240 rows", {F(et.et_down2_row), 0}, EH / 2, et_setup, NULL, down2_run, et_free},
     {"et_integral_row", "640x480, 480 rows", {F(et.et_integral_row), 0}, EH, et_setup, NULL, integral_run, et_free},

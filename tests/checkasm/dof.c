@@ -71,7 +71,7 @@ static void run_all(const char *kernel, runner fn, size_t member)
 /* ------------------------------------------------------------------ tables */
 
 static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row",
-                                     "dof_nearblk_row", "dof_nearbox_row"};
+                                     "dof_nearblk_row", "dof_nearbox_row", "dof_periph_row"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -90,6 +90,7 @@ static void test_tables(void **state)
     assert_true(ref.dof_pyrblur_row == fv_dof_pyrblur_row_c);
     assert_true(ref.dof_nearblk_row == fv_dof_nearblk_row_c);
     assert_true(ref.dof_nearbox_row == fv_dof_nearbox_row_c);
+    assert_true(ref.dof_periph_row == fv_dof_periph_row_c);
     CHECKASM_CHECK_ISA_TABLES("dof", fv_dof_dsp, &ref, names);
 }
 
@@ -616,6 +617,73 @@ static void test_nearbox_row(void **state)
     run_all("dof_nearbox_row", run_nearbox, offsetof(fv_dof_dsp, dof_nearbox_row));
 }
 
+/* ------------------------------------------------------------------ periph_row */
+
+static long pr_blend, pr_near; /* pixels blurred / covered by the near layer (reference, all ISAs) */
+
+/* Rows of w pixels, spans [x0, x0 + n) from odd and even x; the half row an exact-size buffer of
+ * (w + 1) / 2 + 2 texels (the clamped copies at -1 and hw included), so a read past the taps
+ * shows under ASan. CoCs: 0, -0, below a pixel, around the level-1 knee (|c| = sqrt(44 / 3)),
+ * large, both signs; the near layer NULL or with coverage 0, fractions, above 1, and NaN at near
+ * pixels (which the reference does not read: an ISA version may read it but must not use it). */
+static void run_periph1(const fv_dof_dsp *d, const char *isa, int w, int x0, int n, int off)
+{
+    const int hw = (w + 1) / 2, cmode = rndi(5), lmode = rndi(3);
+    buf sharp = buf_new(4 * (size_t)w, off), coc = buf_new((size_t)w, off), half = buf_new(4 * (size_t)(hw + 2), off);
+    buf ln = buf_new(4 * (size_t)w, off);
+    for (int i = 0; i < 4 * (hw + 2); i++)
+        half.p[i] = colour();
+    for (int i = 0; i < w; i++) {
+        static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.0f, -1.0f, 3.8297084f, -3.8297084f, 3.8297086f,
+                                    64.0f, -100.0f, 1e6f, 0.5f, -0.999f};
+        const float u = rnd(), sg = rndi(2) ? 1.0f : -1.0f;
+        coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? sg * 1.2f * rnd() : cmode == 2 ? sg * 6.0f * rnd() :
+                   u < 0.3f ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : sg * 20.0f * rnd();
+        for (int k = 0; k < 4; k++)
+            sharp.p[4 * i + k] = colour();
+        const int near = coc.p[i] < 0.0f;
+        for (int k = 0; k < 3; k++)
+            ln.p[4 * i + k] = near && rndi(3) == 0 ? NAN : colour();
+        const float cv = rnd();
+        ln.p[4 * i + 3] = near && rndi(3) == 0 ? NAN : rndi(3) == 0 ? 0.0f : rndi(3) == 0 ? 1.0f + cv : cv;
+    }
+    const float *lnear = lmode == 0 ? NULL : ln.p;
+    buf r = checkasm_out_f32(4 * (size_t)w, off), o = checkasm_out_f32(4 * (size_t)w, off);
+    fv_dof_periph_row_c(r.p, sharp.p, coc.p, half.p + 4, lnear, x0, n);
+    d->dof_periph_row(o.p, sharp.p, coc.p, half.p + 4, lnear, x0, n);
+    compare_out(&r, &o, 4 * (size_t)w, 4, isa, "periph_row", "whole row + canaries");
+    for (int i = x0; i < x0 + n; i++) {
+        const float m = fabsf(coc.p[i]);
+        pr_blend += m > 0.0f;
+        pr_near += lnear && !(coc.p[i] < 0.0f) && lnear[4 * i + 3] > 0.0f;
+        for (int k = 0; k < 4; k++)
+            assert_true(isfinite(r.p[4 * i + k]));
+    }
+    free(sharp.base), free(coc.base), free(half.base), free(ln.base), free(r.base), free(o.base);
+}
+
+static void run_periph(const fv_dof_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 40; n++)
+        for (int rep = 0; rep < 8; rep++) {
+            const int w = n + (rndi(3) == 0 ? 0 : rndi(20)), x0 = rndi(w - n + 1);
+            run_periph1(d, isa, w, x0, n, rndi(4));
+        }
+    for (int k = 0; k < 12; k++) { /* production rows: the periphery left and right of the disc */
+        const int w = 1280 + (k & 1), a = 300 + rndi(200), b = a + rndi(400);
+        run_periph1(d, isa, w, 0, a, rndi(4));
+        run_periph1(d, isa, w, b, w - b, rndi(4));
+    }
+}
+
+static void test_periph_row(void **state)
+{
+    (void)state;
+    run_all("dof_periph_row", run_periph, offsetof(fv_dof_dsp, dof_periph_row));
+    printf("[ checkasm ] periph pixels blurred (all ISAs): %ld, under the near layer %ld\n", pr_blend, pr_near);
+    assert_true(pr_blend > 1000 && pr_near > 1000);
+}
+
 const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_gauss_tab),
@@ -627,5 +695,6 @@ const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_pyrblur_row),
     cmocka_unit_test(test_nearblk_row),
     cmocka_unit_test(test_nearbox_row),
+    cmocka_unit_test(test_periph_row),
     {0},
 };
