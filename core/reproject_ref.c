@@ -6,6 +6,7 @@
 
 #include "reproject.h"
 #include "reproject_dsp.h"
+#include "sampling.h"
 
 typedef struct {
     float c[4];
@@ -61,6 +62,50 @@ void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, f
                     ptrdiff_t stride, int x0, int y0, int w, int h, struct fv_taa_flow *flow)
 {
     taa_blend_c(f, t, rgbd, wgt, stride, x0, y0, w, h, flow);
+}
+
+/* The still head in place (reproject.h): plain C, a few operations per sample (the projection
+ * is the identity, the level-0 tap one saved texel). The level-0 single tap is tap() with
+ * fx = fy = 0 (b00 = 1, the other three texels weigh +0), written out on the saved texel. */
+void fv_taa_still_tile(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
+                       const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t *rows, float keep,
+                       const fv_taa_still_hist *h)
+{
+    fv_taa_tile t;
+    const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
+    fv_taa_tile_setup(&t, prm, fv_sampler_probability(smp, cx - (float)gx, cy - (float)gy) * keep, smp->prm.p_min,
+                      smp->phases);
+    if (t.alpha >= 1.0f)
+        return; /* samples as traced (the blend's keep_sample), holes hold the history */
+    int k = 0;
+    for (int y = 0; y < th; y++) {
+        float *row = l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0);
+        const float py = (float)(y0 + y) + 0.5f;
+        for (uint32_t r = rows[y]; r; r &= r - 1, k++) {
+            const int i = __builtin_ctz(r);
+            float *px = row + 4 * i;
+            const float d = px[3], rz = 1.0f / d;
+            float o;
+            const int l = taa_footprint(f, (d * rz) * t.widen, &o);
+            const float inv_tol = rz * f->inv_depth_tol;
+            if (l > 0) { /* the history's coarser levels are not overwritten: the blend's taps */
+                const taa_pending q = {px, (float)(x0 + i) + 0.5f, py, d, inv_tol, o, l};
+                taa_taps(f, &t, &q);
+                continue;
+            }
+            const float *c = h->rgbd[k];
+            float a = 1.0f - fabsf(c[3] - d) * inv_tol;
+            a = a > 0.0f ? a : 0.0f;
+            const float w = h->wgt[k] * a;
+            if (!(w > 0.0f))
+                continue; /* no valid history: the sample stands alone */
+            acc4 acc;
+            for (int ch = 0; ch < 4; ch++)
+                acc.c[ch] = 0.0f + w * c[ch];
+            const float a1 = 1.0f - w;
+            out_blend(px, acc, w, a1 > t.alpha ? a1 : t.alpha);
+        }
+    }
 }
 
 /* no vector body: the scalar form does every pixel */
