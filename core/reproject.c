@@ -122,8 +122,9 @@ void fv_taa_still_save(const fv_pyr_level *l0, int x0, int y0, int tw, int th, c
         const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0;
         for (uint32_t r = rows[y]; r; r &= r - 1, k++) {
             const int i = __builtin_ctz(r);
-            memcpy(h->rgbd[k], l0->rgbd + 4 * (o + i), 4 * sizeof(float));
-            h->wgt[k] = l0->wgt[o + i];
+            const float *c = l0->rgbd + 4 * (o + i);
+            h->h[0][k] = c[0], h->h[1][k] = c[1], h->h[2][k] = c[2], h->h[3][k] = c[3];
+            h->h[4][k] = l0->wgt[o + i];
         }
     }
 }

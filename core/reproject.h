@@ -106,8 +106,8 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
  * the blend's taps on the history's untouched coarser levels (the same bits). */
 #define FV_TAA_STILL_MAX_PX 256 /* tiles up to 16 x 16 */
 typedef struct fv_taa_still_hist {
-    float rgbd[FV_TAA_STILL_MAX_PX][4]; /* the samples' history texels, in row-major sample order */
-    float wgt[FV_TAA_STILL_MAX_PX];
+    float h[5][FV_TAA_STILL_MAX_PX]; /* the samples' history texels' r, g, b, depth, weight, in
+                                      * row-major sample order (taa_still's h planes) */
 } fv_taa_still_hist;
 /* Saves the history texels (level 0 = the history) of the samples of rows (bit x - x0 of
  * rows[y - y0]) before the tile's rays are cast over them. tw * th <= FV_TAA_STILL_MAX_PX. */
@@ -117,8 +117,8 @@ void fv_taa_still_save(const fv_pyr_level *l0, int x0, int y0, int tw, int th, c
  * the other pixels are left as they are (the history: the fill's result). f->identity must hold;
  * keep as fv_taa_tile_run_keep's. */
 void fv_taa_still_tile(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
-                       const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t *rows, float keep,
-                       const fv_taa_still_hist *h);
+                       const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
+                       const uint32_t *rows, float keep, const fv_taa_still_hist *h);
 
 /* Prefetches the level-0 history that fv_taa_tile_run of the tile [x0, x0+tw) x [y0, y0+th) will
  * read, guessing the tile's motion from the history's depth at coarse_level (the level where the

@@ -6,6 +6,7 @@
 
 #include "reproject.h"
 #include "reproject_dsp.h"
+#include "reproject_still_lane.h"
 #include "sampling.h"
 
 typedef struct {
@@ -64,12 +65,12 @@ void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, f
     taa_blend_c(f, t, rgbd, wgt, stride, x0, y0, w, h, flow);
 }
 
-/* The still head in place (reproject.h): plain C, a few operations per sample (the projection
- * is the identity, the level-0 tap one saved texel). The level-0 single tap is tap() with
- * fx = fy = 0 (b00 = 1, the other three texels weigh +0), written out on the saved texel. */
+/* The still head in place (reproject.h): the tile's samples gathered into planes for the
+ * taa_still kernel (level-0 footprints, nearly all), the rest through the blend's scalar taps on
+ * the history's coarser levels, which no tile overwrites. */
 void fv_taa_still_tile(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
-                       const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t *rows, float keep,
-                       const fv_taa_still_hist *h)
+                       const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
+                       const uint32_t *rows, float keep, const fv_taa_still_hist *h)
 {
     fv_taa_tile t;
     const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
@@ -77,35 +78,52 @@ void fv_taa_still_tile(const fv_taa_frame *f, const fv_taa_params *prm, const st
                       smp->phases);
     if (t.alpha >= 1.0f)
         return; /* samples as traced (the blend's keep_sample), holes hold the history */
-    int k = 0;
+    enum { P = FV_TAA_STILL_MAX_PX };
+    float s[4][P];
+    float *px[P];
+    uint8_t wide[P], xy[P][2];
+    int n = 0;
     for (int y = 0; y < th; y++) {
         float *row = l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0);
-        const float py = (float)(y0 + y) + 0.5f;
-        for (uint32_t r = rows[y]; r; r &= r - 1, k++) {
+        for (uint32_t r = rows[y]; r; r &= r - 1, n++) {
             const int i = __builtin_ctz(r);
-            float *px = row + 4 * i;
-            const float d = px[3], rz = 1.0f / d;
-            float o;
-            const int l = taa_footprint(f, (d * rz) * t.widen, &o);
-            const float inv_tol = rz * f->inv_depth_tol;
-            if (l > 0) { /* the history's coarser levels are not overwritten: the blend's taps */
-                const taa_pending q = {px, (float)(x0 + i) + 0.5f, py, d, inv_tol, o, l};
-                taa_taps(f, &t, &q);
-                continue;
-            }
-            const float *c = h->rgbd[k];
-            float a = 1.0f - fabsf(c[3] - d) * inv_tol;
-            a = a > 0.0f ? a : 0.0f;
-            const float w = h->wgt[k] * a;
-            if (!(w > 0.0f))
-                continue; /* no valid history: the sample stands alone */
-            acc4 acc;
-            for (int ch = 0; ch < 4; ch++)
-                acc.c[ch] = 0.0f + w * c[ch];
-            const float a1 = 1.0f - w;
-            out_blend(px, acc, w, a1 > t.alpha ? a1 : t.alpha);
+            float *p = px[n] = row + 4 * i;
+            xy[n][0] = (uint8_t)i, xy[n][1] = (uint8_t)y;
+            s[0][n] = p[0], s[1][n] = p[1], s[2][n] = p[2], s[3][n] = p[3];
         }
     }
+    dsp->taa_still(&s[0][0], &h->h[0][0], P, n, t.widen, t.alpha, f->inv_depth_tol, wide);
+    for (int k = 0; k < n; k++) {
+        float *p = px[k];
+        if (!wide[k]) {
+            p[0] = s[0][k], p[1] = s[1][k], p[2] = s[2][k];
+            continue;
+        }
+        /* a footprint of two texels or more: the blend's taps (the coarser levels are the
+         * history's); a one-level pyramid has none, its single texel is the saved one */
+        const float d = p[3], rz = 1.0f / d;
+        float o;
+        const int l = taa_footprint(f, (d * rz) * t.widen, &o);
+        if (l == 0) {
+            uint8_t unused;
+            float one[4][1] = {{p[0]}, {p[1]}, {p[2]}, {d}}, hk[5][1];
+            for (int c = 0; c < 5; c++)
+                hk[c][0] = h->h[c][k];
+            fv_taa_still_c(&one[0][0], &hk[0][0], 1, 1, 1.0f, t.alpha, f->inv_depth_tol, &unused);
+            p[0] = one[0][0], p[1] = one[1][0], p[2] = one[2][0];
+            continue;
+        }
+        const taa_pending q = {p, (float)(x0 + xy[k][0]) + 0.5f, (float)(y0 + xy[k][1]) + 0.5f, d,
+                               rz * f->inv_depth_tol, o, l};
+        taa_taps(f, &t, &q);
+    }
+}
+
+void fv_taa_still_c(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha, float inv_depth_tol,
+                    uint8_t *wide)
+{
+    for (int k = 0; k < n; k++)
+        taa_still_lane(s, h, plane, k, widen, alpha, inv_depth_tol, wide);
 }
 
 /* no vector body: the scalar form does every pixel */
@@ -128,6 +146,7 @@ void fv_reproject_dsp_init(fv_reproject_dsp *d, unsigned isa_mask)
     const unsigned isas = isa_mask & fv_cpu_isas();
     d->taa_blend = fv_taa_blend_c;
     d->taa_fill = fv_taa_fill_c;
+    d->taa_still = fv_taa_still_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_reproject_dsp_init_sse41(d);

@@ -88,7 +88,8 @@ static void run_still(tile_job *j, int index, int thread_id, int x0, int y0, int
     if (aa)
         fv_taa_aa_tile(j->taa, j->aa, l0, x0, y0, tw, th);
     else
-        fv_taa_still_tile(j->taa, j->taa_prm, j->smp, j->gx, j->gy, l0, x0, y0, tw, th, rows, keep, hist);
+        fv_taa_still_tile(j->taa, j->taa_prm, j->smp, j->gx, j->gy, l0, &j->dsp->taa, x0, y0, tw, th, rows, keep,
+                          hist);
     const int64_t t1 = fv_time_ns();
     atomic_fetch_add_explicit(&j->taa_ns, taa_ns + (t1 - t0), memory_order_relaxed);
     if (j->prof)
