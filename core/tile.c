@@ -110,6 +110,14 @@ static void run_tile(void *ctx, int index, int thread_id)
 
     if (j->taa && !j->still) /* early: the lines arrive while the rays are traced */
         fv_taa_prefetch(j->taa, FV_TILE_PULL_LEVELS, x0, y0, tw, th);
+    if (j->still) /* the history is the tile itself: its samples' texels are read before they are written */
+        for (int y = 0; y < th; y++) {
+            const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0;
+            for (int x = 0; x < tw; x += 4)
+                __builtin_prefetch(l0->rgbd + 4 * (o + x), 1);
+            __builtin_prefetch(l0->wgt + o, 1);
+            __builtin_prefetch(l0->wgt + o + tw - 1, 1);
+        }
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++)
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
