@@ -128,19 +128,24 @@ static void catmull_rom(const fv_pyr_level *H, int i0, int j0, float fx, float f
         w[k][2] = q * (0.5f + q * (2.0f - 1.5f * q));
         w[k][3] = q * q * (-0.5f + 0.5f * q);
     }
-    float acc[3] = {0.0f, 0.0f, 0.0f};
+    /* the weights first (any hole: no Catmull-Rom), then the sums in scalars: an array kept them
+     * in memory, each += a store-to-load round trip (the same additions in the same order) */
     for (int j = 0; j < 4; j++) {
-        const ptrdiff_t row = (ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1;
+        const float *wr = H->wgt + (ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1;
+        if (wr[0] != 1.0f || wr[1] != 1.0f || wr[2] != 1.0f || wr[3] != 1.0f)
+            return;
+    }
+    float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f;
+    for (int j = 0; j < 4; j++) {
+        const float *r = H->rgbd + 4 * ((ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1);
         for (int i = 0; i < 4; i++) {
-            if (H->wgt[row + i] != 1.0f)
-                return;
             const float ww = wx[i] * wy[j];
-            for (int c = 0; c < 3; c++)
-                acc[c] += ww * H->rgbd[4 * (row + i) + c];
+            a0 += ww * r[4 * i];
+            a1 += ww * r[4 * i + 1];
+            a2 += ww * r[4 * i + 2];
         }
     }
-    for (int c = 0; c < 3; c++)
-        h[c] = acc[c];
+    h[0] = a0, h[1] = a1, h[2] = a2;
 }
 
 void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
@@ -197,12 +202,13 @@ void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_py
                     const int i0 = (int)fx0, j0 = (int)fy0;
                     const float fx = sx - fx0, fy = sy - fy0;
                     const float b[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
-                    float acc[3] = {0.0f, 0.0f, 0.0f}, accw = 0.0f;
+                    float acc[3] = {0.0f, 0.0f, 0.0f}, accw = 0.0f; /* the sums in scalars (as above) */
                     for (int k = 0; k < 4; k++) {
                         const ptrdiff_t o = (ptrdiff_t)(j0 + (k >> 1) - hy0) * Hs + i0 + (k & 1) - hx0;
                         const float w = b[k] * Hw[o];
-                        for (int c = 0; c < 3; c++)
-                            acc[c] += w * Hrgbd[4 * o + c];
+                        acc[0] += w * Hrgbd[4 * o];
+                        acc[1] += w * Hrgbd[4 * o + 1];
+                        acc[2] += w * Hrgbd[4 * o + 2];
                         accw += w;
                     }
                     if (near && accw > 1e-6f) {
@@ -230,15 +236,15 @@ void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_py
                 continue;
             }
             /* rectification: the 3x3 neighbourhood of this frame's samples, inside the tile */
-            float lo[3], hi[3];
-            for (int c = 0; c < 3; c++)
-                lo[c] = hi[c] = s[y][x][c];
+            /* in scalars: arrays were kept in memory, a store-to-load round trip per min / max */
+            float lo0 = s[y][x][0], lo1 = s[y][x][1], lo2 = s[y][x][2], hi0 = lo0, hi1 = lo1, hi2 = lo2;
             for (int j = y > 0 ? y - 1 : 0; j <= (y + 1 < th ? y + 1 : th - 1); j++)
-                for (int i = x > 0 ? x - 1 : 0; i <= (x + 1 < tw ? x + 1 : tw - 1); i++)
-                    for (int c = 0; c < 3; c++) {
-                        lo[c] = minf(lo[c], s[j][i][c]);
-                        hi[c] = maxf(hi[c], s[j][i][c]);
-                    }
+                for (int i = x > 0 ? x - 1 : 0; i <= (x + 1 < tw ? x + 1 : tw - 1); i++) {
+                    const float *q = s[j][i];
+                    lo0 = minf(lo0, q[0]), lo1 = minf(lo1, q[1]), lo2 = minf(lo2, q[2]);
+                    hi0 = maxf(hi0, q[0]), hi1 = maxf(hi1, q[1]), hi2 = maxf(hi2, q[2]);
+                }
+            const float lo[3] = {lo0, lo1, lo2}, hi[3] = {hi0, hi1, hi2};
             for (int c = 0; c < 3; c++) {
                 const float hc = minf(maxf(h[c], lo[c]), hi[c]);
                 px[c] = hc + alpha * (s[y][x][c] - hc);
