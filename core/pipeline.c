@@ -29,6 +29,8 @@ typedef struct {
     uint32_t *rows;    /* DoF-driven sampling: the last frame's sample bits per tile (ceiling) */
     int rows_valid;    /* the last frame was thinned: rows holds its bits */
     uint8_t *aa_n[2];  /* fovea anti-aliasing: per-pixel sample counts, aa_n[cur] the last frame's */
+    float *aa_snap;    /* the still head in place: the AA tiles' history (fv_taa_aa_snapshot) */
+    size_t aa_snap_cap; /* its floats */
 } eye_state;
 
 struct fv_pipeline {
@@ -215,6 +217,7 @@ void fv_pipeline_destroy(fv_pipeline *p)
         free(p->eyes[e].rows);
         free(p->eyes[e].aa_n[0]);
         free(p->eyes[e].aa_n[1]);
+        free(p->eyes[e].aa_snap);
     }
     fv_dof_work_free(&p->dof_work);
     free(p->dofsamp_map);
@@ -345,6 +348,7 @@ typedef struct {
     fv_tile_opts opt; /* points into tf, dsf, aaf and shade_ns */
     int64_t shade_ns; /* the workers' time shading, when the config asks (time_shading) */
     int64_t t0, tc0;  /* the frame's and the ray stage's span starts (single-eye path) */
+    double snap_ms;   /* the still head's AA snapshot (reprojection time before the tiles) */
 } eye_frame;
 
 /* The eye's camera, reprojection and DoF-sampling set-up (its defocus map into map). */
@@ -401,6 +405,21 @@ static int eye_begin(fv_pipeline *p, eye_frame *f, fv_eye eye, const fv_pose *he
         f->aaf.stride = d.width;
         fv_sampling_jitter((uint32_t)es->frame, &f->aaf.ox, &f->aaf.oy);
         f->opt.aa = &f->aaf;
+    }
+    /* The head still (identical cameras): render over the history's level 0 in place instead of
+     * copying it into the other pyramid (core/reproject.h, fv_taa_still_*). The pyramids swap
+     * their level-0 planes, so pyr[dst] gets the history's; their coarser levels stay apart (the
+     * still blend reads the history's). The AA tiles read a copy of theirs. */
+    if (p->taa && es->hist_valid && f->tf.identity && p->cfg.taa.in_place && p->cfg.taa.fill) {
+        const int64_t ts0 = fv_time_ns();
+        if (p->aa && fv_taa_aa_snapshot(&f->aaf, &es->pyr[es->cur].lv[0], p->smp_cur, f->gx, f->gy, FV_TILE,
+                                        &es->aa_snap, &es->aa_snap_cap))
+            return -1;
+        const fv_pyr_level l0 = es->pyr[es->cur].lv[0];
+        es->pyr[es->cur].lv[0] = es->pyr[f->dst].lv[0];
+        es->pyr[f->dst].lv[0] = l0;
+        f->opt.still = 1;
+        f->snap_ms = (double)(fv_time_ns() - ts0) * 1e-6; /* reprojection's, though outside the tiles */
     }
     return 0;
 }
@@ -463,7 +482,7 @@ int fv_pipeline_render(fv_pipeline *p, fv_eye eye, const fv_pose *head, float ga
     const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, (int)eye);
     eye_finish(p, &f, st);
     const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, (int)eye);
-    trace_stats(p, st, (double)(t1 - tc0) * 1e-6, taa_ms, f.shade_ns);
+    trace_stats(p, st, (double)(t1 - tc0) * 1e-6, taa_ms + f.snap_ms, f.shade_ns); /* the snapshot is inside */
     st->total_ms = (double)(t3 - t0) * 1e-6;
     return 0;
 }
@@ -495,7 +514,7 @@ int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x,
     st[0].samples = fv_tile_pass(p->scene, te[0].cam, p->smp_cur, te[0].gx, te[0].gy, te[0].pyr, &p->dsp, p->pool,
                                  &te[0].opt, &taa_ms);
     const int64_t t1 = fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tc0, FV_EYE_LEFT);
-    trace_stats(p, &st[0], (double)(t1 - tc0) * 1e-6, taa_ms, f[0].shade_ns);
+    trace_stats(p, &st[0], (double)(t1 - tc0) * 1e-6 + f[0].snap_ms, taa_ms + f[0].snap_ms, f[0].shade_ns);
     eye_finish(p, &f[0], &st[0]);
     const int64_t tl = fv_time_ns();
     st[0].total_ms = (double)(tl - t0) * 1e-6;
@@ -505,7 +524,8 @@ int fv_pipeline_render_stereo(fv_pipeline *p, const fv_pose *head, float gaze_x,
     fv_prof_stage_end(p->prof, FV_STAGE_TRACE, tw0, FV_EYE_RIGHT);
     st[1].samples = te[1].rays;
     /* its ray stage ran beside the left eye's stages: the workers' time in its tiles over the threads */
-    trace_stats(p, &st[1], te[1].tile_ms / fv_pool_threads(p->pool), te[1].taa_ms, f[1].shade_ns);
+    trace_stats(p, &st[1], te[1].tile_ms / fv_pool_threads(p->pool) + f[1].snap_ms, te[1].taa_ms + f[1].snap_ms,
+                f[1].shade_ns);
     eye_finish(p, &f[1], &st[1]);
     const int64_t t3 = fv_prof_stage_end(p->prof, FV_PROF_FRAME, t0, FV_PIPELINE_PAIR);
     st[1].total_ms = (double)(t3 - tl) * 1e-6;
@@ -581,7 +601,8 @@ void fv_pipeline_memory_bytes(const fv_pipeline *p, fv_eye eye, fv_pipeline_memo
     m->image = es->out ? image_bytes(&es->pyr[0].lv[0]) : 0;
     m->display = (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height * 3;
     m->other = (es->rows ? rows_bytes(&p->cfg.cam) : 0) +
-               (es->aa_n[0] ? 2 * (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height : 0);
+               (es->aa_n[0] ? 2 * (size_t)p->cfg.cam.width * (size_t)p->cfg.cam.height : 0) +
+               es->aa_snap_cap * sizeof(float);
     if (p->dof) {
         const fv_dof_work *wk = &p->dof_work;
         m->shared = (size_t)wk->stride * (size_t)wk->h * (4 * FV_DOF_PLANES4 + FV_DOF_PLANES1) * sizeof(float) +

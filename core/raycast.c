@@ -137,7 +137,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
     static _Thread_local fv_blend_lane tile_blend_##N[FV_TILE_PACKETS(N)][16]; /* alpha BLEND: blend.c */     \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
                             const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n, float ox, float oy,  \
-                            int64_t *shade_ns)                                                                \
+                            int64_t *shade_ns, void (*before_write)(void *), void *bw_ctx)                 \
     {                                                                                                         \
         struct RTCIntersectContext ictx;                                                                      \
         rtcInitIntersectContext(&ictx);                                                                       \
@@ -180,6 +180,8 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
         }                                                                                                     \
         if (shade_ns)                                                                                         \
             *shade_ns += fv_time_ns() - t0;                                                                   \
+        if (before_write)                                                                                     \
+            before_write(bw_ctx);                                                                             \
         for (int b = 0; b < np; b++)                                                                          \
             write_##N(l0, &rh[b], (const float(*)[16])tile_rgb_##N[b], px + b * N,                             \
                       n - b * N < N ? n - b * N : N, x0, y0);                                                 \
@@ -193,13 +195,34 @@ long fv_raycast_tile(const fv_scene *scene, const fv_camera *cam, const fv_rende
     return fv_raycast_tile_at(scene, cam, dsp, l0, x0, y0, tw, th, rows, 0.5f, 0.5f, shade_ns);
 }
 
-long fv_raycast_tile_at(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
-                        int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], float ox, float oy,
-                        int64_t *shade_ns)
+typedef struct {
+    void (*before_write)(void *);
+    void *ctx;
+    const fv_pyr_level *l0;
+    int x0, y0, th;
+    const uint32_t *rows;
+} still_ctx;
+
+static void still_weights(void *vc)
+{
+    const still_ctx *c = vc;
+    if (c->before_write)
+        c->before_write(c->ctx);
+    for (int y = 0; y < c->th; y++) {
+        float *w = c->l0->wgt + (ptrdiff_t)(c->y0 + y) * c->l0->stride + c->x0;
+        for (uint32_t r = c->rows[y]; r; r &= r - 1)
+            w[__builtin_ctz(r)] = 1.0f;
+    }
+}
+
+static long tile_cast(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
+                      int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], float ox, float oy,
+                      int64_t *shade_ns, int keep_holes, void (*before_write)(void *), void *bw_ctx)
 {
     /* every pixel's weight, from the rows' bits (pull-push never reads the colour of a zero-weight
-     * pixel, so the others' colours are left alone) */
-    for (int y = 0; y < th; y++) {
+     * pixel, so the others' colours are left alone); keep_holes: the samples' only, written with
+     * their colours (below) */
+    for (int y = 0; y < th && !keep_holes; y++) {
         float *w = l0->wgt + (ptrdiff_t)(y0 + y) * l0->stride + x0;
         if (tw == FV_TILE)
             for (int x = 0; x < FV_TILE; x += 4)
@@ -216,14 +239,37 @@ long fv_raycast_tile_at(const fv_scene *scene, const fv_camera *cam, const fv_re
      * asked for before the rays are traced: every line (4 pixels) of a row with a sample; a test
      * per line mispredicted in the sparse periphery */
     for (int y = 0; y < th; y++)
-        if (rows[y])
+        if (rows[y]) {
             for (int x = 0; x < tw; x += 4)
                 __builtin_prefetch(l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0 + x), 1);
+            if (keep_holes) { /* the weights too: before_write reads them (a row spans <= 2 lines) */
+                const float *w = l0->wgt + (ptrdiff_t)(y0 + y) * l0->stride + x0;
+                __builtin_prefetch(w, 1);
+                __builtin_prefetch(w + tw - 1, 1);
+            }
+        }
     for (int q = n; q < n + 16; q++) /* the padding lanes trace the last pixel again, invalid */
         px[q] = px[n - 1];
+    still_ctx sc = {before_write, bw_ctx, l0, x0, y0, th, rows};
+    if (keep_holes) /* before_write first sees the pixels as they were, then the samples' weights */
+        bw_ctx = &sc, before_write = still_weights;
     if (fv_raycast_packet_width() == 16)
-        packets_16(scene, cam, dsp, l0, x0, y0, px, n, ox, oy, shade_ns);
+        packets_16(scene, cam, dsp, l0, x0, y0, px, n, ox, oy, shade_ns, before_write, bw_ctx);
     else
-        packets_8(scene, cam, dsp, l0, x0, y0, px, n, ox, oy, shade_ns);
+        packets_8(scene, cam, dsp, l0, x0, y0, px, n, ox, oy, shade_ns, before_write, bw_ctx);
     return n;
+}
+
+long fv_raycast_tile_at(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp, const fv_pyr_level *l0,
+                        int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], float ox, float oy,
+                        int64_t *shade_ns)
+{
+    return tile_cast(scene, cam, dsp, l0, x0, y0, tw, th, rows, ox, oy, shade_ns, 0, NULL, NULL);
+}
+
+long fv_raycast_tile_keep_holes(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,
+                                const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE],
+                                float ox, float oy, int64_t *shade_ns, void (*before_write)(void *ctx), void *ctx)
+{
+    return tile_cast(scene, cam, dsp, l0, x0, y0, tw, th, rows, ox, oy, shade_ns, 1, before_write, ctx);
 }

@@ -63,4 +63,13 @@ long fv_raycast_tile_at(const fv_scene *scene, const fv_camera *cam, const struc
                         const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE], float ox,
                         float oy, int64_t *shade_ns);
 
+/* fv_raycast_tile_at that writes the samples only (colour, depth, weight 1): the other pixels
+ * keep their weight and colour (the still head renders over its history in place). When the
+ * rays are traced and shaded, before any pixel is written, it calls before_write(ctx) (NULL:
+ * none): the still head saves its samples' history there, when their lines, asked for before
+ * the rays were traced, are in cache. */
+long fv_raycast_tile_keep_holes(const fv_scene *scene, const fv_camera *cam, const struct fv_render_dsp *dsp,
+                                const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t rows[FV_TILE],
+                                float ox, float oy, int64_t *shade_ns, void (*before_write)(void *ctx), void *ctx);
+
 #endif

@@ -16,6 +16,7 @@ void fv_taa_params_default(fv_taa_params *p)
     p->depth_tol = 0.03f;
     p->fill = 1;
     p->fovea_aa = 1;
+    p->in_place = 1;
 }
 
 /* ---------------------------------------------------------------- setup */
@@ -110,6 +111,22 @@ void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const stru
                      const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th)
 {
     fv_taa_tile_run_keep(f, prm, smp, gx, gy, l0, dsp, x0, y0, tw, th, 1.0f);
+}
+
+void fv_taa_still_save(const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t *rows,
+                       fv_taa_still_hist *h)
+{
+    (void)tw;
+    int k = 0;
+    for (int y = 0; y < th; y++) {
+        const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0;
+        for (uint32_t r = rows[y]; r; r &= r - 1, k++) {
+            const int i = __builtin_ctz(r);
+            const float *c = l0->rgbd + 4 * (o + i);
+            h->h[0][k] = c[0], h->h[1][k] = c[1], h->h[2][k] = c[2], h->h[3][k] = c[3];
+            h->h[4][k] = l0->wgt[o + i];
+        }
+    }
 }
 
 void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx,

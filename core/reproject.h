@@ -40,6 +40,8 @@ typedef struct fv_taa_params {
     float depth_tol; /* relative depth tolerance of history texels, default 0.03 */
     int fill;        /* fill pixels without a sample from valid history, default 1 */
     int fovea_aa;    /* anti-aliasing in the fovea (jittered rays accumulated), default 1 */
+    int in_place;    /* head still (identical cameras): render over the history's level 0 in place
+                      * instead of copying it (fv_taa_still_*), default 1 */
 } fv_taa_params;
 
 void fv_taa_params_default(fv_taa_params *p);
@@ -91,6 +93,33 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
                           int gy, const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
                           float keep);
 
+/* ---- the still head in place (docs/reproject.md, "The still head in place") ----
+ * With identical cameras the fill copies every history texel to its own pixel and a sample's
+ * level-0 tap reads only its own pixel's texel. So the frame renders into the history's level 0
+ * itself (the pipeline swaps the two pyramids' level-0 planes; the coarser levels stay double
+ * buffered): holes keep their history (colour, depth, confidence: what the fill would write),
+ * and each tile saves its samples' history texels before its rays overwrite them. Per sample,
+ * with the footprint of fv_taa_tile_run's blend: level 0 -> the saved texel as a single tap
+ * (the same bits as the blend when the footprint is one texel, the default rotating pattern;
+ * where DoF-driven thinning or a static pattern widens it to a level-0 quincunx, the single tap
+ * replaces the five: neighbours' level 0 is being overwritten by other tiles); level >= 1 ->
+ * the blend's taps on the history's untouched coarser levels (the same bits). */
+#define FV_TAA_STILL_MAX_PX 256 /* tiles up to 16 x 16 */
+typedef struct fv_taa_still_hist {
+    float h[5][FV_TAA_STILL_MAX_PX]; /* the samples' history texels' r, g, b, depth, weight, in
+                                      * row-major sample order (taa_still's h planes) */
+} fv_taa_still_hist;
+/* Saves the history texels (level 0 = the history) of the samples of rows (bit x - x0 of
+ * rows[y - y0]) before the tile's rays are cast over them. tw * th <= FV_TAA_STILL_MAX_PX. */
+void fv_taa_still_save(const fv_pyr_level *l0, int x0, int y0, int tw, int th, const uint32_t *rows,
+                       fv_taa_still_hist *h);
+/* Blends the tile's samples (rows, cast over the history in place) with their saved history h;
+ * the other pixels are left as they are (the history: the fill's result). f->identity must hold;
+ * keep as fv_taa_tile_run_keep's. */
+void fv_taa_still_tile(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
+                       const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
+                       const uint32_t *rows, float keep, const fv_taa_still_hist *h);
+
 /* Prefetches the level-0 history that fv_taa_tile_run of the tile [x0, x0+tw) x [y0, y0+th) will
  * read, guessing the tile's motion from the history's depth at coarse_level (the level where the
  * tile is one texel). Call it before the tile's rays are cast, so the lines arrive meanwhile. */
@@ -108,6 +137,12 @@ typedef struct fv_taa_aa_frame {
     uint8_t *n_cur;        /* this frame's: written for every tile (0 outside the AA tiles) */
     ptrdiff_t stride;
     float ox, oy;          /* this frame's ray position inside the AA tiles' pixels, [0, 1) */
+    /* The still head in place: the history's level 0 over the tiles that may take the AA, with
+     * the ring of one pixel they read, copied before the tiles overwrite it (fv_taa_aa_snapshot):
+     * texel (x, y) at h_rgbd + 4 ((y - h_y0) h_stride + x - h_x0). h_rgbd NULL: f->hist's level 0. */
+    const float *h_rgbd, *h_wgt;
+    ptrdiff_t h_stride;
+    int h_x0, h_y0;
 } fv_taa_aa_frame;
 
 /* 1 when the tile [x0, x0+tw) x [y0, y0+th) takes the anti-aliasing: every pixel has a sample in
@@ -120,6 +155,12 @@ int fv_taa_aa_tile_eligible(const struct fv_sampler *smp, int gx, int gy, int x0
  * f NULL (no history yet): the samples stay as traced with count 1. Writes the tile's counts. */
 void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
                     int th);
+/* The still head in place: copies h0 (the history's level 0) over every tile of a w x h image
+ * cut into tile x tile tiles that may take the anti-aliasing (probability 1 at its corner pixels,
+ * as fv_taa_aa_tile_eligible tests) plus one pixel around (within the level's border) into *buf
+ * (grown as needed, *cap floats) and points a's h_* view at it. 0, or -1 when out of memory. */
+int fv_taa_aa_snapshot(fv_taa_aa_frame *a, const fv_pyr_level *h0, const struct fv_sampler *smp, int gx, int gy,
+                       int tile, float **buf, size_t *cap);
 /* Any other tile: its counts are 0. */
 void fv_taa_aa_clear(const fv_taa_aa_frame *a, int x0, int y0, int tw, int th);
 

@@ -5,6 +5,7 @@
 #define FOVEA_REPROJECT_DSP_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "cpu.h"
 
@@ -30,9 +31,21 @@ typedef void (*fv_taa_blend_fn)(const struct fv_taa_frame *f, const struct fv_ta
                                 struct fv_taa_flow *flow);
 typedef void (*fv_taa_fill_fn)(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                                ptrdiff_t stride, int x0, int y0, int w, int h);
+/* taa_still: the still head's level-0 blend (reproject.h, fv_taa_still_*) of n samples held in
+ *   planes `plane` floats apart (SoA): s = the samples' r, g, b, depth (r, g, b rewritten where
+ *   blended), h = their saved history texels' r, g, b, depth, weight. Per sample k:
+ *     rz = 1 / depth, fp = (depth rz) widen
+ *     fp >= 2: wide[k] = 1, sample untouched (its footprint reads coarser levels: the caller's taps)
+ *     else wide[k] = 0; a = max(0, 1 - |h.depth - depth| (rz inv_depth_tol)), w = h.weight a;
+ *       where w > 0: al = max(1 - w, alpha), hc = (0 + w h.c) / w, s.c = hc + al (s.c - hc)
+ *   (the blend's single level-0 tap with fx = fy = 0). Bound: 0 ulp (the ops in this order, no
+ *   FMA, no reciprocal estimate; core/reproject_still_lane.h is the reference lane). */
+typedef void (*fv_taa_still_fn)(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha,
+                                float inv_depth_tol, uint8_t *wide);
 typedef struct fv_reproject_dsp {
     fv_taa_blend_fn taa_blend;
     fv_taa_fill_fn taa_fill;
+    fv_taa_still_fn taa_still;
 } fv_reproject_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -44,6 +57,8 @@ void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, f
                     ptrdiff_t stride, int x0, int y0, int w, int h, struct fv_taa_flow *flow);
 void fv_taa_fill_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                    ptrdiff_t stride, int x0, int y0, int w, int h);
+void fv_taa_still_c(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha, float inv_depth_tol,
+                    uint8_t *wide);
 #if defined(__x86_64__)
 void fv_reproject_dsp_init_sse41(fv_reproject_dsp *d);
 void fv_reproject_dsp_init_avx2(fv_reproject_dsp *d);

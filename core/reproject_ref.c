@@ -6,6 +6,8 @@
 
 #include "reproject.h"
 #include "reproject_dsp.h"
+#include "reproject_still_lane.h"
+#include "sampling.h"
 
 typedef struct {
     float c[4];
@@ -63,6 +65,67 @@ void fv_taa_blend_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, f
     taa_blend_c(f, t, rgbd, wgt, stride, x0, y0, w, h, flow);
 }
 
+/* The still head in place (reproject.h): the tile's samples gathered into planes for the
+ * taa_still kernel (level-0 footprints, nearly all), the rest through the blend's scalar taps on
+ * the history's coarser levels, which no tile overwrites. */
+void fv_taa_still_tile(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx, int gy,
+                       const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
+                       const uint32_t *rows, float keep, const fv_taa_still_hist *h)
+{
+    fv_taa_tile t;
+    const float cx = (float)x0 + 0.5f * (float)tw, cy = (float)y0 + 0.5f * (float)th;
+    fv_taa_tile_setup(&t, prm, fv_sampler_probability(smp, cx - (float)gx, cy - (float)gy) * keep, smp->prm.p_min,
+                      smp->phases);
+    if (t.alpha >= 1.0f)
+        return; /* samples as traced (the blend's keep_sample), holes hold the history */
+    enum { P = FV_TAA_STILL_MAX_PX };
+    float s[4][P];
+    float *px[P];
+    uint8_t wide[P], xy[P][2];
+    int n = 0;
+    for (int y = 0; y < th; y++) {
+        float *row = l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0);
+        for (uint32_t r = rows[y]; r; r &= r - 1, n++) {
+            const int i = __builtin_ctz(r);
+            float *p = px[n] = row + 4 * i;
+            xy[n][0] = (uint8_t)i, xy[n][1] = (uint8_t)y;
+            s[0][n] = p[0], s[1][n] = p[1], s[2][n] = p[2], s[3][n] = p[3];
+        }
+    }
+    dsp->taa_still(&s[0][0], &h->h[0][0], P, n, t.widen, t.alpha, f->inv_depth_tol, wide);
+    for (int k = 0; k < n; k++) {
+        float *p = px[k];
+        if (!wide[k]) {
+            p[0] = s[0][k], p[1] = s[1][k], p[2] = s[2][k];
+            continue;
+        }
+        /* a footprint of two texels or more: the blend's taps (the coarser levels are the
+         * history's); a one-level pyramid has none, its single texel is the saved one */
+        const float d = p[3], rz = 1.0f / d;
+        float o;
+        const int l = taa_footprint(f, (d * rz) * t.widen, &o);
+        if (l == 0) {
+            uint8_t unused;
+            float one[4][1] = {{p[0]}, {p[1]}, {p[2]}, {d}}, hk[5][1];
+            for (int c = 0; c < 5; c++)
+                hk[c][0] = h->h[c][k];
+            fv_taa_still_c(&one[0][0], &hk[0][0], 1, 1, 1.0f, t.alpha, f->inv_depth_tol, &unused);
+            p[0] = one[0][0], p[1] = one[1][0], p[2] = one[2][0];
+            continue;
+        }
+        const taa_pending q = {p, (float)(x0 + xy[k][0]) + 0.5f, (float)(y0 + xy[k][1]) + 0.5f, d,
+                               rz * f->inv_depth_tol, o, l};
+        taa_taps(f, &t, &q);
+    }
+}
+
+void fv_taa_still_c(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha, float inv_depth_tol,
+                    uint8_t *wide)
+{
+    for (int k = 0; k < n; k++)
+        taa_still_lane(s, h, plane, k, widen, alpha, inv_depth_tol, wide);
+}
+
 /* no vector body: the scalar form does every pixel */
 static inline int no_vec(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
                          const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
@@ -83,6 +146,7 @@ void fv_reproject_dsp_init(fv_reproject_dsp *d, unsigned isa_mask)
     const unsigned isas = isa_mask & fv_cpu_isas();
     d->taa_blend = fv_taa_blend_c;
     d->taa_fill = fv_taa_fill_c;
+    d->taa_still = fv_taa_still_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_reproject_dsp_init_sse41(d);

@@ -28,7 +28,74 @@ typedef struct {
     const struct fv_dofsamp_frame *dofs;
     uint32_t *rows_out;
     const fv_taa_aa_frame *aa;
+    int still; /* the still head in place: level 0 is the history (fv_taa_still_*) */
 } tile_job;
+
+/* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level 4.
+ * Tiles start on multiples of 16, so every block starts on even coordinates. */
+static void tile_end(tile_job *j, int index, int thread_id, int x0, int y0, int tw, int th, long rays,
+                     int64_t tile_t0)
+{
+    int xl = x0, yl = y0, wl = tw, hl = th;
+    for (int l = 0; l < FV_TILE_PULL_LEVELS && l + 1 < j->pyr->levels; l++) {
+        fv_pull_block(j->pyr, &j->dsp->pp, l, xl, yl, wl, hl);
+        xl >>= 1, yl >>= 1, wl = (wl + 1) >> 1, hl = (hl + 1) >> 1;
+    }
+    atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
+    if (j->prof)
+        fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_time_ns(), index);
+}
+
+/* the still head's samples' history, saved by the ray caster just before it writes them */
+typedef struct {
+    const fv_pyr_level *l0;
+    int x0, y0, tw, th;
+    const uint32_t *rows;
+    fv_taa_still_hist hist;
+    int64_t ns;
+} still_save;
+
+static void save_hist(void *ctx)
+{
+    still_save *s = ctx;
+    const int64_t t0 = fv_time_ns();
+    fv_taa_still_save(s->l0, s->x0, s->y0, s->tw, s->th, s->rows, &s->hist);
+    s->ns = fv_time_ns() - t0;
+}
+
+/* The still head in place (core/reproject.h): level 0 holds the history; the tile casts its rays
+ * over it leaving the holes (the history) alone, its samples' texels saved just before they are
+ * written, then blends them. The time saving the texels counts as reprojection. */
+static void run_still(tile_job *j, int index, int thread_id, int x0, int y0, int tw, int th, const uint32_t *rows,
+                      float keep, int aa, int64_t tile_t0)
+{
+    const fv_camera *cam = j->cam;
+    const fv_pyr_level *l0 = &j->pyr->lv[0];
+    still_save sv; /* its history filled by save_hist (5 KiB: not cleared) */
+    sv.l0 = l0, sv.x0 = x0, sv.y0 = y0, sv.tw = tw, sv.th = th, sv.rows = rows, sv.ns = 0;
+    int64_t shade_ns = 0;
+    int64_t *sp = j->time_shading ? &shade_ns : NULL;
+    const long rays = fv_raycast_tile_keep_holes(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows,
+                                                 aa ? j->aa->ox : 0.5f, aa ? j->aa->oy : 0.5f, sp,
+                                                 aa ? NULL : save_hist, &sv);
+    int64_t taa_ns = sv.ns;
+    const fv_taa_still_hist *hist = &sv.hist;
+    if (shade_ns)
+        atomic_fetch_add_explicit(&j->shade_ns, shade_ns, memory_order_relaxed);
+    if (j->aa && !aa)
+        fv_taa_aa_clear(j->aa, x0, y0, tw, th);
+    const int64_t t0 = fv_time_ns();
+    if (aa)
+        fv_taa_aa_tile(j->taa, j->aa, l0, x0, y0, tw, th);
+    else
+        fv_taa_still_tile(j->taa, j->taa_prm, j->smp, j->gx, j->gy, l0, &j->dsp->taa, x0, y0, tw, th, rows, keep,
+                          hist);
+    const int64_t t1 = fv_time_ns();
+    atomic_fetch_add_explicit(&j->taa_ns, taa_ns + (t1 - t0), memory_order_relaxed);
+    if (j->prof)
+        fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
+    tile_end(j, index, thread_id, x0, y0, tw, th, rays, tile_t0);
+}
 
 static void run_tile(void *ctx, int index, int thread_id)
 {
@@ -41,8 +108,16 @@ static void run_tile(void *ctx, int index, int thread_id)
     int tw = cam->width - x0 < FV_TILE ? cam->width - x0 : FV_TILE;
     int th = cam->height - y0 < FV_TILE ? cam->height - y0 : FV_TILE;
 
-    if (j->taa) /* early: the lines arrive while the rays are traced */
+    if (j->taa && !j->still) /* early: the lines arrive while the rays are traced */
         fv_taa_prefetch(j->taa, FV_TILE_PULL_LEVELS, x0, y0, tw, th);
+    if (j->still) /* the history is the tile itself: its samples' texels are read before they are written */
+        for (int y = 0; y < th; y++) {
+            const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0;
+            for (int x = 0; x < tw; x += 4)
+                __builtin_prefetch(l0->rgbd + 4 * (o + x), 1);
+            __builtin_prefetch(l0->wgt + o, 1);
+            __builtin_prefetch(l0->wgt + o + tw - 1, 1);
+        }
     uint32_t rows[FV_TILE];
     for (int y = 0; y < th; y++)
         rows[y] = (uint32_t)fv_sampler_row(j->smp, x0, y0 + y, tw, j->gx, j->gy, j->phase);
@@ -54,6 +129,10 @@ static void run_tile(void *ctx, int index, int thread_id)
 
     /* fovea anti-aliasing: a fully sampled tile's rays go through this frame's jittered point */
     const int aa = j->aa && fv_taa_aa_tile_eligible(j->smp, j->gx, j->gy, x0, y0, tw, th, rows);
+    if (j->still) {
+        run_still(j, index, thread_id, x0, y0, tw, th, rows, keep, aa, tile_t0);
+        return;
+    }
     /* writes every weight of the tile: pixels without a sample get 0 */
     int64_t shade_ns = 0;
     int64_t *sp = j->time_shading ? &shade_ns : NULL;
@@ -79,16 +158,7 @@ static void run_tile(void *ctx, int index, int thread_id)
         if (j->prof)
             fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
     }
-    /* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level
-     * 4. Tiles start on multiples of 16, so every block starts on even coordinates. */
-    int xl = x0, yl = y0, wl = tw, hl = th;
-    for (int l = 0; l < FV_TILE_PULL_LEVELS && l + 1 < j->pyr->levels; l++) {
-        fv_pull_block(j->pyr, &j->dsp->pp, l, xl, yl, wl, hl);
-        xl >>= 1, yl >>= 1, wl = (wl + 1) >> 1, hl = (hl + 1) >> 1;
-    }
-    atomic_fetch_add_explicit(&j->rays, rays, memory_order_relaxed);
-    if (j->prof)
-        fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_time_ns(), index);
+    tile_end(j, index, thread_id, x0, y0, tw, th, rays, tile_t0);
 }
 
 static void job_init(tile_job *j, const fv_scene *scene, const fv_camera *cam, const fv_sampler *smp, int gx, int gy,
@@ -104,6 +174,7 @@ static void job_init(tile_job *j, const fv_scene *scene, const fv_camera *cam, c
         j->dofs = opt->dofs;
         j->rows_out = opt->rows_out;
         j->aa = opt->aa;
+        j->still = opt->taa && opt->still;
         j->time_shading = opt->shade_ns != NULL;
     }
     j->tiles_x = (cam->width + FV_TILE - 1) / FV_TILE;

@@ -41,6 +41,9 @@ typedef struct fv_tile_opts {
     int64_t *shade_ns;            /* NULL: shading not timed (no clock reads); else set to the
                                    * workers' summed time shading hits in this pass (ns) */
     const fv_taa_aa_frame *aa;    /* anti-aliasing in the fovea (core/reproject_aa.c); NULL = off */
+    int still;                    /* with taa (identical cameras): level 0 of pyr is the history's,
+                                   * rendered over in place (fv_taa_still_*, core/reproject.h); the
+                                   * AA reads aa's snapshot */
 } fv_tile_opts;
 
 /* Runs every tile of the eye image: the sampler's pixels around the point of regard (gx, gy

@@ -158,6 +158,21 @@ for f in frame_00000.png frame_00001.png frame_00002.png; do
         if cmp -s "$T/d1/$f" "$T/$d/$f"; then ok; else bad "$f differs between d1 and $d"; fi
     done
 done
+# The still head in place (no trace: identical cameras from frame 1 on, docs/reproject.md): the
+# same bytes for 1, 2 and 5 threads, with DoF-driven thinning (medium) and with a fovea of many
+# anti-aliased tiles (r0 40 deg), whose history the tiles of other threads overwrite meanwhile
+for th in 1 2 5; do
+    $R --scene $SCENE --frames 6 --size 160x180 --dof medium --threads $th --out "$T/s$th" --quiet \
+        2>"$T/err" || bad "replay (still) --threads $th failed: $(cat "$T/err")"
+    $R --scene $SCENE --frames 6 --size 160x180 --r0 40 --r1 50 --threads $th --out "$T/sa$th" --quiet \
+        2>"$T/err" || bad "replay (still, r0 40) --threads $th failed: $(cat "$T/err")"
+done
+for f in frame_00002.png frame_00005.png; do
+    for d in 2 5; do
+        cmp -s "$T/s1/$f" "$T/s$d/$f" && ok || bad "still head: $f differs between 1 and $d threads"
+        cmp -s "$T/sa1/$f" "$T/sa$d/$f" && ok || bad "still head, r0 40: $f differs between 1 and $d threads"
+    done
+done
 # Fovea anti-aliasing (issue 17 item 5): with a fovea of many whole tiles (r0 40 deg) along the
 # trace (head and gaze move), the same bytes for 1, 2 and 5 threads; --fovea-aa off gives other
 # frames after the first (frame 0's rays go through the pixel centres either way)

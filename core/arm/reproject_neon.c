@@ -10,6 +10,7 @@
 
 #include "reproject_dsp.h"
 #include "reproject.h"
+#include "reproject_still_lane.h"
 
 typedef float32x4_t acc4;
 
@@ -291,8 +292,46 @@ static inline int fill_vec_neon(const struct fv_taa_frame *f, const struct fv_ta
 
 TAA_FILL_BLOCK(taa_fill_neon, fill_vec_neon)
 
+/* ------------------------------------------------------------------ the still head's blend */
+
+/* taa_still (reproject_dsp.h): four samples a step, the reference lane's operations per lane
+ * (vdivq is IEEE division; compares are false for NaN, selects instead of vmax). */
+static void taa_still_neon(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha,
+                           float inv_depth_tol, uint8_t *wide)
+{
+    const float32x4_t one = vdupq_n_f32(1.0f), two = vdupq_n_f32(2.0f), zero = vdupq_n_f32(0.0f);
+    const float32x4_t vw = vdupq_n_f32(widen), va = vdupq_n_f32(alpha), vt = vdupq_n_f32(inv_depth_tol);
+    int k = 0;
+    for (; k + 4 <= n; k += 4) {
+        const float32x4_t d = vld1q_f32(s + 3 * plane + k);
+        const float32x4_t rz = vdivq_f32(one, d);
+        const uint32x4_t wm = vcgeq_f32(vmulq_f32(vmulq_f32(d, rz), vw), two);
+        const uint16x4_t w16 = vmovn_u32(vshrq_n_u32(wm, 31));
+        const uint8x8_t w8 = vmovn_u16(vcombine_u16(w16, w16));
+        vst1_lane_u32((uint32_t *)(void *)(wide + k), vreinterpret_u32_u8(w8), 0);
+        const float32x4_t dd = vabsq_f32(vsubq_f32(vld1q_f32(h + 3 * plane + k), d));
+        float32x4_t a = vsubq_f32(one, vmulq_f32(dd, vmulq_f32(rz, vt)));
+        a = vbslq_f32(vcgtq_f32(a, zero), a, zero);
+        const float32x4_t w = vmulq_f32(vld1q_f32(h + 4 * plane + k), a);
+        const uint32x4_t ok = vbicq_u32(vcgtq_f32(w, zero), wm);
+        if (!vmaxvq_u32(ok))
+            continue;
+        const float32x4_t a1 = vsubq_f32(one, w);
+        const float32x4_t al = vbslq_f32(vcgtq_f32(a1, va), a1, va);
+        for (int c = 0; c < 3; c++) {
+            const float32x4_t sc = vld1q_f32(s + c * plane + k);
+            const float32x4_t hc = vdivq_f32(vaddq_f32(zero, vmulq_f32(w, vld1q_f32(h + c * plane + k))), w);
+            const float32x4_t o = vaddq_f32(hc, vmulq_f32(al, vsubq_f32(sc, hc)));
+            vst1q_f32(s + c * plane + k, vbslq_f32(ok, o, sc));
+        }
+    }
+    for (; k < n; k++)
+        taa_still_lane(s, h, plane, k, widen, alpha, inv_depth_tol, wide);
+}
+
 void fv_reproject_dsp_init_neon(fv_reproject_dsp *d)
 {
     d->taa_blend = taa_blend_neon;
     d->taa_fill = taa_fill_neon;
+    d->taa_still = taa_still_neon;
 }

@@ -15,6 +15,7 @@
 
 #include "reproject_dsp.h"
 #include "reproject.h"
+#include "reproject_still_lane.h"
 #define FV_X86_W 8
 #define FV_X86_FN(name) name##_avx2
 #include "x86/reproject_tmpl.h"
@@ -354,8 +355,48 @@ static inline __attribute__((always_inline)) int fill_vec_avx2(const struct fv_t
 
 TAA_FILL_BLOCK(taa_fill_avx2, fill_vec_avx2)
 
+/* ------------------------------------------------------------------ the still head's blend */
+
+/* taa_still (reproject_dsp.h): eight samples a step, the reference lane's operations per lane
+ * (ordered compares: a NaN lane takes the C branch's side). */
+static void taa_still_avx2(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha,
+                           float inv_depth_tol, uint8_t *wide)
+{
+    const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f), zero = _mm256_setzero_ps();
+    const __m256 vw = _mm256_set1_ps(widen), va = _mm256_set1_ps(alpha), vt = _mm256_set1_ps(inv_depth_tol);
+    const __m256 absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    int k = 0;
+    for (; k + 8 <= n; k += 8) {
+        const __m256 d = _mm256_loadu_ps(s + 3 * plane + k);
+        const __m256 rz = _mm256_div_ps(one, d);
+        const __m256 wm = _mm256_cmp_ps(_mm256_mul_ps(_mm256_mul_ps(d, rz), vw), two, _CMP_GE_OQ);
+        /* the eight mask bytes: each lane's top bit to bit 0 of its byte */
+        const __m128i m16 = _mm_packs_epi32(_mm256_castsi256_si128(_mm256_castps_si256(wm)),
+                                            _mm256_extracti128_si256(_mm256_castps_si256(wm), 1));
+        _mm_storel_epi64((__m128i *)(wide + k), _mm_and_si128(_mm_packs_epi16(m16, m16), _mm_set1_epi8(1)));
+        const __m256 dd = _mm256_and_ps(_mm256_sub_ps(_mm256_loadu_ps(h + 3 * plane + k), d), absmask);
+        __m256 a = _mm256_sub_ps(one, _mm256_mul_ps(dd, _mm256_mul_ps(rz, vt)));
+        a = _mm256_and_ps(a, _mm256_cmp_ps(a, zero, _CMP_GT_OQ));
+        const __m256 w = _mm256_mul_ps(_mm256_loadu_ps(h + 4 * plane + k), a);
+        const __m256 ok = _mm256_andnot_ps(wm, _mm256_cmp_ps(w, zero, _CMP_GT_OQ));
+        if (_mm256_testz_ps(ok, ok))
+            continue;
+        const __m256 a1 = _mm256_sub_ps(one, w);
+        const __m256 al = _mm256_blendv_ps(va, a1, _mm256_cmp_ps(a1, va, _CMP_GT_OQ));
+        for (int c = 0; c < 3; c++) {
+            const __m256 sc = _mm256_loadu_ps(s + c * plane + k);
+            const __m256 hc = _mm256_div_ps(_mm256_add_ps(zero, _mm256_mul_ps(w, _mm256_loadu_ps(h + c * plane + k))), w);
+            const __m256 o = _mm256_add_ps(hc, _mm256_mul_ps(al, _mm256_sub_ps(sc, hc)));
+            _mm256_storeu_ps(s + c * plane + k, _mm256_blendv_ps(sc, o, ok));
+        }
+    }
+    for (; k < n; k++)
+        taa_still_lane(s, h, plane, k, widen, alpha, inv_depth_tol, wide);
+}
+
 void fv_reproject_dsp_init_avx2(fv_reproject_dsp *d)
 {
     d->taa_blend = taa_blend_avx2;
     d->taa_fill = taa_fill_avx2;
+    d->taa_still = taa_still_avx2;
 }

@@ -8,6 +8,7 @@
 
 #include "reproject_dsp.h"
 #include "reproject.h"
+#include "reproject_still_lane.h"
 #define FV_X86_W 4
 #define FV_X86_FN(name) name##_sse41
 #include "x86/reproject_tmpl.h"
@@ -255,8 +256,47 @@ static inline int fill_vec_sse41(const struct fv_taa_frame *f, const struct fv_t
 
 TAA_FILL_BLOCK(taa_fill_sse41, fill_vec_sse41)
 
+/* ------------------------------------------------------------------ the still head's blend */
+
+/* taa_still (reproject_dsp.h): four samples a step, the reference lane's operations per lane
+ * (ordered compares: a NaN lane takes the C branch's side). */
+static void taa_still_sse41(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha,
+                            float inv_depth_tol, uint8_t *wide)
+{
+    const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f), zero = _mm_setzero_ps();
+    const __m128 vw = _mm_set1_ps(widen), va = _mm_set1_ps(alpha), vt = _mm_set1_ps(inv_depth_tol);
+    const __m128 absmask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    int k = 0;
+    for (; k + 4 <= n; k += 4) {
+        const __m128 d = _mm_loadu_ps(s + 3 * plane + k);
+        const __m128 rz = _mm_div_ps(one, d);
+        const __m128 wm = _mm_cmpge_ps(_mm_mul_ps(_mm_mul_ps(d, rz), vw), two);
+        const int bits = _mm_movemask_ps(wm);
+        for (int i = 0; i < 4; i++)
+            wide[k + i] = (uint8_t)(bits >> i & 1);
+        const __m128 dd = _mm_and_ps(_mm_sub_ps(_mm_loadu_ps(h + 3 * plane + k), d), absmask);
+        __m128 a = _mm_sub_ps(one, _mm_mul_ps(dd, _mm_mul_ps(rz, vt)));
+        a = _mm_and_ps(a, _mm_cmpgt_ps(a, zero));
+        const __m128 w = _mm_mul_ps(_mm_loadu_ps(h + 4 * plane + k), a);
+        const __m128 ok = _mm_andnot_ps(wm, _mm_cmpgt_ps(w, zero));
+        if (!_mm_movemask_ps(ok))
+            continue;
+        const __m128 a1 = _mm_sub_ps(one, w);
+        const __m128 al = _mm_blendv_ps(va, a1, _mm_cmpgt_ps(a1, va));
+        for (int c = 0; c < 3; c++) {
+            const __m128 sc = _mm_loadu_ps(s + c * plane + k);
+            const __m128 hc = _mm_div_ps(_mm_add_ps(zero, _mm_mul_ps(w, _mm_loadu_ps(h + c * plane + k))), w);
+            const __m128 o = _mm_add_ps(hc, _mm_mul_ps(al, _mm_sub_ps(sc, hc)));
+            _mm_storeu_ps(s + c * plane + k, _mm_blendv_ps(sc, o, ok));
+        }
+    }
+    for (; k < n; k++)
+        taa_still_lane(s, h, plane, k, widen, alpha, inv_depth_tol, wide);
+}
+
 void fv_reproject_dsp_init_sse41(fv_reproject_dsp *d)
 {
     d->taa_blend = taa_blend_sse41;
     d->taa_fill = taa_fill_sse41;
+    d->taa_still = taa_still_sse41;
 }

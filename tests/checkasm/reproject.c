@@ -3,6 +3,7 @@
  * (checkasm.h). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "checkasm.h"
@@ -33,7 +34,7 @@ static void compare(const float *ref, const float *got, size_t count, int per_px
 
 /* ------------------------------------------------------------------ tables */
 
-static const char *const names[] = {"taa_blend", "taa_fill"};
+static const char *const names[] = {"taa_blend", "taa_fill", "taa_still"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -45,6 +46,7 @@ static void test_tables(void **state)
     fv_reproject_dsp_init(&ref, FV_ISA_C);
     assert_true(ref.taa_blend == fv_taa_blend_c);
     assert_true(ref.taa_fill == fv_taa_fill_c);
+    assert_true(ref.taa_still == fv_taa_still_c);
     CHECKASM_CHECK_ISA_TABLES("reproject", fv_reproject_dsp, &ref, names);
 }
 
@@ -235,8 +237,87 @@ static void test_taa_blocks(void **state)
     printf("[ checkasm ] taa: %d ISA version(s) tested\n", tested);
 }
 
+/* ------------------------------------------------------------------ the still head's blend */
+
+/* taa_still on n samples in planes pad floats longer than n (SoA, canaried): sample depths mostly
+ * on their history texel's surface (within and beyond the tolerance), some on another, the miss
+ * depth, 0 (1/0: NaN footprints); weights 0, 1, in between; footprint scales on both sides of two
+ * texels (fp = depth / depth x widen) and history shares around the texel's confidence. Counts
+ * the blended and the wide lanes. */
+static long still_blended, still_wide;
+static void run_still(const fv_reproject_dsp *d, const char *isa, int n, int pad, int off)
+{
+    static const float widens[] = {1.0f, 1.0001f, 1.3f, 1.99f, 2.0f, 2.5f, 4.0f};
+    static const float alphas[] = {0.3f, 0.83f, 0.05f, 0.999f};
+    const float widen = widens[fv_test_rand(&checkasm_rng) % 7];
+    const float alpha = alphas[fv_test_rand(&checkasm_rng) % 4];
+    const ptrdiff_t plane = n + pad;
+    float *in = malloc(sizeof(float) * (size_t)(9 * plane + 1));
+    assert_non_null(in);
+    float *hs = in + 4 * plane;
+    for (int k = 0; k < n; k++) {
+        for (int c = 0; c < 3; c++) {
+            in[c * plane + k] = rnd();
+            hs[c * plane + k] = rnd();
+        }
+        const float v = rnd(), dep = v < 0.03f ? 1000.0f : v < 0.05f ? 0.0f : 0.3f + 30.0f * rnd() * rnd();
+        in[3 * plane + k] = dep;
+        const float u = rnd();
+        hs[3 * plane + k] = u < 0.7f ? dep * (1.0f + 0.08f * (rnd() - 0.5f)) : u < 0.9f ? 0.3f + 30.0f * rnd() : dep;
+        const float q = rnd();
+        hs[4 * plane + k] = q < 0.2f ? 0.0f : q < 0.6f ? 1.0f : rnd();
+    }
+    buf rs = checkasm_out_f32(4 * (size_t)plane, off), ts = checkasm_out_f32(4 * (size_t)plane, off);
+    uint8_t *rb, *tb, *rw = checkasm_out_u8((size_t)n, off, &rb), *tw = checkasm_out_u8((size_t)n, off, &tb);
+    for (int c = 0; c < 4; c++) {
+        memcpy(rs.p + c * plane, in + c * plane, sizeof(float) * (size_t)n);
+        memcpy(ts.p + c * plane, in + c * plane, sizeof(float) * (size_t)n);
+    }
+    fv_taa_still_c(rs.p, hs, plane, n, widen, alpha, 30.0f, rw);
+    d->taa_still(ts.p, hs, plane, n, widen, alpha, 30.0f, tw);
+    checkasm_compare(rs.p, ts.p, 4 * (size_t)plane, CHECKASM_F32, 1, CHECKASM_EXACT, "%s taa_still (samples) n=%d pad=%d off=%d",
+                     isa, n, pad, off);
+    checkasm_compare(rw, tw, (size_t)n, CHECKASM_U8, 1, CHECKASM_EXACT, "%s taa_still (wide) n=%d", isa, n);
+    checkasm_check_guards_f32(&ts, 4 * (size_t)plane, isa, "taa_still", n);
+    checkasm_check_guards(tw, (size_t)n, isa, "taa_still", n);
+    for (int k = 0; k < n; k++) {
+        still_wide += rw[k];
+        still_blended += rs.p[k] != in[k];
+    }
+    free(rs.base), free(ts.base), free(rb), free(tb), free(in);
+}
+
+static void test_taa_still(void **state)
+{
+    (void)state;
+    int tested = 0;
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "taa_still"))
+            continue;
+        fv_reproject_dsp d;
+        fv_reproject_dsp_init(&d, isa);
+        if (!d.taa_still || d.taa_still == fv_taa_still_c)
+            fail_msg("taa_still: %s has no version of its own", fv_isa_name(isa));
+        checkasm_rng = 0x57111ull; /* the same inputs for every ISA */
+        int runs = 0;
+        for (int r = 0; r < 3; r++)
+            for (int i = 0; i < NSIZES; i++, runs++)
+                run_still(&d, fv_isa_name(isa), sizes[i], (int)(fv_test_rand(&checkasm_rng) % 9),
+                          (int)(fv_test_rand(&checkasm_rng) % 4));
+        run_still(&d, fv_isa_name(isa), 0, 0, 0);
+        printf("[ checkasm ] taa_still: %-7s == c on %d runs (bit-exact); %ld samples blended, %ld wide\n",
+               fv_isa_name(isa), runs, still_blended, still_wide);
+        assert_true(still_blended > 2000 && still_wide > 1000);
+        still_blended = still_wide = 0;
+        tested++;
+    }
+    printf("[ checkasm ] taa_still: %d ISA version(s) tested\n", tested);
+}
+
 const struct CMUnitTest checkasm_reproject_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_taa_blocks),
+    cmocka_unit_test(test_taa_still),
     {0},
 };
