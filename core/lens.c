@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "base/err.h"
+#include "camera.h"
 
 void fv_lens_default(fv_lens *l)
 {
@@ -85,6 +86,55 @@ void fv_lens_lca_init(fv_lens_lca *t, float k1, float k2, const float scale[3], 
             t->ratio[ch][i] = (float)((double)qx / r);
         }
     }
+}
+
+/* ---- the lens in pixel units (lens.h: fv_lens_map) ---------------------------------- */
+
+int fv_lens_map_init(fv_lens_map *m, const fv_camera *c)
+{
+    memset(m, 0, sizeof *m);
+    if (!c->lens_on)
+        return -1;
+    const double pt = c->px_tan;
+    m->cx = (float)((c->lens_cx - c->tan_left) / pt);
+    m->cy = (float)((c->tan_top - c->lens_cy) / pt);
+    m->s = c->lens_scale;
+    m->k1 = (float)(c->lens_k1 * pt * pt);
+    m->k2 = (float)(c->lens_k2 * pt * pt * pt * pt);
+    const double s = m->s, k1 = m->k1, k2 = m->k2;
+    /* the corners' largest radius, 1.5 x, or less where g(r) = s r (1 + k1 r^2 + k2 r^4) folds over */
+    double rc = 0.0;
+    for (int i = 0; i < 4; i++) {
+        const double dx = (i & 1 ? c->width : 0) - (double)m->cx, dy = (i & 2 ? c->height : 0) - (double)m->cy;
+        rc = fmax(rc, sqrt(dx * dx + dy * dy));
+    }
+    double r_lim = 1.5 * rc;
+    for (int i = 1; i <= 4096; i++) {
+        const double r = 1.5 * rc * i / 4096.0, r2 = r * r;
+        if (!(1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2 * r2 > 0.05)) {
+            r_lim = 1.5 * rc * (i - 1) / 4096.0;
+            break;
+        }
+    }
+    const double gl = s * r_lim * (1.0 + k1 * r_lim * r_lim + k2 * r_lim * r_lim * r_lim * r_lim);
+    m->r2_max = (float)(gl * gl);
+    m->inv_step = (float)FV_LENS_MAP_STEPS / m->r2_max;
+    double r = 0.0;
+    for (int i = 0; i <= FV_LENS_MAP_STEPS; i++) {
+        /* solve g(r) = sqrt(R_i) by Newton from the previous entry's root (g is increasing) */
+        const double rq = sqrt((double)m->r2_max * i / FV_LENS_MAP_STEPS);
+        for (int it = 0; it < 50 && i; it++) {
+            const double r2 = r * r, g = s * r * (1.0 + k1 * r2 + k2 * r2 * r2) - rq;
+            const double dg = s * (1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2 * r2);
+            const double st = g / dg;
+            r -= st;
+            if (fabs(st) < 1e-12 * (1.0 + r))
+                break;
+        }
+        m->rho[i] = i ? (float)(r / rq) : (float)(1.0 / s);
+    }
+    m->rho[FV_LENS_MAP_STEPS + 1] = m->rho[FV_LENS_MAP_STEPS];
+    return 0;
 }
 
 /* ---- profile text (see lens.h) ------------------------------------------------------ */
