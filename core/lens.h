@@ -123,6 +123,16 @@ static inline void fv_lens_map_jac(const fv_lens_map *m, float px, float py, flo
     j[1] = g * ux * uy;
     j[2] = f + g * uy * uy;
 }
+/* A map between two cameras with this lens in the form the reprojection and timewarp kernels use,
+ * (U, V, Z) = T + d (M0 + qx MX + qy MY) at depth d from pinhole coordinates q to the other camera's
+ * pinhole point (U / Z, V / Z), made a map between lensed pixels near pixel p0: F linearised at p0
+ * (q = F(p0) + J_F(p0) (p - p0)) and F^-1 linearised at Q1, p0's image at inverse depth w0
+ * (p' = F^-1(Q1) + J_F(F^-1(Q1))^-1 (Q - Q1)). Both are affine, one before the rows and one after
+ * the division, so they fold into new rows (oT, oM0, oMX, oMY) of the same form: the kernels run
+ * unchanged. Exact for an identity motion; otherwise second order in |p - p0| (and in the depth
+ * difference from w0). The outputs may not alias the inputs. */
+void fv_lens_map_fold(const fv_lens_map *m, const float T[3], const float M0[3], const float MX[3], const float MY[3],
+                      float p0x, float p0y, float w0, float oT[3], float oM0[3], float oMX[3], float oMY[3]);
 /* F^-1; returns 0, or 1 when q lies beyond the table (p is then along the same ray at the table's
  * last ratio: outside the image, in the right direction). */
 static inline int fv_lens_map_inv(const fv_lens_map *m, float qx, float qy, float *px, float *py)
