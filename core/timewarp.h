@@ -28,10 +28,13 @@ void fv_tw_setup(fv_tw_map *m, const fv_camera *display, const fv_camera *source
  * source shows there), so the block warp's planner, its proof and the per-pixel kernels run as
  * they are, on that map. The linearisation's error against the exact map is FV_TW_LENS_ERR_PX
  * (the example profile, 1280 x 1440, the head turning 30 deg/s for one and two refreshes of
- * 90 Hz and moving 2 mm a refresh; tests/test_lens_reproject.c measures every pixel); the block
- * warp's FV_TW_BLOCK_POS_PX comes on top. */
-#define FV_TW_LENS_CELL 32
-#define FV_TW_LENS_ERR_PX 0.1f
+ * 90 Hz and moving 2 mm a refresh: measured 0.055 and 0.118 px; tests/test_lens_reproject.c
+ * measures every pixel); the block warp's FV_TW_BLOCK_POS_PX comes on top. Cells of 64 (the
+ * blocks' size: one map per block) cost the warp of a pair 0.1 ms of planning over the lensless
+ * warp; cells of 32 halve the error (0.023 / 0.049 px) but plan four times as many blocks (+1.2 ms,
+ * docs/headset.md). */
+#define FV_TW_LENS_CELL 64
+#define FV_TW_LENS_ERR_PX 0.15f
 struct fv_lens_map;
 void fv_tw_map_set_lens(fv_tw_map *m, const struct fv_lens_map *l);
 /* The map of the cell [X0, X1) x [Y0, Y1) (m with its lens folded in; lens NULL). */

@@ -279,7 +279,7 @@ static void render_dirs(uint8_t *rgb, const fv_camera *c)
 
 /* Pure rotation through the lens: the warped image equals the image rendered at the rotated
  * camera (each display pixel's own lensed ray), within the block warp's position bound plus the
- * lens's (FV_TW_BLOCK_POS_PX + FV_TW_LENS_ERR_PX px: 0.35 px x ~6 levels a pixel) and rounding;
+ * lens's (FV_TW_BLOCK_POS_PX + FV_TW_LENS_ERR_PX px: 0.4 px x ~6 levels a pixel) and rounding;
  * the same warp ignoring the lens (a pinhole warp of the lensed image) is far off. Both eyes,
  * every ISA's kernels give the same bytes. */
 static void test_timewarp_rotation(void **st)
