@@ -126,16 +126,9 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
     const ptrdiff_t o = (ptrdiff_t)y0 * l0->stride + x0;
     const fv_taa_frame *fk = f; /* the kernels' frame: f, or with a lens the tile's (reproject.h) */
     fv_taa_frame tl;
-    float d0 = 1000.0f; /* with a lens: the tile's mean inverse sample depth, as a depth */
+    float d0 = 1000.0f; /* with a lens: the depth the tile's map is linearised at */
     if (f->lens) {
-        float si = 0.0f, n = 0.0f;
-        for (int y = 0; y < th; y++)
-            for (int x = 0; x < tw; x++) {
-                const ptrdiff_t k = o + (ptrdiff_t)y * l0->stride + x;
-                if (l0->wgt[k] == 1.0f && l0->rgbd[4 * k + 3] > 0.0f)
-                    si += 1.0f / l0->rgbd[4 * k + 3], n += 1.0f;
-            }
-        d0 = si > 0.0f ? n / si : d0;
+        d0 = fv_taa_lens_tile_depth(l0, x0, y0, tw, th);
         fv_taa_lens_tile_blend(f, &tl, cx, cy, d0);
         fk = &tl;
     }

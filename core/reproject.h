@@ -83,7 +83,7 @@ void fv_taa_frame_setup(fv_taa_frame *f, const fv_camera *cur, const fv_camera *
  * profile, as the pipeline's eyes always have). An identity frame stays the identity (pixel to the
  * same pixel, lens or not) and keeps lens NULL. fv_taa_project then maps exactly: F, the rows, F^-1.
  * The kernels get, per tile, the lens linearised around the tile: F at the tile centre p0 and F^-1
- * at p0's projection (at the tile's mean inverse sample depth) for the blend; for the fill, F at the
+ * at p0's projection (at fv_taa_lens_tile_depth) for the blend; for the fill, F at the
  * tile centre moved by the tile's flow and F^-1 at its projection. Affine maps before the rows and
  * after the division fold into the rows, so a tile's map is again (U, V, Z) = T + d (M0 + px MX + py
  * MY) and the kernels run unchanged. Error against the exact map: second order in the distance to
@@ -94,6 +94,10 @@ void fv_taa_frame_setup(fv_taa_frame *f, const fv_camera *cur, const fv_camera *
  * checks every pixel). */
 #define FV_TAA_LENS_ERR_PX 0.05f
 void fv_taa_frame_set_lens(fv_taa_frame *f, const fv_lens_map *m);
+/* The depth a tile's map is linearised at: the harmonic mean of the depths of the samples (weight
+ * 1) among pixels (1 + 4i, 1 + 4j) of the tile [x0, x0+tw) x [y0, y0+th) of level 0; 1000 m (a miss)
+ * when none. */
+float fv_taa_lens_tile_depth(const fv_pyr_level *l0, int x0, int y0, int tw, int th);
 /* The blend's tile frame t: f's lens folded into the rows around current pixel (cx, cy) at view
  * depth d_m. */
 void fv_taa_lens_tile_blend(const fv_taa_frame *f, fv_taa_frame *t, float cx, float cy, float d_m);

@@ -10,6 +10,18 @@ void fv_taa_frame_set_lens(fv_taa_frame *f, const fv_lens_map *m)
     f->lens = f->identity ? NULL : m; /* pixel to the same pixel: no lens to undo */
 }
 
+float fv_taa_lens_tile_depth(const fv_pyr_level *l0, int x0, int y0, int tw, int th)
+{
+    float si = 0.0f, n = 0.0f;
+    for (int y = 1; y < th; y += 4) /* 16 of a 16 x 16 tile's pixels: the depth matters to parallax only */
+        for (int x = 1; x < tw; x += 4) {
+            const ptrdiff_t k = (ptrdiff_t)(y0 + y) * l0->stride + x0 + x;
+            if (l0->wgt[k] == 1.0f && l0->rgbd[4 * k + 3] > 0.0f)
+                si += 1.0f / l0->rgbd[4 * k + 3], n += 1.0f;
+        }
+    return si > 0.0f ? n / si : 1000.0f /* FV_DEPTH_MISS_M */;
+}
+
 void fv_taa_lens_tile_blend(const fv_taa_frame *f, fv_taa_frame *t, float cx, float cy, float d_m)
 {
     *t = *f;

@@ -107,8 +107,9 @@ static float rows_project(const float T[3], const float M0[3], const float MX[3]
 
 /* The per-tile linearisation (what the kernels get) against the exact map through F and F^-1, at
  * every pixel of a 1280 x 1440 eye, for a head turning 30 deg/s (one and two 90 Hz frames: 1/3 and
- * 2/3 deg) while moving 2 mm sideways a frame, depths 0.7 .. 50 m varying across each tile (the tile's linearisation
- * depth: their harmonic mean, as fv_taa_tile_run takes it); the fill's reverse rows likewise. */
+ * 2/3 deg) while moving 2 mm sideways a frame, depths 0.7 .. 50 m varying across each tile (the
+ * depth the tile is linearised at: fv_taa_lens_tile_depth, as fv_taa_tile_run takes it); the fill's
+ * reverse rows likewise. */
 static void test_tile_map(void **st)
 {
     (void)st;
@@ -137,12 +138,16 @@ static void test_tile_map(void **st)
         for (int ty = 0; ty < H; ty += T)
             for (int tx = 0; tx < W; tx += T) {
                 const float cx = (float)tx + 0.5f * T, cy = (float)ty + 0.5f * T;
-                /* depth of pixel (x, y): 0.7 .. 50 m, varying within the tile */
-                float si = 0.0f;
+                /* depth of pixel (x, y): 0.7 .. 50 m, varying within the tile; every pixel a sample */
+                float rgbd[FV_TILE * FV_TILE * 4], wgt[FV_TILE * FV_TILE];
                 for (int y = 0; y < T; y++)
-                    for (int x = 0; x < T; x++)
-                        si += 1.0f / (0.7f + 49.3f * (float)(((x * 7 + y * 3 + tx) % 16)) / 15.0f);
-                const float d0 = (float)(T * T) / si;
+                    for (int x = 0; x < T; x++) {
+                        rgbd[4 * (y * T + x) + 3] = 0.7f + 49.3f * (float)(((x * 7 + y * 3 + tx) % 16)) / 15.0f;
+                        wgt[y * T + x] = 1.0f;
+                    }
+                const fv_pyr_level tile = {T, T, T, rgbd, wgt};
+                const float d0 = fv_taa_lens_tile_depth(&tile, 0, 0, T, T);
+                assert_true(d0 > 0.7f && d0 < 50.0f);
                 fv_taa_frame t;
                 fv_taa_lens_tile_blend(&f, &t, cx, cy, d0);
                 float u0, v0;
