@@ -89,7 +89,6 @@ int main(int argc, char **argv)
     const char *asset_root = NULL; /* --asset-root */
     int shadows = 0;               /* --shadows */
     const char *lens_path = NULL;  /* --lens */
-    int reproject_given = 0;
     const char *scene_path = NULL, *json_path = NULL, *mode = "both", *trace_path = NULL, *kernel = NULL;
     fv_bench_opts bo = {.yaw_rate = 0.0f, .warmup = 3, .frames = 30, .counters = 1, .prof = NULL};
     int kernels = 0, kreps = 7, stereo = 0;
@@ -143,7 +142,6 @@ int main(int argc, char **argv)
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
-            reproject_given |= o == FV_OPT_REPROJECT;
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
@@ -164,7 +162,7 @@ int main(int argc, char **argv)
     fv_common_validate(prog, argc, argv, scene_path, &cfg);
     fv_lens lens; /* --lens: outlives the pipeline (its cameras point at it) */
     if (lens_path)
-        fv_cli_lens(prog, lens_path, &lens, &cfg, reproject_given);
+        fv_cli_lens(prog, lens_path, &lens, &cfg);
     for (int i = 0; i < nsweeps; i++)
         if (fv_sweep_check(&sweeps[i], &cfg, err, sizeof err))
             fv_usage_error(prog, "%s", err);

@@ -58,8 +58,8 @@ static void usage(FILE *f)
             "  --seconds S         run time (default: until SIGINT)\n"
             "  --trace FILE        gaze/head trace (CSV, looped); head pose from it with a camera too\n"
             "  --lens FILE         HMD lens profile: rays along the distorted directions, each eye's\n"
-            "                      axis through its lens centre (turns reprojection off: it does\n"
-            "                      not model the lens yet)\n"
+            "                      axis through its lens centre; reprojection and the timewarp\n"
+            "                      model the lens (docs/headset.md)\n"
             "  --latency-csv FILE  per-frame gaze/ray/done/photon times\n"
             "  --hz HZ             nominal refresh for gpio/replay vsync (default 90)\n"
             "  --camera-fps F      frame rate of a replayed eye video (default 120)\n"
@@ -69,7 +69,6 @@ static void usage(FILE *f)
             "                      at every vsync the newest complete frame is warped to the head\n"
             "                      pose predicted for that refresh (per-pixel depth) and shown.\n"
             "                      off: one frame rendered per shown frame, aimed at a vsync.\n"
-            "                      Off with --lens (the warp does not model the lens yet)\n"
             "  --warp-threads N    1 (default) or 2: with 2 the right eye is warped on a second\n"
             "                      display-priority thread (shorter refreshes, less CPU for rendering)\n" FV_COMMON_HELP
             "  --help              this text\n");
@@ -440,7 +439,7 @@ int main(int argc, char **argv)
     double seconds = 0.0;
     float hz = 90.0f, cam_fps = 120.0f;
     fv_prof *prof = NULL; /* --trace-out's recorder */
-    int reproject_given = 0, timewarp = 1, timewarp_given = 0, warp_threads = 1;
+    int timewarp = 1, warp_threads = 1;
     const char *calibrate_path = NULL; /* --calibrate */
     int calib_dwell_ms = 1500;
     static const struct option opts[] = {
@@ -484,13 +483,10 @@ int main(int argc, char **argv)
         }
         case OPT_TIMEWARP:
             timewarp = fv_arg_onoff(prog, "--timewarp", optarg);
-            timewarp_given = 1;
             break;
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
-            if (o == FV_OPT_REPROJECT)
-                reproject_given = 1;
             if (!fv_common_option(prog, o, optarg, &cfg))
                 fv_usage_error(prog, "unhandled option (see --help)");
         }
@@ -544,12 +540,8 @@ int main(int argc, char **argv)
     if (trace_path && fv_trace_load(&tr, trace_path, err, sizeof err))
         fv_usage_error(prog, "%s", err);
     fv_lens lens;
-    if (lens_path) {
-        fv_cli_lens(prog, lens_path, &lens, &cfg, reproject_given);
-        if (timewarp_given && timewarp)
-            fv_usage_error(prog, "--lens: the timewarp does not model the lens yet; drop --timewarp on");
-        timewarp = 0;
-    }
+    if (lens_path)
+        fv_cli_lens(prog, lens_path, &lens, &cfg);
     app a = {0};
     a.trace = trace_path ? &tr : NULL;
     for (int k = 0; k < 2; k++)

@@ -98,7 +98,7 @@ int main(int argc, char **argv)
     const char *asset_root = NULL; /* --asset-root */
     int shadows = 0;               /* --shadows */
     const char *lens_path = NULL;  /* --lens */
-    int reproject_given = 0, dof_given = 0, pupil_given = 0;
+    int dof_given = 0, pupil_given = 0;
     const char *scene_path = NULL, *trace_path = NULL, *out_dir = NULL, *y4m_path = NULL, *prof_path = NULL;
     long frames = -1;
     int stereo = 0, quiet = 0, vs_full = 0, window = 0, png = 1;
@@ -137,7 +137,6 @@ int main(int argc, char **argv)
         case OPT_HELP: usage(stdout); return FV_EXIT_OK;
         case '?': fv_bad_option(prog, argv);
         default:
-            reproject_given |= o == FV_OPT_REPROJECT;
             dof_given |= o == FV_OPT_DOF;
             pupil_given |= o == FV_OPT_PUPIL_MM;
             if (!fv_common_option(prog, o, optarg, &cfg))
@@ -147,7 +146,7 @@ int main(int argc, char **argv)
     fv_common_validate(prog, argc, argv, scene_path, &cfg);
     fv_lens lens; /* --lens: outlives the pipeline (its cameras point at it) */
     if (lens_path)
-        fv_cli_lens(prog, lens_path, &lens, &cfg, reproject_given);
+        fv_cli_lens(prog, lens_path, &lens, &cfg);
     if (!out_dir)
         fv_usage_error(prog, "--out DIR is required (see --help)");
     /* the reference's lens is the pipeline's eye: same pupil, same fixed focus if one is given */

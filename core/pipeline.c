@@ -25,6 +25,7 @@ typedef struct {
                         * layered model converts its rows straight to the display format */
     int64_t last_t_ns; /* the time of its last frame (focus filter) */
     fv_lens_lca *lca;  /* lateral chromatic aberration tables (a lens with per-channel scales) */
+    fv_lens_map *lmap; /* the lens in pixel units, for the reprojection (NULL: no lens) */
     uint8_t *rgb8;     /* the last frame in the display format: sRGB 8-bit RGB, rows 3 w bytes */
     uint32_t *rows;    /* DoF-driven sampling: the last frame's sample bits per tile (ceiling) */
     int rows_valid;    /* the last frame was thinned: rows holds its bits */
@@ -213,6 +214,7 @@ void fv_pipeline_destroy(fv_pipeline *p)
             fv_pyramid_free(&p->eyes[e].pyr[b]);
         free(p->eyes[e].out);
         free(p->eyes[e].lca);
+        free(p->eyes[e].lmap);
         free(p->eyes[e].rgb8);
         free(p->eyes[e].rows);
         free(p->eyes[e].aa_n[0]);
@@ -366,6 +368,11 @@ static int eye_begin(fv_pipeline *p, eye_frame *f, fv_eye eye, const fv_pose *he
         es->lca = fv_output_lca_create(&es->cam);
     if (p->dof && !es->out && es->lca && es->lca->on && !(es->out = malloc(image_bytes(&es->pyr[0].lv[0]))))
         return -1; /* the lens's output is a pass of its own, from the float image */
+    if (p->taa && es->cam.lens_on && !es->lmap) { /* built once: the lens does not change */
+        if (!(es->lmap = malloc(sizeof *es->lmap)))
+            return -1;
+        fv_lens_map_init(es->lmap, &es->cam);
+    }
     for (int i = 0; i < FV_STAGE_COUNT; i++)
         st->stage_ms[i] = NAN;
     st->shade_ms = NAN;
@@ -380,6 +387,8 @@ static int eye_begin(fv_pipeline *p, eye_frame *f, fv_eye eye, const fv_pose *he
     f->gx = (int)floorf(gaze_x * (float)d.width), f->gy = (int)floorf(gaze_y * (float)d.height);
     if (p->taa && es->hist_valid) {
         fv_taa_frame_setup(&f->tf, &es->cam, &es->prev_cam, &es->pyr[es->cur], p->cfg.taa.depth_tol);
+        if (es->lmap)
+            fv_taa_frame_set_lens(&f->tf, es->lmap);
         f->opt.taa = &f->tf;
         /* The focus this frame is not estimated yet (it needs this frame's depth): the eye
          * accommodates from last frame's focus towards last frame's target, so the frame's focus

@@ -97,6 +97,8 @@ void fv_taa_tile_setup(fv_taa_tile *t, const fv_taa_params *prm, float p, float 
 
 float fv_taa_project(const fv_taa_frame *f, float px, float py, float d, float *u, float *v)
 {
+    if (f->lens)
+        return fv_taa_project_lens(f, px, py, d, u, v);
     const float U = f->T[0] + d * ((f->M0[0] + py * f->MY[0]) + px * f->MX[0]);
     const float V = f->T[1] + d * ((f->M0[1] + py * f->MY[1]) + px * f->MX[1]);
     const float Z = f->T[2] + d * ((f->M0[2] + py * f->MY[2]) + px * f->MX[2]);
@@ -139,7 +141,15 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
                       smp->phases);
     fv_taa_flow fl = {0.0f, 0.0f, 0.0f};
     const ptrdiff_t o = (ptrdiff_t)y0 * l0->stride + x0;
-    dsp->taa_blend(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th, &fl);
+    const fv_taa_frame *fk = f; /* the kernels' frame: f, or with a lens the tile's (reproject.h) */
+    fv_taa_frame tl;
+    float d0 = 1000.0f; /* with a lens: the depth the tile's map is linearised at */
+    if (f->lens) {
+        d0 = fv_taa_lens_tile_depth(l0, x0, y0, tw, th);
+        fv_taa_lens_tile_blend(f, &tl, cx, cy, d0);
+        fk = &tl;
+    }
+    dsp->taa_blend(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th, &fl);
     if (!prm->fill)
         return;
     float fx = 0.0f, fy = 0.0f;
@@ -157,7 +167,12 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
         return;
     tt.flow_x = (int)floorf(fx + 0.5f);
     tt.flow_y = (int)floorf(fy + 0.5f);
-    dsp->taa_fill(f, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
+    if (f->lens) {
+        float u, v;
+        const float z0 = fv_taa_project(f, cx, cy, d0, &u, &v);
+        fv_taa_lens_tile_fill(f, &tl, cx + (float)tt.flow_x, cy + (float)tt.flow_y, z0 > 1e-3f ? z0 : d0);
+    }
+    dsp->taa_fill(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
 }
 
 /* The history a tile will read lies around the tile moved by the head motion: guess the move

@@ -31,6 +31,29 @@ void fv_tw_setup(fv_tw_map *m, const fv_camera *display, const fv_camera *source
     m->w_scale = 1.0f / FV_TW_INVD_PER_M;
 }
 
+void fv_tw_map_set_lens(fv_tw_map *m, const fv_lens_map *l) { m->lens = l; }
+
+void fv_tw_cell_map(const fv_tw_map *m, const fv_tw_src *src, int X0, int X1, int Y0, int Y1, fv_tw_map *out)
+{
+    *out = *m;
+    out->lens = NULL;
+    /* F at the centre; F^-1 where the centre lands at the depth the source shows there (two of the
+     * kernel's fixed-point steps through the exact lens) */
+    const float p0x = 0.5f * (float)(X0 + X1), p0y = 0.5f * (float)(Y0 + Y1);
+    float qx, qy;
+    fv_lens_map_fwd(m->lens, p0x, p0y, &qx, &qy);
+    const float A[3] = {(m->a0[0] + qy * m->ay[0]) + qx * m->ax[0], (m->a0[1] + qy * m->ay[1]) + qx * m->ax[1],
+                        (m->a0[2] + qy * m->ay[2]) + qx * m->ax[2]};
+    float w = 0.0f;
+    for (int it = 0; it < 2; it++) {
+        float u, v;
+        fv_tw_proj(A, m->t, w, &u, &v);
+        fv_lens_map_inv(m->lens, u, v, &u, &v);
+        w = fv_tw_fetch_w(m, src, A[2], u, v);
+    }
+    fv_lens_map_fold(m->lens, m->t, m->a0, m->ax, m->ay, p0x, p0y, w, out->t, out->a0, out->ax, out->ay);
+}
+
 void fv_tw_pack_invd(uint16_t *dst, ptrdiff_t dst_stride, const float *rgbd, ptrdiff_t rgbd_stride, int w, int h)
 {
     for (int y = 0; y < h; y++) {
@@ -48,6 +71,19 @@ long fv_tw_warp_rows_pixel(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst
                            const fv_tw_map *m, const fv_tw_src *src)
 {
     long holes = 0;
+    if (m->lens) { /* each cell with its map */
+        const int C = FV_TW_LENS_CELL;
+        for (int cy = y0 / C * C; cy < y1; cy += C)
+            for (int cx = 0; cx < src->w; cx += C) {
+                const int x1 = cx + C < src->w ? cx + C : src->w, ya = cy > y0 ? cy : y0;
+                const int yb = cy + C < y1 ? cy + C : y1;
+                fv_tw_map cm;
+                fv_tw_cell_map(m, src, cx, x1, cy, cy + C < src->h ? cy + C : src->h, &cm);
+                for (int y = ya; y < yb; y++)
+                    holes += d->tw_row(dst + (ptrdiff_t)y * dst_stride + 3 * cx, cx, y, x1 - cx, &cm, src);
+            }
+        return holes;
+    }
     for (int y = y0; y < y1; y++)
         holes += d->tw_row(dst + (ptrdiff_t)y * dst_stride, 0, y, src->w, m, src);
     return holes;
@@ -274,17 +310,52 @@ static int plan_halves(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw
     return n;
 }
 
-int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
-                      int by, int bx0, int nb, fv_tw_block *out, float *guess)
+/* fv_tw_plan_blocks, and each entry's map in pmap: m, or with a lens its cell's, kept in cells
+ * (at most nb (FV_TW_BLOCK_W / FV_TW_LENS_CELL)^2 of them) */
+static int plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
+                       int by, int bx0, int nb, fv_tw_block *out, float *guess, fv_tw_map *cells,
+                       const fv_tw_map **pmap)
 {
     const int BW = FV_TW_BLOCK_W, Y0 = by * FV_TW_BLOCK_H, Y1 = mini(Y0 + FV_TW_BLOCK_H, src->h);
-    int n = 0;
+    int n = 0, nc = 0;
     for (int i = 0; i < nb; i++) {
         const int X0 = (bx0 + i) * BW, X1 = mini(X0 + BW, src->w);
         if (X0 >= X1)
             break;
-        n += plan_halves(d, m, src, tiles, X0, X1, Y0, Y1, guess, out + n);
+        if (!m->lens) {
+            const int k = plan_halves(d, m, src, tiles, X0, X1, Y0, Y1, guess, out + n);
+            for (int j = 0; j < k; j++)
+                pmap[n + j] = m;
+            n += k;
+            continue;
+        }
+        /* the block's cells in rows, each planned on its own map: the entries covering a row
+         * still come in column order */
+        const int C = FV_TW_LENS_CELL;
+        for (int cy = Y0; cy < Y1; cy += C)
+            for (int cx = X0; cx < X1; cx += C) {
+                const int cx1 = mini(cx + C, X1), cy1 = mini(cy + C, Y1);
+                fv_tw_cell_map(m, src, cx, cx1, cy, cy1, &cells[nc]);
+                const int k = plan_halves(d, &cells[nc], src, tiles, cx, cx1, cy, cy1, guess, out + n);
+                for (int j = 0; j < k; j++)
+                    pmap[n + j] = &cells[nc];
+                n += k, nc++;
+            }
     }
+    return n;
+}
+
+enum { TW_CELLS = (FV_TW_BLOCK_W / FV_TW_LENS_CELL) * (FV_TW_BLOCK_H / FV_TW_LENS_CELL) };
+
+int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
+                      int by, int bx0, int nb, fv_tw_block *out, float *guess)
+{
+    enum { NB = 64 };
+    fv_tw_map cells[TW_CELLS * NB];
+    const fv_tw_map *pmap[FV_TW_BLOCK_SPLIT * NB];
+    int n = 0;
+    for (int i = 0; i < nb; i += NB) /* in groups that fit the arrays: the same entries as in one */
+        n += plan_blocks(d, m, src, tiles, by, bx0 + i, mini(NB, nb - i), out + n, guess, cells, pmap);
     return n;
 }
 
@@ -350,7 +421,9 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
      * others as items (a clamped translated block, or a run of per-pixel parts in one call: the
      * kernel interleaves 64 pixels) */
     tw_runner run[MAXE];
-    struct { const fv_tw_block *b; int xa, xb; } item[MAXE]; /* b NULL: per-pixel columns [xa, xb) */
+    struct { const fv_tw_block *b; const fv_tw_map *m; int xa, xb; } item[MAXE]; /* b NULL: per-pixel columns [xa, xb) */
+    fv_tw_map cells[TW_CELLS * CHUNK]; /* with a lens: the cells' maps */
+    const fv_tw_map *pmap[MAXE];       /* each plan entry's map */
     uint8_t row[3 * CHUNK * FV_TW_BLOCK_W]; /* a row's columns composed in cache, then streamed (tw_stream) */
     const ptrdiff_t stride = src->rgb_stride;
     long holes = 0;
@@ -358,7 +431,7 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
         const int ya = by * BH > y0 ? by * BH : y0, yb = mini(by * BH + BH, y1);
         float guess = 0.0f;
         for (int bx0 = 0; bx0 < nbx; bx0 += CHUNK) {
-            const int n = fv_tw_plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess);
+            const int n = plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess, cells, pmap);
             const int x0 = bx0 * BW, x1 = mini((bx0 + CHUNK) * BW, src->w);
             int nr = 0, ni = 0, next = ya; /* the entries covering the row change on row next */
             for (int y = ya; y < yb; y++) {
@@ -380,10 +453,10 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
                             r->npf = (r->n + 3 + 63) / 64;
                         } else if (b->fast)
                             item[ni].b = b, item[ni++].xa = 0;
-                        else if (prev_slow)
+                        else if (prev_slow && item[ni - 1].m == pmap[i])
                             item[ni - 1].xb = b->x1;
                         else
-                            item[ni].b = NULL, item[ni].xa = b->x0, item[ni++].xb = b->x1;
+                            item[ni].b = NULL, item[ni].m = pmap[i], item[ni].xa = b->x0, item[ni++].xb = b->x1;
                         prev_slow = !b->fast;
                     }
                 }
@@ -409,7 +482,8 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
                         const int64_t q[2] = {b->qu + (int64_t)(y - b->y0) * b->dqu, b->qv + (int64_t)(y - b->y0) * b->dqv};
                         np += block_row(&pc[np], row, x0, y, b, q, src);
                     } else
-                        holes += d->tw_row(row + 3 * (item[k].xa - x0), item[k].xa, y, item[k].xb - item[k].xa, m, src);
+                        holes += d->tw_row(row + 3 * (item[k].xa - x0), item[k].xa, y, item[k].xb - item[k].xa, item[k].m,
+                                           src);
                 }
                 d->tw_spans(row, pc, np);
                 d->tw_stream(dst + (ptrdiff_t)y * dst_stride + 3 * x0, row, 3 * (x1 - x0));
@@ -463,7 +537,10 @@ void fv_tw_frame_capture(fv_tw_frame *f, const fv_pipeline *pl, int e)
     fv_timewarp_dsp_init(&d, ~0u);
     const fv_tw_src s = {f->rgb[e], (ptrdiff_t)f->w * 3, f->invd[e], f->w, f->w, f->h};
     fv_tw_tiles_build(&d, &f->tiles[e], &s);
-    f->cam[e] = *fv_pipeline_camera(pl, eye);
+    const fv_camera *c = fv_pipeline_camera(pl, eye);
+    if (c->lens_on) /* ~50 us: cheaper than telling whether the lens changed */
+        fv_lens_map_init(&f->lmap[e], c);
+    f->cam[e] = *c;
 }
 
 long fv_tw_frame_warp(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, const fv_camera *display, uint8_t *dst,
@@ -471,6 +548,8 @@ long fv_tw_frame_warp(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, con
 {
     fv_tw_map m;
     fv_tw_setup(&m, display, &f->cam[e], tol);
+    if (f->cam[e].lens_on)
+        fv_tw_map_set_lens(&m, &f->lmap[e]);
     const fv_tw_src s = {f->rgb[e], (ptrdiff_t)f->w * 3, f->invd[e], f->w, f->w, f->h};
     return fv_tw_warp_rows(d, dst, dst_stride, 0, f->h, &m, &s, &f->tiles[e]);
 }
@@ -486,10 +565,14 @@ double fv_tw_psnr_outside_holes(const uint8_t *warped, const uint8_t *ref, const
     fv_luma_error(ref, warped, w, h, (ptrdiff_t)w * 3, err);
     double se = 0;
     long n = 0, holes = 0;
+    const int C = FV_TW_LENS_CELL;
+    fv_tw_map cm = *m;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             uint8_t px[3];
-            if (fv_tw_row_c(px, x, y, 1, m, src)) { /* the reference's verdict for this pixel */
+            if (m->lens && (x % C == 0)) /* with a lens: the cell's map */
+                fv_tw_cell_map(m, src, x, mini(x + C, w), y / C * C, mini(y / C * C + C, h), &cm);
+            if (fv_tw_row_c(px, x, y, 1, &cm, src)) { /* the reference's verdict for this pixel */
                 holes++;
                 continue;
             }

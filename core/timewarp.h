@@ -15,9 +15,30 @@
 #include "camera.h"
 #include "timewarp_dsp.h"
 
-/* The mapping from display camera pixels to source camera pixels (both without a lens: the warp
- * is linear; cameras of equal size). tol: the disocclusion tolerance (0.05 = 5 % in inverse depth). */
+/* The mapping from display camera pixels to source camera pixels (cameras of equal size; with a
+ * lens, the pinhole part: fv_tw_map_set_lens). tol: the disocclusion tolerance (0.05 = 5 % in
+ * inverse depth). */
 void fv_tw_setup(fv_tw_map *m, const fv_camera *display, const fv_camera *source, float tol);
+
+/* ---- with a lens ----
+ * Both cameras have the lens l was built from (fv_lens_map_init). The display pixel p then shows
+ * the source pixel F^-1(H(F(p), w)) (H: the pinhole warp at the display inverse depth w). The warp
+ * cuts the display into FV_TW_LENS_CELL squares and gives each the map with the lens linearised
+ * around it (fv_lens_map_fold: F at the cell centre, F^-1 where the centre lands at the depth the
+ * source shows there), so the block warp's planner, its proof and the per-pixel kernels run as
+ * they are, on that map. The linearisation's error against the exact map is FV_TW_LENS_ERR_PX
+ * (the example profile, 1280 x 1440, the head turning 30 deg/s for one and two refreshes of
+ * 90 Hz and moving 2 mm a refresh: measured 0.055 and 0.118 px; tests/test_lens_reproject.c
+ * measures every pixel); the block warp's FV_TW_BLOCK_POS_PX comes on top. Cells of 64 (the
+ * blocks' size: one map per block) cost the warp of a pair 0.1 ms of planning over the lensless
+ * warp; cells of 32 halve the error (0.023 / 0.049 px) but plan four times as many blocks (+1.2 ms,
+ * docs/headset.md). */
+#define FV_TW_LENS_CELL 64
+#define FV_TW_LENS_ERR_PX 0.15f
+struct fv_lens_map;
+void fv_tw_map_set_lens(fv_tw_map *m, const struct fv_lens_map *l);
+/* The map of the cell [X0, X1) x [Y0, Y1) (m with its lens folded in; lens NULL). */
+void fv_tw_cell_map(const fv_tw_map *m, const fv_tw_src *src, int X0, int X1, int Y0, int Y1, fv_tw_map *out);
 
 /* The 16-bit inverse depth of an image of (r, g, b, depth_m) floats (fv_pipeline_depth): round
  * (FV_TW_INVD_PER_M / depth_m), clamped to [0, 65535] (nearer than 6.25 cm: the nearest). */
@@ -109,6 +130,7 @@ typedef struct fv_tw_frame {
     uint8_t *rgb[2];        /* left, right: display bytes, w * 3 a row, FV_TW_RGB_PAD past the end */
     uint16_t *invd[2];      /* w a row, FV_TW_INVD_PAD bytes past the end */
     fv_camera cam[2];       /* the cameras they were rendered from */
+    fv_lens_map lmap[2];    /* their lens in pixel units (cameras with a lens), built at capture */
     fv_tw_tiles tiles[2];   /* of invd, built at capture */
 } fv_tw_frame;
 
@@ -117,7 +139,7 @@ void fv_tw_frame_free(fv_tw_frame *f);
 /* After fv_pipeline_render of eye e (0 left, 1 right): keep its display bytes, inverse depth (and
  * its tiles) and camera. */
 void fv_tw_frame_capture(fv_tw_frame *f, const struct fv_pipeline *pl, int e);
-/* Warps eye e of f to camera `display` (same size, no lens) into dst (rows of dst_stride bytes).
+/* Warps eye e of f to camera `display` (same size and lens) into dst (rows of dst_stride bytes).
  * Returns the disoccluded pixels. */
 long fv_tw_frame_warp(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, const fv_camera *display, uint8_t *dst,
                       ptrdiff_t dst_stride, float tol);

@@ -58,6 +58,10 @@ typedef struct fv_tw_map {
     float t[3];                /* source (U, V, Z) = z_d A + t */
     float tol;                 /* disocclusion: relative inverse-depth mismatch (0.05) */
     float w_scale;             /* 1/m per unit of the source's inverse depth (1 / FV_TW_INVD_PER_M) */
+    /* Both cameras' lens (fv_tw_map_set_lens; NULL = none): the rows above then map pinhole
+     * coordinates (core/lens.h). The kernels never read it: the warp hands them the lens folded
+     * into the rows of each FV_TW_LENS_CELL square (core/timewarp.h). */
+    const struct fv_lens_map *lens;
 } fv_tw_map;
 
 typedef struct fv_tw_src {

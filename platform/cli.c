@@ -187,14 +187,11 @@ void fv_common_validate(const char *prog, int argc, char **argv, const char *sce
         fv_usage_error(prog, "--r0 %g must not exceed --r1 %g", (double)cfg->samp.r0_deg, (double)cfg->samp.r1_deg);
 }
 
-void fv_cli_lens(const char *prog, const char *path, struct fv_lens *lens, fv_pipeline_config *cfg, int reproject_given)
+void fv_cli_lens(const char *prog, const char *path, struct fv_lens *lens, fv_pipeline_config *cfg)
 {
     char err[512];
     const float r_max = 3.0f * tanf(cfg->cam.fov_y_deg * 3.14159265f / 360.0f); /* beyond any corner */
     if (fv_lens_load(lens, path, r_max, err, sizeof err))
         fv_usage_error(prog, "--lens %s", err);
     cfg->cam.lens = lens;
-    if (reproject_given && cfg->taa.enabled)
-        fv_usage_error(prog, "--lens: reprojection does not model the lens yet; drop --reproject on");
-    cfg->taa.enabled = 0;
 }

@@ -90,13 +90,13 @@ enum {
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
 /* --lens FILE (replay, bench, headset): loads the HMD lens profile into *lens (which must outlive
  * the pipeline) and points cfg->cam.lens at it; the lens also places each eye's optical axis (an
- * asymmetric frustum, core/camera.h). Reprojection does not model the lens yet: it is turned off,
- * or refused when reproject_given says --reproject was given. Exits 2 naming the problem. */
+ * asymmetric frustum, core/camera.h). Reprojection stays as configured: it models the lens
+ * (core/reproject.h, "with a lens"). Exits 2 naming the problem. */
 struct fv_lens;
-void fv_cli_lens(const char *prog, const char *path, struct fv_lens *lens, fv_pipeline_config *cfg, int reproject_given);
+void fv_cli_lens(const char *prog, const char *path, struct fv_lens *lens, fv_pipeline_config *cfg);
 #define FV_LENS_HELP                                                                               \
     "  --lens FILE        HMD lens profile (distortion, chromatic aberration, per-eye centres\n"  \
-    "                     that place each eye's optical axis); turns reprojection off\n"
+    "                     that place each eye's optical axis); works with reprojection\n"
 
 /* --asset-root DIR, in every program that loads a scene: the folder tree the scene's external
  * files (buffers, textures) may come from; default the scene file's own folder (fv_scene_load_in). */

@@ -601,19 +601,25 @@ else
 fi
 printf 'k1 0.1\nk9 1\n' >"$T/bad.lens"
 expect_usage "headset bad lens" 'bad.lens:2: unknown key' $HS $HO --lens "$T/bad.lens"
-# --lens in replay and bench too (issue 16 item 3): a bad profile and --reproject on are refused; a good one
-# renders, the same bytes for 1 and 2 threads, and differs from the lensless frame
+# --lens in replay and bench too (issue 16 item 3): a bad profile is refused; a good one renders with
+# reprojection (on by default, and --reproject on is accepted), the same bytes for 1, 2 and 5 threads,
+# and differs from the lensless frame and from the lensed frame without reprojection
 expect_usage "replay bad lens" 'bad.lens:2: unknown key' $R --scene $SCENE --out "$T/ol" --lens "$T/bad.lens"
 expect_usage "bench bad lens" 'bad.lens:2: unknown key' $B/fovea-bench --scene $SCENE --lens "$T/bad.lens"
-expect_usage "replay lens with reproject" '--lens: reprojection does not model the lens yet' $R --scene $SCENE --out "$T/ol" --lens assets/hmd_example.lens --reproject on
-for th in 1 2; do
-    $R --scene $SCENE --size 64x72 --frames 2 --stereo --lens assets/hmd_example.lens --threads $th --quiet --out "$T/lens$th" >/dev/null 2>&1 || bad "replay --lens run ($th threads)"
+for th in 1 2 5; do
+    $R --scene $SCENE --size 64x72 --frames 3 --stereo --trace assets/gaze_sweep.csv --lens assets/hmd_example.lens --reproject on --threads $th --quiet \
+        --out "$T/lens$th" >/dev/null 2>&1 || bad "replay --lens --reproject on run ($th threads)"
 done
-$R --scene $SCENE --size 64x72 --frames 2 --stereo --reproject off --threads 2 --quiet --out "$T/nolens" >/dev/null 2>&1
-if cmp -s "$T/lens1/frame_00001.png" "$T/lens2/frame_00001.png" && ! cmp -s "$T/lens2/frame_00001.png" "$T/nolens/frame_00001.png"; then ok
-else bad "replay --lens: frames differ between thread counts, or equal the lensless frame"; fi
-$B/fovea-bench --scene $SCENE --size 64x72 --frames 1 --warmup 0 --lens assets/hmd_example.lens --counters off >"$T/out" 2>&1 &&
-    grep -q '^foveated' "$T/out" && ok || bad "bench --lens: $(tail -n 3 "$T/out")"
+$R --scene $SCENE --size 64x72 --frames 3 --stereo --trace assets/gaze_sweep.csv --reproject on --threads 2 --quiet --out "$T/nolens" >/dev/null 2>&1
+$R --scene $SCENE --size 64x72 --frames 3 --stereo --trace assets/gaze_sweep.csv --lens assets/hmd_example.lens --reproject off --threads 2 --quiet \
+    --out "$T/lensoff" >/dev/null 2>&1
+f=frame_00002.png
+if [ -s "$T/lens1/$f" ] && cmp -s "$T/lens1/$f" "$T/lens2/$f" && cmp -s "$T/lens1/$f" "$T/lens5/$f" &&
+    ! cmp -s "$T/lens2/$f" "$T/nolens/$f" && ! cmp -s "$T/lens2/$f" "$T/lensoff/$f"; then ok
+else bad "replay --lens --reproject on: frames differ between thread counts, or equal the lensless or unreprojected frame"; fi
+$B/fovea-bench --scene $SCENE --size 64x72 --frames 2 --warmup 1 --yaw-rate 30 --lens assets/hmd_example.lens --reproject on \
+    --counters off >"$T/out" 2>&1 && awk '/^foveated/ { ok = $3 ~ /^[0-9.]+$/ } END { exit !ok }' "$T/out" && ok ||
+    bad "bench --lens --reproject on: no reprojection time: $(tail -n 3 "$T/out")"
 expect_usage "headset bad dof-sampling" '--dof-sampling: .1. is not one of on, off' $HS $HO --dof-sampling 1
 expect_usage "headset no scene" '--scene FILE is required' $HS --size 64x72
 
@@ -654,7 +660,15 @@ else
 fi
 expect_usage "headset bad warp threads" '--warp-threads: 3 is out of range' $HS $HO --warp-threads 3
 expect_usage "headset bad timewarp" "--timewarp: 'sideways'" $HS $HO --timewarp sideways
-expect_usage "headset timewarp with lens" '--lens: the timewarp does not model the lens' $HS $HO --lens assets/hmd_example.lens --timewarp on
+# --lens with the timewarp (and reprojection): the contract lines, timewarp on
+if $HS $HO --seconds 1 --trace assets/gaze_sweep.csv --lens assets/hmd_example.lens --timewarp on --reproject on --display png:"$T/lpng" \
+    >"$T/out" 2>"$T/err"; then
+    head -n 1 "$T/out" | grep -Eq "$L1" && grep -Eq "$L2" "$T/out" && grep -q 'timewarp on' "$T/out" && ok ||
+        bad "headset --lens --timewarp on: $(cat "$T/out")"
+    ls "$T/lpng"/frame_00000.png >/dev/null 2>&1 && ok || bad "headset --lens --timewarp on wrote no frame"
+else
+    bad "headset --lens --timewarp on failed: $(cat "$T/err")"
+fi
 # --trace-out: valid trace, one track per worker, the stage tracks and the loop's markers
 if $HS $HO --seconds 2 --trace-out "$T/hs.json" >"$T/out" 2>"$T/err"; then
     out=$(python3 tools/check_trace.py "$T/hs.json" 2 --stages) && ok || bad "headset trace: $out"

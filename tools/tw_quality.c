@@ -6,11 +6,12 @@
  * per-pixel reference, the disoccluded share, the share of translated blocks, and the PSNR of
  * showing the old frame unwarped.
  *   tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] [--step MM] [--eye left|right]
- *              [--png DIR] [--bench N]
+ *              [--png DIR] [--bench N] [--lens FILE]
  * --png: DIR/warped_K.png, DIR/direct_K.png and DIR/error_K.png (the luma error x8 around grey).
  * --bench N: times the stereo pair (both eyes of the frame, one refresh old) warped on this one
  * thread, block warp and per-pixel, against a copy of the same bytes (memcpy of both eyes), each
- * N times alternately; prints medians of thread CPU time and of wall time and the ratios. */
+ * N times alternately; prints medians of thread CPU time and of wall time and the ratios.
+ * --lens FILE: every camera with the HMD lens profile (the warp through it, core/timewarp.h). */
 #define _DEFAULT_SOURCE /* getloadavg */
 #include <math.h>
 #include <stdio.h>
@@ -19,6 +20,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "lens.h"
 #include "metrics.h"
 #include "output.h"
 #include "pipeline.h"
@@ -95,6 +97,7 @@ int main(int argc, char **argv)
     const char *png_dir = NULL;
     double rate = 30.0, hz = 90.0, step_mm = 0.0;
     int bench = 0, bench_pixel = 1;
+    const char *lens_path = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--scene") && i + 1 < argc)
             scene_path = argv[++i];
@@ -109,6 +112,8 @@ int main(int argc, char **argv)
             step_mm = fv_arg_float(prog, "--step", argv[++i], -100.0f, 100.0f);
         else if (!strcmp(argv[i], "--bench") && i + 1 < argc)
             bench = (int)fv_arg_long(prog, "--bench", argv[++i], 1, 1000);
+        else if (!strcmp(argv[i], "--lens") && i + 1 < argc)
+            lens_path = argv[++i];
         else if (!strcmp(argv[i], "--no-per-pixel"))
             bench_pixel = 0;
         else if (!strcmp(argv[i], "--png") && i + 1 < argc)
@@ -122,7 +127,8 @@ int main(int argc, char **argv)
                    "  --png DIR   DIR/warped_K.png, direct_K.png, error_K.png (the luma error x8)\n"
                    "  --bench N   time the stereo pair one refresh old on this thread, block warp,\n"
                    "              per-pixel warp and a copy of the pair's bytes, N times each\n"
-                   "  --no-per-pixel  --bench leaves the per-pixel warp out (profiling the block warp)\n");
+                   "  --no-per-pixel  --bench leaves the per-pixel warp out (profiling the block warp)\n"
+                   "  --lens FILE HMD lens profile: rendered through it, warped through it\n");
             return 0;
         } else
             fv_usage_error(prog, "usage: tw_quality [--scene FILE] [--size WxH] [--rate DEG_PER_S] [--hz HZ] "
@@ -137,6 +143,9 @@ int main(int argc, char **argv)
     cfg.cam.width = w, cfg.cam.height = h;
     cfg.samp.full = 1;
     cfg.taa.enabled = 0;
+    fv_lens lens;
+    if (lens_path)
+        fv_cli_lens(prog, lens_path, &lens, &cfg);
     fv_pipeline *pl = fv_pipeline_create(scene, &cfg, err, sizeof err);
     if (!pl)
         fv_usage_error(prog, "%s", err);
@@ -151,7 +160,8 @@ int main(int argc, char **argv)
     fv_timewarp_dsp d;
     fv_timewarp_dsp_init(&d, ~0u);
     printf("%s %dx%d %s eye, head turning %.1f deg/s, stepping %.2f mm a refresh, at %.1f Hz (full sampling, no TAA, "
-           "no DoF)\n", scene_path, w, h, right ? "right" : "left", rate, step_mm, hz);
+           "no DoF)%s%s\n", scene_path, w, h, right ? "right" : "left", rate, step_mm, hz, lens_path ? ", lens " : "",
+           lens_path ? lens_path : "");
     for (int k = 1; k <= 2; k++) {
         fv_pose p1;
         moved(&p0, rate, hz, step_mm, k, &p1);
@@ -159,6 +169,8 @@ int main(int argc, char **argv)
             fv_fail(prog, FV_EXIT_FAIL, "render failed");
         fv_tw_map m;
         fv_tw_setup(&m, &f1.cam[right], &f0.cam[right], 0.05f);
+        if (lens_path)
+            fv_tw_map_set_lens(&m, &f0.lmap[right]);
         const fv_tw_src s = {f0.rgb[right], (ptrdiff_t)w * 3, f0.invd[right], w, w, h};
         fv_tw_warp_rows(&d, out, (ptrdiff_t)w * 3, 0, h, &m, &s, &f0.tiles[right]);
         fv_tw_warp_rows_pixel(&d, outp, (ptrdiff_t)w * 3, 0, h, &m, &s);
@@ -209,6 +221,8 @@ int main(int argc, char **argv)
             if (fv_camera_setup(&c, &cd, &p1))
                 fv_fail(prog, FV_EXIT_FAIL, "camera set-up failed");
             fv_tw_setup(&m[e], &c, &f0.cam[e], 0.05f);
+            if (lens_path)
+                fv_tw_map_set_lens(&m[e], &f0.lmap[e]);
             s[e] = (fv_tw_src){f0.rgb[e], (ptrdiff_t)w * 3, f0.invd[e], w, w, h};
         }
         uint8_t *pair = malloc((size_t)w * h * 6);
