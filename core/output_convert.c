@@ -31,46 +31,15 @@ fv_lens_lca *fv_output_lca_create(const fv_camera *cam)
     return lca;
 }
 
-/* Channel c of img, bilinear at pixel coordinates (fx, fy) (pixel centres at integers), clamped. */
-static float sample_ch(const float *img, ptrdiff_t stride, int w, int h, float fx, float fy, int c)
-{
-    const float x0f = floorf(fx), y0f = floorf(fy), ax = fx - x0f, ay = fy - y0f;
-    const int x0 = (int)fminf(fmaxf(x0f, 0.0f), (float)(w - 1)), x1 = (int)fminf(fmaxf(x0f + 1.0f, 0.0f), (float)(w - 1));
-    const int y0 = (int)fminf(fmaxf(y0f, 0.0f), (float)(h - 1)), y1 = (int)fminf(fmaxf(y0f + 1.0f, 0.0f), (float)(h - 1));
-    const float *r0 = img + 4 * (ptrdiff_t)y0 * stride, *r1 = img + 4 * (ptrdiff_t)y1 * stride;
-    const float a = r0[4 * x0 + c] + ax * (r0[4 * x1 + c] - r0[4 * x0 + c]);
-    const float b = r1[4 * x0 + c] + ax * (r1[4 * x1 + c] - r1[4 * x0 + c]);
-    return a + ay * (b - a);
-}
-
-static inline uint8_t to_srgb8(const fv_output_conv *p, float v)
-{
-    /* clamp before converting: NaN-free by construction, but never index out of range */
-    return p->srgb[fv_srgb_index(v)];
-}
-
 /* Rows [y0, y0+n) of the image; the lens resampling reads any row of img. */
 static void convert_rows(const fv_output_conv *p, const float *img, ptrdiff_t stride, int w, int h, const fv_camera *c,
                          const fv_lens_lca *lca, uint8_t *dst, ptrdiff_t dst_stride, int y0, int n)
 {
     if (lca && lca->on) {
         /* red and blue read where green's rays carry their directions (core/lens.h) */
-        const float inv = 1.0f / c->px_tan;
-        for (int y = y0; y < y0 + n; y++) {
-            const float *s = img + 4 * y * stride, ty = c->tan_top - ((float)y + 0.5f) * c->px_tan;
-            uint8_t *o = dst + y * dst_stride;
-            for (int x = 0; x < w; x++) {
-                const float tx = c->tan_left + ((float)x + 0.5f) * c->px_tan;
-                for (int ch = 0; ch < 2; ch++) {
-                    float qx, qy;
-                    fv_lens_lca_source(lca, ch, c->lens_cx, c->lens_cy, tx, ty, &qx, &qy);
-                    const float v = sample_ch(img, stride, w, h, (qx - c->tan_left) * inv - 0.5f,
-                                              (c->tan_top - qy) * inv - 0.5f, ch ? 2 : 0);
-                    o[3 * x + (ch ? 2 : 0)] = to_srgb8(p, v);
-                }
-                o[3 * x + 1] = to_srgb8(p, s[4 * x + 1]);
-            }
-        }
+        const fv_lca_geom g = {c->tan_left, c->tan_top, c->px_tan, 1.0f / c->px_tan, c->lens_cx, c->lens_cy, img, stride, w, h};
+        for (int y = y0; y < y0 + n; y++)
+            p->dsp.lca_row(dst + y * dst_stride, y, &g, lca, p->srgb);
         return;
     }
     for (int y = y0; y < y0 + n; y++)

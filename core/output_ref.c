@@ -20,9 +20,18 @@ void fv_rgb8_row_c(uint8_t *restrict dst, const float *rgbd, int n, const uint8_
             dst[3 * x + c] = lut[fv_srgb_index(rgbd[4 * x + c])];
 }
 
+void fv_lca_row_c(uint8_t *restrict dst, int y, const fv_lca_geom *g, const fv_lens_lca *lca, const uint8_t *lut)
+{
+    const float ty = g->tan_top - ((float)y + 0.5f) * g->px_tan;
+    const float *own = g->img + 4 * (ptrdiff_t)y * g->stride;
+    for (int x = 0; x < g->w; x++)
+        fv_lca_pixel(dst + 3 * x, x, ty, g, lca, own + 4 * x, lut);
+}
+
 void fv_output_dsp_init(fv_output_dsp *d, unsigned isa_mask)
 {
     d->rgb8_row = fv_rgb8_row_c;
+    d->lca_row = fv_lca_row_c;
     const unsigned avail = isa_mask & fv_cpu_isas();
     (void)avail;
 #if defined(__x86_64__)

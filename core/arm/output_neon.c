@@ -31,4 +31,36 @@ static void rgb8_row_neon(uint8_t *restrict dst, const float *rgbd, int n, const
     fv_rgb8_row_c(dst + 3 * x, rgbd + 4 * x, n - x, lut);
 }
 
-void fv_output_dsp_init_neon(fv_output_dsp *d) { d->rgb8_row = rgb8_row_neon; }
+/* lca_row: the radius step 4 pixels at a time (sqrt, table index and weight), the taps lane by
+ * lane through the reference's own steps (no gathers): the reference's bytes */
+static void lca_row_neon(uint8_t *restrict dst, int y, const fv_lca_geom *g, const fv_lens_lca *lca, const uint8_t *lut)
+{
+    const float ty = g->tan_top - ((float)y + 0.5f) * g->px_tan, uy = ty - g->cy;
+    const float *own = g->img + 4 * (ptrdiff_t)y * g->stride;
+    const float32x4_t tl = vdupq_n_f32(g->tan_left), pt = vdupq_n_f32(g->px_tan), cx = vdupq_n_f32(g->cx);
+    const float32x4_t uy2 = vdupq_n_f32(uy * uy), steps = vdupq_n_f32((float)FV_LENS_LCA_STEPS), is = vdupq_n_f32(lca->inv_step);
+    static const int32_t lane[4] = {0, 1, 2, 3};
+    int x = 0;
+    for (; x + 4 <= g->w; x += 4) {
+        const float32x4_t xf = vaddq_f32(vcvtq_f32_s32(vaddq_s32(vdupq_n_s32(x), vld1q_s32(lane))), vdupq_n_f32(0.5f));
+        const float32x4_t ux = vsubq_f32(vaddq_f32(tl, vmulq_f32(xf, pt)), cx);
+        float32x4_t f = vmulq_f32(vsqrtq_f32(vaddq_f32(vmulq_f32(ux, ux), uy2)), is);
+        f = vbslq_f32(vcltq_f32(f, steps), f, steps); /* NaN: STEPS */
+        const int32x4_t i = vminq_s32(vcvtq_s32_f32(f), vdupq_n_s32(FV_LENS_LCA_STEPS - 1));
+        float a[4], u[4];
+        int32_t iv[4];
+        vst1q_f32(a, vsubq_f32(f, vcvtq_f32_s32(i)));
+        vst1q_f32(u, ux);
+        vst1q_s32(iv, i);
+        for (int l = 0; l < 4; l++)
+            fv_lca_finish(dst + 3 * (x + l), iv[l], a[l], u[l], uy, g, lca, own + 4 * (x + l), lut);
+    }
+    for (; x < g->w; x++)
+        fv_lca_pixel(dst + 3 * x, x, ty, g, lca, own + 4 * x, lut);
+}
+
+void fv_output_dsp_init_neon(fv_output_dsp *d)
+{
+    d->rgb8_row = rgb8_row_neon;
+    d->lca_row = lca_row_neon;
+}

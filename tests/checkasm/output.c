@@ -11,7 +11,7 @@
 
 #include "output_dsp.h"
 
-static const char *const names[] = {"rgb8_row"};
+static const char *const names[] = {"rgb8_row", "lca_row"};
 static const int sizes[] = {1, 2, 3, 7, 8, 9, 15, 16, 17, 31, 33, 64, 641, 1280, 1281};
 #define NSIZES ((int)(sizeof sizes / sizeof sizes[0]))
 
@@ -118,9 +118,105 @@ static void test_reference(void **state)
             assert_int_equal(out[3 * i + c], (uint8_t)want[i]);
 }
 
+/* lca_row: a w x h image of random and edge values, a lens whose centre lies inside, on the
+ * edge or outside the image, ratio tables around 1 (and far off it, so that taps leave the
+ * image and clamp); every ISA version gives the reference's bytes (the contract: the same
+ * operations in the same order) */
+static void fill_lca(fv_lens_lca *l, int mode)
+{
+    memset(l, 0, sizeof *l);
+    l->on = 1;
+    l->r_max = 1.2f + checkasm_randf();
+    l->inv_step = (float)FV_LENS_LCA_STEPS / l->r_max;
+    for (int ch = 0; ch < 2; ch++)
+        for (int i = 0; i <= FV_LENS_LCA_STEPS; i++) {
+            const float r = (float)i / FV_LENS_LCA_STEPS;
+            l->ratio[ch][i] = mode == 0 ? 1.0f + (ch ? -0.01f : 0.012f) * r * r : 0.5f + 1.5f * checkasm_randf();
+        }
+}
+
+static void test_lca_row(void **state)
+{
+    (void)state;
+    checkasm_rng = 0x1ca0f00dull;
+    fv_srgb_lut_init(lut);
+    static const int ws[] = {1, 7, 8, 9, 17, 64, 131};
+    static fv_lens_lca lca;
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "lca_row"))
+            continue;
+        fv_output_dsp d;
+        fv_output_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+        for (int trial = 0; trial < 42; trial++) {
+            const int w = ws[trial % 7], h = 1 + (int)(checkasm_rand() % 23), mode = trial % 3;
+            const ptrdiff_t stride = w + (ptrdiff_t)(checkasm_rand() % 3);
+            buf img = buf_new(4 * (size_t)stride * (size_t)h, trial % 3);
+            for (ptrdiff_t i = 0; i < 4 * stride * h; i++)
+                img.p[i] = gen(mode == 2 ? 1 : 0);
+            fill_lca(&lca, mode == 1);
+            const float pt = 0.01f + 0.02f * checkasm_randf(), tl = -0.5f * pt * (float)w, tt = 0.5f * pt * (float)h;
+            const float where = (float)(checkasm_rand() % 3); /* the lens centre: inside, on a corner, outside */
+            const fv_lca_geom g = {tl, tt, pt, 1.0f / pt, tl + where * 0.6f * pt * (float)w, tt - where * 0.5f * pt * (float)h,
+                                   img.p, stride, w, h};
+            for (int y = 0; y < h; y++) {
+                uint8_t *rb, *tb;
+                uint8_t *r = checkasm_out_u8(3 * (size_t)w, y % 3, &rb), *t = checkasm_out_u8(3 * (size_t)w, y % 3, &tb);
+                fv_lca_row_c(r, y, &g, &lca, lut);
+                d.lca_row(t, y, &g, &lca, lut);
+                checkasm_check_guards(t, 3 * (size_t)w, fv_isa_name(isa), "lca_row", w);
+                checkasm_compare(r, t, 3 * (size_t)w, CHECKASM_U8, 3, CHECKASM_EXACT, "%s lca_row trial=%d w=%d h=%d y=%d",
+                                 fv_isa_name(isa), trial, w, h, y);
+                free(rb), free(tb);
+            }
+            free(img.base);
+        }
+    }
+}
+
+/* the reference on a hand case: ratios of exactly 1 (no aberration) and a pixel grid whose
+ * coordinates are exact in binary, so red and blue read their own pixel: the bytes of the plain
+ * conversion (fv_rgb8_row_c) */
+static void test_lca_identity(void **state)
+{
+    (void)state;
+    fv_srgb_lut_init(lut);
+    enum { W = 37, H = 5 };
+    static float img[4 * W * H];
+    for (int i = 0; i < 4 * W * H; i++)
+        img[i] = (float)((i * 2654435761u) % 1000u) / 900.0f - 0.05f;
+    static fv_lens_lca lca;
+    lca.on = 1, lca.r_max = 1.0f, lca.inv_step = (float)FV_LENS_LCA_STEPS;
+    for (int ch = 0; ch < 2; ch++)
+        for (int i = 0; i <= FV_LENS_LCA_STEPS; i++)
+            lca.ratio[ch][i] = 1.0f;
+    const fv_lca_geom g = {-0.0625f, 0.03125f, 1.0f / 256.0f, 256.0f, 0.01171875f, -0.0078125f, img, W, W, H};
+    for (int y = 0; y < H; y++) {
+        uint8_t a[3 * W], b[3 * W];
+        fv_lca_row_c(a, y, &g, &lca, lut);
+        fv_rgb8_row_c(b, img + 4 * W * y, W, lut);
+        assert_memory_equal(a, b, sizeof a);
+    }
+    /* and a shift that cannot be identity: ratios of 2 move red and blue away from the centre */
+    for (int ch = 0; ch < 2; ch++)
+        for (int i = 0; i <= FV_LENS_LCA_STEPS; i++)
+            lca.ratio[ch][i] = 2.0f;
+    int moved = 0;
+    for (int y = 0; y < H; y++) {
+        uint8_t a[3 * W], b[3 * W];
+        fv_lca_row_c(a, y, &g, &lca, lut);
+        fv_rgb8_row_c(b, img + 4 * W * y, W, lut);
+        for (int x = 0; x < W; x++)
+            moved += a[3 * x] != b[3 * x], assert_int_equal(a[3 * x + 1], b[3 * x + 1]); /* green is its own */
+    }
+    assert_true(moved > W);
+}
+
 const struct CMUnitTest checkasm_output_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_reference),
     cmocka_unit_test(test_rgb8_row),
+    cmocka_unit_test(test_lca_row),
+    cmocka_unit_test(test_lca_identity),
     {0},
 };
