@@ -215,7 +215,13 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
     const fv_sampler *smp = f->smp;
     const int sout = !smp->prm.full && smp->prm.kind == FV_SAMPLER_WEIER;
     const double r1sq = (double)smp->r1_px * smp->r1_px, inv_p = 1.0 / (double)smp->prm.p_min;
-    const double g = (double)(f->seed % 1000003u) * 0.6180339887498949; /* small: exact enough */
+    /* The shift: frame x golden ratio, but S_out's pixels by their visit: an S_out pixel is in
+     * the pattern one frame in K (phase = frame mod K), so its variate moves by the golden ratio
+     * between two of its visits (by frame it would move 5 g mod 1 = 0.09 at K 5: a pixel kept
+     * once would be kept the next few visits and then dropped for dozens of frames). */
+    const double gold = 0.6180339887498949;
+    const double g = (double)(f->seed % 1000003u) * gold; /* small: exact enough */
+    const double g_out = (double)((f->seed / (uint32_t)smp->phases) % 1000003u) * gold;
     const int kph = (f->phase % smp->phases + smp->phases) % smp->phases;
     const double koff = (double)kph / smp->phases;
     for (int y = 0; y < th; y++) {
@@ -230,7 +236,7 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
             const double dx = (double)(x0 + x - f->gx);
             double v;
             if (sout && dx * dx + dy * dy >= r1sq)
-                v = fv_sampler_lattice_at(x0 + x, y0 + y, koff) * inv_p + g;
+                v = fv_sampler_lattice_at(x0 + x, y0 + y, koff) * inv_p + g_out;
             else
                 v = fv_sampler_lattice_at(x0 + x, y0 + y, 0.0) + g;
             v -= (double)(long long)v;
