@@ -156,14 +156,19 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
     const int nb = 16 >> sh, ng = nb + 2; /* blocks per tile side, texels per grid side */
     const int ix0 = floor_shr(x0 + fx, sh) - 1, iy0 = floor_shr(y0 + fy, sh) - 1;
     float e[18 * 18], emax = 0.0f;
+    /* the grid's columns inside the map: [ia, ib) */
+    const int ia = ix0 >= -1 ? 0 : -1 - ix0, ib = f->map_w - 1 - ix0 < ng ? f->map_w - 1 - ix0 : ng;
     for (int j = 0; j < ng; j++) {
         const int iy = iy0 + j;
-        for (int i = 0; i < ng; i++) {
-            const int ix = ix0 + i;
-            const int in = ix >= -1 && iy >= -1 && ix <= f->map_w - 2 && iy <= f->map_h - 2;
-            const float ev = in ? f->map[(ptrdiff_t)(iy + 1) * f->map_w + ix + 1] : 0.0f;
-            e[ng * j + i] = ev;
-            emax = ev > emax ? ev : emax;
+        float *er = e + ng * j;
+        for (int i = 0; i < ng; i++)
+            er[i] = 0.0f;
+        if (iy < -1 || iy > f->map_h - 2)
+            continue;
+        const float *mr = f->map + (ptrdiff_t)(iy + 1) * f->map_w + ix0 + 1;
+        for (int i = ia; i < ib; i++) {
+            er[i] = mr[i];
+            emax = mr[i] > emax ? mr[i] : emax;
         }
     }
     /* CoCs up to kappa / sqrt(p_hi) keep every sample: most tiles stop here */
