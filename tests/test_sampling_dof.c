@@ -493,6 +493,70 @@ static void test_fovea_thinned_evenly(void **st)
     fixture_free(&fx);
 }
 
+/* Over time in the periphery: an S_out pixel is in the pattern one frame in K (phase = frame mod
+ * K); at q ~ 0.3 each pixel is re-traced within 6 of its visits (the golden-ratio shift per
+ * visit; shifted per frame, the variate moved 5 g mod 1 = 0.09 between visits: runs of 9 visits
+ * without a ray), and every pixel is traced. */
+static void test_periphery_revisits(void **st)
+{
+    (void)st;
+    fixture fx;
+    fixture_init(&fx, 0);
+    const float depth_m = 2.33f; /* c 8.1 px: d 0.06, q 0.3 at p_min 0.2 */
+    history_depth(&fx, depth_m);
+    const double q = expect_density(expect_coc(depth_m)) / fx.smp.prm.p_min;
+    assert_true(q > 0.25 && q < 0.35);
+    fv_sampler_free(&fx.smp); /* the rotating pattern, as with reprojection */
+    fv_sampling_params sp;
+    fv_sampling_params_default(&sp);
+    sp.rotate = 1;
+    assert_int_equal(fv_sampler_init(&fx.smp, W, H, fx.cam.focal_px, &sp), 0);
+    const int K = fx.smp.phases;
+    assert_int_equal(K, 5);
+    enum { N = 64, X0 = 64, Y0 = 64 };
+    static int last[N][N], visits[N][N], kept_n[N][N];
+    int maxgap = 0;
+    for (int y = 0; y < N; y++)
+        for (int x = 0; x < N; x++)
+            last[y][x] = -1, visits[y][x] = 0, kept_n[y][x] = 0;
+    for (uint32_t fr = 0; fr < 40u * (uint32_t)K; fr++) {
+        const int ph = (int)(fr % (uint32_t)K);
+        fv_dofsamp_frame f;
+        fv_dofsamp_frame_setup(&f, &fx.prm, &fx.tf, &fx.smp, far_gx, far_gy, FOCUS_M, FOCUS_M, TOL_M, PX_PER_DPT, fr,
+                               ph);
+        fv_dofsamp_map_attach(&f, fx.map);
+        fv_dofsamp_map_rows(&f, 0, f.map_h);
+        for (int ty = Y0 / 16; ty < (Y0 + N) / 16; ty++)
+            for (int tx = X0 / 16; tx < (X0 + N) / 16; tx++) {
+                uint32_t rows[16], acu[16];
+                for (int y = 0; y < 16; y++)
+                    rows[y] = acu[y] = (uint32_t)fv_sampler_row(&fx.smp, tx * 16, ty * 16 + y, 16, far_gx, far_gy, ph);
+                fv_dofsamp_tile(&f, tx * 16, ty * 16, 16, 16, rows);
+                for (int y = 0; y < 16; y++)
+                    for (int x = 0; x < 16; x++) {
+                        if (!(acu[y] >> x & 1u))
+                            continue;
+                        const int py = ty * 16 + y - Y0, px = tx * 16 + x - X0;
+                        const int v = visits[py][px]++;
+                        if (rows[y] >> x & 1u) {
+                            if (last[py][px] >= 0 && v - last[py][px] > maxgap)
+                                maxgap = v - last[py][px];
+                            last[py][px] = v;
+                            kept_n[py][px]++;
+                        }
+                    }
+            }
+    }
+    for (int y = 0; y < N; y++)
+        for (int x = 0; x < N; x++) {
+            assert_int_equal(visits[y][x], 40); /* the K phases tile every pixel */
+            assert_true(kept_n[y][x] > 0);
+        }
+    printf("q %.3f: longest run between two rays of a pixel %d visits\n", q, maxgap);
+    assert_true(maxgap <= 6);
+    fixture_free(&fx);
+}
+
 /* A constant image sampled through the roulette and reconstructed by pull-push is that
  * constant at every pixel: holes (their colours poisoned) are filled, nothing is lost. */
 static void test_constant_image_reconstruction(void **st)
@@ -679,6 +743,7 @@ int main(void)
         cmocka_unit_test(test_periphery_thinned_evenly),
         cmocka_unit_test(test_transition_per_block),
         cmocka_unit_test(test_fovea_thinned_evenly),
+        cmocka_unit_test(test_periphery_revisits),
         cmocka_unit_test(test_constant_image_reconstruction),
         cmocka_unit_test(test_pipeline_fewer_rays),
         cmocka_unit_test(test_pipeline_thread_determinism),
