@@ -12,7 +12,7 @@ _Static_assert(FV_TILE == 16, "fv_dofsamp_tile works on 16x16 tiles");
 void fv_dofsamp_params_default(fv_dofsamp_params *p)
 {
     p->enabled = 1;
-    p->kappa = 4.0f;
+    p->kappa = 2.0f;
     p->coc_cap_px = 32.0f;
 }
 
@@ -47,9 +47,9 @@ float fv_dofsamp_coc_px(const fv_dofsamp_frame *f, float depth_m) { return f->px
 
 float fv_dofsamp_density(const fv_dofsamp_frame *f, float c_px)
 {
-    const float c = c_px < f->coc_cap_px ? c_px : f->coc_cap_px;
-    const float s = f->kappa / c; /* c = 0: inf, density 1 */
-    return s < 1.0f ? s * s : 1.0f;
+    const float c = (c_px < f->coc_cap_px ? c_px : f->coc_cap_px) / f->kappa;
+    const float a = c * c + (1.0f / 3.0f); /* the texel area 4^L of the level read (kappa 2) */
+    return a > 1.0f ? 1.0f / a : 1.0f;
 }
 
 float fv_dofsamp_keep(const fv_dofsamp_frame *f, float p, float c_px)
@@ -58,11 +58,6 @@ float fv_dofsamp_keep(const fv_dofsamp_frame *f, float p, float c_px)
     return d < p ? d / p : 1.0f;
 }
 
-
-uint32_t fv_dofsamp_hash(int x, int y, uint32_t seed)
-{
-    return fv_hash32(fv_hash32((uint32_t)x | (uint32_t)y << 16) ^ (seed * 0x9e3779b9u + 0x632be5abu));
-}
 
 static inline int floor_shr(int v, int s) { return v >= 0 ? v >> s : -((-v + (1 << s) - 1) >> s); }
 
@@ -127,15 +122,30 @@ void fv_dofsamp_map_rows(const fv_dofsamp_frame *f, int j0, int j1)
     }
 }
 
+/* The acuity probability at the point of [x0, x1) x [y0, y1) farthest from (lowest p) or nearest
+ * to (highest p) the gaze: the models' p falls with the distance from the gaze. */
+static float rect_p(const fv_dofsamp_frame *f, int x0, int y0, int x1, int y1, int nearest)
+{
+    const float ax = (float)x0 - (float)f->gx, bx = (float)x1 - (float)f->gx;
+    const float ay = (float)y0 - (float)f->gy, by = (float)y1 - (float)f->gy;
+    float dx, dy;
+    if (nearest) {
+        dx = ax > 0.0f ? ax : bx < 0.0f ? bx : 0.0f;
+        dy = ay > 0.0f ? ay : by < 0.0f ? by : 0.0f;
+    } else {
+        dx = fabsf(ax) > fabsf(bx) ? ax : bx;
+        dy = fabsf(ay) > fabsf(by) ? ay : by;
+    }
+    return fv_sampler_probability(f->smp, dx, dy);
+}
+
 float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th, uint32_t rows[16])
 {
     const fv_taa_frame *t = f->taa;
-    /* the acuity probability at the tile's point farthest from the gaze: the tile's lowest p, so
-     * the nearer pixels (higher p) get at least the density asked for */
-    const float ax = (float)x0 - (float)f->gx, bx = (float)(x0 + tw) - (float)f->gx;
-    const float ay = (float)y0 - (float)f->gy, by = (float)(y0 + th) - (float)f->gy;
-    const float p = fv_sampler_probability(f->smp, fabsf(ax) > fabsf(bx) ? ax : bx, fabsf(ay) > fabsf(by) ? ay : by);
-    if (!(f->kappa / f->coc_cap_px < sqrtf(p))) /* even the largest CoC needs every sample */
+    /* the tile's highest acuity probability: where d(c) < p can hold at all */
+    const float p_hi = rect_p(f, x0, y0, x0 + tw, y0 + th, 1);
+    const float d_min = fv_dofsamp_density(f, f->coc_cap_px);
+    if (!(d_min < p_hi)) /* even the largest CoC needs every sample */
         return 1.0f;
 
     /* Defocus of the history's texels around the tile (fv_dofsamp_map), moved by the tile's
@@ -146,20 +156,27 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
     const int nb = 16 >> sh, ng = nb + 2; /* blocks per tile side, texels per grid side */
     const int ix0 = floor_shr(x0 + fx, sh) - 1, iy0 = floor_shr(y0 + fy, sh) - 1;
     float e[18 * 18], emax = 0.0f;
+    /* the grid's columns inside the map: [ia, ib) */
+    const int ia = ix0 >= -1 ? 0 : -1 - ix0, ib = f->map_w - 1 - ix0 < ng ? f->map_w - 1 - ix0 : ng;
     for (int j = 0; j < ng; j++) {
         const int iy = iy0 + j;
-        for (int i = 0; i < ng; i++) {
-            const int ix = ix0 + i;
-            const int in = ix >= -1 && iy >= -1 && ix <= f->map_w - 2 && iy <= f->map_h - 2;
-            const float ev = in ? f->map[(ptrdiff_t)(iy + 1) * f->map_w + ix + 1] : 0.0f;
-            e[ng * j + i] = ev;
-            emax = ev > emax ? ev : emax;
+        float *er = e + ng * j;
+        for (int i = 0; i < ng; i++)
+            er[i] = 0.0f;
+        if (iy < -1 || iy > f->map_h - 2)
+            continue;
+        const float *mr = f->map + (ptrdiff_t)(iy + 1) * f->map_w + ix0 + 1;
+        for (int i = ia; i < ib; i++) {
+            er[i] = mr[i];
+            emax = mr[i] > emax ? mr[i] : emax;
         }
     }
-    /* CoCs up to kappa / sqrt(p) keep every sample: most tiles stop here */
-    const float c_keep = f->kappa / sqrtf(p);
-    if (!(f->px_per_dpt * emax > c_keep))
+    /* CoCs up to kappa / sqrt(p_hi) keep every sample: most tiles stop here */
+    if (!(fv_dofsamp_density(f, f->px_per_dpt * emax) < p_hi))
         return 1.0f;
+    /* the tile's lowest p: one p for every block where the tile lies where p is flat (the
+     * periphery, the fovea's inside) */
+    const float p_lo = rect_p(f, x0, y0, x0 + tw, y0 + th, 0);
     /* per block: the smallest defocus of its 3x3 texel neighbourhood (separable) -> keep
      * threshold */
     float eh[18 * 16];
@@ -172,26 +189,44 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
     uint32_t thr[16][16];
     double qsum = 0.0;
     int any = 0;
+    const int B = 1 << sh;
     for (int j = 0; j < nb; j++)
         for (int i = 0; i < nb; i++) {
             const float *c3 = eh + nb * j + i;
             const float a = c3[0] < c3[nb] ? c3[0] : c3[nb];
             const float c = f->px_per_dpt * (a < c3[2 * nb] ? a : c3[2 * nb]);
-            const float q = c > c_keep ? fv_dofsamp_keep(f, p, c) : 1.0f;
+            const int bw = tw - (i << sh), bh = th - (j << sh);
+            const int cw = bw < 0 ? 0 : bw < B ? bw : B, ch = bh < 0 ? 0 : bh < B ? bh : B;
+            float q = 1.0f;
+            if (cw > 0 && ch > 0) {
+                /* the block's lowest p: its pixels nearer the gaze keep at least d */
+                const float p = p_lo == p_hi ? p_lo
+                                             : rect_p(f, x0 + (i << sh), y0 + (j << sh), x0 + (i << sh) + cw,
+                                                      y0 + (j << sh) + ch, 0);
+                q = fv_dofsamp_keep(f, p, c);
+            }
             /* q = 1: every bit survives (UINT32_MAX marks it, the test below never drops it) */
             thr[j][i] = q < 1.0f ? (uint32_t)((double)q * 4294967296.0) : UINT32_MAX;
             any |= q < 1.0f;
-            const int bx = tw - (i << sh), by = th - (j << sh), B = 1 << sh;
-            qsum += (double)q * (bx < 0 ? 0 : bx < B ? bx : B) * (by < 0 ? 0 : by < B ? by : B);
+            qsum += (double)q * cw * ch;
         }
     if (!any)
         return 1.0f;
-    /* S_out's pixels (outside the r1 disc) are ranked by their lattice value: the kept ones are
-     * a thinner copy of the same even dither (no clumps, no holes), the band of ranks moving by
-     * the golden ratio each frame so the frames together still visit every pixel */
+    /* The variate: outside r1 with Weier's pattern (S_out) the pixel's rank in S_out's lattice
+     * dither, so the kept ones are a thinner copy of the same even dither (no clumps, no holes);
+     * elsewhere (the fovea, the transition's Halton points, Liu's pattern) the R2 lattice's value
+     * at the pixel, an even dither of the pixels the pattern has. Both move by the golden ratio
+     * each frame, so the frames together still visit every pixel. */
     const fv_sampler *smp = f->smp;
+    const int sout = !smp->prm.full && smp->prm.kind == FV_SAMPLER_WEIER;
     const double r1sq = (double)smp->r1_px * smp->r1_px, inv_p = 1.0 / (double)smp->prm.p_min;
-    const double g = (double)(f->seed % 1000003u) * 0.6180339887498949; /* small: exact enough */
+    /* The shift: frame x golden ratio, but S_out's pixels by their visit: an S_out pixel is in
+     * the pattern one frame in K (phase = frame mod K), so its variate moves by the golden ratio
+     * between two of its visits (by frame it would move 5 g mod 1 = 0.09 at K 5: a pixel kept
+     * once would be kept the next few visits and then dropped for dozens of frames). */
+    const double gold = 0.6180339887498949;
+    const double g = (double)(f->seed % 1000003u) * gold; /* small: exact enough */
+    const double g_out = (double)((f->seed / (uint32_t)smp->phases) % 1000003u) * gold;
     const int kph = (f->phase % smp->phases + smp->phases) % smp->phases;
     const double koff = (double)kph / smp->phases;
     for (int y = 0; y < th; y++) {
@@ -204,15 +239,13 @@ float fv_dofsamp_tile(const fv_dofsamp_frame *f, int x0, int y0, int tw, int th,
             if (th_ == UINT32_MAX)
                 continue;
             const double dx = (double)(x0 + x - f->gx);
-            uint32_t u;
-            if (!smp->prm.full && dx * dx + dy * dy >= r1sq) {
-                double v = fv_sampler_lattice_at(x0 + x, y0 + y, koff) * inv_p + g;
-                v -= (double)(long long)v;
-                u = (uint32_t)(v * 4294967296.0);
-            } else {
-                u = fv_dofsamp_hash(x0 + x, y0 + y, f->seed);
-            }
-            if (u >= th_)
+            double v;
+            if (sout && dx * dx + dy * dy >= r1sq)
+                v = fv_sampler_lattice_at(x0 + x, y0 + y, koff) * inv_p + g_out;
+            else
+                v = fv_sampler_lattice_at(x0 + x, y0 + y, 0.0) + g;
+            v -= (double)(long long)v;
+            if ((uint32_t)(v * 4294967296.0) >= th_)
                 out &= ~(1u << x);
         }
         rows[y] = out;

@@ -5,12 +5,16 @@
  * Per tile, after the acuity sampler has set its bits and before the rays are cast, every set
  * bit survives with a keep-probability q, so a pixel the DoF filter will blur over a CoC of
  * c pixels is sampled at density
- *     d(c) = min(p, max(d_floor, (kappa / min(c, c_cap))^2)),   q = d / p,
- * p the acuity model's probability (fv_sampler_probability): kappa samples across the CoC's
- * diameter (one sample per (c / kappa)^2 pixels), never fewer than the filter's largest CoC
- * c_cap needs (d_floor = (kappa / c_cap)^2), never more than the acuity sampler gives. Pixels in
- * focus (c <= kappa sqrt(p)) keep every acuity sample: the fovea's in-focus region stays fully
- * sampled.
+ *     d(c) = min(p, max(d(c_cap), 1 / ((min(c, c_cap) / kappa)^2 + 1/3))),   q = d / p,
+ * p the acuity model's probability (fv_sampler_probability) at the 4x4 block's pixel farthest
+ * from the gaze (the block's lowest p). With kappa = 2 (default), 1 / d is the texel area 4^L
+ * of the pyramid level L the layered filter reads at that CoC (core/dof/weier.c matches the
+ * level's variance (3 4^L - 1) / 12 to the disc's c^2 / 16, so 4^L = c^2 / 4 + 1/3; sigma =
+ * c / 4 in the fovea's Gaussian is that level's blur too): one sample per texel the filter
+ * reads, never fewer than the filter's largest CoC c_cap needs, never more than the acuity
+ * sampler gives. CoCs up to kappa sqrt(1/p - 1/3) (d(c) >= p) keep every acuity sample: the
+ * in-focus part of the fovea (c <= 1.63 px at kappa 2) stays fully sampled, its blurred part and
+ * the transition ring are thinned like the periphery (c > 4.3 px there at p_min 0.2).
  *
  * The expected CoC comes before the frame is traced: the previous frame's reconstructed depth
  * (the reprojection history, level FV_DOFSAMP_LEVEL, mapped to this view through the tile's flow
@@ -23,11 +27,12 @@
  * the in-focus side dense.
  *
  * The roulette (eq. (11): keep when eps < q) draws eps per pixel and frame, the same bytes for
- * any thread count, a different subset every frame (the history accumulates them): in the
- * periphery (S_out, outside r1) eps is the pixel's rank in S_out's lattice dither
- * (fv_sampler_lattice / p_min) shifted by the frame times the golden ratio, so the kept samples
- * are the same even dither at density p q; inside r1 (Halton points, the fovea) a hash of pixel
- * and frame. Kept samples keep weight 1: pull-push normalises its weights and the
+ * any thread count, a different subset every frame (the history accumulates them), always an
+ * even dither (no clumps, no holes): in Weier's periphery (S_out, outside r1) eps is the
+ * pixel's rank in S_out's lattice dither (fv_sampler_lattice / p_min), elsewhere (the fovea, the
+ * transition's Halton points, Liu's pattern) the R2 lattice's value at the pixel; both shifted
+ * by the frame times the golden ratio. Kept samples keep weight 1: pull-push normalises its
+ * weights (so the kept set's expected weight per acuity sample, q / q, is unbiased) and the
  * reprojection's blend recognises samples by weight 1; each tile reports its mean keep
  * probability instead, for the reprojection's history density. Pure: no OS calls. */
 #ifndef FOVEA_SAMPLING_DOF_H
@@ -44,8 +49,8 @@
 
 typedef struct fv_dofsamp_params {
     int enabled;     /* --dof-sampling on|off: default 1 (acts only with DoF on and a history) */
-    float kappa;     /* samples across the CoC's diameter, default 4: a sample every c / 4 = sigma of
-                      * the filter's Gaussian (2 left thin high-contrast edges visibly ragged) */
+    float kappa;     /* the density's CoC scale, default 2: one sample per texel of the pyramid level
+                      * the filter reads (1 / d = (c / kappa)^2 + 1/3); larger: denser */
     float coc_cap_px; /* the largest CoC the filter applies (Weier: far sigma 8 px = c / 4), 32 */
 } fv_dofsamp_params;
 
@@ -75,13 +80,11 @@ void fv_dofsamp_frame_setup(fv_dofsamp_frame *f, const fv_dofsamp_params *prm, c
 
 /* The expected CoC diameter in pixels at view depth depth_m (>= 0: the magnitude). */
 float fv_dofsamp_coc_px(const fv_dofsamp_frame *f, float depth_m);
-/* The sampling density the DoF needs at CoC c_px: max(d_floor, (kappa / min(c, c_cap))^2),
- * at most 1. */
+/* The sampling density the DoF needs at CoC c_px: 1 / ((min(c, c_cap) / kappa)^2 + 1/3), at
+ * most 1. */
 float fv_dofsamp_density(const fv_dofsamp_frame *f, float c_px);
 /* The keep-probability of an acuity sample of probability p at CoC c_px: min(1, density / p). */
 float fv_dofsamp_keep(const fv_dofsamp_frame *f, float p, float c_px);
-/* The roulette's variate for pixel (x, y) in frame `seed`, uniform in [0, 2^32). */
-uint32_t fv_dofsamp_hash(int x, int y, uint32_t seed);
 
 /* The defocus map: computed once per frame from the history (sequential reads; the tiles then
  * read 6 x 6 of it from cache instead of missing on the history six times each).

@@ -85,8 +85,9 @@ enum {
     "  --chroma on|off    liu: longitudinal chromatic aberration (default off)\n" \
     "  --dof-sampling on|off   fewer rays where the depth of field blurs (density falls\n" \
     "                     with the CoC's area; needs --dof and reprojection; default on)\n" \
-    "  --dof-sampling-kappa K  samples across a CoC's diameter it keeps (default 4;\n" \
-    "                     density (K / CoC_px)^2 where below the acuity model's)\n"
+    "  --dof-sampling-kappa K  the density's CoC scale (default 2: one ray per texel\n" \
+    "                     of the pyramid level the filter reads; density\n" \
+    "                     1 / ((CoC_px / K)^2 + 1/3) where below the acuity model's)\n"
 int fv_common_option(const char *prog, int opt, const char *arg, fv_pipeline_config *cfg);
 /* --lens FILE (replay, bench, headset): loads the HMD lens profile into *lens (which must outlive
  * the pipeline) and points cfg->cam.lens at it; the lens also places each eye's optical axis (an

@@ -1,7 +1,9 @@
 /* Depth-of-field-driven sampling (core/sampling_dof.h): the expected CoC against Weier's eq. (3)
- * (coc.c, computed through image distances), the kept density against the equation
- * d(c) = min(p, max(d_floor, (kappa / min(c, c_cap))^2)), the roulette's weights 1/q unbiased,
- * the in-focus region untouched, a constant image reconstructed exactly from the thinned
+ * (coc.c, computed through image distances), the default density against the texel area of
+ * the pyramid level the layered filter reads, the kept density against the equation
+ * d(c) = min(p, 1 / ((min(c, c_cap) / kappa)^2 + 1/3)) with p per 4x4 block (the transition
+ * ring), the roulette's weights 1/q unbiased, the in-focus region untouched, the fovea and the
+ * periphery thinned as even dithers, a constant image reconstructed exactly from the thinned
  * samples, and in the pipeline: fewer rays, the reported bits are the traced ones, and the same
  * bytes for 1, 2 and 5 threads. */
 #include <math.h>
@@ -31,7 +33,7 @@ static const float band_m[W / 16] = {1.0f, 0.5f, 2.0f, 0.25f, 1.1f, 3.0f, 0.7f, 
                                      0.9f, 0.4f, 5.0f, 0.12f, 1.0f, 1.5f, 0.6f, 10.0f};
 
 /* The test's own reading of the model: CoC = k_m focal_px scale * dioptres outside
- * [1 / (F + t), 1 / (F - t)]; density (kappa / min(c, cap))^2 clamped to [floor, 1]. */
+ * [1 / (F + t), 1 / (F - t)]; density 1 / ((min(c, cap) / kappa)^2 + 1/3), at most 1. */
 static double expect_coc(double depth_m)
 {
     const double D = 1.0 / depth_m, lo = 1.0 / (FOCUS_M + TOL_M), hi = 1.0 / (FOCUS_M - TOL_M);
@@ -39,8 +41,8 @@ static double expect_coc(double depth_m)
 }
 static double expect_density(double c)
 {
-    const double cc = c < CAP ? c : CAP, d = (KAPPA / cc) * (KAPPA / cc);
-    return d < 1.0 ? d : 1.0;
+    const double cc = (c < CAP ? c : CAP) / KAPPA, a = cc * cc + 1.0 / 3.0;
+    return a > 1.0 ? 1.0 / a : 1.0;
 }
 
 typedef struct {
@@ -160,6 +162,37 @@ static void test_coc_is_weier(void **st)
     assert_float_equal(fv_dofsamp_coc_px(&f, 10.0f), 10.0f * (1.0f / 2.2f - 0.1f), 1e-4f);
 }
 
+/* The default density is one sample per texel of the pyramid level the layered filter reads at
+ * the CoC: core/dof/weier.c matches the level's variance (3 4^L - 1) / 12 (a level L up-sampled,
+ * docs/dof.md) to the disc's c^2 / 16, so at c_L = sqrt(16 (3 4^L - 1) / 12) it reads level L
+ * alone, whose texels hold 4^L pixels; below level 0's CoC every sample is kept; beyond the cap
+ * (the filter's largest blur) the density stays at the cap's. */
+static void test_density_is_filter_texel(void **st)
+{
+    (void)st;
+    fv_dofsamp_params prm;
+    fv_dofsamp_params_default(&prm);
+    fv_dofsamp_frame f;
+    fv_dofsamp_frame_setup(&f, &prm, NULL, NULL, 0, 0, 1.0f, 1.0f, 0.2f, 10.0f, 0, 0);
+    for (int L = 1; L <= 5; L++) {
+        const double cl = sqrt(16.0 * (3.0 * (double)(1 << (2 * L)) - 1.0) / 12.0);
+        if (cl > prm.coc_cap_px)
+            break;
+        assert_float_equal(fv_dofsamp_density(&f, (float)cl), 1.0 / (double)(1 << (2 * L)), 1e-6);
+    }
+    const double c0 = sqrt(16.0 * 2.0 / 12.0); /* (3 - 1) / 12: level 0's variance, 1.63 px */
+    assert_float_equal(fv_dofsamp_density(&f, 0.0f), 1.0f, 0.0f);
+    assert_float_equal(fv_dofsamp_density(&f, (float)c0 - 1e-3f), 1.0f, 0.0f);
+    assert_true(fv_dofsamp_density(&f, (float)c0 + 1e-2f) < 1.0f);
+    for (float c = 1.75f; c < 40.0f; c += 0.25f) /* falls with the CoC's area, then stays */
+        assert_true(c < prm.coc_cap_px ? fv_dofsamp_density(&f, c + 0.25f) < fv_dofsamp_density(&f, c)
+                                       : fv_dofsamp_density(&f, c + 0.25f) == fv_dofsamp_density(&f, c));
+    /* the periphery (p 0.2) is thinned from 4.32 px on, the fovea from 1.63 px */
+    assert_float_equal(fv_dofsamp_keep(&f, 0.2f, 4.3f), 1.0f, 0.0f);
+    assert_true(fv_dofsamp_keep(&f, 0.2f, 4.4f) < 1.0f);
+    assert_float_equal(fv_dofsamp_keep(&f, 0.2f, 8.0f), 1.0 / ((16.0 + 1.0 / 3.0) * 0.2), 1e-6);
+}
+
 /* Measured kept density per depth band against d(c) / p, within 4.5 binomial sigmas, over 48
  * frames of the roulette; and the tiles' reported mean keep-probability against the same. */
 static void density_case(int full)
@@ -245,7 +278,7 @@ static void roulette_case(int full)
 static void test_roulette_unbiased(void **st)
 {
     (void)st;
-    roulette_case(1); /* hashed */
+    roulette_case(1); /* the R2 lattice */
     roulette_case(0); /* the periphery's lattice ranks */
 }
 
@@ -337,6 +370,190 @@ static void test_periphery_thinned_evenly(void **st)
             printf("frame %u: %d empty %dx%d windows at density %.4f\n", fr, empty, win, win, d);
         assert_int_equal(empty, 0);
     }
+    fixture_free(&fx);
+}
+
+/* Fills the history's levels 1-4 with one depth. */
+static void history_depth(fixture *fx, float depth_m)
+{
+    for (int l = 1; l <= 4; l++) {
+        const fv_pyr_level *L = &fx->hist.lv[l];
+        for (int y = -1; y <= L->h; y++)
+            for (int x = -1; x <= L->w; x++)
+                L->rgbd[4 * (y * L->stride + x) + 3] = depth_m;
+    }
+}
+
+/* The transition ring: every 4x4 block keeps its acuity samples with q = d / p, p the acuity
+ * probability at the block's corner farthest from the gaze (not the tile's: a tile straddling
+ * the ring has blocks much nearer the gaze). Over 48 frames: the kept count against sum(q) within
+ * 4.5 binomial sigmas, the roulette's weights sum(keep / q) / N = 1, and the tiles' reported keep
+ * share against the mean of q over their pixels. */
+static void test_transition_per_block(void **st)
+{
+    (void)st;
+    fixture fx;
+    fixture_init(&fx, 0);
+    history_depth(&fx, 0.5f); /* c = 15 px */
+    const double d = expect_density(expect_coc(0.5));
+    const int gx = W / 2, gy = H / 2;
+    assert_true(fx.smp.r1_px < 60.0f); /* the ring lies well inside the image */
+    double kept = 0.0, expect = 0.0, var = 0.0, wsum = 0.0, n = 0.0, qtile = 0.0, qtile_e = 0.0;
+    for (uint32_t fr = 0; fr < 48; fr++) {
+        fv_dofsamp_frame f;
+        fv_dofsamp_frame_setup(&f, &fx.prm, &fx.tf, &fx.smp, gx, gy, FOCUS_M, FOCUS_M, TOL_M, PX_PER_DPT, fr, 0);
+        fv_dofsamp_map_attach(&f, fx.map);
+        fv_dofsamp_map_rows(&f, 0, f.map_h);
+        for (int ty = 0; ty < H / 16; ty++)
+            for (int tx = 0; tx < W / 16; tx++) {
+                uint32_t rows[16], acu[16];
+                for (int y = 0; y < 16; y++)
+                    rows[y] = acu[y] = (uint32_t)fv_sampler_row(&fx.smp, tx * 16, ty * 16 + y, 16, gx, gy, 0);
+                const float qt = fv_dofsamp_tile(&f, tx * 16, ty * 16, 16, 16, rows);
+                double qpx = 0.0;
+                int ring = 0;
+                for (int by = 0; by < 16; by += B)
+                    for (int bx = 0; bx < 16; bx += B) {
+                        const float ax = (float)(tx * 16 + bx - gx), bx1 = ax + (float)B;
+                        const float ay = (float)(ty * 16 + by - gy), by1 = ay + (float)B;
+                        const float p = fv_sampler_probability(&fx.smp, fabsf(ax) > fabsf(bx1) ? ax : bx1,
+                                                               fabsf(ay) > fabsf(by1) ? ay : by1);
+                        const double q = d < p ? d / p : 1.0;
+                        qpx += q * B * B;
+                        ring |= p > fx.smp.prm.p_min && p < 1.0f;
+                        for (int y = by; y < by + B; y++)
+                            for (int x = bx; x < bx + B; x++) {
+                                if (!(acu[y] >> x & 1u))
+                                    continue;
+                                const int k = rows[y] >> x & 1u;
+                                kept += k;
+                                expect += q;
+                                var += q * (1.0 - q);
+                                wsum += k / q;
+                                n += 1.0;
+                            }
+                    }
+                if (ring) {
+                    qtile += qt;
+                    qtile_e += qpx / 256.0;
+                }
+                for (int y = 0; y < 16; y++)
+                    assert_int_equal(rows[y] & ~acu[y], 0u);
+            }
+    }
+    printf("kept %.0f of %.0f acuity samples, expected %.1f\n", kept, n, expect);
+    assert_true(n > 10000.0);
+    assert_true(fabs(kept - expect) < 4.5 * sqrt(var) + 1.0);
+    assert_true(fabs(wsum / n - 1.0) < 0.02);
+    assert_float_equal(qtile, qtile_e, 1e-5 * qtile_e);
+    fixture_free(&fx);
+}
+
+/* The fovea (every pixel an acuity sample) is thinned as an even dither too: at density d no
+ * window of side ceil(2 / sqrt(d)) is empty (white-noise thinning leaves ~e^-4.5 of them empty,
+ * hundreds here), and the kept share is d. */
+static void test_fovea_thinned_evenly(void **st)
+{
+    (void)st;
+    fixture fx;
+    fixture_init(&fx, 1);
+    history_depth(&fx, 0.5f);
+    const double d = expect_density(expect_coc(0.5));
+    const int win = (int)ceil(2.0 / sqrt(d));
+    for (uint32_t fr = 0; fr < 3; fr++) {
+        fv_dofsamp_frame f;
+        setup_frame(&fx, &f, fr);
+        static uint32_t mask[H][W / 16];
+        long kept = 0;
+        for (int ty = 0; ty < H / 16; ty++)
+            for (int tx = 0; tx < W / 16; tx++) {
+                uint32_t rows[16];
+                for (int y = 0; y < 16; y++)
+                    rows[y] = 0xffffu;
+                fv_dofsamp_tile(&f, tx * 16, ty * 16, 16, 16, rows);
+                for (int y = 0; y < 16; y++) {
+                    mask[ty * 16 + y][tx] = rows[y];
+                    kept += __builtin_popcount(rows[y]);
+                }
+            }
+        assert_float_equal((double)kept / (W * H), d, 0.1 * d);
+        int empty = 0;
+        for (int y = 0; y + win <= H; y++)
+            for (int x = 0; x + win <= W; x++) {
+                int any = 0;
+                for (int j = 0; j < win && !any; j++)
+                    for (int i = 0; i < win && !any; i++)
+                        any = mask[y + j][(x + i) / 16] >> ((x + i) % 16) & 1u;
+                empty += !any;
+            }
+        if (empty)
+            printf("frame %u: %d empty %dx%d windows at density %.4f\n", fr, empty, win, win, d);
+        assert_int_equal(empty, 0);
+    }
+    fixture_free(&fx);
+}
+
+/* Over time in the periphery: an S_out pixel is in the pattern one frame in K (phase = frame mod
+ * K); at q ~ 0.3 each pixel is re-traced within 6 of its visits (the golden-ratio shift per
+ * visit; shifted per frame, the variate moved 5 g mod 1 = 0.09 between visits: runs of 9 visits
+ * without a ray), and every pixel is traced. */
+static void test_periphery_revisits(void **st)
+{
+    (void)st;
+    fixture fx;
+    fixture_init(&fx, 0);
+    const float depth_m = 2.33f; /* c 8.1 px: d 0.06, q 0.3 at p_min 0.2 */
+    history_depth(&fx, depth_m);
+    const double q = expect_density(expect_coc(depth_m)) / fx.smp.prm.p_min;
+    assert_true(q > 0.25 && q < 0.35);
+    fv_sampler_free(&fx.smp); /* the rotating pattern, as with reprojection */
+    fv_sampling_params sp;
+    fv_sampling_params_default(&sp);
+    sp.rotate = 1;
+    assert_int_equal(fv_sampler_init(&fx.smp, W, H, fx.cam.focal_px, &sp), 0);
+    const int K = fx.smp.phases;
+    assert_int_equal(K, 5);
+    enum { N = 64, X0 = 64, Y0 = 64 };
+    static int last[N][N], visits[N][N], kept_n[N][N];
+    int maxgap = 0;
+    for (int y = 0; y < N; y++)
+        for (int x = 0; x < N; x++)
+            last[y][x] = -1, visits[y][x] = 0, kept_n[y][x] = 0;
+    for (uint32_t fr = 0; fr < 40u * (uint32_t)K; fr++) {
+        const int ph = (int)(fr % (uint32_t)K);
+        fv_dofsamp_frame f;
+        fv_dofsamp_frame_setup(&f, &fx.prm, &fx.tf, &fx.smp, far_gx, far_gy, FOCUS_M, FOCUS_M, TOL_M, PX_PER_DPT, fr,
+                               ph);
+        fv_dofsamp_map_attach(&f, fx.map);
+        fv_dofsamp_map_rows(&f, 0, f.map_h);
+        for (int ty = Y0 / 16; ty < (Y0 + N) / 16; ty++)
+            for (int tx = X0 / 16; tx < (X0 + N) / 16; tx++) {
+                uint32_t rows[16], acu[16];
+                for (int y = 0; y < 16; y++)
+                    rows[y] = acu[y] = (uint32_t)fv_sampler_row(&fx.smp, tx * 16, ty * 16 + y, 16, far_gx, far_gy, ph);
+                fv_dofsamp_tile(&f, tx * 16, ty * 16, 16, 16, rows);
+                for (int y = 0; y < 16; y++)
+                    for (int x = 0; x < 16; x++) {
+                        if (!(acu[y] >> x & 1u))
+                            continue;
+                        const int py = ty * 16 + y - Y0, px = tx * 16 + x - X0;
+                        const int v = visits[py][px]++;
+                        if (rows[y] >> x & 1u) {
+                            if (last[py][px] >= 0 && v - last[py][px] > maxgap)
+                                maxgap = v - last[py][px];
+                            last[py][px] = v;
+                            kept_n[py][px]++;
+                        }
+                    }
+            }
+    }
+    for (int y = 0; y < N; y++)
+        for (int x = 0; x < N; x++) {
+            assert_int_equal(visits[y][x], 40); /* the K phases tile every pixel */
+            assert_true(kept_n[y][x] > 0);
+        }
+    printf("q %.3f: longest run between two rays of a pixel %d visits\n", q, maxgap);
+    assert_true(maxgap <= 6);
     fixture_free(&fx);
 }
 
@@ -473,7 +690,7 @@ static void test_pipeline_fewer_rays(void **st)
     fv_scene_free(s);
 }
 
-/* The roulette hashes pixel and frame: the image (after DoF) and the pyramid are the same bytes
+/* The roulette is a function of pixel and frame: the image (after DoF) and the pyramid are the same bytes
  * for 1, 2 and 5 threads, frame after frame, with the head moving (the tile flow). */
 static void test_pipeline_thread_determinism(void **st)
 {
@@ -518,11 +735,15 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_coc_is_weier),
+        cmocka_unit_test(test_density_is_filter_texel),
         cmocka_unit_test(test_density_full),
         cmocka_unit_test(test_density_periphery),
         cmocka_unit_test(test_roulette_unbiased),
         cmocka_unit_test(test_in_focus_untouched),
         cmocka_unit_test(test_periphery_thinned_evenly),
+        cmocka_unit_test(test_transition_per_block),
+        cmocka_unit_test(test_fovea_thinned_evenly),
+        cmocka_unit_test(test_periphery_revisits),
         cmocka_unit_test(test_constant_image_reconstruction),
         cmocka_unit_test(test_pipeline_fewer_rays),
         cmocka_unit_test(test_pipeline_thread_determinism),
