@@ -188,10 +188,12 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
      * material for every lane, broadcast to all 16 (material_at's values, computed once), and
      * each lane only needs its corner normals. */
     unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0;
-    for (int q = 0; q < n && g0 == RTC_INVALID_GEOMETRY_ID; q++)
-        g0 = geom[q];
-    for (int q = 0; q < n; q++) /* branch-free: vectorised */
-        mixed |= (geom[q] != RTC_INVALID_GEOMETRY_ID) & (geom[q] != g0);
+    for (int q = 0; q < n; q++) {
+        const unsigned g = geom[q];
+        if (g == RTC_INVALID_GEOMETRY_ID) continue;
+        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
+        g0 = g;
+    }
     const fv_mesh_rec *um = !mixed && g0 < s->mesh_count ? &s->meshes[g0] : NULL;
     if (um && (um->tex_ref >= 0 || um->col)) um = NULL;
     if (um && (pk_scene != s->serial || pk_geom != g0)) {
