@@ -263,6 +263,12 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
                 fv_tex_taps_prefetch(&taps[j][q]);
             }
             textured |= 1u << q;
+            if (slot_texture(m, 1 + FV_MAP_NRM) >= 0 && pk.u != own.u) {
+                /* a normal-mapped lane gets u = v = 0 below: copy a full packet's u, v now, so
+                 * the stores are done long before the kernel's vector loads read them */
+                memcpy(own.u, h->u, sizeof own.u), memcpy(own.v, h->v, sizeof own.v);
+                pk.u = own.u, pk.v = own.v;
+            }
         } else {
             /* without vertex colours the material is the mesh's: computed once per run of lanes
              * on one mesh */
