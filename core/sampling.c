@@ -234,3 +234,21 @@ uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int g
     uint64_t in = get_bits(inrow, s->in_stride, lo - gx + s->rin, len) << (lo - x0);
     return (out & ~span) | (in & span);
 }
+
+void fv_sampler_rows(const fv_sampler *s, int x0, int y0, int n, int count, int gx, int gy, int phase, uint32_t *rows)
+{
+    /* a tile beyond the r1 disc's bounding box (most tiles): S_out's bits alone, the phase taken
+     * once (a row's own call divides twice for it and tests the disc) */
+    if (!s->prm.full && s->prm.kind != FV_SAMPLER_LIU) {
+        const int r1c = (int)floor((double)s->r1_px) + 1; /* > every half-span h of a row */
+        if (y0 + count - 1 < gy - s->rin || y0 > gy + s->rin || x0 + n - 1 < gx - r1c || x0 > gx + r1c) {
+            const int k = (phase % s->phases + s->phases) % s->phases;
+            const uint64_t *row = s->s_out + ((size_t)k * s->height + y0) * s->out_stride;
+            for (int y = 0; y < count; y++, row += s->out_stride)
+                rows[y] = (uint32_t)get_bits(row, s->out_stride, x0, n);
+            return;
+        }
+    }
+    for (int y = 0; y < count; y++)
+        rows[y] = (uint32_t)fv_sampler_row(s, x0, y0 + y, n, gx, gy, phase);
+}

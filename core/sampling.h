@@ -81,6 +81,9 @@ float fv_sampling_transition_density(const fv_sampling_params *p, float r_deg);
  * `phase` (taken modulo s->phases; 0 for a static pattern). Liu: a gaze outside the image is
  * clamped to its nearest pixel (the table reaches every pixel from any pixel). */
 uint64_t fv_sampler_row(const fv_sampler *s, int x0, int y, int n, int gx, int gy, int phase);
+/* fv_sampler_row of rows y0 .. y0+count-1 into rows[0 .. count), n <= 32 (a tile's rows; the
+ * same bits, with the per-row work done once where the tile is outside the r1 disc). */
+void fv_sampler_rows(const fv_sampler *s, int x0, int y0, int n, int count, int gx, int gy, int phase, uint32_t *rows);
 
 /* S_out's lattice value at pixel (x, y) in pattern phase `phase`, frac(a1 x + a2 y + k / K) in
  * [0, 1): the pixel is in S_out when it is below p_min. S_out's pixels whose value is below

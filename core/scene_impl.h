@@ -90,6 +90,7 @@ struct fv_scene {
     float light_exposure; /* multiplies every KHR light contribution, see update_exposure (scene.c) */
     int has_view;
     float view_pos[3], view_quat[4];
+    unsigned long serial; /* unique per scene in the process (never 0): keys per-thread caches (shade.c) */
     pthread_mutex_t rtc_err_lock; /* Embree may report from its own threads */
     char rtc_err[192];
     char warning[256]; /* the loader's one line for the user ("" when none) */

@@ -132,15 +132,21 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
 
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
 {
-    for (int q = 0; q < n; q++)
-        if (geom[q] < s->mesh_count && prim[q] < s->meshes[geom[q]].tri_count) {
-            const fv_mesh_rec *m = &s->meshes[geom[q]];
-            __builtin_prefetch(&m->attr[prim[q]]);
-            if (m->face)
-                __builtin_prefetch(&m->face[prim[q]]);
-            if (m->tan) /* a normal map's corner tangents (48 bytes) */
-                __builtin_prefetch(&m->tan[12 * (size_t)prim[q]]), __builtin_prefetch(&m->tan[12 * (size_t)prim[q] + 11]);
-        }
+    /* the mesh looked up once per run of lanes on it (a packet mostly hits one or two) */
+    const fv_mesh_rec *m = NULL;
+    unsigned mg = RTC_INVALID_GEOMETRY_ID;
+    for (int q = 0; q < n; q++) {
+        const unsigned g = geom[q], p = prim[q];
+        if (g >= s->mesh_count) continue; /* a miss */
+        if (g != mg)
+            m = &s->meshes[g], mg = g;
+        if (p >= m->tri_count) continue;
+        __builtin_prefetch(&m->attr[p]);
+        if (m->face)
+            __builtin_prefetch(&m->face[p]);
+        if (m->tan) /* a normal map's corner tangents (48 bytes) */
+            __builtin_prefetch(&m->tan[12 * (size_t)p]), __builtin_prefetch(&m->tan[12 * (size_t)p + 11]);
+    }
 }
 
 void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_hit_packet *h, int n,
@@ -149,20 +155,34 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     /* Per thread, zero at start: lanes of misses keep whatever an earlier packet left there
      * (finite, initialised: their results are not used), so a miss costs no stores. */
     static _Thread_local _Alignas(64) fv_shade_packet pk;
+    /* the geometry of short packets and of normal-mapped lanes (a full packet's is read in place) */
+    static _Thread_local _Alignas(64) fv_shade_lanes own;
+    /* the corner normals of lanes without a hit (their results are not used): finite, not degenerate */
+    static const float nrm_none[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+    /* pk's material rows (base, emit, metal, a2, spec, occl) hold mesh pk_geom of scene pk_scene in
+     * every lane (0: not known): a one-mesh packet on the same mesh as the last one skips the
+     * broadcast (208 stores; consecutive packets of a tile mostly hit the same mesh) */
+    static _Thread_local unsigned long pk_scene;
+    static _Thread_local unsigned pk_geom;
     fv_tex_taps taps[FV_SLOTS][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
-    /* the lanes' ray data straight across (a miss lane's values are finite and unused); whole
-     * 64-byte rows for a full packet. Locals: the stores to pk would make the compiler reload h. */
+    /* the lanes' ray data: a full packet's read in place by the kernel, a short one's copied (the
+     * lanes past n keep an earlier packet's values: finite, unused). Locals: the stores to pk
+     * would make the compiler reload h. */
     const unsigned *geom = h->geom, *primv = h->prim;
     if (n == FV_SHADE_LANES) {
-        memcpy(pk.u, h->u, sizeof pk.u), memcpy(pk.v, h->v, sizeof pk.v), memcpy(pk.t, h->t, sizeof pk.t);
-        for (int k = 0; k < 3; k++) memcpy(pk.dir[k], h->dir[k], sizeof pk.dir[k]);
+        pk.u = h->u, pk.v = h->v, pk.t = h->t;
+        for (int k = 0; k < 3; k++) pk.dir[k] = h->dir[k];
     } else {
         const float *hu = h->u, *hv = h->v, *ht = h->t, *d0 = h->dir[0], *d1 = h->dir[1], *d2 = h->dir[2];
         for (int q = 0; q < n; q++) {
-            pk.u[q] = hu[q], pk.v[q] = hv[q], pk.t[q] = ht[q];
-            pk.dir[0][q] = d0[q], pk.dir[1][q] = d1[q], pk.dir[2][q] = d2[q];
+            own.u[q] = hu[q], own.v[q] = hv[q], own.t[q] = ht[q];
+            own.dir[0][q] = d0[q], own.dir[1][q] = d1[q], own.dir[2][q] = d2[q];
         }
+        pk.u = own.u, pk.v = own.v, pk.t = own.t;
+        for (int k = 0; k < 3; k++) pk.dir[k] = own.dir[k];
+        for (int q = n; q < FV_SHADE_LANES; q++)
+            pk.nrm_at[q] = nrm_none;
     }
     /* A packet usually hits one mesh: an untextured mesh without vertex colours then has one
      * material for every lane, broadcast to all 16 (material_at's values, computed once), and
@@ -176,7 +196,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     }
     const fv_mesh_rec *um = !mixed && g0 < s->mesh_count ? &s->meshes[g0] : NULL;
     if (um && (um->tex_ref >= 0 || um->col)) um = NULL;
-    if (um) {
+    if (um && (pk_scene != s->serial || pk_geom != g0)) {
         fv_brdf_mat mat;
         float occ, emit[3];
         material_at(um, 0, 0.0f, 0.0f, 1.0f, NULL, NULL, NULL, NULL, &mat, &occ, emit);
@@ -184,10 +204,16 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             for (int k = 0; k < 3; k++) pk.base[k][q] = mat.base[k], pk.emit[k][q] = emit[k];
             pk.metal[q] = mat.metallic, pk.a2[q] = mat.a2, pk.spec[q] = mat.specular, pk.occl[q] = occ;
         }
+        pk_scene = s->serial, pk_geom = g0;
+    } else if (!um) { /* the lanes' own materials follow */
+        pk_scene = 0;
+    }
+    if (um) {
         const fv_tri_attr *attr = um->attr;
         const size_t tris = um->tri_count;
         for (int q = 0; q < n; q++) {
             const unsigned prim = primv[q];
+            pk.nrm_at[q] = nrm_none;
             if (geom[q] == RTC_INVALID_GEOMETRY_ID)
                 continue;
             if (prim >= tris) { /* no such triangle: black */
@@ -195,10 +221,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
                 continue;
             }
             hits |= 1u << q;
-            const float *a = attr[prim].n;
-            pk.nrm[0][q] = a[0], pk.nrm[1][q] = a[1], pk.nrm[2][q] = a[2];
-            pk.nrm[3][q] = a[3], pk.nrm[4][q] = a[4], pk.nrm[5][q] = a[5];
-            pk.nrm[6][q] = a[6], pk.nrm[7][q] = a[7], pk.nrm[8][q] = a[8];
+            pk.nrm_at[q] = attr[prim].n; /* read by the kernel (NRM9) */
         }
     }
     const fv_mesh_rec *plain_m = NULL; /* the mesh whose material plain holds */
@@ -207,6 +230,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     for (int q = 0; q < n && !um; q++) {
         const unsigned g = geom[q], prim = primv[q];
         const fv_mesh_rec *m = g < s->mesh_count ? &s->meshes[g] : NULL;
+        pk.nrm_at[q] = nrm_none;
         if (!m || prim >= m->tri_count) { /* a miss, or no such triangle (black) */
             if (g != RTC_INVALID_GEOMETRY_ID)
                 black |= 1u << q;
@@ -214,8 +238,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         }
         hits |= 1u << q;
         const fv_tri_attr *at = &m->attr[prim];
-        for (int k = 0; k < 9; k++)
-            pk.nrm[k][q] = at->n[k];
+        pk.nrm_at[q] = at->n;
         const float u = h->u[q], v = h->v[q], t = h->t[q];
         if (m->tex_ref >= 0) { /* the texel fetches of all lanes are asked for before any is used */
             const float dir[3] = {h->dir[0][q], h->dir[1][q], h->dir[2][q]};
@@ -240,6 +263,12 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
                 fv_tex_taps_prefetch(&taps[j][q]);
             }
             textured |= 1u << q;
+            if (slot_texture(m, 1 + FV_MAP_NRM) >= 0 && pk.u != own.u) {
+                /* a normal-mapped lane gets u = v = 0 below: copy a full packet's u, v now, so
+                 * the stores are done long before the kernel's vector loads read them */
+                memcpy(own.u, h->u, sizeof own.u), memcpy(own.v, h->v, sizeof own.v);
+                pk.u = own.u, pk.v = own.v;
+            }
         } else {
             /* without vertex colours the material is the mesh's: computed once per run of lanes
              * on one mesh */
@@ -271,8 +300,13 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         if (tx[1 + FV_MAP_NRM]) { /* normal map: the kernel gets the mapped normal as corner 0 at u = v = 0 */
             float nm[3], nn;
             fv_shade_normal_mapped(m, h->prim[q], u, v, 1.0f - u - v, tx[1 + FV_MAP_NRM], nm, &nn);
-            for (int k = 0; k < 3; k++) pk.nrm[k][q] = nm[k], pk.nrm[3 + k][q] = 0.0f, pk.nrm[6 + k][q] = 0.0f;
-            pk.u[q] = 0.0f, pk.v[q] = 0.0f;
+            for (int k = 0; k < 3; k++) own.nrm[q][k] = nm[k], own.nrm[q][3 + k] = 0.0f, own.nrm[q][6 + k] = 0.0f;
+            pk.nrm_at[q] = own.nrm[q];
+            if (pk.u != own.u) { /* a full packet's u, v were read in place */
+                memcpy(own.u, h->u, sizeof own.u), memcpy(own.v, h->v, sizeof own.v);
+                pk.u = own.u, pk.v = own.v;
+            }
+            own.u[q] = 0.0f, own.v[q] = 0.0f;
         }
     }
     if (!hits) { /* all misses: nothing to shade */

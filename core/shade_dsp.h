@@ -33,12 +33,16 @@ typedef struct fv_shade_env {
     const float *lit;
 } fv_shade_env;
 
-/* One packet's hits, lane i in element i of every array. */
+/* One packet's hits, lane i in element i of every array. The geometry is read where it lies:
+ * each lane's corner normals in its triangle's record (nrm_at), barycentrics, distances and
+ * directions in the traced packet (Embree's SoA RTCRayHit16 rows). Copying them into the packet
+ * first cost a scalar store per value, and the kernel's vector loads of those rows then waited for
+ * the stores (a load spanning several smaller stores is not forwarded): docs/raystage.md. */
 typedef struct fv_shade_packet {
-    float nrm[9][FV_SHADE_LANES];  /* the hit triangle's vertex normals: n0 x y z, n1 x y z, n2 x y z */
-    float u[FV_SHADE_LANES], v[FV_SHADE_LANES]; /* Embree's barycentrics: u weights n1, v n2 */
-    float t[FV_SHADE_LANES];       /* hit distance along dir */
-    float dir[3][FV_SHADE_LANES];  /* ray direction (unnormalised) */
+    const float *nrm_at[FV_SHADE_LANES]; /* lane i's triangle's vertex normals: n0 x y z, n1 x y z, n2 x y z */
+    const float *u, *v;            /* FV_SHADE_LANES each: Embree's barycentrics (u weights n1, v n2) */
+    const float *t;                /* hit distance along dir */
+    const float *dir[3];           /* ray direction (unnormalised) */
     float base[3][FV_SHADE_LANES]; /* base colour, texture applied */
     float metal[FV_SHADE_LANES];   /* metallic */
     float a2[FV_SHADE_LANES];      /* fv_ggx_a2(roughness) (core/brdf.h) */
@@ -46,6 +50,19 @@ typedef struct fv_shade_packet {
     float emit[3][FV_SHADE_LANES]; /* emitted radiance, linear RGB */
     float occl[FV_SHADE_LANES];    /* ambient occlusion, 1 = none */
 } fv_shade_packet;
+
+/* Storage for a packet's geometry where it is not read in place (short packets, normal-mapped
+ * lanes, tests); fv_shade_packet_lanes points p at it. */
+typedef struct fv_shade_lanes {
+    float nrm[FV_SHADE_LANES][9];
+    float u[FV_SHADE_LANES], v[FV_SHADE_LANES], t[FV_SHADE_LANES], dir[3][FV_SHADE_LANES];
+} fv_shade_lanes;
+static inline void fv_shade_packet_lanes(fv_shade_packet *p, const fv_shade_lanes *l)
+{
+    for (int i = 0; i < FV_SHADE_LANES; i++) p->nrm_at[i] = l->nrm[i];
+    p->u = l->u, p->v = l->v, p->t = l->t;
+    for (int k = 0; k < 3; k++) p->dir[k] = l->dir[k];
+}
 
 /* brdf: rgb of every one of the FV_SHADE_LANES lanes (all lanes are read and written: pad a
  * short packet with copies of a real lane). Returns the lanes whose interpolated normal is

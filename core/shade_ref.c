@@ -10,7 +10,7 @@ unsigned fv_shade_brdf_c(const fv_shade_packet *p, const fv_shade_env *env, floa
         const float u = p->u[i], v = p->v[i], w = 1.0f - u - v;
         float n[3];
         for (int k = 0; k < 3; k++)
-            n[k] = w * p->nrm[k][i] + u * p->nrm[3 + k][i] + v * p->nrm[6 + k][i];
+            n[k] = w * p->nrm_at[i][k] + u * p->nrm_at[i][3 + k] + v * p->nrm_at[i][6 + k];
         const float nn = fv_lane_dot3(n, n);
         if (!(nn > 1e-24f))
             degenerate |= 1u << i;

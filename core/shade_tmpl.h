@@ -8,6 +8,8 @@
  *   MAND(a, b)                both
  *   VSEL(m, a, b)             m ? a : b per lane
  *   MBITS(m)                  the lanes of m as the low SW bits
+ *   NRM9(at, n)               n[k] lane j = at[j][k] for k < 9, j < SW: the corner normals of SW
+ *                             lanes from their records (a transpose; at[j][0..8] readable)
  *   SHADE_FN                  the kernel's name
  * Each line does what core/shade_lane.h (fv_shade_lane, core/brdf.h) does for one lane, in the same
  * order, so the bits agree. */
@@ -94,10 +96,11 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
     for (int i = 0; i < FV_SHADE_LANES; i += SW) {
         const V u = VLD(p->u + i), v = VLD(p->v + i);
         const V w = VSUB(VSUB(one, u), v);
+        V c[9];
+        NRM9(p->nrm_at + i, c);
         V n[3];
         for (int k = 0; k < 3; k++)
-            n[k] = VADD(VADD(VMUL(w, VLD(p->nrm[k] + i)), VMUL(u, VLD(p->nrm[3 + k] + i))),
-                        VMUL(v, VLD(p->nrm[6 + k] + i)));
+            n[k] = VADD(VADD(VMUL(w, c[k]), VMUL(u, c[3 + k])), VMUL(v, c[6 + k]));
         const V nn = dot3v(n, n);
         degenerate |= (~(unsigned)MBITS(VGT(nn, VS(1e-24f))) & ((1u << SW) - 1u)) << i;
         const V d[3] = {VLD(p->dir[0] + i), VLD(p->dir[1] + i), VLD(p->dir[2] + i)};

@@ -81,7 +81,8 @@ void fv_shadow_packet(const fv_scene *s, const fv_shade_packet *pk, unsigned lan
         const int q = __builtin_ctz(r);
         const float u = pk->u[q], v = pk->v[q], w = 1.0f - u - v;
         float m[3];
-        for (int k = 0; k < 3; k++) m[k] = w * pk->nrm[k][q] + u * pk->nrm[3 + k][q] + v * pk->nrm[6 + k][q];
+        const float *nq = pk->nrm_at[q];
+        for (int k = 0; k < 3; k++) m[k] = w * nq[k] + u * nq[3 + k] + v * nq[6 + k];
         const float mm = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
         if (!(mm > 1e-24f)) continue; /* degenerate: the scalar path shades this lane */
         const float d[3] = {pk->dir[0][q], pk->dir[1][q], pk->dir[2][q]};

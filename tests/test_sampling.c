@@ -112,6 +112,42 @@ static void test_transition_density(void **st)
     }
 }
 
+/* fv_sampler_rows (a tile's rows at once, the ray stage's call) gives fv_sampler_row's bits for
+ * 16x16 tiles (and a narrower edge tile) all over the image, gazes at the centre, an edge and
+ * outside, every phase, full and foveated. */
+static void test_tile_rows_match_rows(void **st)
+{
+    (void)st;
+    for (int variant = 0; variant < 2; variant++) {
+        fv_sampling_params p;
+        fv_sampling_params_default(&p);
+        p.rotate = 1;
+        p.full = variant == 1;
+        fv_sampler s;
+        make(&s, &p);
+        static const int gaze[][2] = {{W / 2, H / 2}, {3, H - 2}, {W + 40, -30}, {W / 3, H / 4}};
+        long inside = 0;
+        for (int g = 0; g < 4; g++)
+            for (int ph = 0; ph < s.phases + 1; ph++)
+                for (int y0 = 0; y0 < H; y0 += 16)
+                    for (int x0 = 0; x0 < W; x0 += 16) {
+                        const int tw = W - x0 < 16 ? W - x0 : 16, th = H - y0 < 16 ? H - y0 : 16;
+                        uint32_t rows[16];
+                        fv_sampler_rows(&s, x0, y0, tw, th, gaze[g][0], gaze[g][1], ph, rows);
+                        for (int y = 0; y < th; y++) {
+                            const uint32_t want = (uint32_t)fv_sampler_row(&s, x0, y0 + y, tw, gaze[g][0], gaze[g][1], ph);
+                            if (rows[y] != want)
+                                fail_msg("tile %d,%d row %d gaze %d phase %d: %#x, want %#x", x0, y0, y, g, ph,
+                                         rows[y], want);
+                        }
+                        const double dx = x0 + 8 - gaze[g][0], dy = y0 + 8 - gaze[g][1];
+                        inside += dx * dx + dy * dy < (double)s.r1_px * s.r1_px;
+                    }
+        assert_true(inside > 0); /* tiles with S_in rows were among them */
+        fv_sampler_free(&s);
+    }
+}
+
 /* Rotating pattern (temporal reprojection): every phase keeps the static pattern's statistics,
  * phase 0 is the static pattern, the phases are periodic, and together they sample every
  * pixel of the periphery within K = ceil(1/p_min) frames. */
@@ -277,7 +313,7 @@ int main(void)
         cmocka_unit_test(test_eq1_inverts_cdf),        cmocka_unit_test(test_fovea_full),
         cmocka_unit_test(test_transition_density),     cmocka_unit_test(test_sout_density_and_evenness),
         cmocka_unit_test(test_row_matches_per_pixel),  cmocka_unit_test(test_full_and_ratio),
-        cmocka_unit_test(test_rotating_phases),
+        cmocka_unit_test(test_rotating_phases),        cmocka_unit_test(test_tile_rows_match_rows),
     };
     return cmocka_run_group_tests_name("sampling", tests, NULL, NULL);
 }

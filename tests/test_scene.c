@@ -5,6 +5,7 @@
 #include "testutil.h"
 
 #include "scene.h"
+#include "testscene.h"
 #include "shade_dsp.h"
 #include "blend.h"
 #include "texture_tap.h" /* the packet shading's inline taps (internal) */
@@ -885,10 +886,13 @@ static void check_packets(const fv_scene *s, uint64_t seed)
             hit h;
             if (!cast(s, p, d, &h))
                 h.geom = RTC_INVALID_GEOMETRY_ID;
+            if (it % 4 == 0 && l < 2) /* packets starting with misses */
+                h.geom = RTC_INVALID_GEOMETRY_ID;
             geom[l] = h.geom, prim[l] = h.prim, u[l] = h.u, v[l] = h.v, t[l] = h.t;
             for (int k = 0; k < 3; k++) dir[k][l] = d[k];
         }
         const fv_hit_packet hp = {geom, prim, u, v, t, {dir[0], dir[1], dir[2]}};
+        fv_scene_shade_prefetch(s, geom, prim, n); /* as the ray stage does, misses anywhere */
         for (size_t i = 0; i < sizeof isas / sizeof isas[0]; i++) {
             if (isas[i] && !(fv_cpu_isas() & isas[i]))
                 continue;
@@ -944,6 +948,17 @@ static void test_packet_shading_matches_scalar(void **state)
     s = commit_or_fail(s);
     check_packets(s, 3);
     fv_scene_free(s);
+    /* one plain mesh, geometry 0, in two scenes one after the other (the second may reuse the
+     * first's memory): packets on one such mesh take its material from a per-thread cache, which
+     * must not serve the first scene's colour to the second */
+    static const float rgb[2][3] = {{0.9f, 0.1f, 0.1f}, {0.1f, 0.8f, 0.3f}};
+    for (int c = 0; c < 2; c++) {
+        s = fv_scene_create();
+        fv_test_add_quad(s, -1, -1, 1, 1, 0, rgb[c], -1);
+        s = commit_or_fail(s);
+        check_packets(s, 4 + (uint64_t)c);
+        fv_scene_free(s);
+    }
 }
 
 /* ---- glTF materials ------------------------------------------------------------------ */

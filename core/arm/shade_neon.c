@@ -27,6 +27,22 @@ static inline int mbits(uint32x4_t m)
     return (int)vaddvq_u32(vandq_u32(m, vld1q_u32(bit)));
 }
 #define MBITS mbits
+/* the corner normals of 4 lanes from their records: 4x4 transposes of elements 0-3 and 4-7, then
+ * element 8 on its own (only 9 floats of a record are read) */
+static inline void nrm9(const float *const *at, V c[9])
+{
+    for (int j = 0; j < 8; j += 4) {
+        const float32x4x2_t p01 = vtrnq_f32(vld1q_f32(at[0] + j), vld1q_f32(at[1] + j));
+        const float32x4x2_t p23 = vtrnq_f32(vld1q_f32(at[2] + j), vld1q_f32(at[3] + j));
+        c[j] = vcombine_f32(vget_low_f32(p01.val[0]), vget_low_f32(p23.val[0]));
+        c[j + 1] = vcombine_f32(vget_low_f32(p01.val[1]), vget_low_f32(p23.val[1]));
+        c[j + 2] = vcombine_f32(vget_high_f32(p01.val[0]), vget_high_f32(p23.val[0]));
+        c[j + 3] = vcombine_f32(vget_high_f32(p01.val[1]), vget_high_f32(p23.val[1]));
+    }
+    const float e8[4] = {at[0][8], at[1][8], at[2][8], at[3][8]};
+    c[8] = vld1q_f32(e8);
+}
+#define NRM9 nrm9
 #define SHADE_FN brdf_neon
 #include "shade_tmpl.h"
 

@@ -532,6 +532,7 @@ static void tw_free(void *st)
 #define SH_SET 64 /* distinct packets, cycled */
 typedef struct {
     fv_shade_packet p[SH_SET];
+    fv_shade_lanes geo[SH_SET];
     fv_light_rec lights[2];
     float rgb[3][FV_SHADE_LANES];
 } shade_st;
@@ -544,10 +545,12 @@ static void *shade_setup(void)
     for (int i = 0; i < SH_SET; i++)
         for (int q = 0; q < FV_SHADE_LANES; q++) {
             fv_shade_packet *p = &t->p[i];
-            p->u[q] = frand(&s, 0.0f, 0.5f), p->v[q] = frand(&s, 0.0f, 0.5f), p->t[q] = frand(&s, 0.5f, 20.0f);
-            for (int k = 0; k < 9; k++) p->nrm[k][q] = frand(&s, -1.0f, 1.0f);
+            fv_shade_lanes *l = &t->geo[i];
+            fv_shade_packet_lanes(p, l);
+            l->u[q] = frand(&s, 0.0f, 0.5f), l->v[q] = frand(&s, 0.0f, 0.5f), l->t[q] = frand(&s, 0.5f, 20.0f);
+            for (int k = 0; k < 9; k++) l->nrm[q][k] = frand(&s, -1.0f, 1.0f);
             for (int k = 0; k < 3; k++)
-                p->dir[k][q] = k == 2 ? -1.0f : frand(&s, -1.0f, 1.0f), p->base[k][q] = frand(&s, 0.0f, 1.0f);
+                l->dir[k][q] = k == 2 ? -1.0f : frand(&s, -1.0f, 1.0f), p->base[k][q] = frand(&s, 0.0f, 1.0f);
             p->metal[q] = q & 1 ? 1.0f : 0.0f, p->a2[q] = frand(&s, 0.0f, 1.0f); /* glTF materials */
             p->spec[q] = 1.0f, p->occl[q] = 1.0f;
         }

@@ -17,31 +17,33 @@ static float rnd(float lo, float hi) { return lo + (hi - lo) * checkasm_randf();
 
 enum { M_RANDOM, M_EDGE, M_COUNT };
 
-static void gen_packet(fv_shade_packet *p, int mode)
+/* p's geometry in l (fv_shade_packet_lanes); some lanes share another lane's corner normals (a
+ * packet's lanes on one triangle) */
+static void gen_packet(fv_shade_packet *p, fv_shade_lanes *l, int mode)
 {
     static const float ext[] = {0.0f, -0.0f, 1e-30f, 1e-20f, 1.0f, -1.0f, 1e4f, 3e38f, 0.5f};
     for (int q = 0; q < FV_SHADE_LANES; q++) {
         float u = rnd(0.0f, 1.0f), v = rnd(0.0f, 1.0f - u);
         float n0[3] = {rnd(-1, 1), rnd(-1, 1), rnd(-1, 1)};
         for (int k = 0; k < 9; k++)
-            p->nrm[k][q] = k < 3 ? n0[k] : rnd(-1.0f, 1.0f);
+            l->nrm[q][k] = k < 3 ? n0[k] : rnd(-1.0f, 1.0f);
         float t = rnd(0.01f, 100.0f);
         if (mode == M_EDGE) {
             switch (checkasm_rand() % 8) {
             case 0: /* opposite vertex normals at the midpoint: degenerate */
-                for (int k = 0; k < 3; k++) p->nrm[3 + k][q] = -n0[k], p->nrm[6 + k][q] = 0.0f;
+                for (int k = 0; k < 3; k++) l->nrm[q][3 + k] = -n0[k], l->nrm[q][6 + k] = 0.0f;
                 u = 0.5f, v = 0.0f;
                 break;
             case 1: t = 0.0f; break; /* the hit at the eye: L = 0 */
             case 2: t = ext[checkasm_rand() % (sizeof ext / sizeof ext[0])]; break;
             case 3: u = 1.0f, v = 0.0f; break;
-            case 4: for (int k = 0; k < 9; k++) p->nrm[k][q] = 0.0f; break; /* zero normals */
+            case 4: for (int k = 0; k < 9; k++) l->nrm[q][k] = 0.0f; break; /* zero normals */
             default: break;
             }
         }
-        p->u[q] = u, p->v[q] = v, p->t[q] = t;
+        l->u[q] = u, l->v[q] = v, l->t[q] = t;
         for (int k = 0; k < 3; k++) {
-            p->dir[k][q] = k == 2 ? -1.0f : rnd(-1.5f, 1.5f);
+            l->dir[k][q] = k == 2 ? -1.0f : rnd(-1.5f, 1.5f);
             p->base[k][q] = rnd(0.0f, 1.0f);
             p->emit[k][q] = checkasm_rand() % 4 ? 0.0f : rnd(0.0f, 2.0f);
         }
@@ -54,6 +56,10 @@ static void gen_packet(fv_shade_packet *p, int mode)
         p->a2[q] = fv_ggx_a2(r);
         p->occl[q] = checkasm_rand() % 2 ? 1.0f : rnd(0.0f, 1.0f);
     }
+    fv_shade_packet_lanes(p, l);
+    for (int q = 0; q < FV_SHADE_LANES; q++)
+        if (checkasm_rand() % 8 == 0)
+            p->nrm_at[q] = l->nrm[checkasm_rand() % FV_SHADE_LANES];
 }
 
 static int gen_lights(fv_light_rec *l, int max, int mode)
@@ -104,8 +110,9 @@ static void test_brdf(void **state)
         for (int r = 0; r < 2000; r++) {
             const int mode = r % M_COUNT;
             fv_shade_packet p;
+            fv_shade_lanes geo;
             fv_light_rec lights[6];
-            gen_packet(&p, mode);
+            gen_packet(&p, &geo, mode);
             const int nl = r < 200 ? 0 : gen_lights(lights, 6, mode);
             /* every third run with shadows: each light occluded on random lanes (fv_shade_env.lit) */
             float lit[6][FV_SHADE_LANES];
