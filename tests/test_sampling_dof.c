@@ -323,6 +323,21 @@ static void test_in_focus_untouched(void **st)
 /* The periphery is thinned along S_out's own lattice dither: the kept samples are evenly spread
  * at density p q, no window of side ceil(2 / sqrt(p q)) is empty (white-noise thinning leaves
  * ~e^-4 of them empty, hundreds here); and fv_sampler_lattice is S_out's membership. */
+/* the win x win windows of a W x H sample mask (16-bit rows per tile column) that hold no sample */
+static int empty_windows(const uint32_t mask[H][W / 16], int win)
+{
+    int empty = 0;
+    for (int y = 0; y + win <= H; y++)
+        for (int x = 0; x + win <= W; x++) {
+            int any = 0;
+            for (int j = 0; j < win && !any; j++)
+                for (int i = 0; i < win && !any; i++)
+                    any = mask[y + j][(x + i) / 16] >> ((x + i) % 16) & 1u;
+            empty += !any;
+        }
+    return empty;
+}
+
 static void test_periphery_thinned_evenly(void **st)
 {
     (void)st;
@@ -357,15 +372,7 @@ static void test_periphery_thinned_evenly(void **st)
                 }
             }
         assert_float_equal((double)kept / (W * H), d, 0.1 * d);
-        int empty = 0;
-        for (int y = 0; y + win <= H; y++)
-            for (int x = 0; x + win <= W; x++) {
-                int any = 0;
-                for (int j = 0; j < win && !any; j++)
-                    for (int i = 0; i < win && !any; i++)
-                        any = mask[y + j][(x + i) / 16] >> ((x + i) % 16) & 1u;
-                empty += !any;
-            }
+        const int empty = empty_windows(mask, win);
         if (empty)
             printf("frame %u: %d empty %dx%d windows at density %.4f\n", fr, empty, win, win, d);
         assert_int_equal(empty, 0);
@@ -477,15 +484,7 @@ static void test_fovea_thinned_evenly(void **st)
                 }
             }
         assert_float_equal((double)kept / (W * H), d, 0.1 * d);
-        int empty = 0;
-        for (int y = 0; y + win <= H; y++)
-            for (int x = 0; x + win <= W; x++) {
-                int any = 0;
-                for (int j = 0; j < win && !any; j++)
-                    for (int i = 0; i < win && !any; i++)
-                        any = mask[y + j][(x + i) / 16] >> ((x + i) % 16) & 1u;
-                empty += !any;
-            }
+        const int empty = empty_windows(mask, win);
         if (empty)
             printf("frame %u: %d empty %dx%d windows at density %.4f\n", fr, empty, win, win, d);
         assert_int_equal(empty, 0);

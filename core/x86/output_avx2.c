@@ -135,9 +135,8 @@ static void lca_row_avx2(uint8_t *restrict dst, int y, const fv_lca_geom *g, con
         memcpy(dst + 3 * x, tmp, 12);
         memcpy(dst + 3 * x + 12, tmp + 16, 12);
     }
-    const float tyv = ty;
     for (; x < g->w; x++)
-        fv_lca_pixel(dst + 3 * x, x, tyv, g, lca, own + 4 * x, lut);
+        fv_lca_pixel(dst + 3 * x, x, ty, g, lca, own + 4 * x, lut);
 }
 
 void fv_output_dsp_init_avx2(fv_output_dsp *d)
