@@ -5,7 +5,8 @@
  * filled from the farther surface beside the hole. The warp used (fv_tw_warp_rows) is a block
  * warp over it: 16x16 display blocks whose every pixel's reference tap is provably within
  * FV_TW_BLOCK_POS_PX of one translation per row are resampled at it (tw_spans); the other
- * blocks run the per-pixel kernel. OS-free. */
+ * blocks run the per-pixel kernel. The display path runs fv_tw_warp_rows_bounded: the per-pixel
+ * kernel within a budget, grid cells beyond it (its cost does not grow with the frame's age). OS-free. */
 #ifndef FOVEA_TIMEWARP_H
 #define FOVEA_TIMEWARP_H
 
