@@ -95,7 +95,13 @@ int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
     const int n = l->ncompose < l->p.margin_frames ? l->ncompose : l->p.margin_frames;
     for (int i = 0; i < n; i++)
         worst = l->compose_ns[i] > worst ? l->compose_ns[i] : worst;
-    return (int64_t)((double)worst * l->p.margin_scale) + l->p.margin_extra_ns;
+    const int64_t m = (int64_t)((double)worst * l->p.margin_scale) + l->p.margin_extra_ns;
+    /* at most 7/8 of a period: waking before the vsync ahead of the target only skips refreshes
+     * (a composition longer than a period is late whatever the margin), and one slow composition
+     * (cold caches, first touch of the images) would otherwise space the next 16 refreshes by
+     * several periods each; the 1/8 leaves the wake-up after the previous vsync's edge */
+    const int64_t cap = l->p.nominal_period_ns - l->p.nominal_period_ns / 8;
+    return m < cap ? m : cap;
 }
 
 /* the vsync side of this loop (fv_vsync_edges_take, fv_vsync_edges_wait) */
@@ -187,7 +193,7 @@ void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refr
     memset(s, 0, sizeof *s);
     s->displayed_hz = s->mtp_p50_ms = s->mtp_p99_ms = s->g2p_p50_ms = s->g2p_p99_ms = NAN;
     s->compose_p50_ms = s->compose_p99_ms = s->age_p50_ms = s->pose_err_p50_deg = s->pose_err_p99_deg = NAN;
-    s->disoccluded_frac = NAN;
+    s->disoccluded_frac = s->grid_frac = NAN;
     s->refreshes = n;
     if (n <= 0)
         return;
@@ -195,7 +201,7 @@ void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refr
     if (!v)
         return;
     long m, warped = 0;
-    double holes = 0;
+    double holes = 0, grid = 0;
     long last = -1;
     for (long i = 0; i < n; i++) {
         s->late += r[i].late;
@@ -207,6 +213,7 @@ void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refr
             last = r[i].frame;
             warped++;
             holes += (double)r[i].disoccluded;
+            grid += (double)r[i].grid_px;
         }
     }
     for (long i = 1; i < n && period_ns > 0; i++) {
@@ -242,6 +249,7 @@ void fv_display_summarise(const fv_refresh_record *r, long n, double px_per_refr
             v[m++] = r[i].pose_err_deg;
     s->pose_err_p50_deg = fv_percentile(v, m, 0.5), s->pose_err_p99_deg = fv_percentile(v, m, 0.99);
     if (warped && px_per_refresh > 0)
-        s->disoccluded_frac = holes / ((double)warped * px_per_refresh);
+        s->disoccluded_frac = holes / ((double)warped * px_per_refresh),
+        s->grid_frac = grid / ((double)warped * px_per_refresh);
     free(v);
 }

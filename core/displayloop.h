@@ -8,8 +8,8 @@
  * Per refresh:
  *   1. take the vsync edges that came in (the predictor: core/vsyncpred.h);
  *   2. target V = the first predicted vsync at least one margin away; sleep to V - margin
- *      (margin = the slowest of the last 16 compositions x 1.25 + 0.5 ms: a late refresh costs a
- *      whole period, so it errs early);
+ *      (margin = the slowest of the last 16 compositions x 1.25 + 0.5 ms, at most 7/8 of a period:
+ *      a late refresh costs a whole period, so it errs early);
  *   3. compose(V): newest frame, pose predicted for V, warp, present;
  *   4. done by V: shown from V; wait for V's edge (photon time). Done after V (late): V showed
  *      the previous image again; this one shows from the next vsync.
@@ -67,6 +67,7 @@ typedef struct fv_refresh_record {
     int64_t frame_start_ns; /* the rendered frame's ray start and completion */
     int64_t frame_done_ns;
     long disoccluded;       /* pixels of both eyes filled as disocclusions */
+    long grid_px;           /* pixels of both eyes warped as grid cells (the bounded warp's fallback) */
     double pose_err_deg;    /* predicted head pose vs the true one at photon_ns (NAN: unknown) */
     double pose_err_mm;
 } fv_refresh_record;
@@ -121,6 +122,7 @@ typedef struct fv_display_summary {
     double age_p50_ms;                                     /* rendered frame's completion -> photon */
     double pose_err_p50_deg, pose_err_p99_deg;
     double disoccluded_frac;                               /* of the pixels warped */
+    double grid_frac;                                      /* of the pixels warped: grid cells */
 } fv_display_summary;
 /* px_per_refresh: pixels warped per refresh (both eyes), for disoccluded_frac; period_ns: the
  * refresh period, for the vsyncs skipped between refreshes (a composition longer than a period). */

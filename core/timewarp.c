@@ -1,6 +1,7 @@
 /* fovea: timewarp set-up (the kernel: timewarp_dsp.h, timewarp_ref.c). */
 #include "timewarp.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -154,6 +155,32 @@ static inline void row_offsets(int64_t qu, int64_t qv, int *ox, int *oy, int *fx
     *fx = (int)(u & 63), *fy = (int)(v & 63);
 }
 
+/* b's rows from its first and last row's translation (u0, v0, u1, v1): the fixed-point start and
+ * step, fast, inner. 0 when they are not finite. */
+static int block_rows(fv_tw_block *b, const fv_tw_src *s)
+{
+    const int X0 = b->x0, X1 = b->x1, Y0 = b->y0, Y1 = b->y1;
+    if (!(fabsf(b->u0) < 1e6f && fabsf(b->v0) < 1e6f && fabsf(b->u1) < 1e6f && fabsf(b->v1) < 1e6f))
+        return 0;
+    /* the rows' translations in 1/64 px with 16 more bits, stepped per row (no float per row) */
+    const double rows = Y1 - Y0 > 1 ? (double)(Y1 - Y0 - 1) : 1.0, k = 64.0 * 65536.0;
+    b->qu = (int64_t)((double)b->u0 * k + (b->u0 < 0 ? -0.5 : 0.5));
+    b->qv = (int64_t)((double)b->v0 * k + (b->v0 < 0 ? -0.5 : 0.5));
+    const double su = ((double)b->u1 - b->u0) / rows * k, sv = ((double)b->v1 - b->v0) / rows * k;
+    b->dqu = (int64_t)(su + (su < 0 ? -0.5 : 0.5)), b->dqv = (int64_t)(sv + (sv < 0 ? -0.5 : 0.5));
+    b->fast = 1;
+    /* inner: no row clamps (fv_tw_warp_rows' block_row). The rows' offsets are roundings of a
+     * linear function of y, so the source rows y + oy and columns x + ox are monotonic in y:
+     * the first and the last row bound them all. */
+    int ox0, oy0, ox1, oy1, f0, f1;
+    row_offsets(b->qu, b->qv, &ox0, &oy0, &f0, &f1);
+    row_offsets(b->qu + (int64_t)(Y1 - 1 - Y0) * b->dqu, b->qv + (int64_t)(Y1 - 1 - Y0) * b->dqv, &ox1, &oy1, &f0, &f1);
+    const int sy0 = Y0 + oy0, sy1 = Y1 - 1 + oy1;
+    b->inner = (sy0 < sy1 ? sy0 : sy1) >= 0 && (sy0 > sy1 ? sy0 : sy1) <= s->h - 2 && X0 + (ox0 < ox1 ? ox0 : ox1) >= 0 &&
+               X1 + (ox0 > ox1 ? ox0 : ox1) <= s->w - 1;
+    return 1;
+}
+
 /* one block (the proof: timewarp.h); 1 when translated */
 static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *s, const fv_tw_tiles *tiles,
                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *b)
@@ -234,25 +261,7 @@ static int plan_block(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
         return 0;
     b->u0 = (fu[0][0] + fu[0][1]) * 0.5f, b->v0 = (fv[0][0] + fv[0][1]) * 0.5f;
     b->u1 = (fu[1][0] + fu[1][1]) * 0.5f, b->v1 = (fv[1][0] + fv[1][1]) * 0.5f;
-    if (!(fabsf(b->u0) < 1e6f && fabsf(b->v0) < 1e6f && fabsf(b->u1) < 1e6f && fabsf(b->v1) < 1e6f))
-        return 0;
-    /* the rows' translations in 1/64 px with 16 more bits, stepped per row (no float per row) */
-    const double rows = Y1 - Y0 > 1 ? (double)(Y1 - Y0 - 1) : 1.0, k = 64.0 * 65536.0;
-    b->qu = (int64_t)((double)b->u0 * k + (b->u0 < 0 ? -0.5 : 0.5));
-    b->qv = (int64_t)((double)b->v0 * k + (b->v0 < 0 ? -0.5 : 0.5));
-    const double su = ((double)b->u1 - b->u0) / rows * k, sv = ((double)b->v1 - b->v0) / rows * k;
-    b->dqu = (int64_t)(su + (su < 0 ? -0.5 : 0.5)), b->dqv = (int64_t)(sv + (sv < 0 ? -0.5 : 0.5));
-    b->fast = 1;
-    /* inner: no row clamps (fv_tw_warp_rows' block_row). The rows' offsets are roundings of a
-     * linear function of y, so the source rows y + oy and columns x + ox are monotonic in y:
-     * the first and the last row bound them all. */
-    int ox0, oy0, ox1, oy1, f0, f1;
-    row_offsets(b->qu, b->qv, &ox0, &oy0, &f0, &f1);
-    row_offsets(b->qu + (int64_t)(Y1 - 1 - Y0) * b->dqu, b->qv + (int64_t)(Y1 - 1 - Y0) * b->dqv, &ox1, &oy1, &f0, &f1);
-    const int sy0 = Y0 + oy0, sy1 = Y1 - 1 + oy1;
-    b->inner = (sy0 < sy1 ? sy0 : sy1) >= 0 && (sy0 > sy1 ? sy0 : sy1) <= s->h - 2 && X0 + (ox0 < ox1 ? ox0 : ox1) >= 0 &&
-               X1 + (ox0 > ox1 ? ox0 : ox1) <= s->w - 1;
-    return 1;
+    return block_rows(b, s);
 }
 
 void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int *fy)
@@ -266,20 +275,20 @@ void fv_tw_block_row(const fv_tw_block *b, int y, int *ox, int *oy, int *fx, int
  * side halves the spread of a smooth mapping, so even its smallest parts would fail (a frame
  * warped far: planning 85 parts a block would cost more than the per-pixel warp saves). */
 static int plan_split(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
-                      int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out)
+                      int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out, int MIN)
 {
-    const int MIN = FV_TW_BLOCK_MIN, side = X1 - X0 > Y1 - Y0 ? X1 - X0 : Y1 - Y0;
+    const int side = X1 - X0 > Y1 - Y0 ? X1 - X0 : Y1 - Y0;
     if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || side <= MIN ||
         out->err_px > FV_TW_BLOCK_POS_PX * (float)side / (float)MIN)
         return 1;
     const int Xm = X1 - X0 > MIN ? X0 + (X1 - X0 + 1) / 2 : X1, Ym = Y1 - Y0 > MIN ? Y0 + (Y1 - Y0 + 1) / 2 : Y1;
-    int n = plan_split(d, m, src, tiles, X0, Xm, Y0, Ym, guess, out);
+    int n = plan_split(d, m, src, tiles, X0, Xm, Y0, Ym, guess, out, MIN);
     if (Xm < X1)
-        n += plan_split(d, m, src, tiles, Xm, X1, Y0, Ym, guess, out + n);
+        n += plan_split(d, m, src, tiles, Xm, X1, Y0, Ym, guess, out + n, MIN);
     if (Ym < Y1) {
-        n += plan_split(d, m, src, tiles, X0, Xm, Ym, Y1, guess, out + n);
+        n += plan_split(d, m, src, tiles, X0, Xm, Ym, Y1, guess, out + n, MIN);
         if (Xm < X1)
-            n += plan_split(d, m, src, tiles, Xm, X1, Ym, Y1, guess, out + n);
+            n += plan_split(d, m, src, tiles, Xm, X1, Ym, Y1, guess, out + n, MIN);
     }
     return n;
 }
@@ -289,11 +298,11 @@ static int plan_split(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
  * the rows' blend of the top and bottom edges follows the vertical change), so halving the width
  * usually proves both halves: two plans instead of the quarters' four, and the same pieces a row. */
 static int plan_halves(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
-                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out)
+                       int X0, int X1, int Y0, int Y1, float *guess, fv_tw_block *out, int MIN)
 {
-    const int MIN = FV_TW_BLOCK_MIN, side = X1 - X0 > Y1 - Y0 ? X1 - X0 : Y1 - Y0;
+    const int side = X1 - X0 > Y1 - Y0 ? X1 - X0 : Y1 - Y0;
     if (X1 - X0 <= MIN || Y1 - Y0 <= MIN)
-        return plan_split(d, m, src, tiles, X0, X1, Y0, Y1, guess, out);
+        return plan_split(d, m, src, tiles, X0, X1, Y0, Y1, guess, out, MIN);
     if (plan_block(d, m, src, tiles, X0, X1, Y0, Y1, guess, out) || out->err_px > FV_TW_BLOCK_POS_PX * (float)side / (float)MIN)
         return 1;
     const int Xm = X0 + (X1 - X0 + 1) / 2, Ym = Y0 + (Y1 - Y0 + 1) / 2;
@@ -304,8 +313,8 @@ static int plan_halves(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw
             n++;
             continue;
         }
-        n += plan_split(d, m, src, tiles, xa, xb, Y0, Ym, guess, out + n);
-        n += plan_split(d, m, src, tiles, xa, xb, Ym, Y1, guess, out + n);
+        n += plan_split(d, m, src, tiles, xa, xb, Y0, Ym, guess, out + n, MIN);
+        n += plan_split(d, m, src, tiles, xa, xb, Ym, Y1, guess, out + n, MIN);
     }
     return n;
 }
@@ -314,7 +323,7 @@ static int plan_halves(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw
  * (at most nb (FV_TW_BLOCK_W / FV_TW_LENS_CELL)^2 of them) */
 static int plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles,
                        int by, int bx0, int nb, fv_tw_block *out, float *guess, fv_tw_map *cells,
-                       const fv_tw_map **pmap)
+                       const fv_tw_map **pmap, int min)
 {
     const int BW = FV_TW_BLOCK_W, Y0 = by * FV_TW_BLOCK_H, Y1 = mini(Y0 + FV_TW_BLOCK_H, src->h);
     int n = 0, nc = 0;
@@ -323,7 +332,7 @@ static int plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw
         if (X0 >= X1)
             break;
         if (!m->lens) {
-            const int k = plan_halves(d, m, src, tiles, X0, X1, Y0, Y1, guess, out + n);
+            const int k = plan_halves(d, m, src, tiles, X0, X1, Y0, Y1, guess, out + n, min);
             for (int j = 0; j < k; j++)
                 pmap[n + j] = m;
             n += k;
@@ -336,7 +345,7 @@ static int plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw
             for (int cx = X0; cx < X1; cx += C) {
                 const int cx1 = mini(cx + C, X1), cy1 = mini(cy + C, Y1);
                 fv_tw_cell_map(m, src, cx, cx1, cy, cy1, &cells[nc]);
-                const int k = plan_halves(d, &cells[nc], src, tiles, cx, cx1, cy, cy1, guess, out + n);
+                const int k = plan_halves(d, &cells[nc], src, tiles, cx, cx1, cy, cy1, guess, out + n, min);
                 for (int j = 0; j < k; j++)
                     pmap[n + j] = &cells[nc];
                 n += k, nc++;
@@ -355,8 +364,158 @@ int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
     const fv_tw_map *pmap[FV_TW_BLOCK_SPLIT * NB];
     int n = 0;
     for (int i = 0; i < nb; i += NB) /* in groups that fit the arrays: the same entries as in one */
-        n += plan_blocks(d, m, src, tiles, by, bx0 + i, mini(NB, nb - i), out + n, guess, cells, pmap);
+        n += plan_blocks(d, m, src, tiles, by, bx0 + i, mini(NB, nb - i), out + n, guess, cells, pmap, FV_TW_BLOCK_MIN);
     return n;
+}
+
+/* ---- the bounded warp's grid fallback (timewarp.h) ---- */
+
+/* the reference's tap offsets (source minus display position) at n display points (px, py):
+ * three fixed-point steps; where the last two disagree, the farther surface (the smaller inverse
+ * depth). The points' steps go in lockstep, each depth prefetched a stage ahead (the fetches
+ * miss the cache: a part's taps are scattered over the plane). 0 when a point lands behind the
+ * source camera or off the float range. */
+enum { TW_GRID_TAPS = (FV_TW_BLOCK_W / FV_TW_GRID_W + 1) * (FV_TW_BLOCK_H / FV_TW_GRID_H + 1) };
+static int grid_taps(const fv_tw_map *m, const fv_tw_src *s, int n, const float *px, const float *py, float *du,
+                     float *dv)
+{
+    float A[TW_GRID_TAPS][3], u[TW_GRID_TAPS], v[TW_GRID_TAPS], w[TW_GRID_TAPS], wp[TW_GRID_TAPS];
+    for (int i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++)
+            A[i][k] = (m->a0[k] + py[i] * m->ay[k]) + px[i] * m->ax[k];
+        w[i] = wp[i] = 0.0f;
+    }
+    for (int it = 0; it < 3; it++) {
+        for (int i = 0; i < n; i++) {
+            fv_tw_proj(A[i], m->t, w[i], &u[i], &v[i]);
+            const int ix = (int)fv_tw_clampf(u[i], (float)(s->w - 1)), iy = (int)fv_tw_clampf(v[i], (float)(s->h - 1));
+            __builtin_prefetch(s->invd + (ptrdiff_t)iy * s->invd_stride + ix);
+        }
+        for (int i = 0; i < n; i++)
+            wp[i] = w[i], w[i] = fv_tw_fetch_w(m, s, A[i][2], u[i], v[i]);
+    }
+    for (int i = 0; i < n; i++) {
+        float wi = w[i];
+        const float dw = wi > wp[i] ? wi - wp[i] : wp[i] - wi;
+        if (dw > m->tol * (wi > wp[i] ? wi : wp[i]))
+            wi = wi < wp[i] ? wi : wp[i];
+        if (!(A[i][2] + m->t[2] * wi > 2.0f * FV_TW_ZMIN))
+            return 0;
+        float uu, vv;
+        fv_tw_proj(A[i], m->t, wi, &uu, &vv);
+        du[i] = uu - px[i], dv[i] = vv - py[i];
+        if (!(fabsf(du[i]) < 1e6f && fabsf(dv[i]) < 1e6f))
+            return 0;
+    }
+    return 1;
+}
+
+/* the part b (failed) as grid cells into out (at most ceil(w / FV_TW_GRID_W) ceil(h / FV_TW_GRID_H)
+ * entries, in rows: those covering a row in column order); the taps at the cells' top and bottom
+ * edges (shared by the cells above and below), each cell's first and last row's translation
+ * interpolated between them. 0 when a tap cannot be placed (the part then stays per pixel). */
+static int grid_cells(const fv_tw_map *m, const fv_tw_src *s, const fv_tw_block *b, fv_tw_block *out)
+{
+    enum { GW = FV_TW_GRID_W, GH = FV_TW_GRID_H, NX = FV_TW_BLOCK_W / GW + 1, NY = FV_TW_BLOCK_H / GH + 1 };
+    float px[TW_GRID_TAPS], py[TW_GRID_TAPS], tu[TW_GRID_TAPS], tv[TW_GRID_TAPS];
+    const int nx = (b->x1 - b->x0 + GW - 1) / GW, ny = (b->y1 - b->y0 + GH - 1) / GH;
+    if (nx > NX - 1 || ny > NY - 1)
+        return 0;
+    for (int j = 0; j <= ny; j++)
+        for (int i = 0; i < nx; i++) {
+            px[j * nx + i] = 0.5f * (float)(b->x0 + i * GW + mini(b->x0 + (i + 1) * GW, b->x1));
+            py[j * nx + i] = (float)mini(b->y0 + j * GH, b->y1);
+        }
+    if (!grid_taps(m, s, (ny + 1) * nx, px, py, tu, tv))
+        return 0;
+    int n = 0;
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) {
+            fv_tw_block *c = &out[n++];
+            memset(c, 0, sizeof *c);
+            c->x0 = b->x0 + i * GW, c->x1 = mini(c->x0 + GW, b->x1);
+            c->y0 = b->y0 + j * GH, c->y1 = mini(c->y0 + GH, b->y1);
+            const int t = j * nx + i, l = t + nx; /* the taps at its top and bottom edge */
+            const float h = (float)(c->y1 - c->y0), f0 = 0.5f / h, f1 = (h - 0.5f) / h;
+            c->u0 = tu[t] + (tu[l] - tu[t]) * f0, c->v0 = tv[t] + (tv[l] - tv[t]) * f0;
+            c->u1 = tu[t] + (tu[l] - tu[t]) * f1, c->v1 = tv[t] + (tv[l] - tv[t]) * f1;
+            if (!block_rows(c, s))
+                return 0;
+            c->grid = 1;
+        }
+    return n;
+}
+
+/* The bounded warp's share-out within a group of planned entries (plan, pmap: n of them, at
+ * most MAXE after): the failed parts, largest bound first, run per pixel while *allow lasts; the
+ * others become grid cells. Returns the new count. */
+static int bound_entries(const fv_tw_src *src, fv_tw_block *plan, const fv_tw_map **pmap, int n, int maxe, long *allow,
+                         fv_tw_warp_stats *st)
+{
+    enum { MAXF = FV_TW_BLOCK_SPLIT * 8 };
+    int fail[MAXF], nf = 0;
+    long need = 0;
+    for (int i = 0; i < n && nf < MAXF; i++)
+        if (!plan[i].fast) {
+            fail[nf++] = i;
+            need += (long)(plan[i].x1 - plan[i].x0) * (plan[i].y1 - plan[i].y0);
+        }
+    if (need <= *allow) {
+        *allow -= need;
+        if (st)
+            st->pixel_px += need;
+        return n;
+    }
+    /* largest bound first (insertion sort: a few dozen entries); a part the planner gave up on
+     * before bounding it (err_px 0) counts as unbounded */
+    for (int i = 1; i < nf; i++)
+        for (int j = i; j > 0; j--) {
+            const float ea = plan[fail[j - 1]].err_px, eb = plan[fail[j]].err_px;
+            if ((ea > 0.0f ? ea : INFINITY) >= (eb > 0.0f ? eb : INFINITY))
+                break;
+            const int t = fail[j - 1];
+            fail[j - 1] = fail[j], fail[j] = t;
+        }
+    char keep[FV_TW_BLOCK_SPLIT * 8];
+    memset(keep, 0, sizeof keep);
+    for (int k = 0; k < nf; k++) {
+        const fv_tw_block *b = &plan[fail[k]];
+        const long px = (long)(b->x1 - b->x0) * (b->y1 - b->y0);
+        if (px <= *allow) {
+            *allow -= px;
+            keep[fail[k]] = 1;
+            if (st)
+                st->pixel_px += px;
+        }
+    }
+    /* rebuild: each entry to grid becomes its cells where it stood (a row's entries stay in
+     * column order); a part of s x s has at most ceil(s / 16)^2 <= s^2 / 64 cells for s >= 8 */
+    fv_tw_block tmp[FV_TW_BLOCK_SPLIT * 8];
+    const fv_tw_map *tmap[FV_TW_BLOCK_SPLIT * 8];
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        if (plan[i].fast || keep[i]) {
+            tmp[k] = plan[i], tmap[k++] = pmap[i];
+            continue;
+        }
+        const fv_tw_block b = plan[i];
+        const int cells = ((b.x1 - b.x0 + FV_TW_GRID_W - 1) / FV_TW_GRID_W) * ((b.y1 - b.y0 + FV_TW_GRID_H - 1) / FV_TW_GRID_H);
+        const int c = k + cells + (n - 1 - i) <= maxe ? grid_cells(pmap[i], src, &b, tmp + k) : 0;
+        if (!c) { /* cannot be placed (or no room): per pixel, over the budget */
+            tmp[k] = b, tmap[k++] = pmap[i];
+            if (st)
+                st->pixel_px += (long)(b.x1 - b.x0) * (b.y1 - b.y0);
+            continue;
+        }
+        for (int j = 0; j < c; j++)
+            tmap[k + j] = pmap[i];
+        k += c;
+        if (st)
+            st->grid_px += (long)(b.x1 - b.x0) * (b.y1 - b.y0);
+    }
+    memcpy(plan, tmp, sizeof *tmp * (size_t)k);
+    memcpy(pmap, tmap, sizeof *tmap * (size_t)k);
+    return k;
 }
 
 #define FV_TW_PREFETCH_ROWS 3
@@ -412,6 +571,13 @@ static inline int block_row(fv_tw_piece *pc, uint8_t *o, int xo, int y, const fv
 long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1, const fv_tw_map *m,
                      const fv_tw_src *src, const fv_tw_tiles *tiles)
 {
+    return fv_tw_warp_rows_bounded(d, dst, dst_stride, y0, y1, m, src, tiles, LONG_MAX, NULL);
+}
+
+long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1,
+                             const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles, long budget_px,
+                             fv_tw_warp_stats *stats)
+{
     enum { CHUNK = 8, MAXE = FV_TW_BLOCK_SPLIT * CHUNK }; /* blocks planned at a time, their entries */
     const int BW = FV_TW_BLOCK_W, BH = FV_TW_BLOCK_H, nbx = (src->w + BW - 1) / BW;
     fv_tw_block plan[MAXE];
@@ -426,13 +592,26 @@ long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_strid
     const fv_tw_map *pmap[MAXE];       /* each plan entry's map */
     uint8_t row[3 * CHUNK * FV_TW_BLOCK_W]; /* a row's columns composed in cache, then streamed (tw_stream) */
     const ptrdiff_t stride = src->rgb_stride;
-    long holes = 0;
+    long holes = 0, budget_left = budget_px, rem_px = (long)(y1 - y0) * src->w;
     for (int by = y0 / BH; by * BH < y1; by++) {
         const int ya = by * BH > y0 ? by * BH : y0, yb = mini(by * BH + BH, y1);
         float guess = 0.0f;
         for (int bx0 = 0; bx0 < nbx; bx0 += CHUNK) {
-            const int n = plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess, cells, pmap);
+            /* bounded: parts no smaller than a grid cell (a failed part is cells of that size anyway;
+             * proving 8x8 parts costs more planning and twice the pieces a row) */
+            int n = plan_blocks(d, m, src, tiles, by, bx0, mini(CHUNK, nbx - bx0), plan, &guess, cells, pmap,
+                                budget_px == LONG_MAX ? FV_TW_BLOCK_MIN : FV_TW_GRID_MIN);
             const int x0 = bx0 * BW, x1 = mini((bx0 + CHUNK) * BW, src->w);
+            if (budget_px != LONG_MAX) { /* this group's share of what is left, in proportion to its pixels */
+                const long px = (long)(x1 - x0) * (yb - ya);
+                long allow = rem_px > px ? (long)((double)budget_left * (double)px / (double)rem_px) : budget_left;
+                const long given = allow;
+                n = bound_entries(src, plan, pmap, n, MAXE, &allow, stats);
+                budget_left -= given - allow;
+                rem_px -= px;
+            } else if (stats)
+                for (int i = 0; i < n; i++)
+                    stats->pixel_px += plan[i].fast ? 0 : (long)(plan[i].x1 - plan[i].x0) * (plan[i].y1 - plan[i].y0);
             int nr = 0, ni = 0, next = ya; /* the entries covering the row change on row next */
             for (int y = ya; y < yb; y++) {
                 if (y == next) {
@@ -552,6 +731,17 @@ long fv_tw_frame_warp(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, con
         fv_tw_map_set_lens(&m, &f->lmap[e]);
     const fv_tw_src s = {f->rgb[e], (ptrdiff_t)f->w * 3, f->invd[e], f->w, f->w, f->h};
     return fv_tw_warp_rows(d, dst, dst_stride, 0, f->h, &m, &s, &f->tiles[e]);
+}
+
+long fv_tw_frame_warp_bounded(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, const fv_camera *display,
+                              uint8_t *dst, ptrdiff_t dst_stride, float tol, long budget_px, fv_tw_warp_stats *stats)
+{
+    fv_tw_map m;
+    fv_tw_setup(&m, display, &f->cam[e], tol);
+    if (f->cam[e].lens_on)
+        fv_tw_map_set_lens(&m, &f->lmap[e]);
+    const fv_tw_src s = {f->rgb[e], (ptrdiff_t)f->w * 3, f->invd[e], f->w, f->w, f->h};
+    return fv_tw_warp_rows_bounded(d, dst, dst_stride, 0, f->h, &m, &s, &f->tiles[e], budget_px, stats);
 }
 
 double fv_tw_psnr_outside_holes(const uint8_t *warped, const uint8_t *ref, const fv_tw_map *m, const fv_tw_src *src,

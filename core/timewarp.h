@@ -5,7 +5,8 @@
  * filled from the farther surface beside the hole. The warp used (fv_tw_warp_rows) is a block
  * warp over it: 16x16 display blocks whose every pixel's reference tap is provably within
  * FV_TW_BLOCK_POS_PX of one translation per row are resampled at it (tw_spans); the other
- * blocks run the per-pixel kernel. OS-free. */
+ * blocks run the per-pixel kernel. The display path runs fv_tw_warp_rows_bounded: the per-pixel
+ * kernel within a budget, grid cells beyond it (its cost does not grow with the frame's age). OS-free. */
 #ifndef FOVEA_TIMEWARP_H
 #define FOVEA_TIMEWARP_H
 
@@ -83,6 +84,8 @@ typedef struct fv_tw_block {
     float err_px;       /* the planner's bound on the position error (translated blocks) */
     int inner;          /* translated and every row's taps inside the source (no clamping): the warp's
                          * short path, the same bytes */
+    int grid;           /* translated without a proof: a cell of the bounded warp's grid fallback
+                         * (fv_tw_warp_rows_bounded) */
 } fv_tw_block;
 /* Row y's translation of a translated block, its rows' linear blend of the first's and the last's
  * (in fixed point, within 2^-16 px) rounded to 1/64: display pixel (x, y) resamples the source at (x + ox + fx / 64, y + oy + fy / 64). */
@@ -113,6 +116,35 @@ int fv_tw_plan_blocks(const fv_timewarp_dsp *d, const fv_tw_map *m, const fv_tw_
  * the block warp (tiles: NULL, or src's). Returns the disoccluded pixels (of the per-pixel blocks). */
 long fv_tw_warp_rows(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1, const fv_tw_map *m,
                      const fv_tw_src *src, const fv_tw_tiles *tiles);
+/* ---- the bounded warp (the display path: its cost must not depend on the frame's age) ----
+ * A frame far from the display's pose (a slow renderer, a fast head) fails the block proof almost
+ * everywhere and the per-pixel kernel (~5.5 ns a pixel with AVX2: ~20 ms a pair) would set the
+ * display rate. fv_tw_warp_rows_bounded gives the per-pixel kernel at most budget_px pixels of
+ * the rows, shared out over the block rows in proportion to their pixels (what a block row leaves
+ * goes to the next); within a group of blocks the failed parts with the largest position bound
+ * get it first (depth edges with parallax, where a translation shows most). The other failed
+ * parts are cut into FV_TW_GRID_W x FV_TW_GRID_H cells, each translated without a proof, as a grid warp with a
+ * depth per vertex: its first and last row's translation is the reference's tap (three
+ * fixed-point steps, the farther surface where they disagree) at the middle of its top and
+ * bottom row. Its error: the homography's change over half a cell (a turn's stretch: ~0.8 px at
+ * the panel's edge for a 3 degree turn) and, across a depth edge inside the cell, the parallax
+ * between the two surfaces; no disocclusion fill there. Cost: the planning, the translated
+ * resample (memory speed) and the budget. budget_px = LONG_MAX is fv_tw_warp_rows (the same
+ * bytes). stats (NULL: not wanted) adds the pixels that ran per pixel and those of grid cells. */
+#ifndef FV_TW_GRID_W
+#define FV_TW_GRID_W 16 /* columns of a grid cell */
+#endif
+#ifndef FV_TW_GRID_H
+#define FV_TW_GRID_H 16 /* its rows */
+#endif
+#define FV_TW_GRID_MIN 16 /* the bounded warp's smallest proven part (FV_TW_BLOCK_MIN otherwise) */
+typedef struct fv_tw_warp_stats {
+    long pixel_px, grid_px;
+} fv_tw_warp_stats;
+long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1,
+                             const fv_tw_map *m, const fv_tw_src *src, const fv_tw_tiles *tiles, long budget_px,
+                             fv_tw_warp_stats *stats);
+
 /* The same rows with the per-pixel kernel everywhere (the reference the block warp is held to). */
 long fv_tw_warp_rows_pixel(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t dst_stride, int y0, int y1,
                            const fv_tw_map *m, const fv_tw_src *src);
@@ -143,6 +175,9 @@ void fv_tw_frame_capture(fv_tw_frame *f, const struct fv_pipeline *pl, int e);
  * Returns the disoccluded pixels. */
 long fv_tw_frame_warp(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, const fv_camera *display, uint8_t *dst,
                       ptrdiff_t dst_stride, float tol);
+/* The same with the bounded warp (fv_tw_warp_rows_bounded). */
+long fv_tw_frame_warp_bounded(const fv_timewarp_dsp *d, const fv_tw_frame *f, int e, const fv_camera *display,
+                              uint8_t *dst, ptrdiff_t dst_stride, float tol, long budget_px, fv_tw_warp_stats *stats);
 
 /* The warp's image quality: luma PSNR (dB) of `warped` against `ref` (a frame rendered directly
  * at the display camera), both w x h 8-bit RGB rows of w * 3 bytes, over the pixels the warp

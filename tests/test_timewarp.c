@@ -3,6 +3,7 @@
  * from a camera stepped sideways moves by focal * step / depth pixels (two planes, two depths),
  * and a disocclusion behind a near square is counted to the expected width and filled with the
  * background. The kernels' agreement with this reference is checkasm's (tests/checkasm/timewarp.c). */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,6 +67,21 @@ static long warp(planes *p, const fv_camera *display, const fv_camera *source)
     return fv_tw_warp_rows(&d, p->out, W * 3, 0, H, &m, &s, NULL);
 }
 
+static long warp_bounded(planes *p, const fv_camera *display, const fv_camera *source, long budget,
+                         fv_tw_warp_stats *st)
+{
+    fv_timewarp_dsp d;
+    fv_timewarp_dsp_init(&d, FV_ISA_C);
+    fv_tw_map m;
+    fv_tw_setup(&m, display, source, 0.05f);
+    const fv_tw_src s = {p->rgb, W * 3, p->invd, W, W, H};
+    fv_tw_tiles t;
+    static uint16_t lohi[2 * ((W + 7) / 8) * ((H + 7) / 8)], lohi4[2 * ((W + 31) / 32) * ((H + 31) / 32)];
+    t.lohi = lohi, t.lohi4 = lohi4;
+    fv_tw_tiles_build(&d, &t, &s);
+    return fv_tw_warp_rows_bounded(&d, p->out, W * 3, 0, H, &m, &s, &t, budget, st);
+}
+
 static void test_pure_rotation(void **state)
 {
     (void)state;
@@ -111,6 +127,64 @@ static void test_pure_rotation(void **state)
     free(p);
 }
 
+/* The bounded warp with no per-pixel budget on a turn of 6 degrees about a tilted axis (the block
+ * proof fails: a 64-pixel row's offsets spread by more than 0.25 px): nothing runs per pixel, the
+ * failed parts are grid cells, and the image is the rotated one within the cells' position error
+ * (the homography's change over half a cell, under 0.5 px here) times the pattern's slope (at
+ * most ~7 levels a pixel) plus the bilinear tap's 3 levels: 8 (measured 7). */
+static void test_bounded_rotation(void **state)
+{
+    (void)state;
+    planes *p = calloc(1, sizeof *p);
+    assert_non_null(p);
+    const float a = 6.0f * 3.14159265f / 360.0f;
+    const float ax[3] = {0.3f, 0.9f, 0.1f}, an = sqrtf(0.91f);
+    fv_pose p0 = {{0.1f, 1.6f, 2.0f}, {0, 0, 0, 1}};
+    fv_pose p1 = {{0.1f, 1.6f, 2.0f}, {ax[0] / an * sinf(a), ax[1] / an * sinf(a), ax[2] / an * sinf(a), cosf(a)}};
+    fv_camera c0, c1;
+    cam(&c0, &p0);
+    cam(&c1, &p1);
+    render_dirs(p->rgb, &c0);
+    for (int i = 0; i < W * H; i++)
+        p->invd[i] = (uint16_t)(FV_TW_INVD_PER_M / (0.5f + (float)(i % 7)));
+    fv_tw_warp_stats st = {0, 0};
+    assert_int_equal(warp_bounded(p, &c1, &c0, 0, &st), 0);
+    assert_int_equal(st.pixel_px, 0);
+    if (st.grid_px < W * H / 4)
+        fail_msg("grid cells: %ld of %d pixels (the case should fail the block proof)", st.grid_px, W * H);
+    static uint8_t want[W * H * 3];
+    render_dirs(want, &c1);
+    int checked = 0, maxd = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float d[3], px[3], u, v;
+            fv_camera_ray(&c1, (float)x + 0.5f, (float)y + 0.5f, d);
+            for (int k = 0; k < 3; k++)
+                px[k] = c1.eye_pos[k] + d[k];
+            fv_camera_project(&c0, px, &u, &v);
+            if (u < 2 || v < 2 || u > W - 2 || v > H - 2)
+                continue;
+            checked++;
+            for (int k = 0; k < 3; k++) {
+                const int i = (y * W + x) * 3 + k, e = abs((int)p->out[i] - (int)want[i]);
+                maxd = e > maxd ? e : maxd;
+            }
+        }
+    assert_true(checked > W * H / 2);
+    if (maxd > 8) /* measured 7; the per-pixel warp 3 */
+        fail_msg("bounded rotation: max error %d levels over %d pixels", maxd, checked);
+    /* an unbounded budget is the block warp (the per-pixel kernel where the proof fails) */
+    static uint8_t blockw[W * H * 3];
+    warp(p, &c1, &c0);
+    memcpy(blockw, p->out, sizeof blockw);
+    fv_tw_warp_stats su = {0, 0};
+    warp_bounded(p, &c1, &c0, LONG_MAX, &su);
+    assert_memory_equal(blockw, p->out, sizeof blockw);
+    assert_int_equal(su.grid_px, 0);
+    assert_true(su.pixel_px > 0);
+    free(p);
+}
+
 /* two fronto-parallel planes (left half 2 m, right half 4 m); the camera steps right by s: a
  * point at depth z moves left by focal * s / z pixels, so display pixel x shows source x + shift */
 static void test_translated_planes(void **state)
@@ -145,6 +219,49 @@ static void test_translated_planes(void **state)
             checked++;
         }
     assert_true(checked > W * H / 2);
+    free(p);
+}
+
+/* The bounded warp on the two planes stepped farther (24 px at 2 m, 12 px at 4 m: every block that
+ * sees both planes fails the proof) with no per-pixel budget: each grid cell takes the depth at
+ * its vertices, so a cell on one plane moves by that plane's shift exactly. */
+static void test_bounded_planes(void **state)
+{
+    (void)state;
+    planes *p = calloc(1, sizeof *p);
+    assert_non_null(p);
+    fv_pose p0 = {{0, 0, 0}, {0, 0, 0, 1}};
+    fv_camera c0;
+    cam(&c0, &p0);
+    const float step = 24.0f * 2.0f / c0.focal_px;
+    fv_pose p1 = {{step, 0, 0}, {0, 0, 0, 1}};
+    fv_camera c1;
+    cam(&c1, &p1);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            uint8_t *q = p->rgb + (y * W + x) * 3;
+            q[0] = (uint8_t)x, q[1] = (uint8_t)y, q[2] = (uint8_t)(x < W / 2 ? 50 : 200);
+            p->invd[y * W + x] = (uint16_t)(FV_TW_INVD_PER_M / (x < W / 2 ? 2.0f : 4.0f) + 0.5f);
+        }
+    fv_tw_warp_stats st = {0, 0};
+    warp_bounded(p, &c1, &c0, 0, &st);
+    assert_int_equal(st.pixel_px, 0);
+    assert_true(st.grid_px > 0);
+    int checked = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            /* whole cells on one plane: a cell (16 columns) clear of the step on both sides */
+            const int cx0 = x / FV_TW_GRID_W * FV_TW_GRID_W, cx1 = cx0 + FV_TW_GRID_W;
+            const int shift = cx1 + 24 <= W / 2 ? 24 : (cx0 + 12 >= W / 2 && cx1 + 12 < W) ? 12 : 0;
+            if (!shift)
+                continue;
+            const uint8_t *o = p->out + (y * W + x) * 3;
+            if (abs((int)o[0] - (x + shift)) > 1 || abs((int)o[1] - y) > 1)
+                fail_msg("plane at %s: pixel (%d, %d) shows source (%d, %d), want (%d, %d)", shift == 24 ? "2 m" : "4 m",
+                         x, y, o[0], o[1], x + shift, y);
+            checked++;
+        }
+    assert_true(checked > W * H / 3);
     free(p);
 }
 
@@ -362,6 +479,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pure_rotation),
+        cmocka_unit_test(test_bounded_rotation),
+        cmocka_unit_test(test_bounded_planes),
         cmocka_unit_test(test_translated_planes),
         cmocka_unit_test(test_disocclusion),
         cmocka_unit_test(test_block_footprint),

@@ -13,6 +13,7 @@
  * N times alternately; prints medians of thread CPU time and of wall time and the ratios.
  * --lens FILE: every camera with the HMD lens profile (the warp through it, core/timewarp.h). */
 #define _DEFAULT_SOURCE /* getloadavg */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -97,6 +98,7 @@ int main(int argc, char **argv)
     const char *png_dir = NULL;
     double rate = 30.0, hz = 90.0, step_mm = 0.0;
     int bench = 0, bench_pixel = 1;
+    long budget = LONG_MAX; /* --budget: the bounded warp's per-pixel pixels an eye */
     const char *lens_path = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--scene") && i + 1 < argc)
@@ -114,6 +116,8 @@ int main(int argc, char **argv)
             bench = (int)fv_arg_long(prog, "--bench", argv[++i], 1, 1000);
         else if (!strcmp(argv[i], "--lens") && i + 1 < argc)
             lens_path = argv[++i];
+        else if (!strcmp(argv[i], "--budget") && i + 1 < argc)
+            budget = fv_arg_long(prog, "--budget", argv[++i], 0, 1L << 40);
         else if (!strcmp(argv[i], "--no-per-pixel"))
             bench_pixel = 0;
         else if (!strcmp(argv[i], "--png") && i + 1 < argc)
@@ -128,6 +132,8 @@ int main(int argc, char **argv)
                    "  --bench N   time the stereo pair one refresh old on this thread, block warp,\n"
                    "              per-pixel warp and a copy of the pair's bytes, N times each\n"
                    "  --no-per-pixel  --bench leaves the per-pixel warp out (profiling the block warp)\n"
+                   "  --budget PX the bounded warp (the headset's): at most PX pixels an eye per pixel,\n"
+                   "              the rest of the failed parts as grid cells (default: no bound)\n"
                    "  --lens FILE HMD lens profile: rendered through it, warped through it\n");
             return 0;
         } else
@@ -172,7 +178,8 @@ int main(int argc, char **argv)
         if (lens_path)
             fv_tw_map_set_lens(&m, &f0.lmap[right]);
         const fv_tw_src s = {f0.rgb[right], (ptrdiff_t)w * 3, f0.invd[right], w, w, h};
-        fv_tw_warp_rows(&d, out, (ptrdiff_t)w * 3, 0, h, &m, &s, &f0.tiles[right]);
+        fv_tw_warp_stats ws = {0, 0};
+        fv_tw_warp_rows_bounded(&d, out, (ptrdiff_t)w * 3, 0, h, &m, &s, &f0.tiles[right], budget, &ws);
         fv_tw_warp_rows_pixel(&d, outp, (ptrdiff_t)w * 3, 0, h, &m, &s);
         double holes;
         const double psnr = fv_tw_psnr_outside_holes(out, f1.rgb[right], &m, &s, &holes);
@@ -202,8 +209,9 @@ int main(int argc, char **argv)
             free(vis);
         }
         printf("  %d refresh%s old (%.3f deg): block warp %.2f dB luma PSNR outside disocclusions (%.1f %% of pixels "
-               "translated), per-pixel %.2f dB; disoccluded %.4f %% of pixels; unwarped %.2f dB\n",
-               k, k > 1 ? "es" : "", rate * k / hz, psnr, 100.0 * fast, psnr_px, 100.0 * holes, stale);
+               "translated, %.1f %% grid cells), per-pixel %.2f dB; disoccluded %.4f %% of pixels; unwarped %.2f dB\n",
+               k, k > 1 ? "es" : "", rate * k / hz, psnr, 100.0 * fast, 100.0 * (double)ws.grid_px / ((double)w * h),
+               psnr_px, 100.0 * holes, stale);
     }
     if (bench) {
         /* the pair: the other eye's frame too, both warped one refresh */
@@ -240,7 +248,8 @@ int main(int argc, char **argv)
                     if (v == 0)
                         memcpy(o, f0.rgb[e], (size_t)w * h * 3);
                     else if (v == 1)
-                        hb = fv_tw_warp_rows(&d, o, (ptrdiff_t)w * 3, 0, h, &m[e], &s[e], &f0.tiles[e]);
+                        hb = fv_tw_warp_rows_bounded(&d, o, (ptrdiff_t)w * 3, 0, h, &m[e], &s[e], &f0.tiles[e], budget,
+                                                     NULL);
                     else
                         hp = fv_tw_warp_rows_pixel(&d, o, (ptrdiff_t)w * 3, 0, h, &m[e], &s[e]);
                 }
@@ -262,6 +271,8 @@ int main(int argc, char **argv)
         printf("  pair (2 x %dx%d, one refresh), one thread, %s, median of %d, load %.2f: thread CPU ms / wall ms\n",
                w, h, fv_isa_name(fv_cpu_best_isa(~0u)), bench, la[0]);
         printf("    copy of the pair's bytes (2 x %.1f MB): %.3f / %.3f ms\n", (double)w * h * 3 / 1e6, med[0], med[3]);
+        if (budget != LONG_MAX)
+            printf("    bounded warp, at most %ld pixels an eye per pixel (--budget)\n", budget);
         printf("    block warp: %.3f / %.3f ms (%.2fx the copy; planning %.3f ms of it; %.1f %% of pixels translated; "
                "%ld disoccluded)\n",
                med[1], med[4], med[1] / med[0], med[6], 100.0 * fast, hb);

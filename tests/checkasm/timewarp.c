@@ -282,7 +282,7 @@ static void test_block_warp(void **state)
     (void)state;
     checkasm_rng = 0x5eed0b10ull;
     const size_t npx = (size_t)BW_W * BW_H;
-    uint8_t *rgb = malloc(npx * 3 + FV_TW_RGB_PAD), *ref = malloc(npx * 3), *blk = malloc(npx * 3);
+    uint8_t *rgb = malloc(npx * 3 + FV_TW_RGB_PAD), *ref = malloc(npx * 3), *blk = malloc(npx * 3), *bnd = malloc(npx * 3);
     uint16_t *invd = malloc((npx + FV_TW_INVD_PAD / 2) * sizeof *invd);
     uint8_t *refhole = malloc(npx), *fastpx = malloc(npx);
     const int tw = (BW_W + FV_TW_TILE - 1) / FV_TW_TILE, th = (BW_H + FV_TW_TILE - 1) / FV_TW_TILE;
@@ -291,13 +291,13 @@ static void test_block_warp(void **state)
     uint16_t *lohi4 = malloc(2 * (size_t)tw4 * th4 * sizeof *lohi), *want4 = malloc(2 * (size_t)tw4 * th4 * sizeof *lohi);
     const int nbx = (BW_W + FV_TW_BLOCK_W - 1) / FV_TW_BLOCK_W;
     fv_tw_block *plan = malloc(FV_TW_BLOCK_SPLIT * (size_t)nbx * sizeof *plan);
-    assert_true(rgb && ref && blk && invd && refhole && fastpx && lohi && want_tiles && lohi4 && want4 && plan);
+    assert_true(rgb && ref && blk && bnd && invd && refhole && fastpx && lohi && want_tiles && lohi4 && want4 && plan);
     fv_camera_desc cd;
     fv_camera_desc_default(&cd);
     cd.width = BW_W, cd.height = BW_H;
     fv_timewarp_dsp c;
     fv_timewarp_dsp_init(&c, FV_ISA_C);
-    long fast_total = 0, slow_total = 0, checked = 0;
+    long fast_total = 0, slow_total = 0, checked = 0, grid_total = 0;
     float worst_pos = 0.0f;
     for (int trial = 0; trial < 40; trial++) {
         /* sources: depth blocks with edges (random colours, and smooth colours so the value bound
@@ -374,6 +374,28 @@ static void test_block_warp(void **state)
             uint8_t *o = checkasm_out_u8(npx * 3, 1, &ob);
             const long holes = fv_tw_warp_rows(&d, o, (ptrdiff_t)BW_W * 3, 0, BW_H, &m, &s, tp);
             checkasm_check_guards(o, npx * 3, fv_isa_name(isa), "block warp", trial);
+            { /* the bounded warp (grid cells where the proof fails beyond a per-pixel budget of a
+               * 16th of the pixels): every ISA gives the C one's bytes and split */
+                uint8_t *bb;
+                uint8_t *bo = checkasm_out_u8(npx * 3, 1, &bb);
+                fv_tw_warp_stats st = {0, 0};
+                const long bh = fv_tw_warp_rows_bounded(&d, bo, (ptrdiff_t)BW_W * 3, 0, BW_H, &m, &s, tp, (long)npx / 16, &st);
+                checkasm_check_guards(bo, npx * 3, fv_isa_name(isa), "bounded warp", trial);
+                static long c_holes, c_pixel, c_grid;
+                if (k < 0) {
+                    memcpy(bnd, bo, npx * 3);
+                    c_holes = bh, c_pixel = st.pixel_px, c_grid = st.grid_px;
+                    grid_total += st.grid_px;
+                    assert_true(st.pixel_px <= (long)npx / 16 + FV_TW_BLOCK_W * FV_TW_BLOCK_H); /* the budget (+ a part) */
+                } else {
+                    checkasm_compare(bnd, bo, npx * 3, CHECKASM_U8, 3, CHECKASM_EXACT, "%s bounded warp trial=%d",
+                                     fv_isa_name(isa), trial);
+                    assert_int_equal(bh, c_holes);
+                    assert_int_equal(st.pixel_px, c_pixel);
+                    assert_int_equal(st.grid_px, c_grid);
+                }
+                free(bb);
+            }
             if (k >= 0) { /* the kernels are exact: the same bytes as the C block warp */
                 checkasm_compare(blk, o, npx * 3, CHECKASM_U8, 3, CHECKASM_EXACT, "%s block warp trial=%d",
                                  fv_isa_name(isa), trial);
@@ -450,12 +472,14 @@ static void test_block_warp(void **state)
                          want_holes);
         }
     }
+    printf("    bounded warp: %.1f %% of the pixels as grid cells\n", 100.0 * (double)grid_total / (double)checked);
     printf("    block warp: %ld pixels checked, %.1f %% translated, worst tap distance %.4f px\n", checked,
            100.0 * (double)fast_total / (double)(checked ? checked : 1), worst_pos);
     /* both paths were exercised */
     assert_true(fast_total > checked / 4);
     assert_true(slow_total > 0);
-    free(rgb), free(ref), free(blk), free(invd), free(refhole), free(fastpx), free(lohi), free(want_tiles), free(lohi4), free(want4), free(plan);
+    assert_true(grid_total > 0); /* the bounded warp's grid cells were exercised */
+    free(rgb), free(ref), free(blk), free(bnd), free(invd), free(refhole), free(fastpx), free(lohi), free(want_tiles), free(lohi4), free(want4), free(plan);
 }
 
 const struct CMUnitTest checkasm_timewarp_tests[] = {
