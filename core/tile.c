@@ -12,8 +12,12 @@
 
 /* The tiles' sums (rays, times) per worker, each on its own cache line: one shared counter, added
  * to after every tile by both workers, moved its line between the cores 2-3 times per tile
- * (7200 tiles a frame). Atomic still (a slot is one thread's at a time, but not always the same
- * thread's: pool background jobs), relaxed: uncontended. */
+ * (7200 tiles a frame). A slot below the last is one thread's at a time (thread_id is unique
+ * among the running items, core/pool.h; the pool's job start and end order its uses), so it is
+ * added to by a relaxed load and store (SLOT_ADD): a locked add drains the store buffer, and right
+ * after a tile's sample writes (stores waiting for their lines) it stalled there (86 % of
+ * run_still's samples on the instruction after it). Worker ids from TILE_SLOTS - 1 on share the
+ * last slot and add atomically. */
 #define TILE_SLOTS 16 /* worker ids beyond share the last slot */
 typedef struct {
     _Alignas(64) atomic_long rays;
@@ -45,6 +49,16 @@ static inline tile_slot *slot_of(tile_job *j, int thread_id)
     return &j->slot[thread_id < TILE_SLOTS ? thread_id : TILE_SLOTS - 1];
 }
 
+#define SLOT_ADD(j, thread_id, field, v)                                                                       \
+    do {                                                                                                       \
+        tile_slot *s_ = slot_of(j, thread_id);                                                                 \
+        if ((thread_id) < TILE_SLOTS - 1)                                                                      \
+            atomic_store_explicit(&s_->field, atomic_load_explicit(&s_->field, memory_order_relaxed) + (v),  \
+                                  memory_order_relaxed);                                                       \
+        else                                                                                                   \
+            atomic_fetch_add_explicit(&s_->field, (v), memory_order_relaxed);                                  \
+    } while (0)
+
 /* Pull the tile up the pyramid while it is in cache: a 16x16 tile is a 1x1 block of level 4.
  * Tiles start on multiples of 16, so every block starts on even coordinates. */
 static void tile_end(tile_job *j, int index, int thread_id, int x0, int y0, int tw, int th, long rays,
@@ -55,7 +69,7 @@ static void tile_end(tile_job *j, int index, int thread_id, int x0, int y0, int 
         fv_pull_block(j->pyr, &j->dsp->pp, l, xl, yl, wl, hl);
         xl >>= 1, yl >>= 1, wl = (wl + 1) >> 1, hl = (hl + 1) >> 1;
     }
-    atomic_fetch_add_explicit(&slot_of(j, thread_id)->rays, rays, memory_order_relaxed);
+    SLOT_ADD(j, thread_id, rays, rays);
     if (j->prof)
         fv_prof_span(j->prof, thread_id, thread_id, "tile", tile_t0, fv_time_ns(), index);
 }
@@ -95,7 +109,7 @@ static void run_still(tile_job *j, int index, int thread_id, int x0, int y0, int
     int64_t taa_ns = sv.ns;
     const fv_taa_still_hist *hist = &sv.hist;
     if (shade_ns)
-        atomic_fetch_add_explicit(&slot_of(j, thread_id)->shade_ns, shade_ns, memory_order_relaxed);
+        SLOT_ADD(j, thread_id, shade_ns, shade_ns);
     if (j->aa && !aa)
         fv_taa_aa_clear(j->aa, x0, y0, tw, th);
     const int64_t t0 = fv_time_ns();
@@ -105,7 +119,7 @@ static void run_still(tile_job *j, int index, int thread_id, int x0, int y0, int
         fv_taa_still_tile(j->taa, j->taa_prm, j->smp, j->gx, j->gy, l0, &j->dsp->taa, x0, y0, tw, th, rows, keep,
                           hist);
     const int64_t t1 = fv_time_ns();
-    atomic_fetch_add_explicit(&slot_of(j, thread_id)->taa_ns, taa_ns + (t1 - t0), memory_order_relaxed);
+    SLOT_ADD(j, thread_id, taa_ns, taa_ns + (t1 - t0));
     if (j->prof)
         fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
     tile_end(j, index, thread_id, x0, y0, tw, th, rays, tile_t0);
@@ -151,16 +165,15 @@ static void run_tile(void *ctx, int index, int thread_id)
     int64_t *sp = j->time_shading ? &shade_ns : NULL;
     const long rays = aa ? fv_raycast_tile_at(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows, j->aa->ox, j->aa->oy, sp)
                          : fv_raycast_tile(j->scene, cam, j->dsp, l0, x0, y0, tw, th, rows, sp);
-    tile_slot *ts = slot_of(j, thread_id);
     if (shade_ns)
-        atomic_fetch_add_explicit(&ts->shade_ns, shade_ns, memory_order_relaxed);
+        SLOT_ADD(j, thread_id, shade_ns, shade_ns);
     if (j->aa && !aa)
         fv_taa_aa_clear(j->aa, x0, y0, tw, th);
     if (aa) {
         const int64_t t0 = fv_time_ns();
         fv_taa_aa_tile(j->taa, j->aa, l0, x0, y0, tw, th);
         const int64_t t1 = fv_time_ns();
-        atomic_fetch_add_explicit(&ts->taa_ns, t1 - t0, memory_order_relaxed);
+        SLOT_ADD(j, thread_id, taa_ns, t1 - t0);
         if (j->prof)
             fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
     } else if (j->taa) {
@@ -168,7 +181,7 @@ static void run_tile(void *ctx, int index, int thread_id)
         fv_taa_tile_run_keep(j->taa, j->taa_prm, j->smp, j->gx, j->gy, &j->pyr->lv[0], &j->dsp->taa, x0, y0, tw, th,
                              keep);
         const int64_t t1 = fv_time_ns();
-        atomic_fetch_add_explicit(&ts->taa_ns, t1 - t0, memory_order_relaxed);
+        SLOT_ADD(j, thread_id, taa_ns, t1 - t0);
         if (j->prof)
             fv_prof_span(j->prof, thread_id, thread_id, "reproject", t0, t1, index);
     }

@@ -4,6 +4,7 @@
 #include <immintrin.h>
 
 #include "pullpush_dsp.h"
+#include "x86/pull_tail.h"
 
 static inline __m256i pair_idx(int k) /* lanes 0-3 <- element 2k, lanes 4-7 <- element 2k+1 */
 {
@@ -55,9 +56,7 @@ static void pull_row_avx2(float *restrict dst_rgbd, float *restrict dst_wgt, con
         _mm256_storeu_ps(dst_rgbd + 4 * x, divmask(s01, sw01));
         _mm256_storeu_ps(dst_rgbd + 4 * x + 8, divmask(s23, sw23));
     }
-    if (x < n)
-        fv_pull_row_c(dst_rgbd + 4 * x, dst_wgt + x, src0_rgbd + 8 * x, src0_wgt + 2 * x, src1_rgbd + 8 * x,
-                      src1_wgt + 2 * x, n - x);
+    pull_tail_sse(dst_rgbd, dst_wgt, src0_rgbd, src0_wgt, src1_rgbd, src1_wgt, x, n);
 }
 
 /* v = near + 1/4 (far - near) for two coarse pixels */

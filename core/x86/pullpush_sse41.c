@@ -3,6 +3,7 @@
 #include <smmintrin.h>
 
 #include "pullpush_dsp.h"
+#include "x86/pull_tail.h"
 
 #define BCAST(v, i) _mm_shuffle_ps((v), (v), _MM_SHUFFLE((i), (i), (i), (i)))
 
@@ -43,9 +44,7 @@ static void pull_row_sse41(float *restrict dst_rgbd, float *restrict dst_wgt, co
         _mm_storeu_ps(o + 12, pull_px(a + 24, b + 24, BCAST(wah, 2), BCAST(wah, 3), BCAST(wbh, 2),
                                       BCAST(wbh, 3), BCAST(sw, 3)));
     }
-    if (x < n)
-        fv_pull_row_c(dst_rgbd + 4 * x, dst_wgt + x, src0_rgbd + 8 * x, src0_wgt + 2 * x, src1_rgbd + 8 * x,
-                      src1_wgt + 2 * x, n - x);
+    pull_tail_sse(dst_rgbd, dst_wgt, src0_rgbd, src0_wgt, src1_rgbd, src1_wgt, x, n);
 }
 
 /* v = near + 1/4 (far - near) */
