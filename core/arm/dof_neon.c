@@ -398,8 +398,22 @@ static void periph_row_neon(float *restrict out, const float *sharp, const float
         fv_dof_periph_row_c(out, sharp, coc, half, lnear, x, x0 + n - x);
 }
 
+/* 4 texels a step: vpaddq gives the reference's pair sums in order (a0+a1 a2+a3 b0+b1 b2+b3) */
+static void hcoc_row_neon(float *restrict hc, const float *ca, const float *cb, int n)
+{
+    int u = 0;
+    for (; u + 4 <= n; u += 4) {
+        const float32x4_t a = vpaddq_f32(vabsq_f32(vld1q_f32(ca + 2 * u)), vabsq_f32(vld1q_f32(ca + 2 * u + 4)));
+        const float32x4_t b = vpaddq_f32(vabsq_f32(vld1q_f32(cb + 2 * u)), vabsq_f32(vld1q_f32(cb + 2 * u + 4)));
+        vst1q_f32(hc + u, vmulq_n_f32(vaddq_f32(a, b), 0.25f));
+    }
+    if (u < n)
+        fv_dof_hcoc_row_c(hc + u, ca + 2 * u, cb + 2 * u, n - u);
+}
+
 void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
+    d->dof_hcoc_row = hcoc_row_neon;
     d->dof_periph_row = periph_row_neon;
     d->dof_nearbox_row = nearbox_row_neon;
     d->dof_nearblk_row = nearblk_row_neon;

@@ -58,6 +58,11 @@ struct fv_dof_pyrblur_args;
  *   several pixels at once and keep each by selects on these conditions (they may read, never use,
  *   lnear at near pixels): same bits. */
 #define FV_DOF_L1_SLOPE (3.0f / 44.0f)
+/* dof_hcoc_row: the half-resolution periphery's CoC, for u in [0, n):
+ *   hc[u] = 0.25 ((|ca[2u]| + |ca[2u+1]|) + (|cb[2u]| + |cb[2u+1]|)) (ca, cb: two CoC rows; the
+ *   mean |c| of a level-1 texel's 2x2 pixels, in that order of additions). ca, cb hold 2n
+ *   floats. */
+typedef void (*fv_dof_hcoc_row_fn)(float *restrict hc, const float *ca, const float *cb, int n);
 typedef void (*fv_dof_periph_row_fn)(float *restrict out, const float *sharp, const float *coc, const float *half,
                                      const float *lnear, int x0, int n);
 typedef void (*fv_dof_nearblk_row_fn)(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd,
@@ -91,6 +96,7 @@ typedef struct fv_dof_dsp {
     fv_dof_nearblk_row_fn dof_nearblk_row;
     fv_dof_nearbox_row_fn dof_nearbox_row;
     fv_dof_periph_row_fn dof_periph_row;
+    fv_dof_hcoc_row_fn dof_hcoc_row;
 } fv_dof_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -112,6 +118,7 @@ void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *res
                           const float *r, const float *wgt, int w, int x0, int n, int reach);
 void fv_dof_periph_row_c(float *restrict out, const float *sharp, const float *coc, const float *half,
                          const float *lnear, int x0, int n);
+void fv_dof_hcoc_row_c(float *restrict hc, const float *ca, const float *cb, int n);
 #if defined(__x86_64__)
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d);
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d);

@@ -192,6 +192,12 @@ void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *res
     }
 }
 
+void fv_dof_hcoc_row_c(float *restrict hc, const float *ca, const float *cb, int n)
+{
+    for (int u = 0; u < n; u++)
+        hc[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
+}
+
 void fv_dof_periph_row_c(float *restrict out, const float *sharp, const float *coc, const float *half,
                          const float *lnear, int x0, int n)
 {
@@ -231,6 +237,7 @@ void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
     d->dof_nearblk_row = fv_dof_nearblk_row_c;
     d->dof_nearbox_row = fv_dof_nearbox_row_c;
     d->dof_periph_row = fv_dof_periph_row_c;
+    d->dof_hcoc_row = fv_dof_hcoc_row_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_dof_dsp_init_sse41(d);

@@ -57,8 +57,7 @@ void fvw_coc_band(void *ctx, int band, int tid)
             const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
             float *ch = x->hcoc + (ptrdiff_t)vy * x->hw;
             const int uw = x->w / 2; /* texels with two columns */
-            for (int u = 0; u < uw; u++)
-                ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
+            x->dsp->dof_hcoc_row(ch, ca, cb, uw);
             for (int u = uw; u < x->hw; u++)
                 ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u])));
         }

@@ -58,8 +58,28 @@ static void periph_row_sse41(float *restrict out, const float *sharp, const floa
     dof_periph_row_x86(out, sharp, coc, half, lnear, x0, n);
 }
 
+/* 4 texels a step: the pair sums as even + odd lanes (a0 + a1, ..., the reference's additions; a
+ * float add commutes bit for bit; shuffles are cheaper than hadd); |x| by clearing the sign bit,
+ * exact like fabsf */
+static inline __m128 hcoc_pairs(const float *c, __m128 abs)
+{
+    const __m128 a = _mm_and_ps(_mm_loadu_ps(c), abs), b = _mm_and_ps(_mm_loadu_ps(c + 4), abs);
+    return _mm_add_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)), _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+}
+
+static void hcoc_row_sse41(float *restrict hc, const float *ca, const float *cb, int n)
+{
+    const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), q = _mm_set1_ps(0.25f);
+    int u = 0;
+    for (; u + 4 <= n; u += 4)
+        _mm_storeu_ps(hc + u, _mm_mul_ps(q, _mm_add_ps(hcoc_pairs(ca + 2 * u, abs), hcoc_pairs(cb + 2 * u, abs))));
+    if (u < n)
+        fv_dof_hcoc_row_c(hc + u, ca + 2 * u, cb + 2 * u, n - u);
+}
+
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d)
 {
+    d->dof_hcoc_row = hcoc_row_sse41;
     d->dof_periph_row = periph_row_sse41;
     d->dof_nearbox_row = nearbox_row_sse41;
     d->dof_nearblk_row = nearblk_row_sse41;

@@ -265,6 +265,14 @@ static void nearblk_run(void *st, const checkasm_dsp *d, int row0, int rows)
                                t->rgbd + 4 * y * W, W);
     }
 }
+static void hcoc_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) { /* one level-1 row from two CoC rows, as core/dof/weier_coc.c */
+        const size_t v = (size_t)((row0 + k) % (H / 2));
+        d->dof.dof_hcoc_row(t->t + v * (W / 2), t->coc + 2 * v * W, t->coc + (2 * v + 1) * W, W / 2);
+    }
+}
 static void nearbox_reset(void *st) /* radii (t) and box weights (c4) from the CoC, as core/dof/weier_filter.c */
 {
     dof_st *t = st;
@@ -614,6 +622,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"dof_coc_row", "1280x1440, 1440 rows", {F(dof.dof_coc_row), 0}, H, dof_setup, NULL, coc_run, dof_free},
     {"dof_nearblk_row", "1280x1440, 1440 rows, 4x4 blocks", {F(dof.dof_nearblk_row), 0}, H, dof_setup, NULL,
      nearblk_run, dof_free},
+    {"dof_hcoc_row", "1280x1440 -> 640x720, 720 rows", {F(dof.dof_hcoc_row), 0}, H / 2, dof_setup, NULL, hcoc_run,
+     dof_free},
     {"dof_nearbox_row", "1280x1440, 1440 rows, reach 3", {F(dof.dof_nearbox_row), 0}, H, dof_setup, nearbox_reset,
      nearbox_run, dof_free},
     {"dof_hgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_hgauss_row), 0}, H, dof_setup, NULL,

@@ -71,7 +71,7 @@ static void run_all(const char *kernel, runner fn, size_t member)
 /* ------------------------------------------------------------------ tables */
 
 static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row",
-                                     "dof_nearblk_row", "dof_nearbox_row", "dof_periph_row"};
+                                     "dof_nearblk_row", "dof_nearbox_row", "dof_periph_row", "dof_hcoc_row"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -91,6 +91,7 @@ static void test_tables(void **state)
     assert_true(ref.dof_nearblk_row == fv_dof_nearblk_row_c);
     assert_true(ref.dof_nearbox_row == fv_dof_nearbox_row_c);
     assert_true(ref.dof_periph_row == fv_dof_periph_row_c);
+    assert_true(ref.dof_hcoc_row == fv_dof_hcoc_row_c);
     CHECKASM_CHECK_ISA_TABLES("dof", fv_dof_dsp, &ref, names);
 }
 
@@ -684,6 +685,43 @@ static void test_periph_row(void **state)
     assert_true(pr_blend > 1000 && pr_near > 1000);
 }
 
+/* ------------------------------------------------------------------ hcoc_row */
+
+/* Two CoC rows of 2n floats in exact-size buffers (an over-read shows under ASan): both signs,
+ * signed zeros, tiny and large values; bit for bit (the same additions in the same order; |x| is
+ * exact). Also a hand-computed case against the formula. */
+static void run_hcoc(const fv_dof_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 42; n++)
+        for (int rep = 0; rep < 6; rep++) {
+            const int nn = n <= 40 ? n : n == 41 ? 640 : 641, off = rndi(4);
+            buf ca = buf_new(2 * (size_t)nn, off), cb = buf_new(2 * (size_t)nn, off);
+            for (int i = 0; i < 2 * nn; i++) {
+                static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, 0.125f, -64.0f, 1e6f, -3.9f};
+                ca.p[i] = rndi(4) == 0 ? ext[rndi(9)] : 40.0f * rnd() - 20.0f;
+                cb.p[i] = rndi(4) == 0 ? ext[rndi(9)] : 40.0f * rnd() - 20.0f;
+            }
+            buf r = checkasm_out_f32((size_t)nn, off), t = checkasm_out_f32((size_t)nn, off);
+            fv_dof_hcoc_row_c(r.p, ca.p, cb.p, nn);
+            d->dof_hcoc_row(t.p, ca.p, cb.p, nn);
+            compare_out(&r, &t, (size_t)nn, 1, isa, "hcoc_row", "half-resolution CoC + canaries");
+            free(ca.base), free(cb.base), free(r.base), free(t.base);
+        }
+    /* (|-1| + |2|) + (|-0.5| + |4.5|) = 8, / 4 = 2, for 9 texels (a vector step and a tail) */
+    float a[18], b[18], o[9];
+    for (int i = 0; i < 9; i++)
+        a[2 * i] = -1.0f, a[2 * i + 1] = 2.0f, b[2 * i] = -0.5f, b[2 * i + 1] = 4.5f;
+    d->dof_hcoc_row(o, a, b, 9);
+    for (int i = 0; i < 9; i++)
+        assert_true(o[i] == 2.0f);
+}
+
+static void test_hcoc_row(void **state)
+{
+    (void)state;
+    run_all("dof_hcoc_row", run_hcoc, offsetof(fv_dof_dsp, dof_hcoc_row));
+}
+
 const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_gauss_tab),
@@ -696,5 +734,6 @@ const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_nearblk_row),
     cmocka_unit_test(test_nearbox_row),
     cmocka_unit_test(test_periph_row),
+    cmocka_unit_test(test_hcoc_row),
     {0},
 };
