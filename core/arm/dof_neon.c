@@ -422,15 +422,16 @@ static void nearfin_row_neon(float *restrict rad, float *restrict rb, float *res
     int i = 0;
     for (; i + 4 <= n; i += 4) {
         const float32x4x2_t e = vld2q_f32(ext + 2 * i);
-        float32x4x4_t s = vld4q_f32(sum + 4 * i);
+        const float32x4x4_t s = vld4q_f32(sum + 4 * i);
         const float32x4_t r = vminq_f32(vrndmq_f32(vmulq_n_f32(vnegq_f32(e.val[0]), 0.5f)), rmax);
         const float32x4_t b = vbslq_f32(vcgtq_f32(s.val[3], zero), vrndmq_f32(vmulq_n_f32(r, 0.25f)), m1);
         vst1q_f32(rad + i, r);
         vst1q_f32(rb + i, b);
         vst1q_f32(wgt + i, vdivq_f32(one, vaddq_f32(vmulq_n_f32(vmaxq_f32(b, zero), 2.0f), one)));
-        for (int k = 0; k < 4; k++)
-            s.val[k] = vmulq_n_f32(s.val[k], inv);
-        vst4q_f32(sum + 4 * i, s);
+        /* the four written out: a loop over s.val makes gcc spill s to the stack */
+        const float32x4x4_t m = {{vmulq_n_f32(s.val[0], inv), vmulq_n_f32(s.val[1], inv), vmulq_n_f32(s.val[2], inv),
+                                  vmulq_n_f32(s.val[3], inv)}};
+        vst4q_f32(sum + 4 * i, m);
     }
     if (i < n)
         fv_dof_nearfin_row_c(rad + i, rb + i, wgt + i, sum + 4 * i, ext + 2 * i, n - i, inv);
