@@ -490,18 +490,22 @@ static void nearbox_row_avx2(float *restrict out, float *restrict out_r, float *
     }
 }
 
-/* 8 texels a step: hadd gives the reference's pair sums per 128-bit half (a0+a1 a2+a3 b0+b1 b2+b3 |
- * a4+a5 a6+a7 b4+b5 b6+b7 with a, b the two 8-float loads), the 64-bit permute puts them in order */
+/* 8 texels a step: the pair sums as even + odd lanes per 128-bit half (a0+a1 a2+a3 b0+b1 b2+b3 |
+ * a4+a5 a6+a7 b4+b5 b6+b7 with a, b the two 8-float loads: the reference's additions; shuffles
+ * are cheaper than hadd), the 64-bit permute puts them in order */
+static inline __m256 hcoc_pairs8(const float *c, __m256 abs)
+{
+    const __m256 a = _mm256_and_ps(_mm256_loadu_ps(c), abs), b = _mm256_and_ps(_mm256_loadu_ps(c + 8), abs);
+    return _mm256_add_ps(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)),
+                         _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+}
+
 static void hcoc_row_avx2(float *restrict hc, const float *ca, const float *cb, int n)
 {
     const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), q = _mm256_set1_ps(0.25f);
     int u = 0;
     for (; u + 8 <= n; u += 8) {
-        const __m256 a = _mm256_hadd_ps(_mm256_and_ps(_mm256_loadu_ps(ca + 2 * u), abs),
-                                        _mm256_and_ps(_mm256_loadu_ps(ca + 2 * u + 8), abs));
-        const __m256 b = _mm256_hadd_ps(_mm256_and_ps(_mm256_loadu_ps(cb + 2 * u), abs),
-                                        _mm256_and_ps(_mm256_loadu_ps(cb + 2 * u + 8), abs));
-        const __m256 s = _mm256_mul_ps(q, _mm256_add_ps(a, b));
+        const __m256 s = _mm256_mul_ps(q, _mm256_add_ps(hcoc_pairs8(ca + 2 * u, abs), hcoc_pairs8(cb + 2 * u, abs)));
         _mm256_storeu_ps(hc + u, _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(s), _MM_SHUFFLE(3, 1, 2, 0))));
     }
     if (u < n)
