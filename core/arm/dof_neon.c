@@ -398,8 +398,49 @@ static void periph_row_neon(float *restrict out, const float *sharp, const float
         fv_dof_periph_row_c(out, sharp, coc, half, lnear, x, x0 + n - x);
 }
 
+/* 4 texels a step: vpaddq gives the reference's pair sums in order (a0+a1 a2+a3 b0+b1 b2+b3) */
+static void hcoc_row_neon(float *restrict hc, const float *ca, const float *cb, int n)
+{
+    int u = 0;
+    for (; u + 4 <= n; u += 4) {
+        const float32x4_t a = vpaddq_f32(vabsq_f32(vld1q_f32(ca + 2 * u)), vabsq_f32(vld1q_f32(ca + 2 * u + 4)));
+        const float32x4_t b = vpaddq_f32(vabsq_f32(vld1q_f32(cb + 2 * u)), vabsq_f32(vld1q_f32(cb + 2 * u + 4)));
+        vst1q_f32(hc + u, vmulq_n_f32(vaddq_f32(a, b), 0.25f));
+    }
+    if (u < n)
+        fv_dof_hcoc_row_c(hc + u, ca + 2 * u, cb + 2 * u, n - u);
+}
+
+/* 4 blocks a step: LD2 splits ext into min / max, LD4 the sums into channels (the count is lane
+ * 3); floor by FRINTM; FMIN / FMAX give the reference's selects on these values (whole numbers
+ * and -0: max(-0, +0) is +0, as the reference's select); true division */
+static void nearfin_row_neon(float *restrict rad, float *restrict rb, float *restrict wgt, float *restrict sum,
+                             const float *ext, int n, float inv)
+{
+    const float32x4_t rmax = vdupq_n_f32((float)FV_DOF_RMAX), zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f);
+    const float32x4_t m1 = vdupq_n_f32(-1.0f);
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const float32x4x2_t e = vld2q_f32(ext + 2 * i);
+        const float32x4x4_t s = vld4q_f32(sum + 4 * i);
+        const float32x4_t r = vminq_f32(vrndmq_f32(vmulq_n_f32(vnegq_f32(e.val[0]), 0.5f)), rmax);
+        const float32x4_t b = vbslq_f32(vcgtq_f32(s.val[3], zero), vrndmq_f32(vmulq_n_f32(r, 0.25f)), m1);
+        vst1q_f32(rad + i, r);
+        vst1q_f32(rb + i, b);
+        vst1q_f32(wgt + i, vdivq_f32(one, vaddq_f32(vmulq_n_f32(vmaxq_f32(b, zero), 2.0f), one)));
+        /* the four written out: a loop over s.val makes gcc spill s to the stack */
+        const float32x4x4_t m = {{vmulq_n_f32(s.val[0], inv), vmulq_n_f32(s.val[1], inv), vmulq_n_f32(s.val[2], inv),
+                                  vmulq_n_f32(s.val[3], inv)}};
+        vst4q_f32(sum + 4 * i, m);
+    }
+    if (i < n)
+        fv_dof_nearfin_row_c(rad + i, rb + i, wgt + i, sum + 4 * i, ext + 2 * i, n - i, inv);
+}
+
 void fv_dof_dsp_init_neon(fv_dof_dsp *d)
 {
+    d->dof_nearfin_row = nearfin_row_neon;
+    d->dof_hcoc_row = hcoc_row_neon;
     d->dof_periph_row = periph_row_neon;
     d->dof_nearbox_row = nearbox_row_neon;
     d->dof_nearblk_row = nearblk_row_neon;

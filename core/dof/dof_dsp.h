@@ -58,6 +58,18 @@ struct fv_dof_pyrblur_args;
  *   several pixels at once and keep each by selects on these conditions (they may read, never use,
  *   lnear at near pixels): same bits. */
 #define FV_DOF_L1_SLOPE (3.0f / 44.0f)
+/* dof_hcoc_row: the half-resolution periphery's CoC, for u in [0, n):
+ *   hc[u] = 0.25 ((|ca[2u]| + |ca[2u+1]|) + (|cb[2u]| + |cb[2u+1]|)) (ca, cb: two CoC rows; the
+ *   mean |c| of a level-1 texel's 2x2 pixels, in that order of additions). ca, cb hold 2n
+ *   floats. */
+typedef void (*fv_dof_hcoc_row_fn)(float *restrict hc, const float *ca, const float *cb, int n);
+/* dof_nearfin_row: the CoC pass's per-block finish of a block row (after dof_nearblk_row's 4 rows),
+ *   for i in [0, n): r = floor(-ext[2i] 0.5), r = r < FV_DOF_RMAX ? r : FV_DOF_RMAX (the block's
+ *   largest near radius, capped); rad[i] = r; rb[i] = sum[4i+3] > 0 ? floor(r / 4) : -1 (the
+ *   radius in whole blocks, -1: no near pixel); wgt[i] = 1 / (2 (rb[i] > 0 ? rb[i] : 0) + 1);
+ *   sum[4i..4i+3] *= inv (the block's mean). ext finite. */
+typedef void (*fv_dof_nearfin_row_fn)(float *restrict rad, float *restrict rb, float *restrict wgt,
+                                      float *restrict sum, const float *ext, int n, float inv);
 typedef void (*fv_dof_periph_row_fn)(float *restrict out, const float *sharp, const float *coc, const float *half,
                                      const float *lnear, int x0, int n);
 typedef void (*fv_dof_nearblk_row_fn)(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd,
@@ -91,6 +103,8 @@ typedef struct fv_dof_dsp {
     fv_dof_nearblk_row_fn dof_nearblk_row;
     fv_dof_nearbox_row_fn dof_nearbox_row;
     fv_dof_periph_row_fn dof_periph_row;
+    fv_dof_hcoc_row_fn dof_hcoc_row;
+    fv_dof_nearfin_row_fn dof_nearfin_row;
 } fv_dof_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -112,6 +126,9 @@ void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *res
                           const float *r, const float *wgt, int w, int x0, int n, int reach);
 void fv_dof_periph_row_c(float *restrict out, const float *sharp, const float *coc, const float *half,
                          const float *lnear, int x0, int n);
+void fv_dof_hcoc_row_c(float *restrict hc, const float *ca, const float *cb, int n);
+void fv_dof_nearfin_row_c(float *restrict rad, float *restrict rb, float *restrict wgt, float *restrict sum,
+                          const float *ext, int n, float inv);
 #if defined(__x86_64__)
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d);
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d);

@@ -192,6 +192,26 @@ void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *res
     }
 }
 
+void fv_dof_hcoc_row_c(float *restrict hc, const float *ca, const float *cb, int n)
+{
+    for (int u = 0; u < n; u++)
+        hc[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
+}
+
+void fv_dof_nearfin_row_c(float *restrict rad, float *restrict rb, float *restrict wgt, float *restrict sum,
+                          const float *ext, int n, float inv)
+{
+    for (int i = 0; i < n; i++) {
+        float r = floorf(-ext[2 * i] * 0.5f);
+        r = r < (float)FV_DOF_RMAX ? r : (float)FV_DOF_RMAX;
+        const float b = sum[4 * i + 3] > 0.0f ? floorf(r / 4.0f) : -1.0f;
+        rad[i] = r, rb[i] = b;
+        wgt[i] = 1.0f / (2.0f * (b > 0.0f ? b : 0.0f) + 1.0f);
+        for (int k = 0; k < 4; k++)
+            sum[4 * i + k] *= inv;
+    }
+}
+
 void fv_dof_periph_row_c(float *restrict out, const float *sharp, const float *coc, const float *half,
                          const float *lnear, int x0, int n)
 {
@@ -231,6 +251,8 @@ void fv_dof_dsp_init(fv_dof_dsp *d, unsigned isa_mask)
     d->dof_nearblk_row = fv_dof_nearblk_row_c;
     d->dof_nearbox_row = fv_dof_nearbox_row_c;
     d->dof_periph_row = fv_dof_periph_row_c;
+    d->dof_hcoc_row = fv_dof_hcoc_row_c;
+    d->dof_nearfin_row = fv_dof_nearfin_row_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_dof_dsp_init_sse41(d);

@@ -19,7 +19,7 @@ void fvw_coc_band(void *ctx, int band, int tid)
      * (dof_nearblk_row), the smallest and largest c (ext: the largest near radius, the largest
      * far c) */
     const float inv_blk = 1.0f / (LOW * LOW);
-    float *ext = fvw_slot(x, tid, 0);
+    float *ext = fvw_slot(x, tid, 0); /* 2 lw floats, then lw of near radii (the slot holds 4 w) */
     for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
         float *src = x->l_src + 4 * (ptrdiff_t)by * x->lw;
         memset(src, 0, (size_t)x->lw * 4 * sizeof(float));
@@ -35,20 +35,20 @@ void fvw_coc_band(void *ctx, int band, int tid)
             const int xa = i * LOW;
             if (src[4 * i + 3] < full_h * (float)(fv_mini(xa + LOW, x->w) - xa))
                 nlo = nlo < i ? nlo : i, nhi = i + 1;
-            float r = floorf(-ext[2 * i] * 0.5f); /* the largest near radius in pixels, capped */
-            r = r < (float)FV_DOF_RMAX ? r : (float)FV_DOF_RMAX;
+        }
+        /* per block the largest near radius (capped), the radius in whole blocks (the up-sampling
+         * adds about one; -1: no near pixel), its box weight and the mean colour */
+        float *rad = ext + 2 * x->lw;
+        x->dsp->dof_nearfin_row(rad, x->l_r + (ptrdiff_t)by * x->lw, x->l_w + (ptrdiff_t)by * x->lw, src, ext, x->lw,
+                                inv_blk);
+        for (int i = 0; i < x->lw; i++) {
+            const int xa = i * LOW;
             /* the tile's largest near radius and far c (first block of the tile in the band: reset) */
             float *tn = &x->t_near_own[band * x->tw + xa / TILE], *tf = &x->t_fsig_own[band * x->tw + xa / TILE];
             if (by == y0 / LOW && xa % TILE == 0)
                 *tn = 0.0f, *tf = 0.0f;
-            *tn = r > *tn ? r : *tn;
+            *tn = rad[i] > *tn ? rad[i] : *tn;
             *tf = ext[2 * i + 1] > *tf ? ext[2 * i + 1] : *tf;
-            /* radius in whole blocks (the up-sampling adds about one); -1: no near pixel */
-            const float rb = src[4 * i + 3] > 0.0f ? floorf(r / LOW) : -1.0f;
-            x->l_r[(ptrdiff_t)by * x->lw + i] = rb;
-            x->l_w[(ptrdiff_t)by * x->lw + i] = 1.0f / (2.0f * (rb > 0.0f ? rb : 0.0f) + 1.0f);
-            for (int k = 0; k < 4; k++)
-                src[4 * i + k] *= inv_blk;
         }
         x->l_nn[2 * by] = nlo, x->l_nn[2 * by + 1] = nhi;
         /* the half-resolution periphery's CoC while the block row is in cache: per level-1 texel
@@ -57,8 +57,7 @@ void fvw_coc_band(void *ctx, int band, int tid)
             const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
             float *ch = x->hcoc + (ptrdiff_t)vy * x->hw;
             const int uw = x->w / 2; /* texels with two columns */
-            for (int u = 0; u < uw; u++)
-                ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u + 1])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u + 1])));
+            x->dsp->dof_hcoc_row(ch, ca, cb, uw);
             for (int u = uw; u < x->hw; u++)
                 ch[u] = 0.25f * ((fabsf(ca[2 * u]) + fabsf(ca[2 * u])) + (fabsf(cb[2 * u]) + fabsf(cb[2 * u])));
         }

@@ -490,8 +490,70 @@ static void nearbox_row_avx2(float *restrict out, float *restrict out_r, float *
     }
 }
 
+/* 8 texels a step: the pair sums as even + odd lanes per 128-bit half (a0+a1 a2+a3 b0+b1 b2+b3 |
+ * a4+a5 a6+a7 b4+b5 b6+b7 with a, b the two 8-float loads: the reference's additions; shuffles
+ * are cheaper than hadd), the 64-bit permute puts them in order */
+static inline __m256 hcoc_pairs8(const float *c, __m256 abs)
+{
+    const __m256 a = _mm256_and_ps(_mm256_loadu_ps(c), abs), b = _mm256_and_ps(_mm256_loadu_ps(c + 8), abs);
+    return _mm256_add_ps(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)),
+                         _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+}
+
+static void hcoc_row_avx2(float *restrict hc, const float *ca, const float *cb, int n)
+{
+    const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), q = _mm256_set1_ps(0.25f);
+    int u = 0;
+    for (; u + 8 <= n; u += 8) {
+        const __m256 s = _mm256_mul_ps(q, _mm256_add_ps(hcoc_pairs8(ca + 2 * u, abs), hcoc_pairs8(cb + 2 * u, abs)));
+        _mm256_storeu_ps(hc + u, _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(s), _MM_SHUFFLE(3, 1, 2, 0))));
+    }
+    if (u < n)
+        fv_dof_hcoc_row_c(hc + u, ca + 2 * u, cb + 2 * u, n - u);
+}
+
+/* 8 blocks a step, as the SSE4.1 version (core/x86/dof_sse41.c); the shuffles work per 128-bit
+ * half, the permutes put the blocks in order */
+static void nearfin_row_avx2(float *restrict rad, float *restrict rb, float *restrict wgt, float *restrict sum,
+                             const float *ext, int n, float inv)
+{
+    const __m256 half = _mm256_set1_ps(0.5f), rmax = _mm256_set1_ps((float)FV_DOF_RMAX), q = _mm256_set1_ps(0.25f);
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+    const __m256 m1 = _mm256_set1_ps(-1.0f), vinv = _mm256_set1_ps(inv), sgn = _mm256_set1_ps(-0.0f);
+    const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+    int i = 0;
+    for (; i + 8 <= n; i += 8) {
+        /* (b0 b1 b4 b5 | b2 b3 b6 b7) -> in order by 64-bit pieces */
+        const __m256 e2 = _mm256_shuffle_ps(_mm256_loadu_ps(ext + 2 * i), _mm256_loadu_ps(ext + 2 * i + 8),
+                                            _MM_SHUFFLE(2, 0, 2, 0));
+        const __m256 e = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(e2), _MM_SHUFFLE(3, 1, 2, 0)));
+        float *s = sum + 4 * i;
+        const __m256 s0 = _mm256_loadu_ps(s), s1 = _mm256_loadu_ps(s + 8), s2 = _mm256_loadu_ps(s + 16),
+                     s3 = _mm256_loadu_ps(s + 24);
+        /* counts: (b0 b2 b4 b6 | b1 b3 b5 b7), then in order */
+        const __m256 c2 = _mm256_shuffle_ps(_mm256_shuffle_ps(s0, s1, _MM_SHUFFLE(3, 3, 3, 3)),
+                                            _mm256_shuffle_ps(s2, s3, _MM_SHUFFLE(3, 3, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
+        const __m256 cnt = _mm256_permutevar8x32_ps(c2, order);
+        /* -e 0.5 as the reference: the sign flipped exactly, then the multiply; r / 4 = r 0.25
+         * exactly (r is a whole number or -0) */
+        const __m256 r = _mm256_min_ps(_mm256_floor_ps(_mm256_mul_ps(_mm256_xor_ps(e, sgn), half)), rmax);
+        const __m256 b = _mm256_blendv_ps(m1, _mm256_floor_ps(_mm256_mul_ps(r, q)), _mm256_cmp_ps(cnt, zero, _CMP_GT_OQ));
+        _mm256_storeu_ps(rad + i, r);
+        _mm256_storeu_ps(rb + i, b);
+        _mm256_storeu_ps(wgt + i, _mm256_div_ps(one, _mm256_add_ps(_mm256_mul_ps(two, _mm256_max_ps(b, zero)), one)));
+        _mm256_storeu_ps(s, _mm256_mul_ps(s0, vinv));
+        _mm256_storeu_ps(s + 8, _mm256_mul_ps(s1, vinv));
+        _mm256_storeu_ps(s + 16, _mm256_mul_ps(s2, vinv));
+        _mm256_storeu_ps(s + 24, _mm256_mul_ps(s3, vinv));
+    }
+    if (i < n)
+        fv_dof_nearfin_row_c(rad + i, rb + i, wgt + i, sum + 4 * i, ext + 2 * i, n - i, inv);
+}
+
 void fv_dof_dsp_init_avx2(fv_dof_dsp *d)
 {
+    d->dof_hcoc_row = hcoc_row_avx2;
+    d->dof_nearfin_row = nearfin_row_avx2;
     d->dof_periph_row = periph_row_avx2;
     d->dof_nearbox_row = nearbox_row_avx2;
     d->dof_nearblk_row = nearblk_row_avx2;

@@ -58,8 +58,60 @@ static void periph_row_sse41(float *restrict out, const float *sharp, const floa
     dof_periph_row_x86(out, sharp, coc, half, lnear, x0, n);
 }
 
+/* 4 texels a step: the pair sums as even + odd lanes (a0 + a1, ..., the reference's additions; a
+ * float add commutes bit for bit; shuffles are cheaper than hadd); |x| by clearing the sign bit,
+ * exact like fabsf */
+static inline __m128 hcoc_pairs(const float *c, __m128 abs)
+{
+    const __m128 a = _mm_and_ps(_mm_loadu_ps(c), abs), b = _mm_and_ps(_mm_loadu_ps(c + 4), abs);
+    return _mm_add_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)), _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+}
+
+static void hcoc_row_sse41(float *restrict hc, const float *ca, const float *cb, int n)
+{
+    const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), q = _mm_set1_ps(0.25f);
+    int u = 0;
+    for (; u + 4 <= n; u += 4)
+        _mm_storeu_ps(hc + u, _mm_mul_ps(q, _mm_add_ps(hcoc_pairs(ca + 2 * u, abs), hcoc_pairs(cb + 2 * u, abs))));
+    if (u < n)
+        fv_dof_hcoc_row_c(hc + u, ca + 2 * u, cb + 2 * u, n - u);
+}
+
+/* 4 blocks a step: the blocks' min CoC (even lanes of ext) and counts (lane 3 of each sum) by
+ * shuffles; floor by roundps, the caps and selects as the reference's (min/max_ps return the
+ * second operand where the compare is false, the reference's choice), true division */
+static void nearfin_row_sse41(float *restrict rad, float *restrict rb, float *restrict wgt, float *restrict sum,
+                              const float *ext, int n, float inv)
+{
+    const __m128 half = _mm_set1_ps(0.5f), rmax = _mm_set1_ps((float)FV_DOF_RMAX), q = _mm_set1_ps(0.25f);
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f), m1 = _mm_set1_ps(-1.0f);
+    const __m128 vinv = _mm_set1_ps(inv), sgn = _mm_set1_ps(-0.0f);
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const __m128 e = _mm_shuffle_ps(_mm_loadu_ps(ext + 2 * i), _mm_loadu_ps(ext + 2 * i + 4), _MM_SHUFFLE(2, 0, 2, 0));
+        float *s = sum + 4 * i;
+        const __m128 s0 = _mm_loadu_ps(s), s1 = _mm_loadu_ps(s + 4), s2 = _mm_loadu_ps(s + 8), s3 = _mm_loadu_ps(s + 12);
+        const __m128 cnt = _mm_shuffle_ps(_mm_shuffle_ps(s0, s1, _MM_SHUFFLE(3, 3, 3, 3)),
+                                          _mm_shuffle_ps(s2, s3, _MM_SHUFFLE(3, 3, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
+        /* -e 0.5 as the reference: the sign flipped exactly, then the multiply */
+        const __m128 r = _mm_min_ps(_mm_floor_ps(_mm_mul_ps(_mm_xor_ps(e, sgn), half)), rmax);
+        const __m128 b = _mm_blendv_ps(m1, _mm_floor_ps(_mm_mul_ps(r, q)), _mm_cmpgt_ps(cnt, zero));
+        _mm_storeu_ps(rad + i, r);
+        _mm_storeu_ps(rb + i, b);
+        _mm_storeu_ps(wgt + i, _mm_div_ps(one, _mm_add_ps(_mm_mul_ps(two, _mm_max_ps(b, zero)), one)));
+        _mm_storeu_ps(s, _mm_mul_ps(s0, vinv));
+        _mm_storeu_ps(s + 4, _mm_mul_ps(s1, vinv));
+        _mm_storeu_ps(s + 8, _mm_mul_ps(s2, vinv));
+        _mm_storeu_ps(s + 12, _mm_mul_ps(s3, vinv));
+    }
+    if (i < n)
+        fv_dof_nearfin_row_c(rad + i, rb + i, wgt + i, sum + 4 * i, ext + 2 * i, n - i, inv);
+}
+
 void fv_dof_dsp_init_sse41(fv_dof_dsp *d)
 {
+    d->dof_nearfin_row = nearfin_row_sse41;
+    d->dof_hcoc_row = hcoc_row_sse41;
     d->dof_periph_row = periph_row_sse41;
     d->dof_nearbox_row = nearbox_row_sse41;
     d->dof_nearblk_row = nearblk_row_sse41;

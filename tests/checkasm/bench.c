@@ -265,6 +265,25 @@ static void nearblk_run(void *st, const checkasm_dsp *d, int row0, int rows)
                                t->rgbd + 4 * y * W, W);
     }
 }
+static void hcoc_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) { /* one level-1 row from two CoC rows, as core/dof/weier_coc.c */
+        /* rows in cache, as there (the CoC pass has just written them): a whole plane would time
+         * the memory */
+        const size_t v = (size_t)((row0 + k) % 4);
+        d->dof.dof_hcoc_row(t->t + v * (W / 2), t->coc + 2 * v * W, t->coc + (2 * v + 1) * W, W / 2);
+    }
+}
+static void nearfin_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) { /* a block row (320 blocks): near sums in a4, min / max c in coc */
+        const size_t v = (size_t)((row0 + k) % (H / 4));
+        d->dof.dof_nearfin_row(t->t + v * W, t->t + v * W + W / 4, t->t + v * W + W / 2, t->a4 + 4 * v * (W / 4),
+                               t->coc + v * (W / 2), W / 4, 1.0f); /* 1: the sums stay as they are, rep after rep */
+    }
+}
 static void nearbox_reset(void *st) /* radii (t) and box weights (c4) from the CoC, as core/dof/weier_filter.c */
 {
     dof_st *t = st;
@@ -614,6 +633,10 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"dof_coc_row", "1280x1440, 1440 rows", {F(dof.dof_coc_row), 0}, H, dof_setup, NULL, coc_run, dof_free},
     {"dof_nearblk_row", "1280x1440, 1440 rows, 4x4 blocks", {F(dof.dof_nearblk_row), 0}, H, dof_setup, NULL,
      nearblk_run, dof_free},
+    {"dof_hcoc_row", "1280-px rows in cache, 720 out", {F(dof.dof_hcoc_row), 0}, H / 2, dof_setup, NULL, hcoc_run,
+     dof_free},
+    {"dof_nearfin_row", "1280x1440, 360 rows of 4x4 blocks", {F(dof.dof_nearfin_row), 0}, H / 4, dof_setup, NULL,
+     nearfin_run, dof_free},
     {"dof_nearbox_row", "1280x1440, 1440 rows, reach 3", {F(dof.dof_nearbox_row), 0}, H, dof_setup, nearbox_reset,
      nearbox_run, dof_free},
     {"dof_hgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_hgauss_row), 0}, H, dof_setup, NULL,

@@ -71,7 +71,8 @@ static void run_all(const char *kernel, runner fn, size_t member)
 /* ------------------------------------------------------------------ tables */
 
 static const char *const names[] = {"dof_coc_row", "dof_hgauss_row", "dof_vgauss_row", "dof_combine_row", "dof_upsample_row", "dof_pyrblur_row",
-                                     "dof_nearblk_row", "dof_nearbox_row", "dof_periph_row"};
+                                     "dof_nearblk_row", "dof_nearbox_row", "dof_periph_row", "dof_hcoc_row",
+                                     "dof_nearfin_row"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -91,6 +92,8 @@ static void test_tables(void **state)
     assert_true(ref.dof_nearblk_row == fv_dof_nearblk_row_c);
     assert_true(ref.dof_nearbox_row == fv_dof_nearbox_row_c);
     assert_true(ref.dof_periph_row == fv_dof_periph_row_c);
+    assert_true(ref.dof_hcoc_row == fv_dof_hcoc_row_c);
+    assert_true(ref.dof_nearfin_row == fv_dof_nearfin_row_c);
     CHECKASM_CHECK_ISA_TABLES("dof", fv_dof_dsp, &ref, names);
 }
 
@@ -684,6 +687,97 @@ static void test_periph_row(void **state)
     assert_true(pr_blend > 1000 && pr_near > 1000);
 }
 
+/* ------------------------------------------------------------------ hcoc_row */
+
+/* Two CoC rows of 2n floats in exact-size buffers (an over-read shows under ASan): both signs,
+ * signed zeros, tiny and large values; bit for bit (the same additions in the same order; |x| is
+ * exact). Also a hand-computed case against the formula. */
+static void run_hcoc(const fv_dof_dsp *d, const char *isa)
+{
+    for (int n = 1; n <= 42; n++)
+        for (int rep = 0; rep < 6; rep++) {
+            const int nn = n <= 40 ? n : n == 41 ? 640 : 641, off = rndi(4);
+            buf ca = buf_new(2 * (size_t)nn, off), cb = buf_new(2 * (size_t)nn, off);
+            for (int i = 0; i < 2 * nn; i++) {
+                static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, 0.125f, -64.0f, 1e6f, -3.9f};
+                ca.p[i] = rndi(4) == 0 ? ext[rndi(9)] : 40.0f * rnd() - 20.0f;
+                cb.p[i] = rndi(4) == 0 ? ext[rndi(9)] : 40.0f * rnd() - 20.0f;
+            }
+            buf r = checkasm_out_f32((size_t)nn, off), t = checkasm_out_f32((size_t)nn, off);
+            fv_dof_hcoc_row_c(r.p, ca.p, cb.p, nn);
+            d->dof_hcoc_row(t.p, ca.p, cb.p, nn);
+            compare_out(&r, &t, (size_t)nn, 1, isa, "hcoc_row", "half-resolution CoC + canaries");
+            free(ca.base), free(cb.base), free(r.base), free(t.base);
+        }
+    /* (|-1| + |2|) + (|-0.5| + |4.5|) = 8, / 4 = 2, for 9 texels (a vector step and a tail) */
+    float a[18], b[18], o[9];
+    for (int i = 0; i < 9; i++)
+        a[2 * i] = -1.0f, a[2 * i + 1] = 2.0f, b[2 * i] = -0.5f, b[2 * i + 1] = 4.5f;
+    d->dof_hcoc_row(o, a, b, 9);
+    for (int i = 0; i < 9; i++)
+        assert_true(o[i] == 2.0f);
+}
+
+static void test_hcoc_row(void **state)
+{
+    (void)state;
+    run_all("dof_hcoc_row", run_hcoc, offsetof(fv_dof_dsp, dof_hcoc_row));
+}
+
+/* ------------------------------------------------------------------ nearfin_row */
+
+/* Block rows of n blocks in exact-size buffers: min CoC (ext even) +0 (nearblk's zero), negative
+ * (near: radii below, at and above the cap, fractions, whole and odd multiples of 2 and 8 px),
+ * positive (no near pixel), tiny; counts 0, fractions, whole; sums and radii bit for bit (so the
+ * -0 radius of a block whose min is +0 counts). Also a hand-computed block. */
+static void run_nearfin(const fv_dof_dsp *d, const char *isa)
+{
+    static const float emin[] = {0.0f, -1e-30f, 1e-30f, -0.5f, -2.0f, -3.9f, -8.0f, -9.9f, -16.0f, -48.0f, -49.5f,
+                                 -50.0f, -200.0f, 3.0f, -1e6f};
+    for (int n = 1; n <= 42; n++)
+        for (int rep = 0; rep < 6; rep++) {
+            const int nn = n <= 40 ? n : n == 41 ? 320 : 321, off = rndi(4);
+            buf ext = buf_new(2 * (size_t)nn, off), s0 = buf_new(4 * (size_t)nn, off);
+            for (int i = 0; i < nn; i++) {
+                ext.p[2 * i] = rndi(3) == 0 ? emin[rndi((int)(sizeof emin / sizeof emin[0]))] : -60.0f * rnd() + 4.0f;
+                ext.p[2 * i + 1] = 20.0f * rnd() - 2.0f;
+                for (int k = 0; k < 3; k++)
+                    s0.p[4 * i + k] = colour();
+                s0.p[4 * i + 3] = rndi(3) == 0 ? 0.0f : rndi(2) ? (float)(1 + rndi(16)) : 16.0f * rnd();
+            }
+            buf rs = checkasm_out_f32(4 * (size_t)nn, off), ts = checkasm_out_f32(4 * (size_t)nn, off);
+            memcpy(rs.p, s0.p, 4 * (size_t)nn * sizeof(float)), memcpy(ts.p, s0.p, 4 * (size_t)nn * sizeof(float));
+            buf rr = checkasm_out_f32((size_t)nn, off), tr = checkasm_out_f32((size_t)nn, off);
+            buf rb = checkasm_out_f32((size_t)nn, off), tb = checkasm_out_f32((size_t)nn, off);
+            buf rw = checkasm_out_f32((size_t)nn, off), tw = checkasm_out_f32((size_t)nn, off);
+            const float inv = rndi(2) ? 1.0f / 16.0f : 1.0f / 12.0f;
+            fv_dof_nearfin_row_c(rr.p, rb.p, rw.p, rs.p, ext.p, nn, inv);
+            d->dof_nearfin_row(tr.p, tb.p, tw.p, ts.p, ext.p, nn, inv);
+            compare_out(&rs, &ts, 4 * (size_t)nn, 4, isa, "nearfin_row", "block means + canaries");
+            compare_out(&rr, &tr, (size_t)nn, 1, isa, "nearfin_row", "near radius + canaries");
+            compare_out(&rb, &tb, (size_t)nn, 1, isa, "nearfin_row", "radius in blocks + canaries");
+            compare_out(&rw, &tw, (size_t)nn, 1, isa, "nearfin_row", "box weight + canaries");
+            free(ext.base), free(s0.base), free(rs.base), free(ts.base), free(rr.base), free(tr.base);
+            free(rb.base), free(tb.base), free(rw.base), free(tw.base);
+        }
+    /* min c -19 px: radius floor(9.5) = 9, 2 blocks, weight 1/5; a count of 8: mean = sum / 16;
+     * 5 blocks (a vector step of 4 and a tail) */
+    float e[10], s[20], r[5], b[5], w[5];
+    for (int i = 0; i < 5; i++) {
+        e[2 * i] = -19.0f, e[2 * i + 1] = 1.0f;
+        s[4 * i] = 4.0f, s[4 * i + 1] = 2.0f, s[4 * i + 2] = 1.0f, s[4 * i + 3] = 8.0f;
+    }
+    d->dof_nearfin_row(r, b, w, s, e, 5, 1.0f / 16.0f);
+    for (int i = 0; i < 5; i++)
+        assert_true(r[i] == 9.0f && b[i] == 2.0f && w[i] == 1.0f / 5.0f && s[4 * i] == 0.25f && s[4 * i + 3] == 0.5f);
+}
+
+static void test_nearfin_row(void **state)
+{
+    (void)state;
+    run_all("dof_nearfin_row", run_nearfin, offsetof(fv_dof_dsp, dof_nearfin_row));
+}
+
 const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_gauss_tab),
@@ -696,5 +790,7 @@ const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_nearblk_row),
     cmocka_unit_test(test_nearbox_row),
     cmocka_unit_test(test_periph_row),
+    cmocka_unit_test(test_hcoc_row),
+    cmocka_unit_test(test_nearfin_row),
     {0},
 };
