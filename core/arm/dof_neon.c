@@ -14,6 +14,8 @@
  * it. The values read for those extra taps lie in the rows / columns the call covers and must be
  * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
 #include <arm_neon.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "dof/weier_impl.h"
 #include "base/util.h"
@@ -99,37 +101,83 @@ static void hgauss_row_neon(float *restrict dst, const float *rgbd, const float 
     }
 }
 
+/* Four output pixels, each its own sigma, to the block's largest radius. of: the taps' row offsets. */
+static inline void vg4(float *o, const float *col, const ptrdiff_t *of, const uint8_t *s, const fv_dof_gauss_tab *tab)
+{
+    const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
+    const int R = fv_maxi(fv_maxi(tab->rad[s[0]], tab->rad[s[1]]), fv_maxi(tab->rad[s[2]], tab->rad[s[3]]));
+    float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
+    for (int j = -R; j <= R; j++) {
+        const int k = j < 0 ? -j : j;
+        const float *p = col + of[j];
+        a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
+        a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
+        a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
+        a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
+    }
+    vst1q_f32(o, a0);
+    vst1q_f32(o + 4, a1);
+    vst1q_f32(o + 8, a2);
+    vst1q_f32(o + 12, a3);
+}
+
+/* The taps' row offsets are clamped once a call (the reference clamps per tap and pixel). Eight
+ * pixels of one sigma (the usual case: the far region's CoC varies slowly along a row) share each
+ * tap's weight and offset; mixed blocks run as two blocks of 4. */
 static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
                             int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
 {
+    ptrdiff_t off[2 * FV_DOF_RMAX + 1];
+    int Rm = 0;
+    for (int i = 0; i < n; i++)
+        Rm = fv_maxi(Rm, tab->rad[sig[i]]);
+    for (int j = -Rm; j <= Rm; j++)
+        off[j + Rm] = 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride;
+    const ptrdiff_t *of = off + Rm;
     int i = 0;
-    for (; i + 4 <= n; i += 4) {
+    for (; i + 8 <= n; i += 8) {
         const uint8_t *s = sig + i;
-        const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
-        const int R = fv_maxi(fv_maxi(tab->rad[s[0]], tab->rad[s[1]]), fv_maxi(tab->rad[s[2]], tab->rad[s[3]]));
         const float *col = src + 4 * (ptrdiff_t)(x0 + i);
-        float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
-        for (int j = -R; j <= R; j++) {
-            const int k = j < 0 ? -j : j;
-            const float *p = col + 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride;
-            a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
-            a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
-            a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
-            a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
-        }
         float *o = dst + 4 * (ptrdiff_t)(x0 + i);
+        uint64_t s8;
+        memcpy(&s8, s, 8);
+        if (s8 != s[0] * 0x0101010101010101ull) {
+            vg4(o, col, of, s, tab);
+            vg4(o + 16, col + 16, of, s + 4, tab);
+            continue;
+        }
+        const float *wt = tab->w[s[0]];
+        const int R = tab->rad[s[0]];
+        float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0, a4 = a0, a5 = a0, a6 = a0, a7 = a0;
+        for (int j = -R; j <= R; j++) {
+            const float g = wt[j < 0 ? -j : j];
+            const float *p = col + of[j];
+            a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), g));
+            a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), g));
+            a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), g));
+            a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), g));
+            a4 = vaddq_f32(a4, vmulq_n_f32(vld1q_f32(p + 16), g));
+            a5 = vaddq_f32(a5, vmulq_n_f32(vld1q_f32(p + 20), g));
+            a6 = vaddq_f32(a6, vmulq_n_f32(vld1q_f32(p + 24), g));
+            a7 = vaddq_f32(a7, vmulq_n_f32(vld1q_f32(p + 28), g));
+        }
         vst1q_f32(o, a0);
         vst1q_f32(o + 4, a1);
         vst1q_f32(o + 8, a2);
         vst1q_f32(o + 12, a3);
+        vst1q_f32(o + 16, a4);
+        vst1q_f32(o + 20, a5);
+        vst1q_f32(o + 24, a6);
+        vst1q_f32(o + 28, a7);
     }
+    for (; i + 4 <= n; i += 4)
+        vg4(dst + 4 * (ptrdiff_t)(x0 + i), src + 4 * (ptrdiff_t)(x0 + i), of, sig + i, tab);
     for (; i < n; i++) {
         const float *wt = tab->w[sig[i]], *col = src + 4 * (ptrdiff_t)(x0 + i);
         const int R = tab->rad[sig[i]];
         float32x4_t a = vdupq_n_f32(0.0f);
         for (int j = -R; j <= R; j++)
-            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride),
-                                         wt[j < 0 ? -j : j]));
+            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + of[j]), wt[j < 0 ? -j : j]));
         vst1q_f32(dst + 4 * (ptrdiff_t)(x0 + i), a);
     }
 }
@@ -221,16 +269,6 @@ static void upsample_row_neon(float *restrict dst, const float *tmp, const int32
         vst1q_f32(dst + 4 * x, up1(tmp, i0[x], i1[x], ax[x]));
 }
 
-/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act */
-static inline float32x4_t pb1(float32x4_t b, const float *u0p, const float *u1p, float f, float t, uint32_t mix,
-                              uint32_t act)
-{
-    const float32x4_t u0 = vld1q_f32(u0p), u1 = vld1q_f32(u1p);
-    const float32x4_t pv = vaddq_f32(u0, vmulq_n_f32(vsubq_f32(u1, u0), f));
-    const float32x4_t r = sel(vdupq_n_u32(mix), vaddq_f32(b, vmulq_n_f32(vsubq_f32(pv, b), t)), pv);
-    return sel(vdupq_n_u32(act), r, b);
-}
-
 /* 4 pixels at a time: their scalars as lanes, then one pixel a vector, each kept by selects (a
  * pixel the reference skips gets its own bits back). The LUT index: the reference's
  * min((int)(m steps), max) is, for m steps in [0, 2^31), (int) of min(m steps, max) (max an
@@ -254,25 +292,32 @@ static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a,
         float32x4_t v = vmulq_n_f32(m, steps);
         v = sel(vcgtq_f32(v, zero), v, zero); /* NaN -> 0 */
         v = sel(vcltq_f32(v, lmax), v, lmax);
-        int32_t li[4], L0[4], L1[4];
-        uint32_t mk[4], ak[4];
-        float fk[4], tk[4];
+        int32_t li[4];
         vst1q_s32(li, vcvtq_s32_f32(v));
         const float32_t lv[4] = {a->lambda[li[0]], a->lambda[li[1]], a->lambda[li[2]], a->lambda[li[3]]};
         float32x4_t l = vld1q_f32(lv);
         l = sel(vcltq_f32(l, need), l, need); /* l < need ? l : need */
         const int32x4_t l0 = vcvtq_s32_f32(l);
-        vst1q_f32(fk, vsubq_f32(l, vcvtq_f32_s32(l0)));
-        vst1q_s32(L0, l0);
-        vst1q_s32(L1, vsubq_s32(l0, vreinterpretq_s32_u32(vcltq_s32(l0, needi)))); /* + 1 where L0 < need */
-        vst1q_u32(mk, vandq_u32(vcgtq_f32(c, zero), vcltq_f32(t, one)));
-        vst1q_u32(ak, act);
-        vst1q_f32(tk, t);
-        for (int k = 0; k < 4; k++) {
-            const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
-            float *b = blur + o;
-            vst1q_f32(b, pb1(vld1q_f32(b), up[L0[k]] + o, up[L1[k]] + o, fk[k], tk[k], mk[k], ak[k]));
-        }
+        const float32x4_t f = vsubq_f32(l, vcvtq_f32_s32(l0));
+        const int32x4_t l1 = vsubq_s32(l0, vreinterpretq_s32_u32(vcltq_s32(l0, needi))); /* + 1 where L0 < need */
+        const uint32x4_t mix = vandq_u32(vcgtq_f32(c, zero), vcltq_f32(t, one));
+        /* pixel k: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act. Written out
+         * per lane (lane operands straight from the vectors: a loop over k made gcc store them to
+         * the stack and reload them one by one) */
+#define PB1(k)                                                                                                    \
+    do {                                                                                                          \
+        const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);                                                               \
+        const float32x4_t b = vld1q_f32(blur + o);                                                                \
+        const float32x4_t u0 = vld1q_f32(up[vgetq_lane_s32(l0, k)] + o), u1 = vld1q_f32(up[vgetq_lane_s32(l1, k)] + o); \
+        const float32x4_t pv = vaddq_f32(u0, vmulq_laneq_f32(vsubq_f32(u1, u0), f, k));                          \
+        const float32x4_t r = sel(vdupq_laneq_u32(mix, k), vaddq_f32(b, vmulq_laneq_f32(vsubq_f32(pv, b), t, k)), pv); \
+        vst1q_f32(blur + o, sel(vdupq_laneq_u32(act, k), r, b));                                                 \
+    } while (0)
+        PB1(0);
+        PB1(1);
+        PB1(2);
+        PB1(3);
+#undef PB1
     }
     if (i < x0 + n)
         fv_dof_pyrblur_row_c(blur, a, i, x0 + n - i);
