@@ -277,38 +277,44 @@ static void upsample_row_neon(float *restrict dst, const float *tmp, const int32
  * >= 0): a skipped pixel's loads stay in the rows up[0..need] at the call's pixels. */
 static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
+    /* the rows L0 and L1 = L0 < need ? L0 + 1 : L0 by L0 (L1 without vector work) */
+    const float *up0[8], *up1[8];
+    if (a->need > 7) {
+        fv_dof_pyrblur_row_c(blur, a, x0, n);
+        return;
+    }
+    for (int L = 0; L <= a->need; L++)
+        up0[L] = a->up[L], up1[L] = a->up[L < a->need ? L + 1 : L];
     const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f), lmax = vdupq_n_f32((float)a->lambda_max);
     const float32x4_t need = vdupq_n_f32((float)a->need);
-    const int32x4_t needi = vdupq_n_s32(a->need);
     const float steps = (float)a->lambda_steps;
-    const float *const *up = a->up;
+    const float *const coc = a->coc, *const tr = a->t, *const lambda = a->lambda;
     int i = x0;
     for (; i + 4 <= x0 + n; i += 4) {
-        const float32x4_t c = vld1q_f32(a->coc + i), t = vld1q_f32(a->t + i);
+        const float32x4_t c = vld1q_f32(coc + i), t = vld1q_f32(tr + i);
         const float32x4_t m = vabsq_f32(c); /* -0 -> +0: skipped either way */
         const uint32x4_t act = vandq_u32(vcgtq_f32(m, zero), vcgtq_f32(t, zero));
         if (!vmaxvq_u32(act))
             continue;
-        float32x4_t v = vmulq_n_f32(m, steps);
-        v = sel(vcgtq_f32(v, zero), v, zero); /* NaN -> 0 */
-        v = sel(vcltq_f32(v, lmax), v, lmax);
-        int32_t li[4];
-        vst1q_s32(li, vcvtq_s32_f32(v));
-        const float32_t lv[4] = {a->lambda[li[0]], a->lambda[li[1]], a->lambda[li[2]], a->lambda[li[3]]};
-        float32x4_t l = vld1q_f32(lv);
+        /* m steps >= +0 or NaN: FMAXNM makes NaN 0 (as the select v > 0 ? v : 0), then FMIN */
+        const uint32x4_t li = vcvtq_u32_f32(vminq_f32(vmaxnmq_f32(vmulq_n_f32(m, steps), zero), lmax));
+        float32x4_t l = vld1q_dup_f32(lambda + vgetq_lane_u32(li, 0));
+        l = vld1q_lane_f32(lambda + vgetq_lane_u32(li, 1), l, 1);
+        l = vld1q_lane_f32(lambda + vgetq_lane_u32(li, 2), l, 2);
+        l = vld1q_lane_f32(lambda + vgetq_lane_u32(li, 3), l, 3);
         l = sel(vcltq_f32(l, need), l, need); /* l < need ? l : need */
         const int32x4_t l0 = vcvtq_s32_f32(l);
         const float32x4_t f = vsubq_f32(l, vcvtq_f32_s32(l0));
-        const int32x4_t l1 = vsubq_s32(l0, vreinterpretq_s32_u32(vcltq_s32(l0, needi))); /* + 1 where L0 < need */
         const uint32x4_t mix = vandq_u32(vcgtq_f32(c, zero), vcltq_f32(t, one));
         /* pixel k: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act. Written out
          * per lane (lane operands straight from the vectors: a loop over k made gcc store them to
-         * the stack and reload them one by one) */
+         * the stack and reload them one by one; channel vectors by LD4 to lanes made it spill the
+         * structs: 1.81x) */
 #define PB1(k)                                                                                                    \
     do {                                                                                                          \
         const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);                                                               \
-        const float32x4_t b = vld1q_f32(blur + o);                                                                \
-        const float32x4_t u0 = vld1q_f32(up[vgetq_lane_s32(l0, k)] + o), u1 = vld1q_f32(up[vgetq_lane_s32(l1, k)] + o); \
+        const uint32_t L0 = vgetq_lane_u32(vreinterpretq_u32_s32(l0), k); /* >= 0: no sign extension */      \
+        const float32x4_t b = vld1q_f32(blur + o), u0 = vld1q_f32(up0[L0] + o), u1 = vld1q_f32(up1[L0] + o);         \
         const float32x4_t pv = vaddq_f32(u0, vmulq_laneq_f32(vsubq_f32(u1, u0), f, k));                          \
         const float32x4_t r = sel(vdupq_laneq_u32(mix, k), vaddq_f32(b, vmulq_laneq_f32(vsubq_f32(pv, b), t, k)), pv); \
         vst1q_f32(blur + o, sel(vdupq_laneq_u32(act, k), r, b));                                                 \
