@@ -194,12 +194,18 @@ static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float32x4_t s)
  * bits; the skipped step may read and compute garbage, which the select drops). */
 static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {
+    /* the arguments in locals (stores to out may alias *a as far as the compiler knows) and the
+     * channels as named vectors, every per-channel step written out: arrays of vectors or a
+     * float32x4x4_t indexed in a loop made gcc keep them on the stack (1.59x) */
+    const float *const sharp = a->sharp, *const coc = a->coc, *const tr = a->t, *const farp = a->far;
+    const float *const nearp = a->near, *const lnear = a->lnear, *const enh = a->enh;
+    const float gain = a->gain;
     const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f);
     int x = x0;
     for (; x + 4 <= x0 + n; x += 4) {
-        const float32x4x4_t s = vld4q_f32(a->sharp + 4 * x);
-        float32x4_t o[3] = {s.val[0], s.val[1], s.val[2]};
-        const float32x4_t c = vld1q_f32(a->coc + x), t = vld1q_f32(a->t + x);
+        const float32x4x4_t s = vld4q_f32(sharp + 4 * x);
+        float32x4_t o0 = s.val[0], o1 = s.val[1], o2 = s.val[2];
+        const float32x4_t c = vld1q_f32(coc + x), t = vld1q_f32(tr + x);
         const uint32x4_t cneg = vcltq_f32(c, zero), tp = vcgtq_f32(t, zero);
         /* towards the pixel's own blur by ab = c > 0 ? min(c, 1) : c < 0 && t > 0 ? t min(-c, 1) : 0 */
         const float32x4_t nc = vnegq_f32(c);
@@ -207,39 +213,48 @@ static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, 
         const float32x4_t ab = sel(vcgtq_f32(c, zero), sel(vcltq_f32(c, one), c, one), abn);
         const uint32x4_t far = vcgtq_f32(ab, zero);
         if (vmaxvq_u32(far)) {
-            const float32x4x4_t f = vld4q_f32(a->far + 4 * x);
-            for (int k = 0; k < 3; k++)
-                o[k] = sel(far, lerp(o[k], f.val[k], ab), o[k]);
+            const float32x4x4_t f = vld4q_f32(farp + 4 * x);
+            const float32x4_t f0 = f.val[0], f1 = f.val[1], f2 = f.val[2];
+            o0 = sel(far, lerp(o0, f0, ab), o0);
+            o1 = sel(far, lerp(o1, f1, ab), o1);
+            o2 = sel(far, lerp(o2, f2, ab), o2);
         }
-        float32x4x4_t nv = {{zero, zero, zero, zero}};
-        if (a->near)
-            nv = vld4q_f32(a->near + 4 * x);
-        if (a->lnear && vmaxvq_u32(tp)) {
+        float32x4_t n0 = zero, n1 = zero, n2 = zero, n3 = zero;
+        if (nearp) {
+            const float32x4x4_t q = vld4q_f32(nearp + 4 * x);
+            n0 = q.val[0], n1 = q.val[1], n2 = q.val[2], n3 = q.val[3];
+        }
+        if (lnear && vmaxvq_u32(tp)) {
             const float32x4_t sc = sel(cneg, zero, one); /* c < 0 ? 0 : 1 */
-            const float32x4x4_t q = vld4q_f32(a->lnear + 4 * x);
-            for (int k = 0; k < 4; k++)
-                nv.val[k] = sel(tp, vaddq_f32(nv.val[k], vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q.val[k]), nv.val[k]))),
-                                nv.val[k]);
+            const float32x4x4_t q = vld4q_f32(lnear + 4 * x);
+            const float32x4_t q0 = q.val[0], q1 = q.val[1], q2 = q.val[2], q3 = q.val[3];
+            n0 = sel(tp, vaddq_f32(n0, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q0), n0))), n0);
+            n1 = sel(tp, vaddq_f32(n1, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q1), n1))), n1);
+            n2 = sel(tp, vaddq_f32(n2, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q2), n2))), n2);
+            n3 = sel(tp, vaddq_f32(n3, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q3), n3))), n3);
         }
-        const float32x4_t n3 = nv.val[3];
         const uint32x4_t pos = vcgtq_f32(n3, zero);
         if (vmaxvq_u32(pos)) {
             const float32x4_t cov = sel(vcltq_f32(n3, one), n3, one);
-            for (int k = 0; k < 3; k++)
-                o[k] = sel(pos, lerp(o[k], vdivq_f32(nv.val[k], n3), cov), o[k]);
+            o0 = sel(pos, lerp(o0, vdivq_f32(n0, n3), cov), o0);
+            o1 = sel(pos, lerp(o1, vdivq_f32(n1, n3), cov), o1);
+            o2 = sel(pos, lerp(o2, vdivq_f32(n2, n3), cov), o2);
         }
-        if (a->enh) {
-            const float32x4_t g = vmulq_n_f32(t, a->gain);
+        if (enh) {
+            const float32x4_t g = vmulq_n_f32(t, gain);
             const uint32x4_t gp = vcgtq_f32(g, zero);
             if (vmaxvq_u32(gp)) {
-                const float32x4x4_t b = vld4q_f32(a->enh + 4 * x);
-                for (int k = 0; k < 3; k++) {
-                    const float32x4_t v = vaddq_f32(o[k], vmulq_f32(g, vsubq_f32(o[k], b.val[k])));
-                    o[k] = sel(gp, sel(vcgtq_f32(v, zero), v, zero), o[k]); /* v > 0 ? v : +0 */
-                }
+                const float32x4x4_t b = vld4q_f32(enh + 4 * x);
+                const float32x4_t b0 = b.val[0], b1 = b.val[1], b2 = b.val[2];
+                const float32x4_t v0 = vaddq_f32(o0, vmulq_f32(g, vsubq_f32(o0, b0)));
+                const float32x4_t v1 = vaddq_f32(o1, vmulq_f32(g, vsubq_f32(o1, b1)));
+                const float32x4_t v2 = vaddq_f32(o2, vmulq_f32(g, vsubq_f32(o2, b2)));
+                o0 = sel(gp, sel(vcgtq_f32(v0, zero), v0, zero), o0); /* v > 0 ? v : +0 */
+                o1 = sel(gp, sel(vcgtq_f32(v1, zero), v1, zero), o1);
+                o2 = sel(gp, sel(vcgtq_f32(v2, zero), v2, zero), o2);
             }
         }
-        const float32x4x4_t r = {{o[0], o[1], o[2], s.val[3]}};
+        const float32x4x4_t r = {{o0, o1, o2, s.val[3]}};
         vst4q_f32(out + 4 * x, r);
     }
     if (x < x0 + n)
