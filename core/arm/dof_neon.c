@@ -14,6 +14,8 @@
  * it. The values read for those extra taps lie in the rows / columns the call covers and must be
  * finite (they are: level 0 and far_h are finite everywhere the pass reads). */
 #include <arm_neon.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "dof/weier_impl.h"
 #include "base/util.h"
@@ -99,37 +101,83 @@ static void hgauss_row_neon(float *restrict dst, const float *rgbd, const float 
     }
 }
 
+/* Four output pixels, each its own sigma, to the block's largest radius. of: the taps' row offsets. */
+static inline void vg4(float *o, const float *col, const ptrdiff_t *of, const uint8_t *s, const fv_dof_gauss_tab *tab)
+{
+    const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
+    const int R = fv_maxi(fv_maxi(tab->rad[s[0]], tab->rad[s[1]]), fv_maxi(tab->rad[s[2]], tab->rad[s[3]]));
+    float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
+    for (int j = -R; j <= R; j++) {
+        const int k = j < 0 ? -j : j;
+        const float *p = col + of[j];
+        a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
+        a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
+        a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
+        a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
+    }
+    vst1q_f32(o, a0);
+    vst1q_f32(o + 4, a1);
+    vst1q_f32(o + 8, a2);
+    vst1q_f32(o + 12, a3);
+}
+
+/* The taps' row offsets are clamped once a call (the reference clamps per tap and pixel). Eight
+ * pixels of one sigma (the usual case: the far region's CoC varies slowly along a row) share each
+ * tap's weight and offset; mixed blocks run as two blocks of 4. */
 static void vgauss_row_neon(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi,
                             int x0, int n, const uint8_t *sig, const fv_dof_gauss_tab *tab)
 {
+    ptrdiff_t off[2 * FV_DOF_RMAX + 1];
+    int Rm = 0;
+    for (int i = 0; i < n; i++)
+        Rm = fv_maxi(Rm, tab->rad[sig[i]]);
+    for (int j = -Rm; j <= Rm; j++)
+        off[j + Rm] = 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride;
+    const ptrdiff_t *of = off + Rm;
     int i = 0;
-    for (; i + 4 <= n; i += 4) {
+    for (; i + 8 <= n; i += 8) {
         const uint8_t *s = sig + i;
-        const float *w0 = tab->w[s[0]], *w1 = tab->w[s[1]], *w2 = tab->w[s[2]], *w3 = tab->w[s[3]];
-        const int R = fv_maxi(fv_maxi(tab->rad[s[0]], tab->rad[s[1]]), fv_maxi(tab->rad[s[2]], tab->rad[s[3]]));
         const float *col = src + 4 * (ptrdiff_t)(x0 + i);
-        float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0;
-        for (int j = -R; j <= R; j++) {
-            const int k = j < 0 ? -j : j;
-            const float *p = col + 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride;
-            a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), w0[k]));
-            a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), w1[k]));
-            a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), w2[k]));
-            a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), w3[k]));
-        }
         float *o = dst + 4 * (ptrdiff_t)(x0 + i);
+        uint64_t s8;
+        memcpy(&s8, s, 8);
+        if (s8 != s[0] * 0x0101010101010101ull) {
+            vg4(o, col, of, s, tab);
+            vg4(o + 16, col + 16, of, s + 4, tab);
+            continue;
+        }
+        const float *wt = tab->w[s[0]];
+        const int R = tab->rad[s[0]];
+        float32x4_t a0 = vdupq_n_f32(0.0f), a1 = a0, a2 = a0, a3 = a0, a4 = a0, a5 = a0, a6 = a0, a7 = a0;
+        for (int j = -R; j <= R; j++) {
+            const float g = wt[j < 0 ? -j : j];
+            const float *p = col + of[j];
+            a0 = vaddq_f32(a0, vmulq_n_f32(vld1q_f32(p), g));
+            a1 = vaddq_f32(a1, vmulq_n_f32(vld1q_f32(p + 4), g));
+            a2 = vaddq_f32(a2, vmulq_n_f32(vld1q_f32(p + 8), g));
+            a3 = vaddq_f32(a3, vmulq_n_f32(vld1q_f32(p + 12), g));
+            a4 = vaddq_f32(a4, vmulq_n_f32(vld1q_f32(p + 16), g));
+            a5 = vaddq_f32(a5, vmulq_n_f32(vld1q_f32(p + 20), g));
+            a6 = vaddq_f32(a6, vmulq_n_f32(vld1q_f32(p + 24), g));
+            a7 = vaddq_f32(a7, vmulq_n_f32(vld1q_f32(p + 28), g));
+        }
         vst1q_f32(o, a0);
         vst1q_f32(o + 4, a1);
         vst1q_f32(o + 8, a2);
         vst1q_f32(o + 12, a3);
+        vst1q_f32(o + 16, a4);
+        vst1q_f32(o + 20, a5);
+        vst1q_f32(o + 24, a6);
+        vst1q_f32(o + 28, a7);
     }
+    for (; i + 4 <= n; i += 4)
+        vg4(dst + 4 * (ptrdiff_t)(x0 + i), src + 4 * (ptrdiff_t)(x0 + i), of, sig + i, tab);
     for (; i < n; i++) {
         const float *wt = tab->w[sig[i]], *col = src + 4 * (ptrdiff_t)(x0 + i);
         const int R = tab->rad[sig[i]];
         float32x4_t a = vdupq_n_f32(0.0f);
         for (int j = -R; j <= R; j++)
-            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + 4 * (ptrdiff_t)fv_clampi(y + j, ylo, yhi - 1) * stride),
-                                         wt[j < 0 ? -j : j]));
+            a = vaddq_f32(a, vmulq_n_f32(vld1q_f32(col + of[j]), wt[j < 0 ? -j : j]));
         vst1q_f32(dst + 4 * (ptrdiff_t)(x0 + i), a);
     }
 }
@@ -146,12 +194,18 @@ static inline float32x4_t lerp(float32x4_t a, float32x4_t b, float32x4_t s)
  * bits; the skipped step may read and compute garbage, which the select drops). */
 static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, int x0, int n)
 {
+    /* the arguments in locals (stores to out may alias *a as far as the compiler knows) and the
+     * channels as named vectors, every per-channel step written out: arrays of vectors or a
+     * float32x4x4_t indexed in a loop made gcc keep them on the stack (1.59x) */
+    const float *const sharp = a->sharp, *const coc = a->coc, *const tr = a->t, *const farp = a->far;
+    const float *const nearp = a->near, *const lnear = a->lnear, *const enh = a->enh;
+    const float gain = a->gain;
     const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f);
     int x = x0;
     for (; x + 4 <= x0 + n; x += 4) {
-        const float32x4x4_t s = vld4q_f32(a->sharp + 4 * x);
-        float32x4_t o[3] = {s.val[0], s.val[1], s.val[2]};
-        const float32x4_t c = vld1q_f32(a->coc + x), t = vld1q_f32(a->t + x);
+        const float32x4x4_t s = vld4q_f32(sharp + 4 * x);
+        float32x4_t o0 = s.val[0], o1 = s.val[1], o2 = s.val[2];
+        const float32x4_t c = vld1q_f32(coc + x), t = vld1q_f32(tr + x);
         const uint32x4_t cneg = vcltq_f32(c, zero), tp = vcgtq_f32(t, zero);
         /* towards the pixel's own blur by ab = c > 0 ? min(c, 1) : c < 0 && t > 0 ? t min(-c, 1) : 0 */
         const float32x4_t nc = vnegq_f32(c);
@@ -159,39 +213,48 @@ static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, 
         const float32x4_t ab = sel(vcgtq_f32(c, zero), sel(vcltq_f32(c, one), c, one), abn);
         const uint32x4_t far = vcgtq_f32(ab, zero);
         if (vmaxvq_u32(far)) {
-            const float32x4x4_t f = vld4q_f32(a->far + 4 * x);
-            for (int k = 0; k < 3; k++)
-                o[k] = sel(far, lerp(o[k], f.val[k], ab), o[k]);
+            const float32x4x4_t f = vld4q_f32(farp + 4 * x);
+            const float32x4_t f0 = f.val[0], f1 = f.val[1], f2 = f.val[2];
+            o0 = sel(far, lerp(o0, f0, ab), o0);
+            o1 = sel(far, lerp(o1, f1, ab), o1);
+            o2 = sel(far, lerp(o2, f2, ab), o2);
         }
-        float32x4x4_t nv = {{zero, zero, zero, zero}};
-        if (a->near)
-            nv = vld4q_f32(a->near + 4 * x);
-        if (a->lnear && vmaxvq_u32(tp)) {
+        float32x4_t n0 = zero, n1 = zero, n2 = zero, n3 = zero;
+        if (nearp) {
+            const float32x4x4_t q = vld4q_f32(nearp + 4 * x);
+            n0 = q.val[0], n1 = q.val[1], n2 = q.val[2], n3 = q.val[3];
+        }
+        if (lnear && vmaxvq_u32(tp)) {
             const float32x4_t sc = sel(cneg, zero, one); /* c < 0 ? 0 : 1 */
-            const float32x4x4_t q = vld4q_f32(a->lnear + 4 * x);
-            for (int k = 0; k < 4; k++)
-                nv.val[k] = sel(tp, vaddq_f32(nv.val[k], vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q.val[k]), nv.val[k]))),
-                                nv.val[k]);
+            const float32x4x4_t q = vld4q_f32(lnear + 4 * x);
+            const float32x4_t q0 = q.val[0], q1 = q.val[1], q2 = q.val[2], q3 = q.val[3];
+            n0 = sel(tp, vaddq_f32(n0, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q0), n0))), n0);
+            n1 = sel(tp, vaddq_f32(n1, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q1), n1))), n1);
+            n2 = sel(tp, vaddq_f32(n2, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q2), n2))), n2);
+            n3 = sel(tp, vaddq_f32(n3, vmulq_f32(t, vsubq_f32(vmulq_f32(sc, q3), n3))), n3);
         }
-        const float32x4_t n3 = nv.val[3];
         const uint32x4_t pos = vcgtq_f32(n3, zero);
         if (vmaxvq_u32(pos)) {
             const float32x4_t cov = sel(vcltq_f32(n3, one), n3, one);
-            for (int k = 0; k < 3; k++)
-                o[k] = sel(pos, lerp(o[k], vdivq_f32(nv.val[k], n3), cov), o[k]);
+            o0 = sel(pos, lerp(o0, vdivq_f32(n0, n3), cov), o0);
+            o1 = sel(pos, lerp(o1, vdivq_f32(n1, n3), cov), o1);
+            o2 = sel(pos, lerp(o2, vdivq_f32(n2, n3), cov), o2);
         }
-        if (a->enh) {
-            const float32x4_t g = vmulq_n_f32(t, a->gain);
+        if (enh) {
+            const float32x4_t g = vmulq_n_f32(t, gain);
             const uint32x4_t gp = vcgtq_f32(g, zero);
             if (vmaxvq_u32(gp)) {
-                const float32x4x4_t b = vld4q_f32(a->enh + 4 * x);
-                for (int k = 0; k < 3; k++) {
-                    const float32x4_t v = vaddq_f32(o[k], vmulq_f32(g, vsubq_f32(o[k], b.val[k])));
-                    o[k] = sel(gp, sel(vcgtq_f32(v, zero), v, zero), o[k]); /* v > 0 ? v : +0 */
-                }
+                const float32x4x4_t b = vld4q_f32(enh + 4 * x);
+                const float32x4_t b0 = b.val[0], b1 = b.val[1], b2 = b.val[2];
+                const float32x4_t v0 = vaddq_f32(o0, vmulq_f32(g, vsubq_f32(o0, b0)));
+                const float32x4_t v1 = vaddq_f32(o1, vmulq_f32(g, vsubq_f32(o1, b1)));
+                const float32x4_t v2 = vaddq_f32(o2, vmulq_f32(g, vsubq_f32(o2, b2)));
+                o0 = sel(gp, sel(vcgtq_f32(v0, zero), v0, zero), o0); /* v > 0 ? v : +0 */
+                o1 = sel(gp, sel(vcgtq_f32(v1, zero), v1, zero), o1);
+                o2 = sel(gp, sel(vcgtq_f32(v2, zero), v2, zero), o2);
             }
         }
-        const float32x4x4_t r = {{o[0], o[1], o[2], s.val[3]}};
+        const float32x4x4_t r = {{o0, o1, o2, s.val[3]}};
         vst4q_f32(out + 4 * x, r);
     }
     if (x < x0 + n)
@@ -221,16 +284,6 @@ static void upsample_row_neon(float *restrict dst, const float *tmp, const int32
         vst1q_f32(dst + 4 * x, up1(tmp, i0[x], i1[x], ax[x]));
 }
 
-/* b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act */
-static inline float32x4_t pb1(float32x4_t b, const float *u0p, const float *u1p, float f, float t, uint32_t mix,
-                              uint32_t act)
-{
-    const float32x4_t u0 = vld1q_f32(u0p), u1 = vld1q_f32(u1p);
-    const float32x4_t pv = vaddq_f32(u0, vmulq_n_f32(vsubq_f32(u1, u0), f));
-    const float32x4_t r = sel(vdupq_n_u32(mix), vaddq_f32(b, vmulq_n_f32(vsubq_f32(pv, b), t)), pv);
-    return sel(vdupq_n_u32(act), r, b);
-}
-
 /* 4 pixels at a time: their scalars as lanes, then one pixel a vector, each kept by selects (a
  * pixel the reference skips gets its own bits back). The LUT index: the reference's
  * min((int)(m steps), max) is, for m steps in [0, 2^31), (int) of min(m steps, max) (max an
@@ -239,40 +292,53 @@ static inline float32x4_t pb1(float32x4_t b, const float *u0p, const float *u1p,
  * >= 0): a skipped pixel's loads stay in the rows up[0..need] at the call's pixels. */
 static void pyrblur_row_neon(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
+    /* the rows L0 and L1 = L0 < need ? L0 + 1 : L0 by L0 (L1 without vector work) */
+    const float *up0[8], *up1[8];
+    if (a->need > 7) {
+        fv_dof_pyrblur_row_c(blur, a, x0, n);
+        return;
+    }
+    for (int L = 0; L <= a->need; L++)
+        up0[L] = a->up[L], up1[L] = a->up[L < a->need ? L + 1 : L];
     const float32x4_t zero = vdupq_n_f32(0.0f), one = vdupq_n_f32(1.0f), lmax = vdupq_n_f32((float)a->lambda_max);
     const float32x4_t need = vdupq_n_f32((float)a->need);
-    const int32x4_t needi = vdupq_n_s32(a->need);
     const float steps = (float)a->lambda_steps;
-    const float *const *up = a->up;
+    const float *const coc = a->coc, *const tr = a->t, *const lambda = a->lambda;
     int i = x0;
     for (; i + 4 <= x0 + n; i += 4) {
-        const float32x4_t c = vld1q_f32(a->coc + i), t = vld1q_f32(a->t + i);
+        const float32x4_t c = vld1q_f32(coc + i), t = vld1q_f32(tr + i);
         const float32x4_t m = vabsq_f32(c); /* -0 -> +0: skipped either way */
         const uint32x4_t act = vandq_u32(vcgtq_f32(m, zero), vcgtq_f32(t, zero));
         if (!vmaxvq_u32(act))
             continue;
-        float32x4_t v = vmulq_n_f32(m, steps);
-        v = sel(vcgtq_f32(v, zero), v, zero); /* NaN -> 0 */
-        v = sel(vcltq_f32(v, lmax), v, lmax);
-        int32_t li[4], L0[4], L1[4];
-        uint32_t mk[4], ak[4];
-        float fk[4], tk[4];
-        vst1q_s32(li, vcvtq_s32_f32(v));
-        const float32_t lv[4] = {a->lambda[li[0]], a->lambda[li[1]], a->lambda[li[2]], a->lambda[li[3]]};
-        float32x4_t l = vld1q_f32(lv);
+        /* m steps >= +0 or NaN: FMAXNM makes NaN 0 (as the select v > 0 ? v : 0), then FMIN */
+        const uint32x4_t li = vcvtq_u32_f32(vminq_f32(vmaxnmq_f32(vmulq_n_f32(m, steps), zero), lmax));
+        float32x4_t l = vld1q_dup_f32(lambda + vgetq_lane_u32(li, 0));
+        l = vld1q_lane_f32(lambda + vgetq_lane_u32(li, 1), l, 1);
+        l = vld1q_lane_f32(lambda + vgetq_lane_u32(li, 2), l, 2);
+        l = vld1q_lane_f32(lambda + vgetq_lane_u32(li, 3), l, 3);
         l = sel(vcltq_f32(l, need), l, need); /* l < need ? l : need */
         const int32x4_t l0 = vcvtq_s32_f32(l);
-        vst1q_f32(fk, vsubq_f32(l, vcvtq_f32_s32(l0)));
-        vst1q_s32(L0, l0);
-        vst1q_s32(L1, vsubq_s32(l0, vreinterpretq_s32_u32(vcltq_s32(l0, needi)))); /* + 1 where L0 < need */
-        vst1q_u32(mk, vandq_u32(vcgtq_f32(c, zero), vcltq_f32(t, one)));
-        vst1q_u32(ak, act);
-        vst1q_f32(tk, t);
-        for (int k = 0; k < 4; k++) {
-            const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
-            float *b = blur + o;
-            vst1q_f32(b, pb1(vld1q_f32(b), up[L0[k]] + o, up[L1[k]] + o, fk[k], tk[k], mk[k], ak[k]));
-        }
+        const float32x4_t f = vsubq_f32(l, vcvtq_f32_s32(l0));
+        const uint32x4_t mix = vandq_u32(vcgtq_f32(c, zero), vcltq_f32(t, one));
+        /* pixel k: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0); kept where act. Written out
+         * per lane (lane operands straight from the vectors: a loop over k made gcc store them to
+         * the stack and reload them one by one; channel vectors by LD4 to lanes made it spill the
+         * structs: 1.81x) */
+#define PB1(k)                                                                                                    \
+    do {                                                                                                          \
+        const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);                                                               \
+        const uint32_t L0 = vgetq_lane_u32(vreinterpretq_u32_s32(l0), k); /* >= 0: no sign extension */      \
+        const float32x4_t b = vld1q_f32(blur + o), u0 = vld1q_f32(up0[L0] + o), u1 = vld1q_f32(up1[L0] + o);         \
+        const float32x4_t pv = vaddq_f32(u0, vmulq_laneq_f32(vsubq_f32(u1, u0), f, k));                          \
+        const float32x4_t r = sel(vdupq_laneq_u32(mix, k), vaddq_f32(b, vmulq_laneq_f32(vsubq_f32(pv, b), t, k)), pv); \
+        vst1q_f32(blur + o, sel(vdupq_laneq_u32(act, k), r, b));                                                 \
+    } while (0)
+        PB1(0);
+        PB1(1);
+        PB1(2);
+        PB1(3);
+#undef PB1
     }
     if (i < x0 + n)
         fv_dof_pyrblur_row_c(blur, a, i, x0 + n - i);

@@ -5,6 +5,7 @@
  * references'. The combine takes 8 pixels at a time without branches (see there); the
  * up-sampling and the periphery's level blend 8 at a time as 4 pixel pairs. */
 #include <immintrin.h>
+#include <string.h>
 
 #define FV_X86_W 8
 #define FV_X86_FN(name) name##_avx2
@@ -80,6 +81,37 @@ static inline void dof_gauss_8(float *d, const float *p, const ptrdiff_t *off, i
     int i = 0;
     for (; i + 8 <= n; i += 8) {
         const uint8_t *s = sig + i;
+        if (i + 16 <= n && !memcmp(s, s + 1, 15)) {
+            /* 16 pixels of one sigma: 8 accumulators, so the adds' latency (4 chains of one
+             * add a tap for 8 pixels) no longer bounds the loop */
+            const float *wt = tab->w[s[0]], *q0 = p + 4 * i;
+            const int R = tab->rad[s[0]];
+            __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0, a4 = a0, a5 = a0, a6 = a0, a7 = a0;
+            for (int j = -R; j <= R; j++) {
+                const float *q = q0 + off[j];
+                const __m256 g = _mm256_broadcast_ss(wt + (j < 0 ? -j : j));
+                a0 = _mm256_add_ps(a0, _mm256_mul_ps(g, _mm256_loadu_ps(q)));
+                a1 = _mm256_add_ps(a1, _mm256_mul_ps(g, _mm256_loadu_ps(q + 8)));
+                a2 = _mm256_add_ps(a2, _mm256_mul_ps(g, _mm256_loadu_ps(q + 16)));
+                a3 = _mm256_add_ps(a3, _mm256_mul_ps(g, _mm256_loadu_ps(q + 24)));
+                a4 = _mm256_add_ps(a4, _mm256_mul_ps(g, _mm256_loadu_ps(q + 32)));
+                a5 = _mm256_add_ps(a5, _mm256_mul_ps(g, _mm256_loadu_ps(q + 40)));
+                a6 = _mm256_add_ps(a6, _mm256_mul_ps(g, _mm256_loadu_ps(q + 48)));
+                a7 = _mm256_add_ps(a7, _mm256_mul_ps(g, _mm256_loadu_ps(q + 56)));
+            }
+            const __m256 inv = _mm256_set1_ps(tab->inv[s[0]]);
+            float *o = d + 4 * i;
+            _mm256_storeu_ps(o, norm ? _mm256_mul_ps(a0, inv) : a0);
+            _mm256_storeu_ps(o + 8, norm ? _mm256_mul_ps(a1, inv) : a1);
+            _mm256_storeu_ps(o + 16, norm ? _mm256_mul_ps(a2, inv) : a2);
+            _mm256_storeu_ps(o + 24, norm ? _mm256_mul_ps(a3, inv) : a3);
+            _mm256_storeu_ps(o + 32, norm ? _mm256_mul_ps(a4, inv) : a4);
+            _mm256_storeu_ps(o + 40, norm ? _mm256_mul_ps(a5, inv) : a5);
+            _mm256_storeu_ps(o + 48, norm ? _mm256_mul_ps(a6, inv) : a6);
+            _mm256_storeu_ps(o + 56, norm ? _mm256_mul_ps(a7, inv) : a7);
+            i += 8; /* and 8 by the loop */
+            continue;
+        }
         const float *const wt[8] = {tab->w[s[0]], tab->w[s[1]], tab->w[s[2]], tab->w[s[3]],
                                     tab->w[s[4]], tab->w[s[5]], tab->w[s[6]], tab->w[s[7]]};
         __m256 a[4];

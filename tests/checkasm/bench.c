@@ -201,6 +201,7 @@ static void taa_run(void *st, const checkasm_dsp *d, int row0, int rows)
 typedef struct {
     float *rgbd, *coc, *a4, *b4, *c4, *out, *t;
     uint8_t *sig;
+    uint8_t *sigr; /* vgauss: sigmas in runs */
     fv_dof_gauss_tab *tab;
     int32_t *i0, *i1; /* up-sampling by 2: taps into a 640-pixel coarse row */
     float *ax, *lambda;
@@ -210,7 +211,7 @@ typedef struct {
 static void dof_free(void *st)
 {
     dof_st *t = st;
-    free(t->rgbd), free(t->coc), free(t->a4), free(t->b4), free(t->c4), free(t->out), free(t->t), free(t->sig);
+    free(t->rgbd), free(t->coc), free(t->a4), free(t->b4), free(t->c4), free(t->out), free(t->t), free(t->sig), free(t->sigr);
     free(t->tab), free(t->i0), free(t->i1), free(t->ax), free(t->lambda), free(t);
 }
 static void *dof_setup(void)
@@ -220,11 +221,11 @@ static void *dof_setup(void)
         return NULL;
     const size_t n = (size_t)W * H;
     t->rgbd = fplane(4 * n), t->coc = fplane(n), t->a4 = fplane(4 * n), t->b4 = fplane(4 * n);
-    t->c4 = fplane(4 * n), t->out = fplane(4 * n), t->t = fplane(n), t->sig = malloc(n);
+    t->c4 = fplane(4 * n), t->out = fplane(4 * n), t->t = fplane(n), t->sig = malloc(n), t->sigr = malloc(n);
     t->tab = malloc(sizeof *t->tab);
     t->i0 = malloc(W * sizeof *t->i0), t->i1 = malloc(W * sizeof *t->i1), t->ax = fplane(W);
     t->lambda = fplane(64 * LSTEPS + 1);
-    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->tab || !t->i0 ||
+    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->sigr || !t->tab || !t->i0 ||
         !t->i1 || !t->ax || !t->lambda)
         return dof_free(t), NULL;
     for (int x = 0; x < W; x++) { /* pixel centres: x = 2 X + 0.5 +- 0.25 */
@@ -245,6 +246,16 @@ static void *dof_setup(void)
         t->coc[i] = frand(&s, -6.0f, 6.0f);
         t->t[i] = frand(&s, -0.5f, 1.0f) < 0.0f ? 0.0f : frand(&s, 0.0f, 1.0f);
         t->sig[i] = (uint8_t)(4 + rnd(&s) % 13); /* sigma 1 .. 4 px */
+    }
+    /* the vertical Gaussian's sigmas as core/dof/weier_filter.c makes them, from a far CoC that
+     * varies slowly along a row (one step of 1/4 px sigma is 1 px of CoC): runs of 8 .. 71 pixels
+     * of one sigma 1 .. 4 px (a sigma per pixel made every 4-pixel block run to its largest
+     * radius, which the pipeline does only at the edges of runs) */
+    for (size_t i = 0; i < n;) {
+        const size_t len = 8 + rnd(&s) % 64;
+        const uint8_t v = (uint8_t)(4 + rnd(&s) % 13);
+        for (size_t k = 0; k < len && i < n; k++, i++)
+            t->sigr[i] = v;
     }
     return t;
 }
@@ -318,7 +329,7 @@ static void vgauss_run(void *st, const checkasm_dsp *d, int row0, int rows)
     for (int k = 0; k < rows; k++) {
         const int y = (row0 + k) % H;
         for (int xs = 0; xs < W; xs += SPAN)
-            d->dof.dof_vgauss_row(t->out + 4 * (size_t)y * W, t->a4, W, y, 0, H, xs, SPAN, t->sig + (size_t)y * W + xs,
+            d->dof.dof_vgauss_row(t->out + 4 * (size_t)y * W, t->a4, W, y, 0, H, xs, SPAN, t->sigr + (size_t)y * W + xs,
                                   t->tab);
     }
 }
@@ -641,7 +652,7 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
      nearbox_run, dof_free},
     {"dof_hgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_hgauss_row), 0}, H, dof_setup, NULL,
      hgauss_run, dof_free},
-    {"dof_vgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4", {F(dof.dof_vgauss_row), 0}, H, dof_setup, NULL,
+    {"dof_vgauss_row", "1280x1440, 10 128-px spans/row, sigma 1-4 in runs of 8-71 px", {F(dof.dof_vgauss_row), 0}, H, dof_setup, NULL,
      vgauss_run, dof_free},
     {"dof_upsample_row", "1280-px rows in cache, 1440, by 2 from 640", {F(dof.dof_upsample_row), 0}, H, dof_setup, NULL,
      upsample_run, dof_free},
