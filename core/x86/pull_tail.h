@@ -20,8 +20,10 @@ static inline void pull_tail_sse(float *restrict dst_rgbd, float *restrict dst_w
     for (; x < n; x++) {
         const float *a = src0_rgbd + 8 * x, *b = src1_rgbd + 8 * x;
         /* lanes 0, 1: the children's weights (8 bytes each row) */
-        const __m128 wa = _mm_castpd_ps(_mm_load_sd((const double *)(src0_wgt + 2 * x)));
-        const __m128 wb = _mm_castpd_ps(_mm_load_sd((const double *)(src1_wgt + 2 * x)));
+        /* (weights are 4-byte aligned only: _mm_loadl_epi64 takes an unaligned 64-bit load, where
+         * _mm_load_sd's double type is undefined behaviour there) */
+        const __m128 wa = _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)(src0_wgt + 2 * x)));
+        const __m128 wb = _mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)(src1_wgt + 2 * x)));
         const __m128 cs = _mm_add_ps(wa, wb);                   /* wa0 + wb0, wa1 + wb1 */
         const __m128 sw = PT_BCAST(_mm_hadd_ps(cs, cs), 0); /* (wa0 + wb0) + (wa1 + wb1) */
         _mm_store_ss(dst_wgt + x, _mm_min_ss(sw, _mm_set1_ps(1.0f)));
