@@ -82,6 +82,30 @@ static long warp_bounded(planes *p, const fv_camera *display, const fv_camera *s
     return fv_tw_warp_rows_bounded(&d, p->out, W * 3, 0, H, &m, &s, &t, budget, st);
 }
 
+/* The warped image p->out against want (the image rendered at c1) where c1's display ray falls
+ * inside the source c0 (away from the clamped edge): pixels checked, the largest channel error,
+ * and the channels of the unwarped p->rgb more than 8 levels from want (it must have moved). */
+static void rotation_error(const planes *p, const uint8_t *want, const fv_camera *c0, const fv_camera *c1,
+                           int *checked, int *maxd, int *moved)
+{
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float d[3], px[3], u, v;
+            fv_camera_ray(c1, (float)x + 0.5f, (float)y + 0.5f, d);
+            for (int k = 0; k < 3; k++)
+                px[k] = c1->eye_pos[k] + d[k];
+            fv_camera_project(c0, px, &u, &v);
+            if (u < 2 || v < 2 || u > W - 2 || v > H - 2)
+                continue;
+            (*checked)++;
+            for (int k = 0; k < 3; k++) {
+                const int i = (y * W + x) * 3 + k, e = abs((int)p->out[i] - (int)want[i]);
+                *maxd = e > *maxd ? e : *maxd;
+                *moved += abs((int)p->rgb[i] - (int)want[i]) > 8;
+            }
+        }
+}
+
 static void test_pure_rotation(void **state)
 {
     (void)state;
@@ -100,25 +124,8 @@ static void test_pure_rotation(void **state)
     assert_int_equal(warp(p, &c1, &c0), 0);
     static uint8_t want[W * H * 3];
     render_dirs(want, &c1);
-    /* compare where the display ray falls inside the source (away from the clamped edge) */
     int checked = 0, maxd = 0, moved = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            float d[3], px[3], u, v;
-            fv_camera_ray(&c1, (float)x + 0.5f, (float)y + 0.5f, d);
-            for (int k = 0; k < 3; k++)
-                px[k] = c1.eye_pos[k] + d[k];
-            fv_camera_project(&c0, px, &u, &v);
-            if (u < 2 || v < 2 || u > W - 2 || v > H - 2)
-                continue;
-            checked++;
-            for (int k = 0; k < 3; k++) {
-                const int i = (y * W + x) * 3 + k;
-                const int e = abs((int)p->out[i] - (int)want[i]);
-                maxd = e > maxd ? e : maxd;
-                moved += abs((int)p->rgb[i] - (int)want[i]) > 8;
-            }
-        }
+    rotation_error(p, want, &c0, &c1, &checked, &maxd, &moved);
     assert_true(checked > W * H / 2);
     assert_true(moved > checked / 4); /* the unwarped image is far from the answer */
     /* bilinear interpolation of the 8-bit pattern (curvature ~ 100 * 5^2 * pixel_angle^2 / 8) */
@@ -154,22 +161,8 @@ static void test_bounded_rotation(void **state)
         fail_msg("grid cells: %ld of %d pixels (the case should fail the block proof)", st.grid_px, W * H);
     static uint8_t want[W * H * 3];
     render_dirs(want, &c1);
-    int checked = 0, maxd = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            float d[3], px[3], u, v;
-            fv_camera_ray(&c1, (float)x + 0.5f, (float)y + 0.5f, d);
-            for (int k = 0; k < 3; k++)
-                px[k] = c1.eye_pos[k] + d[k];
-            fv_camera_project(&c0, px, &u, &v);
-            if (u < 2 || v < 2 || u > W - 2 || v > H - 2)
-                continue;
-            checked++;
-            for (int k = 0; k < 3; k++) {
-                const int i = (y * W + x) * 3 + k, e = abs((int)p->out[i] - (int)want[i]);
-                maxd = e > maxd ? e : maxd;
-            }
-        }
+    int checked = 0, maxd = 0, moved = 0;
+    rotation_error(p, want, &c0, &c1, &checked, &maxd, &moved);
     assert_true(checked > W * H / 2);
     if (maxd > 8) /* measured 7; the per-pixel warp 3 */
         fail_msg("bounded rotation: max error %d levels over %d pixels", maxd, checked);
