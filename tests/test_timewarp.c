@@ -106,21 +106,28 @@ static void rotation_error(const planes *p, const uint8_t *want, const fv_camera
         }
 }
 
+/* The rotation cases: c1 turned 6 degrees from c0 about a tilted axis, the pattern rendered at c0
+ * into p->rgb, depths varying per pixel (a pure rotation's warp must not depend on them). */
+static void rotation_case(planes *p, fv_camera *c0, fv_camera *c1)
+{
+    const float a = 6.0f * 3.14159265f / 360.0f;
+    const float ax[3] = {0.3f, 0.9f, 0.1f}, an = sqrtf(0.91f);
+    fv_pose p0 = {{0.1f, 1.6f, 2.0f}, {0, 0, 0, 1}};
+    fv_pose p1 = {{0.1f, 1.6f, 2.0f}, {ax[0] / an * sinf(a), ax[1] / an * sinf(a), ax[2] / an * sinf(a), cosf(a)}};
+    cam(c0, &p0);
+    cam(c1, &p1);
+    render_dirs(p->rgb, c0);
+    for (int i = 0; i < W * H; i++)
+        p->invd[i] = (uint16_t)(FV_TW_INVD_PER_M / (0.5f + (float)(i % 7)));
+}
+
 static void test_pure_rotation(void **state)
 {
     (void)state;
     planes *p = calloc(1, sizeof *p);
     assert_non_null(p);
-    const float a = 6.0f * 3.14159265f / 360.0f; /* 6 degrees about a tilted axis */
-    const float ax[3] = {0.3f, 0.9f, 0.1f}, an = sqrtf(0.91f);
-    fv_pose p0 = {{0.1f, 1.6f, 2.0f}, {0, 0, 0, 1}};
-    fv_pose p1 = {{0.1f, 1.6f, 2.0f}, {ax[0] / an * sinf(a), ax[1] / an * sinf(a), ax[2] / an * sinf(a), cosf(a)}};
     fv_camera c0, c1;
-    cam(&c0, &p0);
-    cam(&c1, &p1);
-    render_dirs(p->rgb, &c0);
-    for (int i = 0; i < W * H; i++)
-        p->invd[i] = (uint16_t)(FV_TW_INVD_PER_M / (0.5f + (float)(i % 7))); /* depth must not matter */
+    rotation_case(p, &c0, &c1);
     assert_int_equal(warp(p, &c1, &c0), 0);
     static uint8_t want[W * H * 3];
     render_dirs(want, &c1);
@@ -144,16 +151,8 @@ static void test_bounded_rotation(void **state)
     (void)state;
     planes *p = calloc(1, sizeof *p);
     assert_non_null(p);
-    const float a = 6.0f * 3.14159265f / 360.0f;
-    const float ax[3] = {0.3f, 0.9f, 0.1f}, an = sqrtf(0.91f);
-    fv_pose p0 = {{0.1f, 1.6f, 2.0f}, {0, 0, 0, 1}};
-    fv_pose p1 = {{0.1f, 1.6f, 2.0f}, {ax[0] / an * sinf(a), ax[1] / an * sinf(a), ax[2] / an * sinf(a), cosf(a)}};
     fv_camera c0, c1;
-    cam(&c0, &p0);
-    cam(&c1, &p1);
-    render_dirs(p->rgb, &c0);
-    for (int i = 0; i < W * H; i++)
-        p->invd[i] = (uint16_t)(FV_TW_INVD_PER_M / (0.5f + (float)(i % 7)));
+    rotation_case(p, &c0, &c1);
     fv_tw_warp_stats st = {0, 0};
     assert_int_equal(warp_bounded(p, &c1, &c0, 0, &st), 0);
     assert_int_equal(st.pixel_px, 0);
