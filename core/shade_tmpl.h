@@ -165,7 +165,9 @@ SH_INLINE unsigned shade_headv(const fv_shade_packet *p, float rgb[3][FV_SHADE_L
 }
 
 /* KHR lights: the loop as it was (pairs of groups as in shade_headv measured slower here, 17.8 ->
- * 19.3 ms a frame on AVX2: the lights' chains already overlap) */
+ * 19.3 ms a frame on AVX2: the lights' chains already overlap). Its geometry is lane_geomv's, written
+ * out: through the helper GCC 12 allocated the light loop's registers worse (brdf_lights +3.2 %
+ * instructions on AVX2, +3.1 % on SSE4.1, more stack traffic; docs/raystage.md) */
 static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, float rgb[3][FV_SHADE_LANES])
 {
     if (env->nlights == 0)
@@ -198,14 +200,7 @@ static unsigned SHADE_FN(const fv_shade_packet *p, const fv_shade_env *env, floa
         const V base[3] = {VLD(p->base[0] + i), VLD(p->base[1] + i), VLD(p->base[2] + i)};
         const V metal = VLD(p->metal + i), a2 = VLD(p->a2 + i), specw = VLD(p->spec + i);
         V out[3];
-        { /* fv_brdf_ambient */
-            const V f0 = VMUL(specw, VS(FV_DIELECTRIC_F0));
-            const V amb = VMUL(VS(FV_SCENE_AMBIENT), VLD(p->occl + i));
-            for (int k = 0; k < 3; k++) {
-                const V diel = VADD(VMUL(VSUB(one, f0), base[k]), f0);
-                out[k] = VMUL(amb, VADD(VMUL(VSUB(one, metal), diel), VMUL(metal, base[k])));
-            }
-        }
+        ambientv(p, i, base, metal, specw, out);
         for (int j = 0; j < env->nlights; j++) {
             const fv_light_rec *lr = &env->lights[j];
             const fv_light *l = &lr->l;
