@@ -17,6 +17,7 @@ void fv_taa_params_default(fv_taa_params *p)
     p->fill = 1;
     p->fovea_aa = 1;
     p->in_place = 1;
+    p->half_fill = 1;
 }
 
 /* ---------------------------------------------------------------- setup */
@@ -172,7 +173,110 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
         const float z0 = fv_taa_project(f, cx, cy, d0, &u, &v);
         fv_taa_lens_tile_fill(f, &tl, cx + (float)tt.flow_x, cy + (float)tt.flow_y, z0 > 1e-3f ? z0 : d0);
     }
+    /* the moving head's periphery: the fill at half resolution (the still head's history is exact) */
+    if (prm->half_fill && !f->identity && tw <= 16 && th <= 16 && !(x0 & 1) && !(y0 & 1) &&
+        f->hist->levels > 1 && fv_taa_tile_is_periphery(smp, gx, gy, x0, y0, tw, th)) {
+        fv_taa_frame hf;
+        fv_pyramid p1;
+        fv_taa_frame_half(fk, &hf, &p1);
+        fv_taa_fill_half(&hf, dsp, l0, x0, y0, tw, th, fx, fy);
+        return;
+    }
     dsp->taa_fill(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
+}
+
+int fv_taa_tile_is_periphery(const struct fv_sampler *smp, int gx, int gy, int x0, int y0, int tw, int th)
+{
+    /* the tile's nearest pixel centre to the gaze */
+    const float dx = (float)gx < (float)x0 + 0.5f ? (float)x0 + 0.5f - (float)gx
+                     : (float)gx > (float)(x0 + tw) - 0.5f ? (float)gx - ((float)(x0 + tw) - 0.5f) : 0.0f;
+    const float dy = (float)gy < (float)y0 + 0.5f ? (float)y0 + 0.5f - (float)gy
+                     : (float)gy > (float)(y0 + th) - 0.5f ? (float)gy - ((float)(y0 + th) - 0.5f) : 0.0f;
+    const float r = smp->r1_px + FV_TAA_HALF_MARGIN_PX;
+    return dx * dx + dy * dy > r * r;
+}
+
+void fv_taa_frame_half(const fv_taa_frame *f, fv_taa_frame *h, fv_pyramid *pyr1)
+{
+    *h = *f;
+    memset(pyr1, 0, sizeof *pyr1);
+    pyr1->levels = 1;
+    pyr1->lv[0] = f->hist->lv[1];
+    h->hist = pyr1;
+    /* previous level-1 texel (s, t) is level-0 (2 s, 2 t); (U, V) in level-1 units are half the
+     * level-0 ones: rows 0, 1 halved, the per-texel columns doubled (powers of two: exact) */
+    for (int k = 0; k < 2; k++) {
+        h->T2[k] = 0.5f * f->T2[k];
+        h->N0[k] = 0.5f * f->N0[k];
+    }
+    h->NX[2] = 2.0f * f->NX[2];
+    h->NY[2] = 2.0f * f->NY[2];
+    h->prev_w = (float)f->hist->lv[1].w;
+    h->prev_h = (float)f->hist->lv[1].h;
+    h->lens = NULL;
+}
+
+void fv_taa_fill_half(const fv_taa_frame *h, const fv_reproject_dsp *dsp, const fv_pyr_level *l0, int x0, int y0,
+                      int tw, int th, float flow_x, float flow_y)
+{
+    /* the tile's level-1 block with a ring of one texel: block texel (i, j), i, j in -1 .. 8, at
+     * [j + 1][i + 1], the history texel (hx0 + i + Rx, hy0 + j + Ry) (R: the level-1 flow rounded)
+     * checked against where the tile's mean flow F puts it: level-1 centre (hx0 + i + 1/2 - ex,
+     * ...), ex = F - R; the holes then interpolate these points bilinearly, so the rounding does
+     * not move the periphery by up to a pixel from frame to frame */
+    enum { S = 10 };
+    _Alignas(64) float rgbd[S * S * 4];
+    _Alignas(64) float wgt[S * S];
+    memset(wgt, 0, sizeof wgt); /* every texel of the block is a hole; colours are read only where filled */
+    const int hx0 = x0 >> 1, hy0 = y0 >> 1, hw = (tw + 1) >> 1, hh = (th + 1) >> 1;
+    const float Fx = 0.5f * flow_x, Fy = 0.5f * flow_y;
+    fv_taa_tile t = {.widen = 1.0f, .alpha = 1.0f};
+    t.flow_x = (int)floorf(Fx + 0.5f);
+    t.flow_y = (int)floorf(Fy + 0.5f);
+    const float ex = Fx - (float)t.flow_x, ey = Fy - (float)t.flow_y;
+    fv_taa_frame hs = *h; /* the check against the shifted points: U + ex Z, V + ey Z */
+    hs.T2[0] += ex * h->T2[2], hs.N0[0] += ex * h->N0[2], hs.NX[0] += ex * h->NX[2], hs.NY[0] += ex * h->NY[2];
+    hs.T2[1] += ey * h->T2[2], hs.N0[1] += ey * h->N0[2], hs.NX[1] += ey * h->NX[2], hs.NY[1] += ey * h->NY[2];
+    dsp->taa_fill(&hs, &t, rgbd, wgt, S, hx0 - 1, hy0 - 1, hw + 2, hh + 2);
+    /* pixel x's centre is block position px = (x + 1/2) / 2 - 1/2 + ex: texel floor(px), weight 1 - frac */
+    int ix[16];
+    float fxw[16];
+    for (int x = 0; x < tw; x++) {
+        const float p = 0.5f * (float)x - 0.25f + ex;
+        const float fl = floorf(p);
+        ix[x] = (int)fl + 1;
+        fxw[x] = p - fl;
+    }
+    for (int y = 0; y < th; y++) {
+        const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0;
+        float *wr = l0->wgt + o, *cr = l0->rgbd + 4 * o;
+        const float p = 0.5f * (float)y - 0.25f + ey, fl = floorf(p), fy = p - fl;
+        const int j = (int)fl + 1;
+        for (int x = 0; x < tw; x++) {
+            if (wr[x] != 0.0f)
+                continue;
+            const int i = ix[x];
+            const float fx = fxw[x];
+            const int k[4] = {j * S + i, j * S + i + 1, (j + 1) * S + i, (j + 1) * S + i + 1};
+            const float b[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
+            float acc[4] = {0, 0, 0, 0}, sw = 0.0f, sc = 0.0f;
+            for (int q = 0; q < 4; q++) {
+                const float ws = wgt[k[q]];
+                if (!(ws > 0.0f && b[q] > 0.0f))
+                    continue;
+                for (int c = 0; c < 4; c++)
+                    acc[c] += b[q] * rgbd[4 * k[q] + c];
+                sw += b[q];
+                sc += b[q] * ws;
+            }
+            if (!(sw > 0.0f))
+                continue;
+            const float inv = 1.0f / sw;
+            for (int c = 0; c < 4; c++)
+                cr[4 * x + c] = acc[c] * inv;
+            wr[x] = sc * inv;
+        }
+    }
 }
 
 /* The history a tile will read lies around the tile moved by the head motion: guess the move
