@@ -176,10 +176,7 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
     /* the moving head's periphery: the fill at half resolution (the still head's history is exact) */
     if (prm->half_fill && !f->identity && tw <= 16 && th <= 16 && !(x0 & 1) && !(y0 & 1) &&
         f->hist->levels > 1 && fv_taa_tile_is_periphery(smp, gx, gy, x0, y0, tw, th)) {
-        fv_taa_frame hf;
-        fv_pyramid p1;
-        fv_taa_frame_half(fk, &hf, &p1);
-        fv_taa_fill_half(&hf, dsp, l0, x0, y0, tw, th, fx, fy);
+        fv_taa_fill_blockcheck(fk, &tt, l0, x0, y0, tw, th);
         return;
     }
     dsp->taa_fill(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
@@ -275,6 +272,60 @@ void fv_taa_fill_half(const fv_taa_frame *h, const fv_reproject_dsp *dsp, const 
             for (int c = 0; c < 4; c++)
                 cr[4 * x + c] = acc[c] * inv;
             wr[x] = sc * inv;
+        }
+    }
+}
+
+/* experiment: the check per level-1 history texel (its mean depth, within one pixel), the
+ * level-0 texels copied as the full-resolution fill does */
+void fv_taa_fill_blockcheck(const fv_taa_frame *f, const fv_taa_tile *t, const fv_pyr_level *l0, int x0, int y0,
+                            int tw, int th)
+{
+    const fv_pyr_level *H0 = &f->hist->lv[0], *H1 = &f->hist->lv[1];
+    const int W = H0->w, Hh = H0->h;
+    const int bx = (x0 + t->flow_x) >> 1, by = (y0 + t->flow_y) >> 1;
+    uint8_t ok[10][10];
+    for (int j = 0; j < 10; j++)
+        for (int i = 0; i < 10; i++) {
+            ok[j][i] = 0;
+            const int s1 = bx + i, t1 = by + j;
+            if (s1 < 0 || t1 < 0 || s1 >= H1->w || t1 >= H1->h)
+                continue;
+            const ptrdiff_t q = (ptrdiff_t)t1 * H1->stride + s1;
+            if (!(H1->wgt[q] > 0.0f))
+                continue;
+            const float D = H1->rgbd[4 * q + 3];
+            const float uc = (float)(2 * s1 + 1), vc = (float)(2 * t1 + 1);
+            const float U = f->T2[0] + D * ((f->N0[0] + vc * f->NY[0]) + uc * f->NX[0]);
+            const float V = f->T2[1] + D * ((f->N0[1] + vc * f->NY[1]) + uc * f->NX[1]);
+            const float z = f->T2[2] + D * ((f->N0[2] + vc * f->NY[2]) + uc * f->NX[2]);
+            if (!(z > 1e-4f))
+                continue;
+            const float ex = U / z - (uc - (float)t->flow_x), ey = V / z - (vc - (float)t->flow_y);
+            ok[j][i] = ex <= 1.0f && ex >= -1.0f && ey <= 1.0f && ey >= -1.0f;
+        }
+    for (int y = 0; y < th; y++) {
+        const int sy = y0 + y + t->flow_y;
+        if (sy < 0 || sy >= Hh)
+            continue;
+        const float vc = (float)sy + 0.5f;
+        const float B2 = f->N0[2] + vc * f->NY[2];
+        const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0, ho = (ptrdiff_t)sy * H0->stride;
+        float *wr = l0->wgt + o, *cr = l0->rgbd + 4 * o;
+        const uint8_t *okr = ok[(sy >> 1) - by];
+        for (int x = 0; x < tw; x++) {
+            const int sx = x0 + x + t->flow_x;
+            if (wr[x] != 0.0f || sx < 0 || sx >= W || !okr[(sx >> 1) - bx])
+                continue;
+            const float ws = H0->wgt[ho + sx];
+            if (!(ws > 0.0f))
+                continue;
+            const float *src = H0->rgbd + 4 * (ho + sx);
+            const float z = f->T2[2] + src[3] * (B2 + ((float)sx + 0.5f) * f->NX[2]);
+            if (!(z > 1e-4f))
+                continue;
+            cr[4 * x] = src[0], cr[4 * x + 1] = src[1], cr[4 * x + 2] = src[2], cr[4 * x + 3] = z;
+            wr[x] = ws;
         }
     }
 }

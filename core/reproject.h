@@ -150,6 +150,9 @@ void fv_taa_frame_half(const fv_taa_frame *f, fv_taa_frame *h, fv_pyramid *pyr1)
 void fv_taa_fill_half(const fv_taa_frame *h, const fv_reproject_dsp *dsp, const fv_pyr_level *l0, int x0, int y0,
                       int tw, int th, float flow_x, float flow_y);
 
+void fv_taa_fill_blockcheck(const fv_taa_frame *f, const fv_taa_tile *t, const fv_pyr_level *l0, int x0, int y0,
+                            int tw, int th);
+
 /* ---- the still head in place (docs/reproject.md, "The still head in place") ----
  * With identical cameras the fill copies every history texel to its own pixel and a sample's
  * level-0 tap reads only its own pixel's texel. So the frame renders into the history's level 0
