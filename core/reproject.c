@@ -302,7 +302,7 @@ void fv_taa_fill_blockcheck(const fv_taa_frame *f, const fv_taa_tile *t, const f
             if (!(z > 1e-4f))
                 continue;
             const float ex = U / z - (uc - (float)t->flow_x), ey = V / z - (vc - (float)t->flow_y);
-            ok[j][i] = ex <= 1.0f && ex >= -1.0f && ey <= 1.0f && ey >= -1.0f;
+            ok[j][i] = ex <= 0.5f && ex >= -0.5f && ey <= 0.5f && ey >= -0.5f;
         }
     for (int y = 0; y < th; y++) {
         const int sy = y0 + y + t->flow_y;
