@@ -150,6 +150,8 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
         fv_taa_lens_tile_blend(f, &tl, cx, cy, d0);
         fk = &tl;
     }
+    if (prm->half_fill && !f->identity && fv_taa_tile_is_periphery(smp, gx, gy, x0, y0, tw, th))
+        tt.alpha = 1.0f; /* experiment: the periphery's samples as traced */
     dsp->taa_blend(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th, &fl);
     if (!prm->fill)
         return;
@@ -172,12 +174,6 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
         float u, v;
         const float z0 = fv_taa_project(f, cx, cy, d0, &u, &v);
         fv_taa_lens_tile_fill(f, &tl, cx + (float)tt.flow_x, cy + (float)tt.flow_y, z0 > 1e-3f ? z0 : d0);
-    }
-    /* the moving head's periphery: the fill at half resolution (the still head's history is exact) */
-    if (prm->half_fill && !f->identity && tw <= 16 && th <= 16 && !(x0 & 1) && !(y0 & 1) &&
-        f->hist->levels > 1 && fv_taa_tile_is_periphery(smp, gx, gy, x0, y0, tw, th)) {
-        fv_taa_fill_blockcheck(fk, &tt, l0, x0, y0, tw, th);
-        return;
     }
     dsp->taa_fill(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
 }
