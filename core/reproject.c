@@ -17,7 +17,6 @@ void fv_taa_params_default(fv_taa_params *p)
     p->fill = 1;
     p->fovea_aa = 1;
     p->in_place = 1;
-    p->half_fill = 1;
 }
 
 /* ---------------------------------------------------------------- setup */
@@ -150,8 +149,6 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
         fv_taa_lens_tile_blend(f, &tl, cx, cy, d0);
         fk = &tl;
     }
-    if (prm->half_fill && !f->identity && fv_taa_tile_is_periphery(smp, gx, gy, x0, y0, tw, th))
-        tt.alpha = 1.0f; /* experiment: the periphery's samples as traced */
     dsp->taa_blend(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th, &fl);
     if (!prm->fill)
         return;
@@ -176,154 +173,6 @@ void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const
         fv_taa_lens_tile_fill(f, &tl, cx + (float)tt.flow_x, cy + (float)tt.flow_y, z0 > 1e-3f ? z0 : d0);
     }
     dsp->taa_fill(fk, &tt, l0->rgbd + 4 * o, l0->wgt + o, l0->stride, x0, y0, tw, th);
-}
-
-int fv_taa_tile_is_periphery(const struct fv_sampler *smp, int gx, int gy, int x0, int y0, int tw, int th)
-{
-    /* the tile's nearest pixel centre to the gaze */
-    const float dx = (float)gx < (float)x0 + 0.5f ? (float)x0 + 0.5f - (float)gx
-                     : (float)gx > (float)(x0 + tw) - 0.5f ? (float)gx - ((float)(x0 + tw) - 0.5f) : 0.0f;
-    const float dy = (float)gy < (float)y0 + 0.5f ? (float)y0 + 0.5f - (float)gy
-                     : (float)gy > (float)(y0 + th) - 0.5f ? (float)gy - ((float)(y0 + th) - 0.5f) : 0.0f;
-    const float r = smp->r1_px + FV_TAA_HALF_MARGIN_PX;
-    return dx * dx + dy * dy > r * r;
-}
-
-void fv_taa_frame_half(const fv_taa_frame *f, fv_taa_frame *h, fv_pyramid *pyr1)
-{
-    *h = *f;
-    memset(pyr1, 0, sizeof *pyr1);
-    pyr1->levels = 1;
-    pyr1->lv[0] = f->hist->lv[1];
-    h->hist = pyr1;
-    /* previous level-1 texel (s, t) is level-0 (2 s, 2 t); (U, V) in level-1 units are half the
-     * level-0 ones: rows 0, 1 halved, the per-texel columns doubled (powers of two: exact) */
-    for (int k = 0; k < 2; k++) {
-        h->T2[k] = 0.5f * f->T2[k];
-        h->N0[k] = 0.5f * f->N0[k];
-    }
-    h->NX[2] = 2.0f * f->NX[2];
-    h->NY[2] = 2.0f * f->NY[2];
-    h->prev_w = (float)f->hist->lv[1].w;
-    h->prev_h = (float)f->hist->lv[1].h;
-    h->lens = NULL;
-}
-
-void fv_taa_fill_half(const fv_taa_frame *h, const fv_reproject_dsp *dsp, const fv_pyr_level *l0, int x0, int y0,
-                      int tw, int th, float flow_x, float flow_y)
-{
-    /* the tile's level-1 block with a ring of one texel: block texel (i, j), i, j in -1 .. 8, at
-     * [j + 1][i + 1], the history texel (hx0 + i + Rx, hy0 + j + Ry) (R: the level-1 flow rounded)
-     * checked against where the tile's mean flow F puts it: level-1 centre (hx0 + i + 1/2 - ex,
-     * ...), ex = F - R; the holes then interpolate these points bilinearly, so the rounding does
-     * not move the periphery by up to a pixel from frame to frame */
-    enum { S = 10 };
-    _Alignas(64) float rgbd[S * S * 4];
-    _Alignas(64) float wgt[S * S];
-    memset(wgt, 0, sizeof wgt); /* every texel of the block is a hole; colours are read only where filled */
-    const int hx0 = x0 >> 1, hy0 = y0 >> 1, hw = (tw + 1) >> 1, hh = (th + 1) >> 1;
-    const float Fx = 0.5f * flow_x, Fy = 0.5f * flow_y;
-    fv_taa_tile t = {.widen = 1.0f, .alpha = 1.0f};
-    t.flow_x = (int)floorf(Fx + 0.5f);
-    t.flow_y = (int)floorf(Fy + 0.5f);
-    const float ex = Fx - (float)t.flow_x, ey = Fy - (float)t.flow_y;
-    fv_taa_frame hs = *h; /* the check against the shifted points: U + ex Z, V + ey Z */
-    hs.T2[0] += ex * h->T2[2], hs.N0[0] += ex * h->N0[2], hs.NX[0] += ex * h->NX[2], hs.NY[0] += ex * h->NY[2];
-    hs.T2[1] += ey * h->T2[2], hs.N0[1] += ey * h->N0[2], hs.NX[1] += ey * h->NX[2], hs.NY[1] += ey * h->NY[2];
-    dsp->taa_fill(&hs, &t, rgbd, wgt, S, hx0 - 1, hy0 - 1, hw + 2, hh + 2);
-    /* pixel x's centre is block position px = (x + 1/2) / 2 - 1/2 + ex: texel floor(px), weight 1 - frac */
-    int ix[16];
-    float fxw[16];
-    for (int x = 0; x < tw; x++) {
-        const float p = 0.5f * (float)x - 0.25f + ex;
-        const float fl = floorf(p);
-        ix[x] = (int)fl + 1;
-        fxw[x] = p - fl;
-    }
-    for (int y = 0; y < th; y++) {
-        const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0;
-        float *wr = l0->wgt + o, *cr = l0->rgbd + 4 * o;
-        const float p = 0.5f * (float)y - 0.25f + ey, fl = floorf(p), fy = p - fl;
-        const int j = (int)fl + 1;
-        for (int x = 0; x < tw; x++) {
-            if (wr[x] != 0.0f)
-                continue;
-            const int i = ix[x];
-            const float fx = fxw[x];
-            const int k[4] = {j * S + i, j * S + i + 1, (j + 1) * S + i, (j + 1) * S + i + 1};
-            const float b[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
-            float acc[4] = {0, 0, 0, 0}, sw = 0.0f, sc = 0.0f;
-            for (int q = 0; q < 4; q++) {
-                const float ws = wgt[k[q]];
-                if (!(ws > 0.0f && b[q] > 0.0f))
-                    continue;
-                for (int c = 0; c < 4; c++)
-                    acc[c] += b[q] * rgbd[4 * k[q] + c];
-                sw += b[q];
-                sc += b[q] * ws;
-            }
-            if (!(sw > 0.0f))
-                continue;
-            const float inv = 1.0f / sw;
-            for (int c = 0; c < 4; c++)
-                cr[4 * x + c] = acc[c] * inv;
-            wr[x] = sc * inv;
-        }
-    }
-}
-
-/* experiment: the check per level-1 history texel (its mean depth, within one pixel), the
- * level-0 texels copied as the full-resolution fill does */
-void fv_taa_fill_blockcheck(const fv_taa_frame *f, const fv_taa_tile *t, const fv_pyr_level *l0, int x0, int y0,
-                            int tw, int th)
-{
-    const fv_pyr_level *H0 = &f->hist->lv[0], *H1 = &f->hist->lv[1];
-    const int W = H0->w, Hh = H0->h;
-    const int bx = (x0 + t->flow_x) >> 1, by = (y0 + t->flow_y) >> 1;
-    uint8_t ok[10][10];
-    for (int j = 0; j < 10; j++)
-        for (int i = 0; i < 10; i++) {
-            ok[j][i] = 0;
-            const int s1 = bx + i, t1 = by + j;
-            if (s1 < 0 || t1 < 0 || s1 >= H1->w || t1 >= H1->h)
-                continue;
-            const ptrdiff_t q = (ptrdiff_t)t1 * H1->stride + s1;
-            if (!(H1->wgt[q] > 0.0f))
-                continue;
-            const float D = H1->rgbd[4 * q + 3];
-            const float uc = (float)(2 * s1 + 1), vc = (float)(2 * t1 + 1);
-            const float U = f->T2[0] + D * ((f->N0[0] + vc * f->NY[0]) + uc * f->NX[0]);
-            const float V = f->T2[1] + D * ((f->N0[1] + vc * f->NY[1]) + uc * f->NX[1]);
-            const float z = f->T2[2] + D * ((f->N0[2] + vc * f->NY[2]) + uc * f->NX[2]);
-            if (!(z > 1e-4f))
-                continue;
-            const float ex = U / z - (uc - (float)t->flow_x), ey = V / z - (vc - (float)t->flow_y);
-            ok[j][i] = ex <= 0.5f && ex >= -0.5f && ey <= 0.5f && ey >= -0.5f;
-        }
-    for (int y = 0; y < th; y++) {
-        const int sy = y0 + y + t->flow_y;
-        if (sy < 0 || sy >= Hh)
-            continue;
-        const float vc = (float)sy + 0.5f;
-        const float B2 = f->N0[2] + vc * f->NY[2];
-        const ptrdiff_t o = (ptrdiff_t)(y0 + y) * l0->stride + x0, ho = (ptrdiff_t)sy * H0->stride;
-        float *wr = l0->wgt + o, *cr = l0->rgbd + 4 * o;
-        const uint8_t *okr = ok[(sy >> 1) - by];
-        for (int x = 0; x < tw; x++) {
-            const int sx = x0 + x + t->flow_x;
-            if (wr[x] != 0.0f || sx < 0 || sx >= W || !okr[(sx >> 1) - bx])
-                continue;
-            const float ws = H0->wgt[ho + sx];
-            if (!(ws > 0.0f))
-                continue;
-            const float *src = H0->rgbd + 4 * (ho + sx);
-            const float z = f->T2[2] + src[3] * (B2 + ((float)sx + 0.5f) * f->NX[2]);
-            if (!(z > 1e-4f))
-                continue;
-            cr[4 * x] = src[0], cr[4 * x + 1] = src[1], cr[4 * x + 2] = src[2], cr[4 * x + 3] = z;
-            wr[x] = ws;
-        }
-    }
 }
 
 /* The history a tile will read lies around the tile moved by the head motion: guess the move

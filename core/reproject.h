@@ -42,8 +42,6 @@ typedef struct fv_taa_params {
     int fovea_aa;    /* anti-aliasing in the fovea (jittered rays accumulated), default 1 */
     int in_place;    /* head still (identical cameras): render over the history's level 0 in place
                       * instead of copying it (fv_taa_still_*), default 1 */
-    int half_fill;   /* the head moving: tiles outside the disc r1 + one tile around the gaze fill their
-                      * holes from the history's level 1 (fv_taa_fill_half), default 1 */
 } fv_taa_params;
 
 void fv_taa_params_default(fv_taa_params *p);
@@ -125,33 +123,6 @@ void fv_taa_tile_run(const fv_taa_frame *f, const fv_taa_params *prm, const stru
 void fv_taa_tile_run_keep(const fv_taa_frame *f, const fv_taa_params *prm, const struct fv_sampler *smp, int gx,
                           int gy, const fv_pyr_level *l0, const fv_reproject_dsp *dsp, int x0, int y0, int tw, int th,
                           float keep);
-
-/* ---- the periphery's fill at half resolution (docs/reproject.md, "The periphery's fill at half
- * resolution") ----
- * Outside the disc of radius r1 + FV_TAA_HALF_MARGIN_PX around the gaze the sampler shoots about
- * one ray per five pixels and the eye cannot tell a 2 x 2 block. There the fill runs on the
- * history's level 1 (one texel per 2 x 2 pixels, the confidence-weighted mean the pull made of
- * them) over the tile's half-resolution block: the same kernel (dsp->taa_fill) on the frame's rows
- * rescaled to level-1 coordinates (fv_taa_frame_half: exact, powers of two), its validity check
- * within half a level-1 texel (one pixel), then each hole of the tile takes its 2 x 2 block's
- * result (colour, depth in this view, confidence) where it passed. A quarter of the checks and of
- * the history bytes the full-resolution fill reads; the samples' blend is unchanged. The still
- * head (identity frames) keeps the exact full-resolution fill (and the in-place path). */
-#define FV_TAA_HALF_MARGIN_PX 16.0f
-/* 1 when tile [x0, x0+tw) x [y0, y0+th) lies wholly outside the disc r1 + margin around (gx, gy). */
-int fv_taa_tile_is_periphery(const struct fv_sampler *smp, int gx, int gy, int x0, int y0, int tw, int th);
-/* h: f's fill part (T2, N*, prev size, hist) for level-1 coordinates of both frames: a texel (s, t)
- * of the history's level 1 with depth D maps to (U / Z, V / Z) in the current level-1 grid.
- * *pyr1 receives the view whose level 0 is f->hist's level 1 (h->hist points at it). */
-void fv_taa_frame_half(const fv_taa_frame *f, fv_taa_frame *h, fv_pyramid *pyr1);
-/* The fill of tile [x0, x0+tw) x [y0, y0+th) (x0, y0 even; tw, th <= 16) from h (fv_taa_frame_half)
- * at the full-resolution flow (flow_x, flow_y) rounded to level-1 texels: holes (weight 0) of l0
- * take their 2 x 2 block's filled texel; others untouched. */
-void fv_taa_fill_half(const fv_taa_frame *h, const fv_reproject_dsp *dsp, const fv_pyr_level *l0, int x0, int y0,
-                      int tw, int th, float flow_x, float flow_y);
-
-void fv_taa_fill_blockcheck(const fv_taa_frame *f, const fv_taa_tile *t, const fv_pyr_level *l0, int x0, int y0,
-                            int tw, int th);
 
 /* ---- the still head in place (docs/reproject.md, "The still head in place") ----
  * With identical cameras the fill copies every history texel to its own pixel and a sample's
