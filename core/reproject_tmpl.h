@@ -244,30 +244,6 @@ static inline const float *taa_fill_setup(const struct fv_taa_frame *f, const st
     return L->rgbd + 4 * o;
 }
 
-/* The fill's history run of row y (the pixels x0 .. x0+n-1 moved by the tile's flow) requested
- * TAA_FILL_AHEAD rows before the fill reaches it (prefetches only: the bits do not change). */
-#define TAA_FILL_AHEAD 4
-static inline void taa_fill_prefetch_row(const struct fv_taa_frame *f, const struct fv_taa_tile *t, int y, int x0,
-                                         int n)
-{
-    const int sy = y + t->flow_y;
-    if (!(sy >= 0 && (float)sy < f->prev_h))
-        return;
-    const fv_pyr_level *L = &f->hist->lv[0];
-    int xa = x0 + t->flow_x, xb = xa + n - 1;
-    xa = xa < 0 ? 0 : xa;
-    xb = (float)xb < f->prev_w ? xb : (int)f->prev_w - 1;
-    if (xa > xb)
-        return;
-    const ptrdiff_t o = (ptrdiff_t)sy * L->stride;
-    const float *c = L->rgbd + 4 * (o + xa);
-    for (int x = 0; x <= 4 * (xb - xa); x += 16) /* a 64-byte line is 4 pixels */
-        __builtin_prefetch(c + x);
-    __builtin_prefetch(c + 4 * (xb - xa) + 3);
-    __builtin_prefetch(L->wgt + o + xa);
-    __builtin_prefetch(L->wgt + o + xb);
-}
-
 /* The fill of a block, defined by each ISA from its vector body
  *   int vec(f, t, rgbd, wgt, hrow, hw, B, x0, py, ilo, ihi)
  * which fills pixels ilo, ilo + step, ... of the contiguous span [ilo, ihi) (taa_fill_span) and
@@ -276,11 +252,7 @@ static inline void taa_fill_prefetch_row(const struct fv_taa_frame *f, const str
     static void name(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk,          \
                      float *wgt_blk, ptrdiff_t stride, int x0, int y0, int w, int h)                     \
     {                                                                                                     \
-        for (int r = 0; r < h && r < TAA_FILL_AHEAD; r++)                                                 \
-            taa_fill_prefetch_row(f, t, y0 + r, x0, w);                                                   \
         for (int r = 0; r < h; r++) {                                                                     \
-            if (r + TAA_FILL_AHEAD < h)                                                                   \
-                taa_fill_prefetch_row(f, t, y0 + r + TAA_FILL_AHEAD, x0, w);                              \
             float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;                          \
             const float *hw, *hrow;                                                                       \
             float B[3];                                                                                   \
