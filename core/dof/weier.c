@@ -156,7 +156,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
         for (int L = 1; L < MAX_UP_LEVEL; L++) /* level L + 1 onto the level 1 grid */
             fvw_xtaps_init(&xh[L], L, half_w(w), (half_w(w) + (1 << L) - 1) >> L);
     }
-    size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
+    size_t rows = (size_t)threads * (NSLOT * 4 * (size_t)w + HBAND_ROWS * 4 * (size_t)half_w(w));
     if (rows < 8 * (size_t)w + (size_t)tw * th) /* the tile dilation's temporary after slots 0, 1 */
         rows = 8 * (size_t)w + (size_t)tw * th;
     if (wk->rows_len < rows) {
@@ -207,6 +207,8 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->up_levels = fv_mini(MAX_UP_LEVEL, v->pyr->levels - 1);
     x->half_on = !v->prm->full_res_periphery && x->up_levels >= 1 && v->pyr->lv[1].w == x->hw && v->pyr->lv[1].h == x->hh;
     x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
+    x->hblur_fused = x->half_on && !x->enh_on && !v->prm->chain_periphery && !v->prm->hblur_pass;
+    x->hband = wk->rows + (size_t)fv_pool_threads(pool) * NSLOT * 4 * (size_t)x->w;
     const int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, x->th, fvw_coc_band, x);
     fvw_dilate_tiles(x);

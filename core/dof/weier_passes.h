@@ -66,6 +66,8 @@ typedef struct {
     int hw, hh;                /* level 1's size */
     float *hblur;              /* hw x hh x 4: level 1 blurred by the half-resolution CoC */
     float *hcoc;               /* hw x hh: that CoC, the 2x2 mean of |c| (written by the CoC pass) */
+    int hblur_fused;           /* the fused path makes each band's half rows itself (fvw_hband), no hblur image */
+    float *hband;              /* the per-thread band rows of it, after the row slots */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
     xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
 } fvw_ctx;
@@ -103,6 +105,11 @@ static inline uint8_t fvw_sig_index(float sigma)
 /* Per-thread row buffers of the fused pass. */
 static inline float *fvw_slot(const fvw_ctx *x, int tid, int k) { return x->wk->rows + ((size_t)tid * NSLOT + (size_t)k) * 4 * (size_t)x->w; }
 
+
+/* Per-thread rows of the half-resolution blur for one band of the fused pass (HBAND_ROWS x hw x 4
+ * floats, after the row slots): the band's TILE / 2 half rows and one of halo each side. */
+#define HBAND_ROWS (TILE / 2 + 2)
+static inline float *fvw_hband(const fvw_ctx *x, int tid) { return x->hband + (size_t)tid * HBAND_ROWS * 4 * (size_t)x->hw; }
 
 /* weier_filter.c: up-sampling helpers */
 void fvw_xtaps_init(xtaps *t, int L, int w, int src_w);
