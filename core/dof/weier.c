@@ -137,7 +137,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
     const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 3 * (size_t)th +
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 4 * (size_t)th +
                        5 * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
@@ -196,7 +196,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_v = a, a += 4 * nl;
     x->l_span = (int32_t *)(void *)a, a += 2 * x->lh; /* int32 and float have the same size */
     x->l_nn = (int32_t *)(void *)a, a += 2 * x->lh;
-    x->band_ms = a, a += 3 * x->th;
+    x->band_ms = a, a += 4 * x->th;
     x->hw = half_w(x->w), x->hh = half_w(x->h);
     x->hblur = a, a += 4 * (ptrdiff_t)x->hw * x->hh;
     x->hcoc = a, a += (ptrdiff_t)x->hw * x->hh;
@@ -224,11 +224,12 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     fv_pool_run(pool, x->th, fvw_vcombine_band, x);
     const int64_t t3 = fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, tf);
     if (t) {
-        double f = 0.0, c = 0.0, o = 0.0;
+        double f = 0.0, c = 0.0, o = 0.0, k = 0.0;
         for (int b = 0; b < x->th; b++)
-            f += x->band_ms[3 * b], c += x->band_ms[3 * b + 1], o += x->band_ms[3 * b + 2];
-        const double fused = (double)(t3 - t2) * 1e-6, all = f + c + o;
-        t->coc_ms = (double)(t1 - t0) * 1e-6;
+            f += x->band_ms[4 * b], c += x->band_ms[4 * b + 1], o += x->band_ms[4 * b + 2], k += x->band_ms[4 * b + 3];
+        const double fused = (double)(t3 - t2) * 1e-6, all = f + c + o + k;
+        /* the CoC rows the fused pass recomputes belong to the coc stage */
+        t->coc_ms = (double)(t1 - t0) * 1e-6 + (all > 0.0 ? fused * k / all : 0.0);
         t->filter_ms = (double)(t2 - tf) * 1e-6 + (all > 0.0 ? fused * f / all : fused);
         t->combine_ms = all > 0.0 ? fused * c / all : 0.0;
         t->output_ms = v->conv ? (all > 0.0 ? fused * o / all : 0.0) : NAN;
