@@ -467,6 +467,73 @@ static void test_fused_threads_and_isas_identical(void **st)
     rig_free(&r);
 }
 
+/* The fused pass makes the half-resolution periphery blur's rows per band (with a half row of
+ * halo each side, recomputed by both bands that read it) instead of one pass writing the whole
+ * image: bound 0, the same bits as that pass (prm.hblur_pass), on the receding floor (every CoC,
+ * so every level the half grid reads) with the gaze at the centre and near a corner (bands whose
+ * halo rows clamp at the image's edge, rows with no disc), for 1, 2 and 5 threads and C / best ISA. */
+static void test_band_hblur_vs_pass(void **st)
+{
+    (void)st;
+    const float gaze[2][2] = {{100.0f, 80.0f}, {23.0f, 151.0f}};
+    for (int g = 0; g < 2; g++) {
+        rig a, b;
+        rig_init(&a, receding_floor, FV_DOF_STRONG, 1.5f, gaze[g][0], gaze[g][1]);
+        rig_init(&b, receding_floor, FV_DOF_STRONG, 1.5f, gaze[g][0], gaze[g][1]);
+        b.prm.hblur_pass = 1;
+        rig_run(&b, NULL, FV_ISA_C);
+        const int threads[] = {1, 2, 5};
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < 2; i++) {
+                fv_pool *pool = fv_pool_create(threads[k]);
+                assert_non_null(pool);
+                memset(a.out, 0, (size_t)a.pyr.lv[0].stride * H * 4 * sizeof(float));
+                rig_run(&a, pool, i ? ~0u : FV_ISA_C);
+                for (int y = 0; y < H; y++)
+                    assert_memory_equal(a.out + 4 * (size_t)y * a.pyr.lv[0].stride, b.out + 4 * (size_t)y * b.pyr.lv[0].stride,
+                                        W * 4 * sizeof(float));
+                fv_pool_destroy(pool);
+            }
+        rig_free(&a);
+        rig_free(&b);
+    }
+}
+
+/* The CoC plane (the first 1-float scratch plane) is written only for the centre rectangle's rows
+ * (the transition disc plus twice the largest blur radius, FV_DOF_RMAX: with r1 = 60 and the gaze
+ * at y = 151 the rows from floor(151 - 60 - 48) = 43 on); the fused pass recomputes the other rows'
+ * CoC from level 0. Poisoned with NaN, rows 0..42 stay NaN and the output keeps its bits
+ * (recomputed rows: the same kernel on the same inputs). Without the change every row is written. */
+static void test_coc_plane_centre_only(void **st)
+{
+    (void)st;
+    rig r;
+    rig_init(&r, busy, FV_DOF_MEDIUM, 1.0f, 23.0f, 151.0f);
+    const size_t n = (size_t)r.pyr.lv[0].stride * H * 4;
+    float *ref = malloc(n * sizeof(float));
+    assert_non_null(ref);
+    rig_run(&r, NULL, FV_ISA_C);
+    memcpy(ref, r.out, n * sizeof(float));
+    fv_pool *pool = fv_pool_create(2);
+    assert_non_null(pool);
+    const unsigned isas[] = {FV_ISA_C, ~0u};
+    for (int k = 0; k < 2; k++) {
+        for (size_t i = 0; i < (size_t)r.wk.stride * H; i++)
+            r.wk.p1[0][i] = NAN;
+        memset(r.out, 0, n * sizeof(float));
+        rig_run(&r, pool, isas[k]);
+        for (int y = 0; y < H; y++) {
+            assert_memory_equal(r.out + 4 * (size_t)y * r.pyr.lv[0].stride, ref + 4 * (size_t)y * r.pyr.lv[0].stride,
+                                W * 4 * sizeof(float));
+            for (int x = 0; x < W; x++)
+                assert_int_equal(isnan(r.wk.p1[0][(size_t)y * r.wk.stride + x]) != 0, y < 43);
+        }
+    }
+    fv_pool_destroy(pool);
+    free(ref);
+    rig_free(&r);
+}
+
 /* The CoC row kernel against eq. (3) in double (core/dof/coc.c), every ISA. */
 static void test_coc_row_matches_eq3(void **st)
 {
@@ -547,6 +614,8 @@ int main(void)
         cmocka_unit_test(test_periph_closed_form),
         cmocka_unit_test(test_fused_periphery_vs_chain),
         cmocka_unit_test(test_fused_threads_and_isas_identical),
+        cmocka_unit_test(test_band_hblur_vs_pass),
+        cmocka_unit_test(test_coc_plane_centre_only),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

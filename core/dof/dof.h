@@ -43,6 +43,8 @@ typedef struct fv_dof_params {
                              * the half-resolution one replaced; tests compare them), default 0 */
     int chain_periphery;   /* weier: 1 = beyond the transition disc the chain of kernels (up-sampling,
                             * level blend, combine) that dof_periph_row replaced; tests compare them */
+    int hblur_pass;        /* weier: 1 = the periphery's half-resolution blur as a pass over the whole
+                            * image (the path the per-band rows of the fused pass replaced) */
     fv_focus_params focus; /* focus estimation; focus.fixed_m > 0 fixes it */
 } fv_dof_params;
 void fv_dof_params_default(fv_dof_params *p);

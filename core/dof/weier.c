@@ -43,9 +43,13 @@
  * The filter's vertical pass and the combine run fused per row (the layers never go to memory
  * as full images); their times are the workers' time in each, scaled to the pass's wall time.
  * Pass order: CoC (+ per-block statistics, kernel dof_nearblk_row, and the half-resolution
- * periphery's 2x2-mean CoC) -> horizontal pass (centre rectangle; near boxes by dof_nearbox_row)
- * -> quarter-resolution vertical pass -> the periphery's half-resolution blur -> fused vertical
- * pass + combine (dof_periph_row beyond the disc).
+ * periphery's 2x2-mean CoC; the CoC plane kept only for the centre rectangle's rows) ->
+ * horizontal pass (centre rectangle; near boxes by dof_nearbox_row) -> quarter-resolution
+ * vertical pass -> fused pass per band: the band's rows of the periphery's half-resolution blur
+ * (with a half row of halo), then per row the CoC recomputed outside the centre rectangle, the
+ * vertical pass, the combine (dof_periph_row beyond the disc) and the output. With contrast
+ * enhancement (or prm.chain_periphery / hblur_pass) the half-resolution blur is a pass of its own
+ * over the whole image, before the fused pass.
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *
@@ -132,13 +136,13 @@ static void tables_at(float *a, int w, const float **lambda, const float **lambd
 
 /* Scratch beyond the planes, allocated on first use and kept: the tables (built then), tiles,
  * the quarter-resolution layer, band times, per-thread rows. */
-static int ensure_aux(fv_dof_work *wk, int threads)
+static int ensure_aux(fv_dof_work *wk, int threads, int hblur)
 {
     const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 3 * (size_t)th +
-                       5 * (size_t)half_w(w) * (size_t)half_w(h);
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 4 * (size_t)th +
+                       (hblur ? 5 : 1) * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
         if (!(wk->aux = malloc(aux * sizeof(float))))
@@ -156,7 +160,7 @@ static int ensure_aux(fv_dof_work *wk, int threads)
         for (int L = 1; L < MAX_UP_LEVEL; L++) /* level L + 1 onto the level 1 grid */
             fvw_xtaps_init(&xh[L], L, half_w(w), (half_w(w) + (1 << L) - 1) >> L);
     }
-    size_t rows = (size_t)threads * NSLOT * 4 * (size_t)w;
+    size_t rows = (size_t)threads * (NSLOT * 4 * (size_t)w + HBAND_ROWS * 4 * (size_t)half_w(w));
     if (rows < 8 * (size_t)w + (size_t)tw * th) /* the tile dilation's temporary after slots 0, 1 */
         rows = 8 * (size_t)w + (size_t)tw * th;
     if (wk->rows_len < rows) {
@@ -175,7 +179,13 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->v = v, x->wk = wk, x->dsp = dsp, x->out = out, x->out_stride = out_stride, x->tab = wk->gauss;
     x->w = v->pyr->lv[0].w, x->h = v->pyr->lv[0].h;
     x->tw = (x->w + TILE - 1) / TILE, x->th = (x->h + TILE - 1) / TILE;
-    if (x->w != wk->w || x->h != wk->h || (!out && !v->conv) || ensure_aux(wk, fv_pool_threads(pool)))
+    x->hw = half_w(x->w), x->hh = half_w(x->h);
+    x->up_levels = fv_mini(MAX_UP_LEVEL, v->pyr->levels - 1);
+    x->half_on = !v->prm->full_res_periphery && x->up_levels >= 1 && v->pyr->lv[1].w == x->hw && v->pyr->lv[1].h == x->hh;
+    x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
+    x->hblur_fused = x->half_on && !x->enh_on && !v->prm->chain_periphery && !v->prm->hblur_pass;
+    /* the whole half-resolution image (7.4 MB at 1280x1440) only for the paths that still make it */
+    if (x->w != wk->w || x->h != wk->h || (!out && !v->conv) || ensure_aux(wk, fv_pool_threads(pool), !x->hblur_fused))
         goto fail;
     x->K = v->prm->pupil_mm * 1e-3f * v->focal_px * v->blur_scale;
     x->dn = fmaxf(v->focus_m - v->prm->tolerance_m, FV_COC_MIN_DEPTH_M), x->df = v->focus_m + v->prm->tolerance_m;
@@ -196,17 +206,14 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_v = a, a += 4 * nl;
     x->l_span = (int32_t *)(void *)a, a += 2 * x->lh; /* int32 and float have the same size */
     x->l_nn = (int32_t *)(void *)a, a += 2 * x->lh;
-    x->band_ms = a, a += 3 * x->th;
-    x->hw = half_w(x->w), x->hh = half_w(x->h);
-    x->hblur = a, a += 4 * (ptrdiff_t)x->hw * x->hh;
+    x->band_ms = a, a += 4 * x->th;
     x->hcoc = a, a += (ptrdiff_t)x->hw * x->hh;
+    x->hblur = x->hblur_fused ? NULL : a; /* last: allocated only when needed */
     /* the centre rectangle: the transition disc plus the kernels' reach */
     const float reach = v->r1_px + 2.0f * FV_DOF_RMAX;
     x->cx0 = fv_clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = fv_clampi((int)ceilf(v->gaze_x + reach), 0, x->w);
     x->cy0 = fv_clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = fv_clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
-    x->up_levels = fv_mini(MAX_UP_LEVEL, v->pyr->levels - 1);
-    x->half_on = !v->prm->full_res_periphery && x->up_levels >= 1 && v->pyr->lv[1].w == x->hw && v->pyr->lv[1].h == x->hh;
-    x->enh_on = v->prm->contrast_gain > 0.0f && v->enh_fp && v->enh_n > 0;
+    x->hband = wk->rows + (size_t)fv_pool_threads(pool) * NSLOT * 4 * (size_t)x->w;
     const int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     fv_pool_run(pool, x->th, fvw_coc_band, x);
     fvw_dilate_tiles(x);
@@ -222,11 +229,12 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     fv_pool_run(pool, x->th, fvw_vcombine_band, x);
     const int64_t t3 = fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, tf);
     if (t) {
-        double f = 0.0, c = 0.0, o = 0.0;
+        double f = 0.0, c = 0.0, o = 0.0, k = 0.0;
         for (int b = 0; b < x->th; b++)
-            f += x->band_ms[3 * b], c += x->band_ms[3 * b + 1], o += x->band_ms[3 * b + 2];
-        const double fused = (double)(t3 - t2) * 1e-6, all = f + c + o;
-        t->coc_ms = (double)(t1 - t0) * 1e-6;
+            f += x->band_ms[4 * b], c += x->band_ms[4 * b + 1], o += x->band_ms[4 * b + 2], k += x->band_ms[4 * b + 3];
+        const double fused = (double)(t3 - t2) * 1e-6, all = f + c + o + k;
+        /* the CoC rows the fused pass recomputes belong to the coc stage */
+        t->coc_ms = (double)(t1 - t0) * 1e-6 + (all > 0.0 ? fused * k / all : 0.0);
         t->filter_ms = (double)(t2 - tf) * 1e-6 + (all > 0.0 ? fused * f / all : fused);
         t->combine_ms = all > 0.0 ? fused * c / all : 0.0;
         t->output_ms = v->conv ? (all > 0.0 ? fused * o / all : 0.0) : NAN;

@@ -20,14 +20,22 @@ void fvw_coc_band(void *ctx, int band, int tid)
      * far c) */
     const float inv_blk = 1.0f / (LOW * LOW);
     float *ext = fvw_slot(x, tid, 0); /* 2 lw floats, then lw of near radii (the slot holds 4 w) */
+    /* the CoC plane is kept only for the centre rectangle's rows (the horizontal pass and the
+     * fused pass read it there); elsewhere the fused pass recomputes its row from level 0, which
+     * it reads anyway, so this pass keeps those rows in the thread's slots 1-2 for the block
+     * statistics and the half-resolution CoC only (7.4 MB less written and read back) */
+    const int pitch = fv_mini((x->w + 15) & ~15, 2 * x->w);
     for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
         float *src = x->l_src + 4 * (ptrdiff_t)by * x->lw;
+        const float *crow[LOW];
         memset(src, 0, (size_t)x->lw * 4 * sizeof(float));
         memset(ext, 0, (size_t)x->lw * 2 * sizeof(float));
         for (int y = by * LOW; y < fv_mini(by * LOW + LOW, x->h); y++) {
             const float *rgbd = l0->rgbd + 4 * (ptrdiff_t)y * l0->stride;
-            x->dsp->dof_coc_row(x->wk->p1[0] + y * st, rgbd, x->w, x->K, x->dn, x->df);
-            x->dsp->dof_nearblk_row(src, ext, x->wk->p1[0] + y * st, rgbd, x->w);
+            float *c = fvw_coc_kept(x, y) ? x->wk->p1[0] + y * st : fvw_slot(x, tid, 1) + (y - by * LOW) * pitch;
+            x->dsp->dof_coc_row(c, rgbd, x->w, x->K, x->dn, x->df);
+            x->dsp->dof_nearblk_row(src, ext, c, rgbd, x->w);
+            crow[y - by * LOW] = c;
         }
         const float full_h = (float)(fv_mini(by * LOW + LOW, x->h) - by * LOW);
         int nlo = x->lw, nhi = 0; /* the blocks with a pixel that is not near */
@@ -54,7 +62,7 @@ void fvw_coc_band(void *ctx, int band, int tid)
         /* the half-resolution periphery's CoC while the block row is in cache: per level-1 texel
          * the mean |c| of its 2x2 pixels (the last column / row of an odd size clamps) */
         for (int vy = 2 * by; x->half_on && vy < fv_mini(2 * by + 2, x->hh); vy++) {
-            const float *ca = x->wk->p1[0] + 2 * vy * st, *cb = x->wk->p1[0] + fv_mini(2 * vy + 1, x->h - 1) * st;
+            const float *ca = crow[2 * vy - by * LOW], *cb = crow[fv_mini(2 * vy + 1, x->h - 1) - by * LOW];
             float *ch = x->hcoc + (ptrdiff_t)vy * x->hw;
             const int uw = x->w / 2; /* texels with two columns */
             x->dsp->dof_hcoc_row(ch, ca, cb, uw);

@@ -13,7 +13,7 @@
 
 #define TILE 16
 #define LOW 4          /* the near layer's reduced resolution in the periphery: 4x4 blocks */
-#define NSLOT 15       /* per-thread row buffers of the fused vertical + combine pass */
+#define NSLOT 16       /* per-thread row buffers of the fused vertical + combine pass */
 #define ENH_LEVELS 3   /* contrast enhancement: levels 1..3 (footprints up to ~8 px) */
 #define MAX_UP_LEVEL 5 /* periphery far blur: levels 1..5 (CoC up to 64 px) */
 #define LAMBDA_STEPS 8 /* the level LUT's steps per pixel of CoC */
@@ -59,13 +59,15 @@ typedef struct {
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
     const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
     int enh_on;                /* contrast enhancement runs */
-    float *band_ms;            /* per band: worker time (ms) in the filter, the combine, the output (triples) */
+    float *band_ms;            /* per band: worker time (ms) in the filter, the combine, the output, the CoC rows (4 each) */
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
     /* the periphery's far blur at half resolution (the level 1 grid), up-sampled once per row */
     int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
     int hw, hh;                /* level 1's size */
     float *hblur;              /* hw x hh x 4: level 1 blurred by the half-resolution CoC */
     float *hcoc;               /* hw x hh: that CoC, the 2x2 mean of |c| (written by the CoC pass) */
+    int hblur_fused;           /* the fused path makes each band's half rows itself (fvw_hband), no hblur image */
+    float *hband;              /* the per-thread band rows of it, after the row slots */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
     xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
 } fvw_ctx;
@@ -100,9 +102,18 @@ static inline uint8_t fvw_sig_index(float sigma)
 }
 
 
+/* Rows whose CoC the CoC pass keeps in the plane p1[0]: the centre rectangle's (the horizontal
+ * pass reads them); the fused pass recomputes the others from level 0. */
+static inline int fvw_coc_kept(const fvw_ctx *x, int y) { return y >= x->cy0 && y < x->cy1; }
+
 /* Per-thread row buffers of the fused pass. */
 static inline float *fvw_slot(const fvw_ctx *x, int tid, int k) { return x->wk->rows + ((size_t)tid * NSLOT + (size_t)k) * 4 * (size_t)x->w; }
 
+
+/* Per-thread rows of the half-resolution blur for one band of the fused pass (HBAND_ROWS x hw x 4
+ * floats, after the row slots): the band's TILE / 2 half rows and one of halo each side. */
+#define HBAND_ROWS (TILE / 2 + 2)
+static inline float *fvw_hband(const fvw_ctx *x, int tid) { return x->hband + (size_t)tid * HBAND_ROWS * 4 * (size_t)x->hw; }
 
 /* weier_filter.c: up-sampling helpers */
 void fvw_xtaps_init(xtaps *t, int L, int w, int src_w);
