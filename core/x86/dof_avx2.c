@@ -301,6 +301,24 @@ static inline void pb_pair(float *blur, const float *const *up, const int32_t *L
     _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
 }
 
+/* pair p when all 8 pixels have the same levels L0, L1 (rows r0 = up[L0] + 4 i, r1 = up[L1] + 4 i):
+ * whole-pair loads, no per-pixel row pointers. The same operations as pb_pair. */
+static inline void pb_pairu(float *blur, const float *r0, const float *r1, __m256 f, __m256 t, __m256 mix, __m256 act,
+                            int i, int p, int sel)
+{
+    float *b = blur + 4 * (ptrdiff_t)(i + 2 * p);
+    const __m256 u0 = _mm256_loadu_ps(r0 + 8 * p), u1 = _mm256_loadu_ps(r1 + 8 * p);
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    if (!sel) {
+        _mm256_storeu_ps(b, pv);
+        return;
+    }
+    const __m256 bv = _mm256_loadu_ps(b);
+    const __m256 r =
+        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+}
+
 /* need == 1 (the periphery beyond the transition ring, whose level 1 is the half-resolution
  * blur): L1 = 1 and L0 = 0 or 1 per pixel, so both levels load whole pairs and L0 is a select
  * (no per-pixel pointers, no branches on the levels) */
@@ -395,10 +413,28 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         const __m256 l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, _mm256_cvttps_epi32(v), 4), need);
         const __m256i l0 = _mm256_cvttps_epi32(l);
         const __m256 f = _mm256_sub_ps(l, _mm256_cvtepi32_ps(l0));
+        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        /* one level pair for all 8 (the CoC varies slowly: most blocks): rows, not pixels */
+        const int l00 = _mm_cvtsi128_si32(_mm256_castsi256_si128(l0));
+        if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(l0, _mm256_set1_epi32(l00)))) == 255) {
+            const float *r0 = up[l00] + 4 * (ptrdiff_t)i, *r1 = up[l00 < a->need ? l00 + 1 : l00] + 4 * (ptrdiff_t)i;
+            const int sel = !(bits == 255 && !_mm256_movemask_ps(mix));
+            if (!sel) {
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 0, 0);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 1, 0);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 2, 0);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 3, 0);
+            } else {
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 0, 1);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 1, 1);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 2, 1);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 3, 1);
+            }
+            continue;
+        }
         _Alignas(32) int32_t L0[8], L1[8];
         _mm256_store_si256((__m256i *)L0, l0);
         _mm256_store_si256((__m256i *)L1, _mm256_sub_epi32(l0, _mm256_cmpgt_epi32(needi, l0))); /* + 1 if L0 < need */
-        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
         if (bits == 255 && !_mm256_movemask_ps(mix)) { /* the periphery */
             pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 0);
             pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 0);

@@ -467,14 +467,15 @@ static void run_pyrblur1(const fv_dof_dsp *d, const char *isa, int w, int x0, in
     buf up[6];
     for (int L = 0; L <= need; L++)
         up[L] = buf_new(w4, off);
-    const int cmode = rndi(6), tmode = rndi(5);
+    const int cmode = rndi(7), tmode = rndi(5);
+    const float camp = 1.0f + 30.0f * rnd(); /* cmode 6: a smooth CoC (blocks of one level pair, as rendered) */
     float run_t = 0.0f;
     for (int i = 0; i < w; i++) {
         static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, -1.4e-45f, 64.0f, -64.0f, 64.0625f,
                                     100.0f, -1000.0f, 1e6f, -1.25e8f, 1.25e8f, 0.125f, -0.0625f};
         const float u = rnd(), sg = rndi(2) ? 1.0f : -1.0f; /* (one draw a statement: the same inputs whatever the compiler) */
         coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? 20.0f * rnd() : cmode == 2 ? -12.0f * rnd() :
-                   cmode == 3 ? sg * 80.0f * rnd() :
+                   cmode == 3 ? sg * 80.0f * rnd() : cmode == 6 ? camp * sinf((float)i * 0.02f) :
                    u < 0.25f ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : sg * 70.0f * rnd();
         if (tmode == 0)
             t.p[i] = 1.0f;
