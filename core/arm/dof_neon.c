@@ -316,9 +316,10 @@ static void up2_neon(float *restrict dst, const float *tmp, int j, int runs)
     }
 }
 
-/* By s >= 4: whole runs, 4 pixels a step (weights as lanes of w4, one 4-register store) */
+/* By s >= 4: whole runs, 4 pixels a step (the weights as lanes of w4, constants once L is: one
+ * 4-register store) */
 static inline __attribute__((always_inline)) void upruns4_neon(float *restrict dst, const float *tmp, int sw, int j,
-                                                                int runs, const float *w, const int L)
+                                                                int runs, const int L)
 {
     const int s = 1 << L;
     for (int q = 0; q < runs; q++, j++) {
@@ -326,7 +327,8 @@ static inline __attribute__((always_inline)) void upruns4_neon(float *restrict d
         const float32x4_t p0 = vld1q_f32(tmp + 4 * (ptrdiff_t)j0);
         const float32x4_t d = vsubq_f32(vld1q_f32(tmp + 4 * (ptrdiff_t)j1), p0);
         for (int g = 0; g < s; g += 4, dst += 16) {
-            const float32x4_t w4 = vld1q_f32(w + g);
+            const float32x4_t w4 = {(float)(2 * g + 1) / (float)(2 * s), (float)(2 * g + 3) / (float)(2 * s),
+                                    (float)(2 * g + 5) / (float)(2 * s), (float)(2 * g + 7) / (float)(2 * s)};
             const float32x4x4_t o = {{vaddq_f32(p0, vmulq_laneq_f32(d, w4, 0)),
                                       vaddq_f32(p0, vmulq_laneq_f32(d, w4, 1)),
                                       vaddq_f32(p0, vmulq_laneq_f32(d, w4, 2)),
@@ -361,15 +363,12 @@ static void upsample_row_neon(float *restrict dst, const float *tmp, int L, int 
     const int a = s * j0 + s / 2, b = a + s * runs;
     upruns_neon(dst, tmp, L, sw, x0, a - x0);
     float *d = dst + 4 * (a - x0);
-    float w[1 << UP_MAXL];
-    for (int r = 0; r < s; r++)
-        w[r] = (float)(2 * r + 1) * (1.0f / (float)(2 * s));
     switch (L) {
     case 1: up2_neon(d, tmp, j0, runs); break;
-    case 2: upruns4_neon(d, tmp, sw, j0, runs, w, 2); break;
-    case 3: upruns4_neon(d, tmp, sw, j0, runs, w, 3); break;
-    case 4: upruns4_neon(d, tmp, sw, j0, runs, w, 4); break;
-    default: upruns4_neon(d, tmp, sw, j0, runs, w, 5); break;
+    case 2: upruns4_neon(d, tmp, sw, j0, runs, 2); break;
+    case 3: upruns4_neon(d, tmp, sw, j0, runs, 3); break;
+    case 4: upruns4_neon(d, tmp, sw, j0, runs, 4); break;
+    default: upruns4_neon(d, tmp, sw, j0, runs, 5); break;
     }
     upruns_neon(dst + 4 * (b - x0), tmp, L, sw, b, x1 - b);
 }

@@ -224,17 +224,20 @@ static inline void up2_avx2(float *restrict dst, const float *tmp, int k, int np
 }
 
 /* By s = 2^L >= 4: whole runs (s even pixels from s j + s/2, even), two pixels a vector: both
- * texels broadcast to the halves, one d a run, the pairs' weights from w2 (each weight 4 times). */
+ * texels broadcast to the halves, one d a run, the pairs' weights (2r + 1) / 2s as constants. */
 static inline __attribute__((always_inline)) void upruns_avx2(float *restrict dst, const float *tmp, int sw, int j,
-                                                               int runs, const float *w2, const int L)
+                                                               int runs, const int L)
 {
     const int s = 1 << L;
     for (int q = 0; q < runs; q++, j++, dst += 4 * s) {
         const __m256 p0 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)fv_clampi(j, 0, sw - 1)));
         const __m256 p1 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)fv_clampi(j + 1, 0, sw - 1)));
         const __m256 d = _mm256_sub_ps(p1, p0);
-        for (int p = 0; p < s / 2; p++)
-            _mm256_storeu_ps(dst + 8 * p, _mm256_add_ps(p0, _mm256_mul_ps(_mm256_loadu_ps(w2 + 8 * p), d)));
+        for (int p = 0; p < s / 2; p++) { /* L constant: the weights fold to constants */
+            const float wa = (float)(4 * p + 1) / (float)(2 * s), wb = (float)(4 * p + 3) / (float)(2 * s);
+            const __m256 w = _mm256_setr_ps(wa, wa, wa, wa, wb, wb, wb, wb);
+            _mm256_storeu_ps(dst + 8 * p, _mm256_add_ps(p0, _mm256_mul_ps(w, d)));
+        }
     }
 }
 
@@ -265,17 +268,13 @@ static void upsample_row_avx2(float *restrict dst, const float *tmp, int L, int 
         dof_upruns_x86(dst, tmp, L, sw, x0, n);
         return;
     }
-    float w2[8 << DOF_UP_MAXL];
-    for (int r = 0; r < s; r++)
-        for (int c = 0; c < 4; c++)
-            w2[4 * r + c] = (float)(2 * r + 1) * (1.0f / (float)(2 * s));
     dof_upruns_x86(dst, tmp, L, sw, x0, a - x0);
     float *d = dst + 4 * (a - x0);
     switch (L) { /* s / 2 pairs a run, unrolled */
-    case 2: upruns_avx2(d, tmp, sw, j0, runs, w2, 2); break;
-    case 3: upruns_avx2(d, tmp, sw, j0, runs, w2, 3); break;
-    case 4: upruns_avx2(d, tmp, sw, j0, runs, w2, 4); break;
-    default: upruns_avx2(d, tmp, sw, j0, runs, w2, 5); break;
+    case 2: upruns_avx2(d, tmp, sw, j0, runs, 2); break;
+    case 3: upruns_avx2(d, tmp, sw, j0, runs, 3); break;
+    case 4: upruns_avx2(d, tmp, sw, j0, runs, 4); break;
+    default: upruns_avx2(d, tmp, sw, j0, runs, 5); break;
     }
     const int b = a + s * runs;
     dof_upruns_x86(dst + 4 * (b - x0), tmp, L, sw, b, x1 - b);

@@ -323,16 +323,16 @@ static inline void dof_up2_x86(float *restrict dst, const float *tmp, int j, int
     }
 }
 
-/* by s >= 4: whole runs, the weights w[0..s) */
+/* by s >= 4: whole runs (L constant: the weights (2r + 1) / 2s fold to constants) */
 static inline __attribute__((always_inline)) void dof_upruns_whole_x86(float *restrict dst, const float *tmp, int sw,
-                                                                       int j, int runs, const float *w, const int L)
+                                                                       int j, int runs, const int L)
 {
     const int s = 1 << L;
     for (int q = 0; q < runs; q++, j++, dst += 4 * s) {
         const __m128 p0 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)fv_clampi(j, 0, sw - 1));
         const __m128 d = _mm_sub_ps(_mm_loadu_ps(tmp + 4 * (ptrdiff_t)fv_clampi(j + 1, 0, sw - 1)), p0);
         for (int r = 0; r < s; r++)
-            _mm_storeu_ps(dst + 4 * r, _mm_add_ps(p0, _mm_mul_ps(_mm_set1_ps(w[r]), d)));
+            _mm_storeu_ps(dst + 4 * r, _mm_add_ps(p0, _mm_mul_ps(_mm_set1_ps((float)(2 * r + 1) / (float)(2 * s)), d)));
     }
 }
 
@@ -364,15 +364,12 @@ static inline void dof_upsample_row_x86(float *restrict dst, const float *tmp, i
     const int s = 1 << L, a = s * j0 + s / 2, b = a + s * runs;
     dof_upruns_x86(dst, tmp, L, sw, x0, a - x0);
     float *d = dst + 4 * (a - x0);
-    float w[1 << DOF_UP_MAXL];
-    for (int r = 0; r < s; r++)
-        w[r] = (float)(2 * r + 1) * (1.0f / (float)(2 * s));
     switch (L) {
     case 1: dof_up2_x86(d, tmp, j0, runs); break;
-    case 2: dof_upruns_whole_x86(d, tmp, sw, j0, runs, w, 2); break;
-    case 3: dof_upruns_whole_x86(d, tmp, sw, j0, runs, w, 3); break;
-    case 4: dof_upruns_whole_x86(d, tmp, sw, j0, runs, w, 4); break;
-    default: dof_upruns_whole_x86(d, tmp, sw, j0, runs, w, 5); break;
+    case 2: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 2); break;
+    case 3: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 3); break;
+    case 4: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 4); break;
+    default: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 5); break;
     }
     dof_upruns_x86(dst + 4 * (b - x0), tmp, L, sw, b, x0 + n - b);
 }
