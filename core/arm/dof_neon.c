@@ -262,26 +262,115 @@ static void combine_row_neon(float *restrict out, const fv_dof_combine_args *a, 
 }
 
 /* one pixel a vector: dst = p0 + a (p1 - p0), 4 weights a load */
-static inline float32x4_t up1(const float *tmp, int32_t i0, int32_t i1, float a)
+/* Up-sampling by s = 2^L, one pixel a vector, run by run: the s pixels of a run (x in
+ * [s j + s/2, s j + s/2 + s)) share texels j, j + 1, so one d = p1 - p0 a run and per pixel
+ * p0 + a d (multiply, then add), the reference's operations on the same values; the weights
+ * (2r + 1) / 2s, r the place in the run, are exact. */
+#define UP_MAXL 5 /* the pyramid's deepest; beyond, the reference */
+
+/* any [x0, x0 + n), partial runs included */
+static void upruns_neon(float *restrict dst, const float *tmp, int L, int sw, int x0, int n)
 {
-    const float32x4_t p0 = vld1q_f32(tmp + 4 * (ptrdiff_t)i0), p1 = vld1q_f32(tmp + 4 * (ptrdiff_t)i1);
-    return vaddq_f32(p0, vmulq_n_f32(vsubq_f32(p1, p0), a));
+    const int s = 1 << L, s2 = 2 << L;
+    const float inv = 1.0f / (float)s2;
+    for (int i = 0; i < n;) {
+        const int m = 2 * (x0 + i) + 1 + s, j = (m >> (L + 1)) - 1, r = (m & (s2 - 1)) >> 1;
+        const int cnt = s - r < n - i ? s - r : n - i;
+        const int j0 = j < 0 ? 0 : j > sw - 1 ? sw - 1 : j, j1 = j + 1 < 0 ? 0 : j + 1 > sw - 1 ? sw - 1 : j + 1;
+        const float32x4_t p0 = vld1q_f32(tmp + 4 * (ptrdiff_t)j0);
+        const float32x4_t d = vsubq_f32(vld1q_f32(tmp + 4 * (ptrdiff_t)j1), p0);
+        for (int k = 0; k < cnt; k++)
+            vst1q_f32(dst + 4 * (i + k), vaddq_f32(p0, vmulq_n_f32(d, (float)(2 * (r + k) + 1) * inv)));
+        i += cnt;
+    }
 }
 
-static void upsample_row_neon(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
-                              const float *ax, int n)
+/* By 2: the run of texels j, j + 1 is pixels 2j + 1 (weight 1/4) and 2j + 2 (3/4); 4 runs (8
+ * pixels) a step from one 4-texel load, the previous step's last texel carried; interior runs
+ * only (j >= 0, j + 1 < sw). */
+static void up2_neon(float *restrict dst, const float *tmp, int j, int runs)
 {
-    int x = 0;
-    for (; x + 4 <= n; x += 4) {
-        const float32x4_t a4 = vld1q_f32(ax + x);
-        float *d = dst + 4 * x;
-        vst1q_f32(d, up1(tmp, i0[x], i1[x], vgetq_lane_f32(a4, 0)));
-        vst1q_f32(d + 4, up1(tmp, i0[x + 1], i1[x + 1], vgetq_lane_f32(a4, 1)));
-        vst1q_f32(d + 8, up1(tmp, i0[x + 2], i1[x + 2], vgetq_lane_f32(a4, 2)));
-        vst1q_f32(d + 12, up1(tmp, i0[x + 3], i1[x + 3], vgetq_lane_f32(a4, 3)));
+    const float *t = tmp + 4 * (ptrdiff_t)j;
+    float32x4_t q0 = vld1q_f32(t);
+    int q = 0;
+    for (; q + 4 <= runs; q += 4, t += 16, dst += 32) {
+        const float32x4x4_t v = vld1q_f32_x4(t + 4);
+        const float32x4_t d0 = vsubq_f32(v.val[0], q0), d1 = vsubq_f32(v.val[1], v.val[0]);
+        const float32x4_t d2 = vsubq_f32(v.val[2], v.val[1]), d3 = vsubq_f32(v.val[3], v.val[2]);
+        const float32x4x4_t o0 = {{vaddq_f32(q0, vmulq_n_f32(d0, 0.25f)), vaddq_f32(q0, vmulq_n_f32(d0, 0.75f)),
+                                   vaddq_f32(v.val[0], vmulq_n_f32(d1, 0.25f)),
+                                   vaddq_f32(v.val[0], vmulq_n_f32(d1, 0.75f))}};
+        const float32x4x4_t o1 = {{vaddq_f32(v.val[1], vmulq_n_f32(d2, 0.25f)),
+                                   vaddq_f32(v.val[1], vmulq_n_f32(d2, 0.75f)),
+                                   vaddq_f32(v.val[2], vmulq_n_f32(d3, 0.25f)),
+                                   vaddq_f32(v.val[2], vmulq_n_f32(d3, 0.75f))}};
+        vst1q_f32_x4(dst, o0);
+        vst1q_f32_x4(dst + 16, o1);
+        q0 = v.val[3];
     }
-    for (; x < n; x++)
-        vst1q_f32(dst + 4 * x, up1(tmp, i0[x], i1[x], ax[x]));
+    for (; q < runs; q++, t += 4, dst += 8) {
+        const float32x4_t q1 = vld1q_f32(t + 4), d = vsubq_f32(q1, q0);
+        vst1q_f32(dst, vaddq_f32(q0, vmulq_n_f32(d, 0.25f)));
+        vst1q_f32(dst + 4, vaddq_f32(q0, vmulq_n_f32(d, 0.75f)));
+        q0 = q1;
+    }
+}
+
+/* By s >= 4: whole runs, 4 pixels a step (the weights as lanes of w4, constants once L is: one
+ * 4-register store) */
+static inline __attribute__((always_inline)) void upruns4_neon(float *restrict dst, const float *tmp, int sw, int j,
+                                                                int runs, const int L)
+{
+    const int s = 1 << L;
+    for (int q = 0; q < runs; q++, j++) {
+        const int j0 = j < 0 ? 0 : j > sw - 1 ? sw - 1 : j, j1 = j + 1 > sw - 1 ? sw - 1 : j + 1;
+        const float32x4_t p0 = vld1q_f32(tmp + 4 * (ptrdiff_t)j0);
+        const float32x4_t d = vsubq_f32(vld1q_f32(tmp + 4 * (ptrdiff_t)j1), p0);
+        for (int g = 0; g < s; g += 4, dst += 16) {
+            const float32x4_t w4 = {(float)(2 * g + 1) / (float)(2 * s), (float)(2 * g + 3) / (float)(2 * s),
+                                    (float)(2 * g + 5) / (float)(2 * s), (float)(2 * g + 7) / (float)(2 * s)};
+            const float32x4x4_t o = {{vaddq_f32(p0, vmulq_laneq_f32(d, w4, 0)),
+                                      vaddq_f32(p0, vmulq_laneq_f32(d, w4, 1)),
+                                      vaddq_f32(p0, vmulq_laneq_f32(d, w4, 2)),
+                                      vaddq_f32(p0, vmulq_laneq_f32(d, w4, 3))}};
+            vst1q_f32_x4(dst, o);
+        }
+    }
+}
+
+static void upsample_row_neon(float *restrict dst, const float *tmp, int L, int sw, int x0, int n)
+{
+    if (L < 1 || L > UP_MAXL) {
+        fv_dof_upsample_row_c(dst, tmp, L, sw, x0, n);
+        return;
+    }
+    const int s = 1 << L, x1 = x0 + n;
+    /* the first run start >= x0 (x = s j + s/2; j0 = ceil((x0 - s/2) / s), x0 >= 0), whole runs
+     * (by 2: interior ones, j >= 0 and j + 1 < sw), the rest */
+    int j0 = (x0 + s / 2 - 1) / s, runs;
+    if (L == 1) {
+        j0 = j0 > 0 ? j0 : 0;
+        const int a = 2 * j0 + 1, e = x1 < 2 * sw - 1 ? x1 : 2 * sw - 1;
+        runs = a < e ? (e - a) >> 1 : 0;
+    } else {
+        const int a = s * j0 + s / 2;
+        runs = a < x1 ? (x1 - a) / s : 0;
+    }
+    if (runs <= 0) {
+        upruns_neon(dst, tmp, L, sw, x0, n);
+        return;
+    }
+    const int a = s * j0 + s / 2, b = a + s * runs;
+    upruns_neon(dst, tmp, L, sw, x0, a - x0);
+    float *d = dst + 4 * (a - x0);
+    switch (L) {
+    case 1: up2_neon(d, tmp, j0, runs); break;
+    case 2: upruns4_neon(d, tmp, sw, j0, runs, 2); break;
+    case 3: upruns4_neon(d, tmp, sw, j0, runs, 3); break;
+    case 4: upruns4_neon(d, tmp, sw, j0, runs, 4); break;
+    default: upruns4_neon(d, tmp, sw, j0, runs, 5); break;
+    }
+    upruns_neon(dst + 4 * (b - x0), tmp, L, sw, b, x1 - b);
 }
 
 /* 4 pixels at a time: their scalars as lanes, then one pixel a vector, each kept by selects (a

@@ -1,5 +1,5 @@
-/* fovea: the output kernel, NEON: the indices of 4 pixels' channels in vector code, the table
- * read per channel (NEON has no gather). */
+/* fovea: the output kernel, NEON: the indices of 8 pixels' channels in vector code, the table
+ * read per channel (NEON has no gather), the bytes assembled in registers. */
 #include <arm_neon.h>
 
 #include "output_dsp.h"
@@ -13,20 +13,28 @@ static inline uint32x4_t srgb_index4(float32x4_t v)
     return vandq_u32(vbslq_u32(lt1, i, vdupq_n_u32(FV_SRGB_LUT)), gt0);
 }
 
+/* 8 table bytes of one channel (indices lo, hi: pixels 0-3, 4-7) as one 64-bit word: a byte load and
+ * an OR a pixel, no stores of single bytes */
+static inline uint8x8_t lut8(const uint8_t *lut, uint32x4_t lo, uint32x4_t hi)
+{
+    const uint64_t w = (uint64_t)lut[vgetq_lane_u32(lo, 0)] | (uint64_t)lut[vgetq_lane_u32(lo, 1)] << 8 |
+                       (uint64_t)lut[vgetq_lane_u32(lo, 2)] << 16 | (uint64_t)lut[vgetq_lane_u32(lo, 3)] << 24 |
+                       (uint64_t)lut[vgetq_lane_u32(hi, 0)] << 32 | (uint64_t)lut[vgetq_lane_u32(hi, 1)] << 40 |
+                       (uint64_t)lut[vgetq_lane_u32(hi, 2)] << 48 | (uint64_t)lut[vgetq_lane_u32(hi, 3)] << 56;
+    return vcreate_u8(w);
+}
+
+/* 8 pixels a step: indices in vector code, the table bytes gathered into a word per channel, one
+ * interleaving 24-byte store (ST3) */
 static void rgb8_row_neon(uint8_t *restrict dst, const float *rgbd, int n, const uint8_t *lut)
 {
     int x = 0;
-    for (; x + 4 <= n; x += 4) {
-        const float32x4x4_t p = vld4q_f32(rgbd + 4 * x); /* r, g, b, d of 4 pixels, deinterleaved */
-        uint32_t ir[4], ig[4], ib[4];
-        vst1q_u32(ir, srgb_index4(p.val[0]));
-        vst1q_u32(ig, srgb_index4(p.val[1]));
-        vst1q_u32(ib, srgb_index4(p.val[2]));
-        for (int k = 0; k < 4; k++) {
-            dst[3 * (x + k) + 0] = lut[ir[k]];
-            dst[3 * (x + k) + 1] = lut[ig[k]];
-            dst[3 * (x + k) + 2] = lut[ib[k]];
-        }
+    for (; x + 8 <= n; x += 8) {
+        const float32x4x4_t p = vld4q_f32(rgbd + 4 * x), q = vld4q_f32(rgbd + 4 * x + 16); /* r, g, b, d */
+        const uint8x8x3_t o = {{lut8(lut, srgb_index4(p.val[0]), srgb_index4(q.val[0])),
+                                lut8(lut, srgb_index4(p.val[1]), srgb_index4(q.val[1])),
+                                lut8(lut, srgb_index4(p.val[2]), srgb_index4(q.val[2]))}};
+        vst3_u8(dst + 3 * x, o);
     }
     fv_rgb8_row_c(dst + 3 * x, rgbd + 4 * x, n - x, lut);
 }

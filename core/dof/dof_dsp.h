@@ -32,8 +32,12 @@
 struct fv_dof_gauss_tab;
 struct fv_dof_combine_args;
 struct fv_dof_pyrblur_args;
-/* dof_upsample_row: dst[x] = tmp[i0[x]] + ax[x] (tmp[i1[x]] - tmp[i0[x]]) for x in [0, n)
- *   (4 channels; the horizontal half of a separable bilinear up-sampling).
+/* dof_upsample_row: the horizontal half of a separable bilinear up-sampling by s = 2^L, texel
+ *   centres at (k + 0.5) s: for i in [0, n), pixel x = x0 + i, u = (x + 0.5) / s - 0.5,
+ *   j = floor(u), a = u - j, p0 = tmp[clamp(j, 0, sw - 1)], p1 = tmp[clamp(j + 1, 0, sw - 1)]
+ *   (4 channels): dst[i] = p0 + a (p1 - p0). L in [0, 20], sw >= 1, x0 >= 0, x0 + n < 2^20; reads
+ *   only the texels it uses. The ISA versions run the s pixels that share j (x in
+ *   [s j + s/2, s j + s/2 + s)) with one p1 - p0: same bits.
  * dof_pyrblur_row: for x in [x0, x0+n) with coc != 0 and t > 0: the continuous level
  *   l = min(lambda[min(int(|coc| steps), max)], need), pv = up[L0] + f (up[L1] - up[L0])
  *   (L0 = int l, L1 = min(L0 + 1, need), f = l - L0), blur[x] = coc > 0 && t < 1 ?
@@ -83,8 +87,7 @@ typedef void (*fv_dof_nearblk_row_fn)(float *restrict sum, float *restrict ext, 
 typedef void (*fv_dof_nearbox_row_fn)(float *restrict out, float *restrict out_r, float *restrict out_w,
                                       const float *src, const float *r, const float *wgt, int w, int x0, int n,
                                       int reach);
-typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
-                                       const float *ax, int n);
+typedef void (*fv_dof_upsample_row_fn)(float *restrict dst, const float *tmp, int L, int sw, int x0, int n);
 typedef void (*fv_dof_pyrblur_row_fn)(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
 typedef void (*fv_dof_coc_row_fn)(float *restrict coc, const float *rgbd, int n, float K, float dn, float df);
 typedef void (*fv_dof_hgauss_row_fn)(float *restrict dst, const float *rgbd, const float *coc, int w, int x0, int n,
@@ -118,8 +121,7 @@ void fv_dof_hgauss_row_c(float *restrict dst, const float *rgbd, const float *co
 void fv_dof_vgauss_row_c(float *restrict dst, const float *src, ptrdiff_t stride, int y, int ylo, int yhi, int x0,
                          int n, const uint8_t *sig, const struct fv_dof_gauss_tab *tab);
 void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args *a, int x0, int n);
-void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
-                           const float *ax, int n);
+void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, int L, int sw, int x0, int n);
 void fv_dof_pyrblur_row_c(float *restrict blur, const struct fv_dof_pyrblur_args *a, int x0, int n);
 void fv_dof_nearblk_row_c(float *restrict sum, float *restrict ext, const float *coc, const float *rgbd, int n);
 void fv_dof_nearbox_row_c(float *restrict out, float *restrict out_r, float *restrict out_w, const float *src,

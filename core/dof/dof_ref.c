@@ -121,13 +121,20 @@ void fv_dof_combine_row_c(float *restrict out, const struct fv_dof_combine_args 
     }
 }
 
-void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
-                           const float *ax, int n)
+void fv_dof_upsample_row_c(float *restrict dst, const float *tmp, int L, int sw, int x0, int n)
 {
-    for (int x = 0; x < n; x++) {
-        const float *p0 = tmp + 4 * (ptrdiff_t)i0[x], *p1 = tmp + 4 * (ptrdiff_t)i1[x], a = ax[x];
+    /* pixel x's left texel j = floor((2x + 1 - s) / 2s) and weight a = ((2x + 1 - s) - 2s j) / 2s,
+     * s = 2^L: the integer form of floor(u), u - floor(u) for u = (x + 0.5) / s - 0.5 (exact:
+     * a has at most L + 1 fraction bits) */
+    const int s2 = 2 << L;
+    const float inv = 1.0f / (float)s2;
+    for (int i = 0; i < n; i++) {
+        const int m = 2 * (x0 + i) + 1 - (1 << L) + s2; /* + 2s: m >= 0, the shift floors */
+        const int j = (m >> (L + 1)) - 1;
+        const float a = (float)(m & (s2 - 1)) * inv;
+        const float *p0 = tmp + 4 * (ptrdiff_t)fv_clampi(j, 0, sw - 1), *p1 = tmp + 4 * (ptrdiff_t)fv_clampi(j + 1, 0, sw - 1);
         for (int c = 0; c < 4; c++)
-            dst[4 * x + c] = p0[c] + a * (p1[c] - p0[c]);
+            dst[4 * i + c] = p0[c] + a * (p1[c] - p0[c]);
     }
 }
 

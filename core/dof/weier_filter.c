@@ -43,7 +43,7 @@ void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps
     const float *rb = src->px + 4 * (ptrdiff_t)fv_clampi((int)fv + 1, 0, src->h - 1) * src->stride;
     const int t0 = xt->i0[xa], t1 = xt->i1[xb - 1] + 1; /* the taps grow with x */
     vlerp(tmp + 4 * t0, ra + 4 * t0, rb + 4 * t0, ay, 4 * (t1 - t0));
-    dsp->dof_upsample_row(dst + 4 * xa, tmp, xt->i0 + xa, xt->i1 + xa, xt->ax + xa, xb - xa);
+    dsp->dof_upsample_row(dst + 4 * xa, tmp, L, src->w, xa, xb - xa);
 }
 
 /* One tap row of the scatter-as-gather box down the columns (the horizontal one is the kernel

@@ -198,82 +198,86 @@ static inline __m256 ld2(const float *lo, const float *hi)
 #define PAIR(v, p) _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(2 * (p), 2 * (p), 2 * (p), 2 * (p), 2 * (p) + 1, \
                                                                  2 * (p) + 1, 2 * (p) + 1, 2 * (p) + 1))
 
-/* texels i and j as one vector: up-sampling by 2^L reads neighbouring or equal texels for
- * neighbouring pixels, one load instead of two and an insert */
-static inline __m256 ld_tex2(const float *tmp, int32_t i, int32_t j)
+/* By 2 (L = 1): pixel 2k reads texels k - 1, k (weight 3/4), pixel 2k + 1 texels k, k + 1 (1/4),
+ * so the pair's p0 and p1 are the two-texel loads at k - 1 and k, and the next pair's p0 is this
+ * one's p1; interior pairs only (k - 1 >= 0, k + 1 < sw), the ends run by run. */
+static inline void up2_avx2(float *restrict dst, const float *tmp, int k, int np)
 {
-    const float *a = tmp + 4 * (ptrdiff_t)i;
-    if (j == i + 1)
-        return _mm256_loadu_ps(a);
-    if (j == i)
-        return _mm256_broadcast_ps((const __m128 *)(const void *)a);
-    return ld2(a, tmp + 4 * (ptrdiff_t)j);
-}
-
-/* pixels xp, xp + 1 (pair p of the 8 whose weights are a8) */
-static inline void up_pair(float *dst, const float *tmp, const int32_t *i0, const int32_t *i1, __m256 a8, int xp,
-                           int p)
-{
-    const __m256 p0 = ld_tex2(tmp, i0[xp], i0[xp + 1]);
-    const __m256 p1 = ld_tex2(tmp, i1[xp], i1[xp + 1]);
-    _mm256_storeu_ps(dst + 4 * xp, _mm256_add_ps(p0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(p1, p0))));
-}
-
-/* lanes 2p of d (the pairs' first pixels) all 1 / all 0: a bit mask of the 4 pairs whose two
- * taps are neighbouring / the same texel */
-static inline int pair_steps(__m256i idx, int step)
-{
-    const __m256i d = _mm256_sub_epi32(_mm256_shuffle_epi32(idx, 0xb1), idx); /* lane 2p: idx[2p+1] - idx[2p] */
-    return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(d, _mm256_set1_epi32(step)))) & 0x55;
-}
-
-/* 8 pixels at a time as 4 pairs (unrolled by hand: the pairs' lane indices are constants), the
- * rest with the 128-bit version. Up-sampling by 2 reads neighbouring texels for each pair, by
- * 4 or more the same texel twice: when all 4 pairs of both taps do, whole-pair or broadcast
- * loads without the per-pair tests. */
-static void upsample_row_avx2(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
-                              const float *ax, int n)
-{
-    int x = 0;
-    for (; x + 8 <= n; x += 8) {
-        const __m256 a8 = _mm256_loadu_ps(ax + x);
-        const __m256i j0 = _mm256_loadu_si256((const __m256i *)(const void *)(i0 + x));
-        const __m256i j1 = _mm256_loadu_si256((const __m256i *)(const void *)(i1 + x));
-        if ((pair_steps(j0, 1) & pair_steps(j1, 1)) == 0x55) {
-#define UP_NB(p)                                                                                                     \
-    do {                                                                                                             \
-        const __m256 q0 = _mm256_loadu_ps(tmp + 4 * (ptrdiff_t)i0[x + 2 * (p)]);                                     \
-        const __m256 q1 = _mm256_loadu_ps(tmp + 4 * (ptrdiff_t)i1[x + 2 * (p)]);                                     \
-        _mm256_storeu_ps(dst + 4 * (x + 2 * (p)), _mm256_add_ps(q0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(q1, q0)))); \
-    } while (0)
-            UP_NB(0);
-            UP_NB(1);
-            UP_NB(2);
-            UP_NB(3);
-#undef UP_NB
-            continue;
-        }
-        if ((pair_steps(j0, 0) & pair_steps(j1, 0)) == 0x55) {
-#define UP_BC(p)                                                                                                     \
-    do {                                                                                                             \
-        const __m256 q0 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)i0[x + 2 * (p)])); \
-        const __m256 q1 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)i1[x + 2 * (p)])); \
-        _mm256_storeu_ps(dst + 4 * (x + 2 * (p)), _mm256_add_ps(q0, _mm256_mul_ps(PAIR(a8, p), _mm256_sub_ps(q1, q0)))); \
-    } while (0)
-            UP_BC(0);
-            UP_BC(1);
-            UP_BC(2);
-            UP_BC(3);
-#undef UP_BC
-            continue;
-        }
-        up_pair(dst, tmp, i0, i1, a8, x, 0);
-        up_pair(dst, tmp, i0, i1, a8, x + 2, 1);
-        up_pair(dst, tmp, i0, i1, a8, x + 4, 2);
-        up_pair(dst, tmp, i0, i1, a8, x + 6, 3);
+    const __m256 a = _mm256_setr_ps(0.75f, 0.75f, 0.75f, 0.75f, 0.25f, 0.25f, 0.25f, 0.25f);
+    const float *t = tmp + 4 * (ptrdiff_t)(k - 1);
+    __m256 q0 = _mm256_loadu_ps(t);
+    int p = 0;
+    for (; p + 4 <= np; p += 4, t += 16, dst += 32) {
+        const __m256 q1 = _mm256_loadu_ps(t + 4), q2 = _mm256_loadu_ps(t + 8), q3 = _mm256_loadu_ps(t + 12);
+        const __m256 q4 = _mm256_loadu_ps(t + 16);
+        _mm256_storeu_ps(dst, _mm256_add_ps(q0, _mm256_mul_ps(a, _mm256_sub_ps(q1, q0))));
+        _mm256_storeu_ps(dst + 8, _mm256_add_ps(q1, _mm256_mul_ps(a, _mm256_sub_ps(q2, q1))));
+        _mm256_storeu_ps(dst + 16, _mm256_add_ps(q2, _mm256_mul_ps(a, _mm256_sub_ps(q3, q2))));
+        _mm256_storeu_ps(dst + 24, _mm256_add_ps(q3, _mm256_mul_ps(a, _mm256_sub_ps(q4, q3))));
+        q0 = q4;
     }
-    if (x < n)
-        dof_upsample_row_x86(dst + 4 * x, tmp, i0 + x, i1 + x, ax + x, n - x);
+    for (; p < np; p++, t += 4, dst += 8) {
+        const __m256 q1 = _mm256_loadu_ps(t + 4);
+        _mm256_storeu_ps(dst, _mm256_add_ps(q0, _mm256_mul_ps(a, _mm256_sub_ps(q1, q0))));
+        q0 = q1;
+    }
+}
+
+/* By s = 2^L >= 4: whole runs (s even pixels from s j + s/2, even), two pixels a vector: both
+ * texels broadcast to the halves, one d a run, the pairs' weights (2r + 1) / 2s as constants. */
+static inline __attribute__((always_inline)) void upruns_avx2(float *restrict dst, const float *tmp, int sw, int j,
+                                                               int runs, const int L)
+{
+    const int s = 1 << L;
+    for (int q = 0; q < runs; q++, j++, dst += 4 * s) {
+        const __m256 p0 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)fv_clampi(j, 0, sw - 1)));
+        const __m256 p1 = _mm256_broadcast_ps((const __m128 *)(const void *)(tmp + 4 * (ptrdiff_t)fv_clampi(j + 1, 0, sw - 1)));
+        const __m256 d = _mm256_sub_ps(p1, p0);
+        for (int p = 0; p < s / 2; p++) { /* L constant: the weights fold to constants */
+            const float wa = (float)(4 * p + 1) / (float)(2 * s), wb = (float)(4 * p + 3) / (float)(2 * s);
+            const __m256 w = _mm256_setr_ps(wa, wa, wa, wa, wb, wb, wb, wb);
+            _mm256_storeu_ps(dst + 8 * p, _mm256_add_ps(p0, _mm256_mul_ps(w, d)));
+        }
+    }
+}
+
+static void upsample_row_avx2(float *restrict dst, const float *tmp, int L, int sw, int x0, int n)
+{
+    if (L < 1 || L > DOF_UP_MAXL) {
+        fv_dof_upsample_row_c(dst, tmp, L, sw, x0, n);
+        return;
+    }
+    const int s = 1 << L, x1 = x0 + n;
+    if (L == 1) { /* pairs from the first even x >= 2 to the last whose k + 1 < sw */
+        const int a = x0 < 2 ? 2 : (x0 + 1) & ~1;
+        const int e = x1 < 2 * sw - 2 ? x1 : 2 * sw - 2, np = (e - a) >> 1;
+        if (np <= 0) {
+            dof_upruns_x86(dst, tmp, L, sw, x0, n);
+            return;
+        }
+        dof_upruns_x86(dst, tmp, L, sw, x0, a - x0);
+        up2_avx2(dst + 4 * (a - x0), tmp, a >> 1, np);
+        const int b = a + 2 * np;
+        dof_upruns_x86(dst + 4 * (b - x0), tmp, L, sw, b, x1 - b);
+        return;
+    }
+    /* the first run start >= x0 (x = s j + s/2), whole runs, the rest */
+    const int j0 = (x0 + s / 2 - 1) / s, a = s * j0 + s / 2; /* ceil((x0 - s/2) / s), x0 >= 0 */
+    const int runs = a < x1 ? (x1 - a) / s : 0;
+    if (runs <= 0) {
+        dof_upruns_x86(dst, tmp, L, sw, x0, n);
+        return;
+    }
+    dof_upruns_x86(dst, tmp, L, sw, x0, a - x0);
+    float *d = dst + 4 * (a - x0);
+    switch (L) { /* s / 2 pairs a run, unrolled */
+    case 2: upruns_avx2(d, tmp, sw, j0, runs, 2); break;
+    case 3: upruns_avx2(d, tmp, sw, j0, runs, 3); break;
+    case 4: upruns_avx2(d, tmp, sw, j0, runs, 4); break;
+    default: upruns_avx2(d, tmp, sw, j0, runs, 5); break;
+    }
+    const int b = a + s * runs;
+    dof_upruns_x86(dst + 4 * (b - x0), tmp, L, sw, b, x1 - b);
 }
 
 /* pair p of the 8 pixels from i: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0), kept where
@@ -285,6 +289,24 @@ static inline void pb_pair(float *blur, const float *const *up, const int32_t *L
     const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
     float *b = blur + o;
     const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
+    if (!sel) {
+        _mm256_storeu_ps(b, pv);
+        return;
+    }
+    const __m256 bv = _mm256_loadu_ps(b);
+    const __m256 r =
+        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+}
+
+/* pair p when all 8 pixels have the same levels L0, L1 (rows r0 = up[L0] + 4 i, r1 = up[L1] + 4 i):
+ * whole-pair loads, no per-pixel row pointers. The same operations as pb_pair. */
+static inline void pb_pairu(float *blur, const float *r0, const float *r1, __m256 f, __m256 t, __m256 mix, __m256 act,
+                            int i, int p, int sel)
+{
+    float *b = blur + 4 * (ptrdiff_t)(i + 2 * p);
+    const __m256 u0 = _mm256_loadu_ps(r0 + 8 * p), u1 = _mm256_loadu_ps(r1 + 8 * p);
     const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
     if (!sel) {
         _mm256_storeu_ps(b, pv);
@@ -390,10 +412,28 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         const __m256 l = _mm256_min_ps(_mm256_i32gather_ps(a->lambda, _mm256_cvttps_epi32(v), 4), need);
         const __m256i l0 = _mm256_cvttps_epi32(l);
         const __m256 f = _mm256_sub_ps(l, _mm256_cvtepi32_ps(l0));
+        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        /* one level pair for all 8 (the CoC varies slowly: most blocks): rows, not pixels */
+        const int l00 = _mm_cvtsi128_si32(_mm256_castsi256_si128(l0));
+        if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(l0, _mm256_set1_epi32(l00)))) == 255) {
+            const float *r0 = up[l00] + 4 * (ptrdiff_t)i, *r1 = up[l00 < a->need ? l00 + 1 : l00] + 4 * (ptrdiff_t)i;
+            const int sel = !(bits == 255 && !_mm256_movemask_ps(mix));
+            if (!sel) {
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 0, 0);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 1, 0);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 2, 0);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 3, 0);
+            } else {
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 0, 1);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 1, 1);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 2, 1);
+                pb_pairu(blur, r0, r1, f, t, mix, act, i, 3, 1);
+            }
+            continue;
+        }
         _Alignas(32) int32_t L0[8], L1[8];
         _mm256_store_si256((__m256i *)L0, l0);
         _mm256_store_si256((__m256i *)L1, _mm256_sub_epi32(l0, _mm256_cmpgt_epi32(needi, l0))); /* + 1 if L0 < need */
-        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
         if (bits == 255 && !_mm256_movemask_ps(mix)) { /* the periphery */
             pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 0);
             pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 0);

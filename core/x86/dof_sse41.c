@@ -22,10 +22,9 @@ static void combine_row_sse41(float *restrict out, const fv_dof_combine_args *a,
     dof_combine_row_x86(out, a, x0, n);
 }
 
-static void upsample_row_sse41(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
-                               const float *ax, int n)
+static void upsample_row_sse41(float *restrict dst, const float *tmp, int L, int sw, int x0, int n)
 {
-    dof_upsample_row_x86(dst, tmp, i0, i1, ax, n);
+    dof_upsample_row_x86(dst, tmp, L, sw, x0, n);
 }
 
 static void pyrblur_row_sse41(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)

@@ -284,29 +284,94 @@ static inline void dof_periph_row_x86(float *restrict out, const float *sharp, c
         fv_dof_periph_row_c(out, sharp, coc, half, lnear, x, x0 + n - x);
 }
 
-/* ---- upsample_row, one pixel a vector: dst = p0 + a (p1 - p0), the reference's per-channel
- * operations (the SSE4.1 version; the AVX2 one's tail) ---- */
+/* ---- upsample_row, one pixel a vector, run by run: the s = 2^L pixels of a run share their
+ * texels j, j + 1 (x in [s j + s/2, s j + s/2 + s)), so one d = p1 - p0 a run and per pixel
+ * p0 + a d, the reference's operations on the same values (the SSE4.1 version; the AVX2 one's
+ * ends). Weights (2r + 1) / 2s, r the pixel's place in its run: exact. ---- */
 
-static inline __m128 dof_up1(const float *tmp, int32_t i0, int32_t i1, __m128 a)
+#define DOF_UP_MAXL 5 /* the pyramid's deepest; beyond, the reference */
+
+/* any [x0, x0 + n), partial runs included */
+static inline void dof_upruns_x86(float *restrict dst, const float *tmp, int L, int sw, int x0, int n)
 {
-    const __m128 p0 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)i0), p1 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)i1);
-    return _mm_add_ps(p0, _mm_mul_ps(a, _mm_sub_ps(p1, p0)));
+    const int s = 1 << L, s2 = 2 << L;
+    const float inv = 1.0f / (float)s2;
+    for (int i = 0; i < n;) {
+        const int m = 2 * (x0 + i) + 1 + s, j = (m >> (L + 1)) - 1, r = (m & (s2 - 1)) >> 1;
+        const int cnt = s - r < n - i ? s - r : n - i;
+        const __m128 p0 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)fv_clampi(j, 0, sw - 1));
+        const __m128 d = _mm_sub_ps(_mm_loadu_ps(tmp + 4 * (ptrdiff_t)fv_clampi(j + 1, 0, sw - 1)), p0);
+        for (int k = 0; k < cnt; k++)
+            _mm_storeu_ps(dst + 4 * (i + k),
+                          _mm_add_ps(p0, _mm_mul_ps(_mm_set1_ps((float)(2 * (r + k) + 1) * inv), d)));
+        i += cnt;
+    }
 }
 
-static inline void dof_upsample_row_x86(float *restrict dst, const float *tmp, const int32_t *i0, const int32_t *i1,
-                                        const float *ax, int n)
+/* by 2: the run of texels j, j + 1 is pixels 2j + 1 (weight 1/4) and 2j + 2 (3/4), the next
+ * run's p0 this one's p1; interior runs only (j >= 0, j + 1 < sw) */
+static inline void dof_up2_x86(float *restrict dst, const float *tmp, int j, int runs)
 {
-    int x = 0;
-    for (; x + 4 <= n; x += 4) { /* 4 weights a load, spread by shuffles */
-        const __m128 a4 = _mm_loadu_ps(ax + x);
-        float *d = dst + 4 * x;
-        _mm_storeu_ps(d, dof_up1(tmp, i0[x], i1[x], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(0, 0, 0, 0))));
-        _mm_storeu_ps(d + 4, dof_up1(tmp, i0[x + 1], i1[x + 1], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(1, 1, 1, 1))));
-        _mm_storeu_ps(d + 8, dof_up1(tmp, i0[x + 2], i1[x + 2], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(2, 2, 2, 2))));
-        _mm_storeu_ps(d + 12, dof_up1(tmp, i0[x + 3], i1[x + 3], _mm_shuffle_ps(a4, a4, _MM_SHUFFLE(3, 3, 3, 3))));
+    const __m128 a1 = _mm_set1_ps(0.25f), a3 = _mm_set1_ps(0.75f);
+    const float *t = tmp + 4 * (ptrdiff_t)j;
+    __m128 q0 = _mm_loadu_ps(t);
+    for (int q = 0; q < runs; q++, t += 4, dst += 8) {
+        const __m128 q1 = _mm_loadu_ps(t + 4), d = _mm_sub_ps(q1, q0);
+        _mm_storeu_ps(dst, _mm_add_ps(q0, _mm_mul_ps(a1, d)));
+        _mm_storeu_ps(dst + 4, _mm_add_ps(q0, _mm_mul_ps(a3, d)));
+        q0 = q1;
     }
-    for (; x < n; x++)
-        _mm_storeu_ps(dst + 4 * x, dof_up1(tmp, i0[x], i1[x], _mm_set1_ps(ax[x])));
+}
+
+/* by s >= 4: whole runs (L constant: the weights (2r + 1) / 2s fold to constants) */
+static inline __attribute__((always_inline)) void dof_upruns_whole_x86(float *restrict dst, const float *tmp, int sw,
+                                                                       int j, int runs, const int L)
+{
+    const int s = 1 << L;
+    for (int q = 0; q < runs; q++, j++, dst += 4 * s) {
+        const __m128 p0 = _mm_loadu_ps(tmp + 4 * (ptrdiff_t)fv_clampi(j, 0, sw - 1));
+        const __m128 d = _mm_sub_ps(_mm_loadu_ps(tmp + 4 * (ptrdiff_t)fv_clampi(j + 1, 0, sw - 1)), p0);
+        for (int r = 0; r < s; r++)
+            _mm_storeu_ps(dst + 4 * r, _mm_add_ps(p0, _mm_mul_ps(_mm_set1_ps((float)(2 * r + 1) / (float)(2 * s)), d)));
+    }
+}
+
+/* the first run start >= x0 (x = s j + s/2; j0 = ceil((x0 - s/2) / s), x0 >= 0) and the number of
+ * whole runs from it (by 2: interior ones, j >= 0 and j + 1 < sw) */
+static inline int dof_up_whole(int L, int sw, int x0, int n, int *j0)
+{
+    const int s = 1 << L, x1 = x0 + n;
+    *j0 = (x0 + s / 2 - 1) / s;
+    const int a = s * *j0 + s / 2;
+    if (L == 1) {
+        const int e = x1 < 2 * sw - 1 ? x1 : 2 * sw - 1;
+        return a < e ? (e - a) >> 1 : 0;
+    }
+    return a < x1 ? (x1 - a) / s : 0;
+}
+
+static inline void dof_upsample_row_x86(float *restrict dst, const float *tmp, int L, int sw, int x0, int n)
+{
+    int j0, runs;
+    if (L < 1 || L > DOF_UP_MAXL) {
+        fv_dof_upsample_row_c(dst, tmp, L, sw, x0, n);
+        return;
+    }
+    if ((runs = dof_up_whole(L, sw, x0, n, &j0)) <= 0) {
+        dof_upruns_x86(dst, tmp, L, sw, x0, n);
+        return;
+    }
+    const int s = 1 << L, a = s * j0 + s / 2, b = a + s * runs;
+    dof_upruns_x86(dst, tmp, L, sw, x0, a - x0);
+    float *d = dst + 4 * (a - x0);
+    switch (L) {
+    case 1: dof_up2_x86(d, tmp, j0, runs); break;
+    case 2: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 2); break;
+    case 3: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 3); break;
+    case 4: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 4); break;
+    default: dof_upruns_whole_x86(d, tmp, sw, j0, runs, 5); break;
+    }
+    dof_upruns_x86(dst + 4 * (b - x0), tmp, L, sw, b, x0 + n - b);
 }
 
 /* ---- pyrblur_row ----

@@ -200,11 +200,11 @@ static void taa_run(void *st, const checkasm_dsp *d, int row0, int rows)
 /* ---- depth of field ---- */
 typedef struct {
     float *rgbd, *coc, *a4, *b4, *c4, *out, *t;
+    float *cocs, *ts; /* pyrblur: a smooth CoC and the transition ramp of t, as the pipeline's */
     uint8_t *sig;
     uint8_t *sigr; /* vgauss: sigmas in runs */
     fv_dof_gauss_tab *tab;
-    int32_t *i0, *i1; /* up-sampling by 2: taps into a 640-pixel coarse row */
-    float *ax, *lambda;
+    float *lambda;
 } dof_st;
 #define LSTEPS 8 /* the level table's steps per pixel of CoC (core/dof/weier.c) */
 #define SPAN 128 /* the Gaussians' span per call in core/dof/weier.c (TILE * 8) */
@@ -212,7 +212,7 @@ static void dof_free(void *st)
 {
     dof_st *t = st;
     free(t->rgbd), free(t->coc), free(t->a4), free(t->b4), free(t->c4), free(t->out), free(t->t), free(t->sig), free(t->sigr);
-    free(t->tab), free(t->i0), free(t->i1), free(t->ax), free(t->lambda), free(t);
+    free(t->cocs), free(t->ts), free(t->tab), free(t->lambda), free(t);
 }
 static void *dof_setup(void)
 {
@@ -223,17 +223,10 @@ static void *dof_setup(void)
     t->rgbd = fplane(4 * n), t->coc = fplane(n), t->a4 = fplane(4 * n), t->b4 = fplane(4 * n);
     t->c4 = fplane(4 * n), t->out = fplane(4 * n), t->t = fplane(n), t->sig = malloc(n), t->sigr = malloc(n);
     t->tab = malloc(sizeof *t->tab);
-    t->i0 = malloc(W * sizeof *t->i0), t->i1 = malloc(W * sizeof *t->i1), t->ax = fplane(W);
+    t->cocs = fplane(n), t->ts = fplane(n);
     t->lambda = fplane(64 * LSTEPS + 1);
-    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->sigr || !t->tab || !t->i0 ||
-        !t->i1 || !t->ax || !t->lambda)
+    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->sigr || !t->tab || !t->lambda || !t->cocs || !t->ts)
         return dof_free(t), NULL;
-    for (int x = 0; x < W; x++) { /* pixel centres: x = 2 X + 0.5 +- 0.25 */
-        const int X = x / 2;
-        t->i0[x] = x & 1 ? X : (X > 0 ? X - 1 : 0);
-        t->i1[x] = x & 1 ? (X + 1 < W / 2 ? X + 1 : X) : X;
-        t->ax[x] = x & 1 ? 0.25f : (X > 0 ? 0.75f : 0.0f);
-    }
     for (int i = 0; i <= 64 * LSTEPS; i++) /* about log2 of the CoC */
         t->lambda[i] = i < LSTEPS ? 0.0f : fminf(5.0f, log2f((float)i / LSTEPS));
     fv_dof_gauss_tab_init(t->tab);
@@ -257,6 +250,16 @@ static void *dof_setup(void)
         for (size_t k = 0; k < len && i < n; k++, i++)
             t->sigr[i] = v;
     }
+    /* pyrblur as core/dof/weier_filter.c calls it: the CoC of a rendered image varies slowly
+     * (here +-6 px over tens of pixels), t is 0 in the fovea, a ramp over the transition ring
+     * (radius 170 .. 350 px around the image centre), 1 beyond */
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const size_t i = (size_t)y * W + (size_t)x;
+            t->cocs[i] = 6.0f * sinf((float)x * 0.043f + (float)y * 0.027f) * cosf((float)x * 0.011f - (float)y * 0.019f);
+            const float dx = (float)x + 0.5f - 0.5f * W, dy = (float)y + 0.5f - 0.5f * H;
+            t->ts[i] = fminf(fmaxf((sqrtf(dx * dx + dy * dy) - 170.0f) / 180.0f, 0.0f), 1.0f);
+        }
     return t;
 }
 static void coc_run(void *st, const checkasm_dsp *d, int row0, int rows)
@@ -340,19 +343,33 @@ static void upsample_run(void *st, const checkasm_dsp *d, int row0, int rows)
         const size_t y = (size_t)((row0 + k) % H);
         /* rows in cache, as core/dof/weier_filter.c runs it (per-thread row buffers): a whole
          * 1280x1440 plane out would time the memory, not the kernel (1.05x for any version) */
-        d->dof.dof_upsample_row(t->out + 4 * (y % 4) * W, t->a4 + 4 * (y % 4) * W, t->i0, t->i1, t->ax, W);
+        d->dof.dof_upsample_row(t->out + 4 * (y % 4) * W, t->a4 + 4 * (y % 4) * W, 1, W / 2, 0, W);
+    }
+}
+static void upsample_spans_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    for (int k = 0; k < rows; k++) {
+        const int y = (row0 + k) % H, L = y % 8 == 7 ? 3 : 1 + (y & 1);
+        const size_t v = (size_t)(y % 4);
+        /* as core/dof/weier_filter.c calls it (range, DoF medium / FlightHelmet strong: by 2 and
+         * by 4 about 1:1 in pixels, some by 8; ~430-px spans at any start) */
+        const int x0 = (y * 97) % (W - 448);
+        d->dof.dof_upsample_row(t->out + 4 * v * W, t->a4 + 4 * v * W, L, (W + (1 << L) - 1) >> L, x0, 448);
     }
 }
 static void pyrblur_run(void *st, const checkasm_dsp *d, int row0, int rows)
 {
     dof_st *t = st;
     for (int k = 0; k < rows; k++) {
-        const size_t y = (size_t)((row0 + k) % H);
-        const float *up[5] = {t->rgbd + 4 * y * W, t->a4 + 4 * y * W, t->b4 + 4 * y * W, t->c4 + 4 * y * W,
-                              t->a4 + 4 * ((y + 1) % H) * W};
-        const fv_dof_pyrblur_args a = {.coc = t->coc + y * W, .t = t->t + y * W, .up = up, .need = 4,
+        const size_t y = (size_t)((row0 + k) % H), v = y % 4;
+        /* the up-sampled levels and the blur row in cache, as core/dof/weier_filter.c's per-thread
+         * rows (whole planes timed the memory: 5 planes in, one read and written) */
+        const float *up[5] = {t->rgbd + 4 * v * W, t->a4 + 4 * v * W, t->b4 + 4 * v * W, t->c4 + 4 * v * W,
+                              t->a4 + 4 * ((v + 1) % 4) * W};
+        const fv_dof_pyrblur_args a = {.coc = t->cocs + y * W, .t = t->ts + y * W, .up = up, .need = 4,
                                        .lambda = t->lambda, .lambda_steps = LSTEPS, .lambda_max = 64 * LSTEPS};
-        d->dof.dof_pyrblur_row(t->out + 4 * y * W, &a, 0, W);
+        d->dof.dof_pyrblur_row(t->out + 4 * v * W, &a, 0, W);
     }
 }
 /* the periphery beyond the disc: half-resolution blur row (with its clamped texel before it), near
@@ -656,7 +673,9 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
      vgauss_run, dof_free},
     {"dof_upsample_row", "1280-px rows in cache, 1440, by 2 from 640", {F(dof.dof_upsample_row), 0}, H, dof_setup, NULL,
      upsample_run, dof_free},
-    {"dof_pyrblur_row", "1280x1440, 1440 rows, 5 levels", {F(dof.dof_pyrblur_row), 0}, H, dof_setup, NULL, pyrblur_run,
+    {"dof_upsample_spans", "1440 448-px spans in cache, by 2, 4, 8", {F(dof.dof_upsample_row), 0}, H, dof_setup, NULL,
+     upsample_spans_run, dof_free},
+    {"dof_pyrblur_row", "1440 rows in cache, 5 levels, smooth CoC, ring t", {F(dof.dof_pyrblur_row), 0}, H, dof_setup, NULL, pyrblur_run,
      dof_free},
     {"dof_combine_row", "1280x1440, 1440 rows, all layers", {F(dof.dof_combine_row), 0}, H, dof_setup, NULL, combine_run,
      dof_free},

@@ -369,48 +369,60 @@ static void test_combine_row(void **state)
 
 static const float below1 = 0x1.fffffep-1f; /* the largest float < 1 */
 
-/* n output pixels from a tmp row of sw texels. tmode 0: core/dof/weier.c's taps (by 2^L, borders
- * clamped); 1: random taps, i0 / i1 often at the row's ends or equal; 2: all taps equal. */
-static void run_upsample1(const fv_dof_dsp *d, const char *isa, int n, int tmode, int off)
+/* n output pixels from x0 by 2^L from a tmp row of sw texels. mode 0: the pipeline's rows
+ * (core/dof/weier_filter.c: sw = ceil((x0 + n) / 2^L), or one more), so the right border clamps
+ * or not; 1: a short row (sw 1..4), most pixels clamped; 2: sw = ceil(w / 2^L) for a row
+ * w >= x0 + n (the call covers part of it). L 0 and 6..7 take the references' path in the ISA
+ * versions. Every texel is finite and distinct; the row is allocated to its exact size (ASan). */
+static void run_upsample1(const fv_dof_dsp *d, const char *isa, int L, int x0, int n, int mode)
 {
-    const int L = 1 + rndi(5);
-    const int sw = tmode == 0 ? ((n + (1 << L) - 1) >> L) + rndi(2) : 1 + rndi(rndi(2) ? 4 : n + 8);
-    buf tmp = buf_new(4 * (size_t)sw, off);
+    const int s = 1 << L, e = x0 + n;
+    const int sw = mode == 0 ? (e + s - 1) / s + rndi(2) : mode == 1 ? 1 + rndi(4) : (e + rndi(64) + s - 1) / s;
+    float *tmp = malloc(4 * sizeof(float) * (size_t)sw);
+    assert_non_null(tmp);
     for (int i = 0; i < 4 * sw; i++)
-        tmp.p[i] = colour();
-    int32_t *i0 = malloc(sizeof(int32_t) * (size_t)n), *i1 = malloc(sizeof(int32_t) * (size_t)n);
-    buf ax = buf_new((size_t)n, off);
-    assert_non_null(i0), assert_non_null(i1);
-    for (int x = 0; x < n; x++) {
-        if (tmode == 0) { /* as xtaps_init */
-            const float u = ((float)x + 0.5f) * (1.0f / (float)(1 << L)) - 0.5f, fu = floorf(u);
-            const int a = (int)fu;
-            i0[x] = a < 0 ? 0 : a > sw - 1 ? sw - 1 : a;
-            i1[x] = a + 1 < 0 ? 0 : a + 1 > sw - 1 ? sw - 1 : a + 1;
-            ax.p[x] = u - fu;
-        } else {
-            const int e = rndi(6);
-            i0[x] = e == 0 ? 0 : e == 1 ? sw - 1 : rndi(sw);
-            i1[x] = tmode == 2 || rndi(4) == 0 ? i0[x] : rndi(3) == 0 ? (rndi(2) ? 0 : sw - 1) : rndi(sw);
-            const int k = rndi(6);
-            ax.p[x] = k == 0 ? 0.0f : k == 1 ? below1 : k == 2 ? 0.5f : rnd();
-        }
-    }
+        tmp[i] = colour();
+    const int off = rndi(4);
     buf r = checkasm_out_f32(4 * (size_t)n, off), t = checkasm_out_f32(4 * (size_t)n, off);
-    fv_dof_upsample_row_c(r.p, tmp.p, i0, i1, ax.p, n);
-    d->dof_upsample_row(t.p, tmp.p, i0, i1, ax.p, n);
+    fv_dof_upsample_row_c(r.p, tmp, L, sw, x0, n);
+    d->dof_upsample_row(t.p, tmp, L, sw, x0, n);
     compare_out(&r, &t, 4 * (size_t)n, 4, isa, "upsample_row", "row + canaries");
-    free(tmp.base), free(i0), free(i1), free(ax.base), free(r.base), free(t.base);
+    free(tmp), free(r.base), free(t.base);
 }
 
 static void run_upsample(const fv_dof_dsp *d, const char *isa)
 {
-    for (int n = 1; n <= 70; n++)
-        for (int tmode = 0; tmode < 3; tmode++)
-            for (int rep = 0; rep < 2; rep++)
-                run_upsample1(d, isa, n, tmode, rndi(4));
-    for (int k = 0; k < 6; k++)
-        run_upsample1(d, isa, 1280, k % 3, rndi(4));
+    for (int L = 0; L <= 7; L++)
+        for (int n = 1; n <= 72; n++)
+            for (int mode = 0; mode < 3; mode++) {
+                const int x0 = rndi(3) == 0 ? rndi(4) : rndi(3 << L); /* the row's start or any phase */
+                run_upsample1(d, isa, L, x0, n, mode);
+            }
+    for (int L = 1; L <= 5; L++) /* whole rows and the transition's spans (any start) */
+        for (int k = 0; k < 4; k++)
+            run_upsample1(d, isa, L, k < 2 ? 0 : rndi(600), 1280 - (k & 1) * rndi(600), k % 3);
+}
+
+/* the reference's taps against the float formula it states (u = (x + 0.5) / s - 0.5): core/dof/
+ * weier_filter.c's rows must keep their bits */
+static void test_upsample_ref_formula(void **state)
+{
+    (void)state;
+    const int sw = 7;
+    float tmp[4 * 7];
+    for (int i = 0; i < 4 * sw; i++)
+        tmp[i] = colour();
+    for (int L = 0; L <= 5; L++)
+        for (int x = 0; x < 8 * sw; x++) {
+            const float u = ((float)x + 0.5f) / (float)(1 << L) - 0.5f, fu = floorf(u), a = u - fu;
+            const int j = (int)fu, i0 = j < 0 ? 0 : j > sw - 1 ? sw - 1 : j, i1 = j + 1 > sw - 1 ? sw - 1 : j + 1 < 0 ? 0 : j + 1;
+            float got[4];
+            fv_dof_upsample_row_c(got, tmp, L, sw, x, 1);
+            for (int c = 0; c < 4; c++) {
+                const float want = tmp[4 * i0 + c] + a * (tmp[4 * i1 + c] - tmp[4 * i0 + c]);
+                assert_memory_equal(&got[c], &want, sizeof want);
+            }
+        }
 }
 
 static void test_upsample_row(void **state)
@@ -455,14 +467,15 @@ static void run_pyrblur1(const fv_dof_dsp *d, const char *isa, int w, int x0, in
     buf up[6];
     for (int L = 0; L <= need; L++)
         up[L] = buf_new(w4, off);
-    const int cmode = rndi(6), tmode = rndi(5);
+    const int cmode = rndi(7), tmode = rndi(5);
+    const float camp = 1.0f + 30.0f * rnd(); /* cmode 6: a smooth CoC (blocks of one level pair, as rendered) */
     float run_t = 0.0f;
     for (int i = 0; i < w; i++) {
         static const float ext[] = {0.0f, -0.0f, 1e-30f, -1e-30f, 1.4e-45f, -1.4e-45f, 64.0f, -64.0f, 64.0625f,
                                     100.0f, -1000.0f, 1e6f, -1.25e8f, 1.25e8f, 0.125f, -0.0625f};
         const float u = rnd(), sg = rndi(2) ? 1.0f : -1.0f; /* (one draw a statement: the same inputs whatever the compiler) */
         coc.p[i] = cmode == 0 ? 0.0f : cmode == 1 ? 20.0f * rnd() : cmode == 2 ? -12.0f * rnd() :
-                   cmode == 3 ? sg * 80.0f * rnd() :
+                   cmode == 3 ? sg * 80.0f * rnd() : cmode == 6 ? camp * sinf((float)i * 0.02f) :
                    u < 0.25f ? ext[rndi((int)(sizeof ext / sizeof ext[0]))] : sg * 70.0f * rnd();
         if (tmode == 0)
             t.p[i] = 1.0f;
@@ -786,6 +799,7 @@ const struct CMUnitTest checkasm_dof_tests[] = {
     cmocka_unit_test(test_vgauss_row),
     cmocka_unit_test(test_combine_row),
     cmocka_unit_test(test_upsample_row),
+    cmocka_unit_test(test_upsample_ref_formula),
     cmocka_unit_test(test_pyrblur_row),
     cmocka_unit_test(test_nearblk_row),
     cmocka_unit_test(test_nearbox_row),
