@@ -69,6 +69,8 @@ void fv_displayloop_default_params(fv_displayloop_params *p, int64_t nominal_per
     p->initial_margin_ns = 3000000;
     p->edge_grace_ns = p->nominal_period_ns / 4;
     p->margin_frames = 16;
+    p->margin_long_frames = 256;
+    p->margin_rank = 3;
 }
 
 void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, const fv_displayloop_ops *ops)
@@ -79,6 +81,11 @@ void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, cons
         l->p.margin_frames = 1;
     if (l->p.margin_frames > FV_DISPLAYLOOP_MAX_MARGIN_FRAMES)
         l->p.margin_frames = FV_DISPLAYLOOP_MAX_MARGIN_FRAMES;
+    if (l->p.margin_long_frames < 0)
+        l->p.margin_long_frames = 0;
+    if (l->p.margin_long_frames > FV_DISPLAYLOOP_MAX_LONG_FRAMES)
+        l->p.margin_long_frames = FV_DISPLAYLOOP_MAX_LONG_FRAMES;
+    l->p.margin_rank = l->p.margin_rank < 1 ? 1 : l->p.margin_rank > FV_DISPLAYLOOP_MAX_RANK ? FV_DISPLAYLOOP_MAX_RANK : l->p.margin_rank;
     l->ops = *ops;
     fv_vsync_pred_params pp;
     fv_vsync_pred_default_params(&pp, p->nominal_period_ns);
@@ -92,9 +99,28 @@ int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
     if (l->ncompose == 0)
         return l->p.initial_margin_ns;
     int64_t worst = 0;
-    const int n = l->ncompose < l->p.margin_frames ? l->ncompose : l->p.margin_frames;
-    for (int i = 0; i < n; i++)
-        worst = l->compose_ns[i] > worst ? l->compose_ns[i] : worst;
+    const long n = l->ncompose < l->p.margin_frames ? l->ncompose : l->p.margin_frames;
+    for (long i = 1; i <= n; i++) { /* the newest n */
+        const int64_t c = l->compose_ns[(l->ncompose - i) % FV_DISPLAYLOOP_MAX_LONG_FRAMES];
+        worst = c > worst ? c : worst;
+    }
+    /* the long window's rank-th slowest (a slow spell of the memory system every few hundred ms
+     * would otherwise find the margin back at the typical composition's every time) */
+    const long nl = l->ncompose < l->p.margin_long_frames ? l->ncompose : l->p.margin_long_frames;
+    if (nl >= l->p.margin_rank) {
+        int64_t top[FV_DISPLAYLOOP_MAX_RANK]; /* the rank slowest, slowest first */
+        int k = 0;
+        for (long i = 1; i <= nl; i++) {
+            const int64_t c = l->compose_ns[(l->ncompose - i) % FV_DISPLAYLOOP_MAX_LONG_FRAMES];
+            if (k == l->p.margin_rank && c <= top[k - 1])
+                continue;
+            int j = k < l->p.margin_rank ? k++ : k - 1;
+            for (; j > 0 && top[j - 1] < c; j--)
+                top[j] = top[j - 1];
+            top[j] = c;
+        }
+        worst = top[l->p.margin_rank - 1] > worst ? top[l->p.margin_rank - 1] : worst;
+    }
     const int64_t m = (int64_t)((double)worst * l->p.margin_scale) + l->p.margin_extra_ns;
     /* at most 7/8 of a period: waking before the vsync ahead of the target only skips refreshes
      * (a composition longer than a period is late whatever the margin), and one slow composition
@@ -149,7 +175,7 @@ int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec)
         return -1;
     const int64_t done = l->ops.now_ns(l->ops.ctx);
     rec->done_ns = done;
-    l->compose_ns[l->ncompose % l->p.margin_frames] = done - now;
+    l->compose_ns[l->ncompose % FV_DISPLAYLOOP_MAX_LONG_FRAMES] = done - now;
     l->ncompose++;
     rec->reused = rec->frame >= 0 && rec->frame == l->last_frame;
     l->reused += rec->reused;

@@ -8,8 +8,10 @@
  * Per refresh:
  *   1. take the vsync edges that came in (the predictor: core/vsyncpred.h);
  *   2. target V = the first predicted vsync at least one margin away; sleep to V - margin
- *      (margin = the slowest of the last 16 compositions x 1.25 + 0.5 ms, at most 7/8 of a period:
- *      a late refresh costs a whole period, so it errs early);
+ *      (margin = x 1.25 + 0.5 ms of the larger of the slowest of the last 16 compositions and the
+ *      third slowest of the last 256 (about their p99), at most 7/8 of a period: a late refresh
+ *      costs a whole period, so it errs early; the long window keeps it over the slow
+ *      compositions that recur every few hundred ms on a machine with memory stalls);
  *   3. compose(V): newest frame, pose predicted for V, warp, present;
  *   4. done by V: shown from V; wait for V's edge (photon time). Done after V (late): V showed
  *      the previous image again; this one shows from the next vsync.
@@ -90,16 +92,22 @@ typedef struct fv_displayloop_params {
     int64_t initial_margin_ns; /* 3 ms: before any composition */
     int64_t edge_grace_ns;     /* period / 4 */
     int margin_frames;         /* 16 */
+    /* the long window: the margin also covers the margin_rank-th slowest of the last
+     * margin_long_frames compositions (256 and 3: the p99; 0 frames: off) */
+    int margin_long_frames;
+    int margin_rank;
 } fv_displayloop_params;
 
 #define FV_DISPLAYLOOP_MAX_MARGIN_FRAMES 64
+#define FV_DISPLAYLOOP_MAX_LONG_FRAMES 1024
+#define FV_DISPLAYLOOP_MAX_RANK 16
 typedef struct fv_displayloop {
     fv_displayloop_params p;
     fv_displayloop_ops ops;
     fv_vsync_pred pred;
     int source_dead;
-    int64_t compose_ns[FV_DISPLAYLOOP_MAX_MARGIN_FRAMES];
-    int ncompose;
+    int64_t compose_ns[FV_DISPLAYLOOP_MAX_LONG_FRAMES]; /* the last compositions, a ring */
+    long ncompose;
     long refreshes, late, reused, edges, last_frame;
     int64_t last_target_ns;
 } fv_displayloop;
