@@ -94,7 +94,8 @@ void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, cons
     l->last_frame = -1;
 }
 
-int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
+/* long_window 0: the slowest of the last margin_frames alone */
+static int64_t margin_of(const fv_displayloop *l, int long_window)
 {
     if (l->ncompose == 0)
         return l->p.initial_margin_ns;
@@ -106,7 +107,7 @@ int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
     }
     /* the long window's rank-th slowest (a slow spell of the memory system every few hundred ms
      * would otherwise find the margin back at the typical composition's every time) */
-    const long nl = l->ncompose < l->p.margin_long_frames ? l->ncompose : l->p.margin_long_frames;
+    const long nl = !long_window ? 0 : l->ncompose < l->p.margin_long_frames ? l->ncompose : l->p.margin_long_frames;
     if (nl >= l->p.margin_rank) {
         int64_t top[FV_DISPLAYLOOP_MAX_RANK]; /* the rank slowest, slowest first */
         int k = 0;
@@ -129,6 +130,9 @@ int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
     const int64_t cap = l->p.nominal_period_ns - l->p.nominal_period_ns / 8;
     return m < cap ? m : cap;
 }
+
+int64_t fv_displayloop_margin_ns(const fv_displayloop *l) { return margin_of(l, 1); }
+int64_t fv_displayloop_reach_ns(const fv_displayloop *l) { return margin_of(l, 0); }
 
 /* the vsync side of this loop (fv_vsync_edges_take, fv_vsync_edges_wait) */
 static fv_vsync_edges edges_of(fv_displayloop *l)
@@ -157,10 +161,12 @@ int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec)
     rec->pose_err_deg = rec->pose_err_mm = NAN;
     int64_t now = l->ops.now_ns(l->ops.ctx), dummy;
     take_edges(l, now, INT64_MAX, INT64_MAX, &dummy);
-    const int64_t margin = fv_displayloop_margin_ns(l);
+    const int64_t margin = fv_displayloop_margin_ns(l), reach = fv_displayloop_reach_ns(l);
     rec->margin_ns = margin;
+    /* the first vsync a composition can still make (the recent compositions' margin): woken
+     * after V - margin (a late wake-up, or a margin near the period), V is still the target */
+    int64_t after = now + (reach < margin ? reach : margin);
     /* never the vsync just composed for (its edge may not have been taken yet) */
-    int64_t after = now + margin;
     if (after <= l->last_target_ns + l->p.nominal_period_ns / 2)
         after = l->last_target_ns + l->p.nominal_period_ns / 2;
     int64_t target = fv_vsync_pred_next(&l->pred, after, now);
@@ -175,8 +181,10 @@ int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec)
         return -1;
     const int64_t done = l->ops.now_ns(l->ops.ctx);
     rec->done_ns = done;
-    l->compose_ns[l->ncompose % FV_DISPLAYLOOP_MAX_LONG_FRAMES] = done - now;
-    l->ncompose++;
+    if (rec->frame >= 0) { /* the compositions that warped a frame (before the first, nothing is done) */
+        l->compose_ns[l->ncompose % FV_DISPLAYLOOP_MAX_LONG_FRAMES] = done - now;
+        l->ncompose++;
+    }
     rec->reused = rec->frame >= 0 && rec->frame == l->last_frame;
     l->reused += rec->reused;
     if (rec->frame >= 0)

@@ -12,6 +12,8 @@
  *      third slowest of the last 256 (about their p99), at most 7/8 of a period: a late refresh
  *      costs a whole period, so it errs early; the long window keeps it over the slow
  *      compositions that recur every few hundred ms on a machine with memory stalls);
+ *      A wake-up later than V - margin (the thread held up, the previous edge taken late) still
+ *      aims at V if V is at least the recent compositions' margin away (fv_displayloop_reach_ns);
  *   3. compose(V): newest frame, pose predicted for V, warp, present;
  *   4. done by V: shown from V; wait for V's edge (photon time). Done after V (late): V showed
  *      the previous image again; this one shows from the next vsync.
@@ -115,6 +117,9 @@ typedef struct fv_displayloop {
 void fv_displayloop_default_params(fv_displayloop_params *p, int64_t nominal_period_ns);
 void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, const fv_displayloop_ops *ops);
 int64_t fv_displayloop_margin_ns(const fv_displayloop *l);
+/* The margin of the recent compositions alone (the last margin_frames): a refresh that wakes
+ * after V - margin still targets V when V is at least this far away. */
+int64_t fv_displayloop_reach_ns(const fv_displayloop *l);
 /* One refresh into *rec: 0, or -1 when compose asked to stop. */
 int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec);
 
