@@ -66,7 +66,8 @@ void fv_displayloop_default_params(fv_displayloop_params *p, int64_t nominal_per
     p->nominal_period_ns = nominal_period_ns > 0 ? nominal_period_ns : 11111111;
     p->margin_scale = 1.25;
     p->margin_extra_ns = 500000;
-    p->initial_margin_ns = 3000000;
+    /* the first compositions are the slowest (cold caches, the images' first touch): start at the cap */
+    p->initial_margin_ns = p->nominal_period_ns - p->nominal_period_ns / 8;
     p->edge_grace_ns = p->nominal_period_ns / 4;
     p->margin_frames = 16;
     p->margin_long_frames = 256;

@@ -91,7 +91,7 @@ typedef struct fv_displayloop_params {
     int64_t nominal_period_ns;
     double margin_scale;       /* 1.25 */
     int64_t margin_extra_ns;   /* 0.5 ms: wake-up slack */
-    int64_t initial_margin_ns; /* 3 ms: before any composition */
+    int64_t initial_margin_ns; /* 7/8 of a period (the cap): before any composition that warped a frame */
     int64_t edge_grace_ns;     /* period / 4 */
     int margin_frames;         /* 16 */
     /* the long window: the margin also covers the margin_rank-th slowest of the last
