@@ -66,9 +66,12 @@ void fv_displayloop_default_params(fv_displayloop_params *p, int64_t nominal_per
     p->nominal_period_ns = nominal_period_ns > 0 ? nominal_period_ns : 11111111;
     p->margin_scale = 1.25;
     p->margin_extra_ns = 500000;
-    p->initial_margin_ns = 3000000;
+    /* the first compositions are the slowest (cold caches, the images' first touch): start at the cap */
+    p->initial_margin_ns = p->nominal_period_ns - p->nominal_period_ns / 8;
     p->edge_grace_ns = p->nominal_period_ns / 4;
     p->margin_frames = 16;
+    p->margin_long_frames = 256;
+    p->margin_rank = 3;
 }
 
 void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, const fv_displayloop_ops *ops)
@@ -79,6 +82,11 @@ void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, cons
         l->p.margin_frames = 1;
     if (l->p.margin_frames > FV_DISPLAYLOOP_MAX_MARGIN_FRAMES)
         l->p.margin_frames = FV_DISPLAYLOOP_MAX_MARGIN_FRAMES;
+    if (l->p.margin_long_frames < 0)
+        l->p.margin_long_frames = 0;
+    if (l->p.margin_long_frames > FV_DISPLAYLOOP_MAX_LONG_FRAMES)
+        l->p.margin_long_frames = FV_DISPLAYLOOP_MAX_LONG_FRAMES;
+    l->p.margin_rank = l->p.margin_rank < 1 ? 1 : l->p.margin_rank > FV_DISPLAYLOOP_MAX_RANK ? FV_DISPLAYLOOP_MAX_RANK : l->p.margin_rank;
     l->ops = *ops;
     fv_vsync_pred_params pp;
     fv_vsync_pred_default_params(&pp, p->nominal_period_ns);
@@ -87,14 +95,34 @@ void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, cons
     l->last_frame = -1;
 }
 
-int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
+/* long_window 0: the slowest of the last margin_frames alone */
+static int64_t margin_of(const fv_displayloop *l, int long_window)
 {
     if (l->ncompose == 0)
         return l->p.initial_margin_ns;
     int64_t worst = 0;
-    const int n = l->ncompose < l->p.margin_frames ? l->ncompose : l->p.margin_frames;
-    for (int i = 0; i < n; i++)
-        worst = l->compose_ns[i] > worst ? l->compose_ns[i] : worst;
+    const long n = l->ncompose < l->p.margin_frames ? l->ncompose : l->p.margin_frames;
+    for (long i = 1; i <= n; i++) { /* the newest n */
+        const int64_t c = l->compose_ns[(l->ncompose - i) % FV_DISPLAYLOOP_MAX_LONG_FRAMES];
+        worst = c > worst ? c : worst;
+    }
+    /* the long window's rank-th slowest (a slow spell of the memory system every few hundred ms
+     * would otherwise find the margin back at the typical composition's every time) */
+    const long nl = !long_window ? 0 : l->ncompose < l->p.margin_long_frames ? l->ncompose : l->p.margin_long_frames;
+    if (nl >= l->p.margin_rank) {
+        int64_t top[FV_DISPLAYLOOP_MAX_RANK]; /* the rank slowest, slowest first */
+        int k = 0;
+        for (long i = 1; i <= nl; i++) {
+            const int64_t c = l->compose_ns[(l->ncompose - i) % FV_DISPLAYLOOP_MAX_LONG_FRAMES];
+            if (k == l->p.margin_rank && c <= top[k - 1])
+                continue;
+            int j = k < l->p.margin_rank ? k++ : k - 1;
+            for (; j > 0 && top[j - 1] < c; j--)
+                top[j] = top[j - 1];
+            top[j] = c;
+        }
+        worst = top[l->p.margin_rank - 1] > worst ? top[l->p.margin_rank - 1] : worst;
+    }
     const int64_t m = (int64_t)((double)worst * l->p.margin_scale) + l->p.margin_extra_ns;
     /* at most 7/8 of a period: waking before the vsync ahead of the target only skips refreshes
      * (a composition longer than a period is late whatever the margin), and one slow composition
@@ -103,6 +131,9 @@ int64_t fv_displayloop_margin_ns(const fv_displayloop *l)
     const int64_t cap = l->p.nominal_period_ns - l->p.nominal_period_ns / 8;
     return m < cap ? m : cap;
 }
+
+int64_t fv_displayloop_margin_ns(const fv_displayloop *l) { return margin_of(l, 1); }
+int64_t fv_displayloop_reach_ns(const fv_displayloop *l) { return margin_of(l, 0); }
 
 /* the vsync side of this loop (fv_vsync_edges_take, fv_vsync_edges_wait) */
 static fv_vsync_edges edges_of(fv_displayloop *l)
@@ -131,10 +162,12 @@ int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec)
     rec->pose_err_deg = rec->pose_err_mm = NAN;
     int64_t now = l->ops.now_ns(l->ops.ctx), dummy;
     take_edges(l, now, INT64_MAX, INT64_MAX, &dummy);
-    const int64_t margin = fv_displayloop_margin_ns(l);
+    const int64_t margin = fv_displayloop_margin_ns(l), reach = fv_displayloop_reach_ns(l);
     rec->margin_ns = margin;
+    /* the first vsync a composition can still make (the recent compositions' margin): woken
+     * after V - margin (a late wake-up, or a margin near the period), V is still the target */
+    int64_t after = now + (reach < margin ? reach : margin);
     /* never the vsync just composed for (its edge may not have been taken yet) */
-    int64_t after = now + margin;
     if (after <= l->last_target_ns + l->p.nominal_period_ns / 2)
         after = l->last_target_ns + l->p.nominal_period_ns / 2;
     int64_t target = fv_vsync_pred_next(&l->pred, after, now);
@@ -149,8 +182,10 @@ int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec)
         return -1;
     const int64_t done = l->ops.now_ns(l->ops.ctx);
     rec->done_ns = done;
-    l->compose_ns[l->ncompose % l->p.margin_frames] = done - now;
-    l->ncompose++;
+    if (rec->frame >= 0) { /* the compositions that warped a frame (before the first, nothing is done) */
+        l->compose_ns[l->ncompose % FV_DISPLAYLOOP_MAX_LONG_FRAMES] = done - now;
+        l->ncompose++;
+    }
     rec->reused = rec->frame >= 0 && rec->frame == l->last_frame;
     l->reused += rec->reused;
     if (rec->frame >= 0)

@@ -8,8 +8,12 @@
  * Per refresh:
  *   1. take the vsync edges that came in (the predictor: core/vsyncpred.h);
  *   2. target V = the first predicted vsync at least one margin away; sleep to V - margin
- *      (margin = the slowest of the last 16 compositions x 1.25 + 0.5 ms, at most 7/8 of a period:
- *      a late refresh costs a whole period, so it errs early);
+ *      (margin = x 1.25 + 0.5 ms of the larger of the slowest of the last 16 compositions and the
+ *      third slowest of the last 256 (about their p99), at most 7/8 of a period: a late refresh
+ *      costs a whole period, so it errs early; the long window keeps it over the slow
+ *      compositions that recur every few hundred ms on a machine with memory stalls);
+ *      A wake-up later than V - margin (the thread held up, the previous edge taken late) still
+ *      aims at V if V is at least the recent compositions' margin away (fv_displayloop_reach_ns);
  *   3. compose(V): newest frame, pose predicted for V, warp, present;
  *   4. done by V: shown from V; wait for V's edge (photon time). Done after V (late): V showed
  *      the previous image again; this one shows from the next vsync.
@@ -87,19 +91,25 @@ typedef struct fv_displayloop_params {
     int64_t nominal_period_ns;
     double margin_scale;       /* 1.25 */
     int64_t margin_extra_ns;   /* 0.5 ms: wake-up slack */
-    int64_t initial_margin_ns; /* 3 ms: before any composition */
+    int64_t initial_margin_ns; /* 7/8 of a period (the cap): before any composition that warped a frame */
     int64_t edge_grace_ns;     /* period / 4 */
     int margin_frames;         /* 16 */
+    /* the long window: the margin also covers the margin_rank-th slowest of the last
+     * margin_long_frames compositions (256 and 3: the p99; 0 frames: off) */
+    int margin_long_frames;
+    int margin_rank;
 } fv_displayloop_params;
 
 #define FV_DISPLAYLOOP_MAX_MARGIN_FRAMES 64
+#define FV_DISPLAYLOOP_MAX_LONG_FRAMES 1024
+#define FV_DISPLAYLOOP_MAX_RANK 16
 typedef struct fv_displayloop {
     fv_displayloop_params p;
     fv_displayloop_ops ops;
     fv_vsync_pred pred;
     int source_dead;
-    int64_t compose_ns[FV_DISPLAYLOOP_MAX_MARGIN_FRAMES];
-    int ncompose;
+    int64_t compose_ns[FV_DISPLAYLOOP_MAX_LONG_FRAMES]; /* the last compositions, a ring */
+    long ncompose;
     long refreshes, late, reused, edges, last_frame;
     int64_t last_target_ns;
 } fv_displayloop;
@@ -107,6 +117,9 @@ typedef struct fv_displayloop {
 void fv_displayloop_default_params(fv_displayloop_params *p, int64_t nominal_period_ns);
 void fv_displayloop_init(fv_displayloop *l, const fv_displayloop_params *p, const fv_displayloop_ops *ops);
 int64_t fv_displayloop_margin_ns(const fv_displayloop *l);
+/* The margin of the recent compositions alone (the last margin_frames): a refresh that wakes
+ * after V - margin still targets V when V is at least this far away. */
+int64_t fv_displayloop_reach_ns(const fv_displayloop *l);
 /* One refresh into *rec: 0, or -1 when compose asked to stop. */
 int fv_displayloop_refresh(fv_displayloop *l, fv_refresh_record *rec);
 
