@@ -23,15 +23,20 @@
 #include "reproject.h"
 #include "reproject_dsp.h"
 
-/* Catmull-Rom of level 0 (fv_taa_aa_tile_c's catmull_rom): h when all 16 texels have weight 1 */
-static inline void TAA_AA_FN(aa_catmull_rom)(const fv_pyr_level *H, int i0, int j0, float fx, float fy, v4 *h)
+/* Catmull-Rom of level 0 (fv_taa_aa_tile_c's catmull_rom), for a pixel whose 16 texels all have
+ * weight 1 (checked before): its texel (i0 - 1, j0 - 1) and the weights per axis */
+typedef struct {
+    const float *r; /* texel (i0 - 1, j0 - 1) */
+    float wx[4], wy[4];
+    int x; /* the pixel in its row */
+} aa_cr;
+static inline int TAA_AA_FN(aa_cr_setup)(const fv_pyr_level *H, int i0, int j0, float fx, float fy, aa_cr *c)
 {
     for (int j = 0; j < 4; j++)
         if (!V_ONES(H->wgt + (ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1))
-            return;
-    float wx[4], wy[4];
+            return 0;
     const float t[2] = {fx, fy};
-    float *w[2] = {wx, wy};
+    float *w[2] = {c->wx, c->wy};
     for (int k = 0; k < 2; k++) {
         const float q = t[k];
         w[k][0] = q * (-0.5f + q * (1.0f - 0.5f * q));
@@ -39,18 +44,47 @@ static inline void TAA_AA_FN(aa_catmull_rom)(const fv_pyr_level *H, int i0, int 
         w[k][2] = q * (0.5f + q * (2.0f - 1.5f * q));
         w[k][3] = q * q * (-0.5f + 0.5f * q);
     }
-    const v4 wxv = V_LD(wx);
+    c->r = H->rgbd + 4 * ((ptrdiff_t)(j0 - 1) * H->stride + i0 - 1);
+    return 1;
+}
+/* the sum over the 16 texels, in the reference's order (a += wx[i] wy[j] texel, j outer) */
+static inline v4 TAA_AA_FN(aa_cr_sum)(const aa_cr *c, ptrdiff_t stride)
+{
+    const v4 wxv = V_LD(c->wx);
     v4 acc = V_DUP(0.0f);
     for (int j = 0; j < 4; j++) {
-        const float *r = H->rgbd + 4 * ((ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1);
-        const v4 ww = V_MUL(wxv, V_DUP(wy[j])); /* wx[i] wy[j], i = 0..3 */
+        const float *r = c->r + 4 * (ptrdiff_t)j * stride;
+        const v4 ww = V_MUL(wxv, V_DUP(c->wy[j])); /* wx[i] wy[j], i = 0..3 */
         acc = V_ADD(acc, V_MUL(V_B0(ww), V_LD(r)));
         acc = V_ADD(acc, V_MUL(V_B1(ww), V_LD(r + 4)));
         acc = V_ADD(acc, V_MUL(V_B2(ww), V_LD(r + 8)));
         acc = V_ADD(acc, V_MUL(V_B3(ww), V_LD(r + 12)));
     }
-    *h = acc;
+    return acc;
 }
+#ifndef AA_CR_PAIR
+/* two pixels' sums interleaved: each is one chain of 16 dependent additions (the reference's
+ * order), so two chains in flight hide half the latency */
+static inline void TAA_AA_FN(aa_cr_pair)(const aa_cr *a, const aa_cr *b, ptrdiff_t stride, v4 *ha, v4 *hb)
+{
+    const v4 wxa = V_LD(a->wx), wxb = V_LD(b->wx);
+    v4 acc = V_DUP(0.0f), bcc = V_DUP(0.0f);
+    for (int j = 0; j < 4; j++) {
+        const float *r = a->r + 4 * (ptrdiff_t)j * stride, *q = b->r + 4 * (ptrdiff_t)j * stride;
+        const v4 wa = V_MUL(wxa, V_DUP(a->wy[j])), wb = V_MUL(wxb, V_DUP(b->wy[j]));
+        acc = V_ADD(acc, V_MUL(V_B0(wa), V_LD(r)));
+        bcc = V_ADD(bcc, V_MUL(V_B0(wb), V_LD(q)));
+        acc = V_ADD(acc, V_MUL(V_B1(wa), V_LD(r + 4)));
+        bcc = V_ADD(bcc, V_MUL(V_B1(wb), V_LD(q + 4)));
+        acc = V_ADD(acc, V_MUL(V_B2(wa), V_LD(r + 8)));
+        bcc = V_ADD(bcc, V_MUL(V_B2(wb), V_LD(q + 8)));
+        acc = V_ADD(acc, V_MUL(V_B3(wa), V_LD(r + 12)));
+        bcc = V_ADD(bcc, V_MUL(V_B3(wb), V_LD(q + 12)));
+    }
+    *ha = acc, *hb = bcc;
+}
+#define AA_CR_PAIR TAA_AA_FN(aa_cr_pair)
+#endif
 
 void TAA_AA_FN(fv_taa_aa_tile)(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0,
                                int y0, int tw, int th)
@@ -97,8 +131,12 @@ void TAA_AA_FN(fv_taa_aa_tile)(const fv_taa_frame *f, const fv_taa_aa_frame *a, 
                     uu[x + k] = ub[k], vv[x + k] = vb[k], zz[x + k] = zb[k];
             }
         }
+        /* 1. history per pixel: the counts, the bilinear taps, which pixels take Catmull-Rom */
+        v4 hh[T];
+        uint8_t nn[T];
+        aa_cr cr[T];
+        int ncr = 0;
         for (int x = 0; x < tw; x++) {
-            float *px = l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0 + x);
             int n = 0;
             v4 h = V_DUP(0.0f);
             if (hist) {
@@ -139,28 +177,51 @@ void TAA_AA_FN(fv_taa_aa_tile)(const fv_taa_frame *f, const fv_taa_aa_frame *a, 
                     if (near && accw > 1e-6f) {
                         n = a->n_prev[(ptrdiff_t)(int)v * a->stride + (int)u];
                         h = V_DIV(acc, V_DUP(accw));
-                        if (catrom && i0 >= 1 && j0 >= 1 && (float)(i0 + 2) < f->prev_w && (float)(j0 + 2) < f->prev_h)
-                            TAA_AA_FN(aa_catmull_rom)(H, i0, j0, fx, fy, &h);
+                        if (catrom && i0 >= 1 && j0 >= 1 && (float)(i0 + 2) < f->prev_w &&
+                            (float)(j0 + 2) < f->prev_h && TAA_AA_FN(aa_cr_setup)(H, i0, j0, fx, fy, &cr[ncr]))
+                            cr[ncr++].x = x;
                     }
                 }
             }
             n = n + 1 < FV_TAA_AA_MAX_N ? n + 1 : FV_TAA_AA_MAX_N;
-            ncur[x] = (uint8_t)n;
+            ncur[x] = nn[x] = (uint8_t)n;
+            hh[x] = h;
+        }
+        /* 2. Catmull-Rom, two pixels at a time */
+        int k = 0;
+        for (; k + 2 <= ncr; k += 2)
+            AA_CR_PAIR(&cr[k], &cr[k + 1], H->stride, &hh[cr[k].x], &hh[cr[k + 1].x]);
+        if (k < ncr)
+            hh[cr[k].x] = TAA_AA_FN(aa_cr_sum)(&cr[k], H->stride);
+        /* 3. the blend, rectified when moving */
+        for (int x = 0; x < tw; x++) {
+            const int n = nn[x];
             if (n == 1)
                 continue;
+            float *px = l0->rgbd + 4 * ((ptrdiff_t)(y0 + y) * l0->stride + x0 + x);
+            const v4 h = hh[x];
             const v4 alpha = V_DUP(1.0f / (float)n), sv = V_LD(s[y][x]);
             if (f->identity) {
                 V_ST(px, V_RGB_S(V_ADD(h, V_MUL(alpha, V_SUB(sv, h))), sv));
                 continue;
             }
             v4 lo = sv, hi = sv;
-            const int ja = y > 0 ? y - 1 : 0, jb = y + 1 < th ? y + 1 : th - 1;
-            const int ia = x > 0 ? x - 1 : 0, ib = x + 1 < tw ? x + 1 : tw - 1;
-            for (int j = ja; j <= jb; j++)
-                for (int i = ia; i <= ib; i++) {
-                    const v4 q = V_LD(s[j][i]);
-                    lo = V_MIN(lo, q), hi = V_MAX(hi, q);
+            if (x > 0 && x + 1 < tw && y > 0 && y + 1 < th) { /* inside the tile: the 3x3 unrolled */
+                for (int j = y - 1; j <= y + 1; j++) {
+                    const v4 q0 = V_LD(s[j][x - 1]), q1 = V_LD(s[j][x]), q2 = V_LD(s[j][x + 1]);
+                    lo = V_MIN(lo, q0), hi = V_MAX(hi, q0);
+                    lo = V_MIN(lo, q1), hi = V_MAX(hi, q1);
+                    lo = V_MIN(lo, q2), hi = V_MAX(hi, q2);
                 }
+            } else {
+                const int ja = y > 0 ? y - 1 : 0, jb = y + 1 < th ? y + 1 : th - 1;
+                const int ia = x > 0 ? x - 1 : 0, ib = x + 1 < tw ? x + 1 : tw - 1;
+                for (int j = ja; j <= jb; j++)
+                    for (int i = ia; i <= ib; i++) {
+                        const v4 q = V_LD(s[j][i]);
+                        lo = V_MIN(lo, q), hi = V_MAX(hi, q);
+                    }
+            }
             const v4 hc = V_MIN(V_MAX(h, lo), hi);
             V_ST(px, V_RGB_S(V_ADD(hc, V_MUL(alpha, V_SUB(sv, hc))), sv));
         }
