@@ -35,17 +35,33 @@ static inline int TAA_AA_FN(aa_cr_setup)(const fv_pyr_level *H, int i0, int j0, 
     for (int j = 0; j < 4; j++)
         if (!V_ONES(H->wgt + (ptrdiff_t)(j0 - 1 + j) * H->stride + i0 - 1))
             return 0;
-    const float t[2] = {fx, fy};
-    float *w[2] = {c->wx, c->wy};
-    for (int k = 0; k < 2; k++) {
-        const float q = t[k];
-        w[k][0] = q * (-0.5f + q * (1.0f - 0.5f * q));
-        w[k][1] = 1.0f + q * q * (-2.5f + 1.5f * q);
-        w[k][2] = q * (0.5f + q * (2.0f - 1.5f * q));
-        w[k][3] = q * q * (-0.5f + 0.5f * q);
-    }
+    c->wx[0] = fx, c->wy[0] = fy; /* the fractions until aa_cr_weights */
     c->r = H->rgbd + 4 * ((ptrdiff_t)(j0 - 1) * H->stride + i0 - 1);
     return 1;
+}
+/* the weights per axis of cr[0 .. n-1] from their fractions, four pixels a step (the
+ * reference's polynomials, lane by lane) */
+static inline void TAA_AA_FN(aa_cr_weights)(aa_cr *cr, int n)
+{
+    for (int k = 0; k < n; k += 4) {
+        float t[2][4];
+        for (int l = 0; l < 4; l++) {
+            const aa_cr *c = &cr[k + l < n ? k + l : n - 1];
+            t[0][l] = c->wx[0], t[1][l] = c->wy[0];
+        }
+        for (int a = 0; a < 2; a++) {
+            const v4 q = V_LD(t[a]);
+            float w[4][4];
+            V_ST(w[0], V_MUL(q, V_ADD(V_DUP(-0.5f), V_MUL(q, V_SUB(V_DUP(1.0f), V_MUL(V_DUP(0.5f), q))))));
+            V_ST(w[1], V_ADD(V_DUP(1.0f), V_MUL(V_MUL(q, q), V_ADD(V_DUP(-2.5f), V_MUL(V_DUP(1.5f), q)))));
+            V_ST(w[2], V_MUL(q, V_ADD(V_DUP(0.5f), V_MUL(q, V_SUB(V_DUP(2.0f), V_MUL(V_DUP(1.5f), q))))));
+            V_ST(w[3], V_MUL(V_MUL(q, q), V_ADD(V_DUP(-0.5f), V_MUL(V_DUP(0.5f), q))));
+            for (int l = 0; l < 4 && k + l < n; l++) {
+                float *d = a ? cr[k + l].wy : cr[k + l].wx;
+                d[0] = w[0][l], d[1] = w[1][l], d[2] = w[2][l], d[3] = w[3][l];
+            }
+        }
+    }
 }
 /* the sum over the 16 texels, in the reference's order (a += wx[i] wy[j] texel, j outer) */
 static inline v4 TAA_AA_FN(aa_cr_sum)(const aa_cr *c, ptrdiff_t stride)
@@ -188,6 +204,7 @@ void TAA_AA_FN(fv_taa_aa_tile)(const fv_taa_frame *f, const fv_taa_aa_frame *a, 
             hh[x] = h;
         }
         /* 2. Catmull-Rom, two pixels at a time */
+        TAA_AA_FN(aa_cr_weights)(cr, ncr);
         int k = 0;
         for (; k + 2 <= ncr; k += 2)
             AA_CR_PAIR(&cr[k], &cr[k + 1], H->stride, &hh[cr[k].x], &hh[cr[k + 1].x]);
