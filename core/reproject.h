@@ -182,10 +182,7 @@ typedef struct fv_taa_aa_frame {
 struct fv_sampler;
 int fv_taa_aa_tile_eligible(const struct fv_sampler *smp, int gx, int gy, int x0, int y0, int tw, int th,
                             const uint32_t *rows);
-/* Accumulates an eligible tile's jittered samples (level 0, all weight 1) with its history;
- * f NULL (no history yet): the samples stay as traced with count 1. Writes the tile's counts. */
-void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
-                    int th);
+/* The accumulation of an eligible tile itself is the dsp table's taa_aa (reproject_dsp.h). */
 /* The still head in place: copies h0 (the history's level 0) over every tile of a w x h image
  * cut into tile x tile tiles that may take the anti-aliasing (probability 1 at its corner pixels,
  * as fv_taa_aa_tile_eligible tests) plus one pixel around (within the level's border) into *buf

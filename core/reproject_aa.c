@@ -1,7 +1,9 @@
 /* fovea: anti-aliasing in the fovea (reproject.h, fv_taa_aa_*): the fully sampled tiles' rays
  * go through a different point of their pixels every frame (fv_sampling_jitter) and each pixel
  * accumulates them in its history, so a still view converges to the pixel's box-filtered
- * value. Plain C: it runs on the fovea's tiles only (about 140 of 7200 at 1280x1440).
+ * value. It runs on the fovea's tiles only (about 140 of 7200 at 1280x1440). fv_taa_aa_tile_c below
+ * is the plain-C reference of the dsp table's taa_aa (reproject_dsp.h); the SIMD versions share
+ * core/reproject_aa_tmpl.h.
  *
  * Per pixel of an AA tile (every pixel has this frame's sample s, depth d):
  *   1. The pixel centre's place in the previous frame: the sample's world point (its ray through
@@ -32,6 +34,7 @@
 #include <string.h>
 
 #include "reproject.h"
+#include "reproject_dsp.h"
 #include "sampling.h"
 
 int fv_taa_aa_tile_eligible(const struct fv_sampler *smp, int gx, int gy, int x0, int y0, int tw, int th,
@@ -148,7 +151,7 @@ static void catmull_rom(const fv_pyr_level *H, int i0, int j0, float fx, float f
     h[0] = a0, h[1] = a1, h[2] = a2;
 }
 
-void fv_taa_aa_tile(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
+void fv_taa_aa_tile_c(const fv_taa_frame *f, const fv_taa_aa_frame *a, const fv_pyr_level *l0, int x0, int y0, int tw,
                     int th)
 {
     enum { T = 16 };

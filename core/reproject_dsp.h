@@ -42,10 +42,20 @@ typedef void (*fv_taa_fill_fn)(const struct fv_taa_frame *f, const struct fv_taa
  *   FMA, no reciprocal estimate; core/reproject_still_lane.h is the reference lane). */
 typedef void (*fv_taa_still_fn)(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha,
                                 float inv_depth_tol, uint8_t *wide);
+/* taa_aa: the fovea's anti-aliasing of one tile (reproject.h, fv_taa_aa_*; tw, th <= 16):
+ *   accumulates an eligible tile's jittered samples (level 0 at (x0, y0), all weight 1) with its
+ *   history; f NULL or a->n_prev NULL (no history yet): the samples stay as traced with count 1.
+ *   Writes the tile's counts. Bound: 0 ulp (each pixel's r, g, b, depth one vector, the
+ *   reference's ops in its order; core/reproject_aa_tmpl.h). */
+struct fv_taa_aa_frame;
+struct fv_pyr_level;
+typedef void (*fv_taa_aa_fn)(const struct fv_taa_frame *f, const struct fv_taa_aa_frame *a,
+                             const struct fv_pyr_level *l0, int x0, int y0, int tw, int th);
 typedef struct fv_reproject_dsp {
     fv_taa_blend_fn taa_blend;
     fv_taa_fill_fn taa_fill;
     fv_taa_still_fn taa_still;
+    fv_taa_aa_fn taa_aa;
 } fv_reproject_dsp;
 
 /* Fills d with the best kernels allowed by isa_mask & fv_cpu_isas() (FV_ISA_C: the references);
@@ -59,10 +69,18 @@ void fv_taa_fill_c(const struct fv_taa_frame *f, const struct fv_taa_tile *t, fl
                    ptrdiff_t stride, int x0, int y0, int w, int h);
 void fv_taa_still_c(float *s, const float *h, ptrdiff_t plane, int n, float widen, float alpha, float inv_depth_tol,
                     uint8_t *wide);
+void fv_taa_aa_tile_c(const struct fv_taa_frame *f, const struct fv_taa_aa_frame *a, const struct fv_pyr_level *l0,
+                      int x0, int y0, int tw, int th);
 #if defined(__x86_64__)
+void fv_taa_aa_tile_sse41(const struct fv_taa_frame *f, const struct fv_taa_aa_frame *a,
+                          const struct fv_pyr_level *l0, int x0, int y0, int tw, int th);
+void fv_taa_aa_tile_avx2(const struct fv_taa_frame *f, const struct fv_taa_aa_frame *a, const struct fv_pyr_level *l0,
+                         int x0, int y0, int tw, int th);
 void fv_reproject_dsp_init_sse41(fv_reproject_dsp *d);
 void fv_reproject_dsp_init_avx2(fv_reproject_dsp *d);
 #elif defined(__aarch64__)
+void fv_taa_aa_tile_neon(const struct fv_taa_frame *f, const struct fv_taa_aa_frame *a, const struct fv_pyr_level *l0,
+                         int x0, int y0, int tw, int th);
 void fv_reproject_dsp_init_neon(fv_reproject_dsp *d);
 #endif
 

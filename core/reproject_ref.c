@@ -147,6 +147,7 @@ void fv_reproject_dsp_init(fv_reproject_dsp *d, unsigned isa_mask)
     d->taa_blend = fv_taa_blend_c;
     d->taa_fill = fv_taa_fill_c;
     d->taa_still = fv_taa_still_c;
+    d->taa_aa = fv_taa_aa_tile_c;
 #if defined(__x86_64__)
     if (isas & FV_ISA_SSE41)
         fv_reproject_dsp_init_sse41(d);

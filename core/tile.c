@@ -114,7 +114,7 @@ static void run_still(tile_job *j, int index, int thread_id, int x0, int y0, int
         fv_taa_aa_clear(j->aa, x0, y0, tw, th);
     const int64_t t0 = fv_time_ns();
     if (aa)
-        fv_taa_aa_tile(j->taa, j->aa, l0, x0, y0, tw, th);
+        j->dsp->taa.taa_aa(j->taa, j->aa, l0, x0, y0, tw, th);
     else
         fv_taa_still_tile(j->taa, j->taa_prm, j->smp, j->gx, j->gy, l0, &j->dsp->taa, x0, y0, tw, th, rows, keep,
                           hist);
@@ -171,7 +171,7 @@ static void run_tile(void *ctx, int index, int thread_id)
         fv_taa_aa_clear(j->aa, x0, y0, tw, th);
     if (aa) {
         const int64_t t0 = fv_time_ns();
-        fv_taa_aa_tile(j->taa, j->aa, l0, x0, y0, tw, th);
+        j->dsp->taa.taa_aa(j->taa, j->aa, l0, x0, y0, tw, th);
         const int64_t t1 = fv_time_ns();
         SLOT_ADD(j, thread_id, taa_ns, t1 - t0);
         if (j->prof)

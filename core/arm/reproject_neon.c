@@ -334,4 +334,5 @@ void fv_reproject_dsp_init_neon(fv_reproject_dsp *d)
     d->taa_blend = taa_blend_neon;
     d->taa_fill = taa_fill_neon;
     d->taa_still = taa_still_neon;
+    d->taa_aa = fv_taa_aa_tile_neon; /* core/arm/reproject_aa_neon.c */
 }

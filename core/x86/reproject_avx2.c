@@ -399,4 +399,5 @@ void fv_reproject_dsp_init_avx2(fv_reproject_dsp *d)
     d->taa_blend = taa_blend_avx2;
     d->taa_fill = taa_fill_avx2;
     d->taa_still = taa_still_avx2;
+    d->taa_aa = fv_taa_aa_tile_avx2; /* core/x86/reproject_aa_avx2.c */
 }

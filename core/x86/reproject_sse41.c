@@ -299,4 +299,5 @@ void fv_reproject_dsp_init_sse41(fv_reproject_dsp *d)
     d->taa_blend = taa_blend_sse41;
     d->taa_fill = taa_fill_sse41;
     d->taa_still = taa_still_sse41;
+    d->taa_aa = fv_taa_aa_tile_sse41; /* core/x86/reproject_aa_sse41.c */
 }

@@ -197,6 +197,81 @@ static void taa_run(void *st, const checkasm_dsp *d, int row0, int rows)
     }
 }
 
+/* ---- the fovea's anti-aliasing: the 12x12 AA tiles around the gaze, head turning or still ---- */
+#define AA_T 12 /* tiles a side: 144, about the fovea's ~140 at 1280x1440 */
+typedef struct {
+    fv_camera cur, prev;
+    fv_pyramid hist, l;
+    float *rgbd0; /* the current level 0 before the AA */
+    uint8_t *n_prev, *n_cur;
+    fv_taa_frame f, still;
+    fv_taa_aa_frame a;
+} aa_st;
+static void aa_free(void *st)
+{
+    aa_st *t = st;
+    fv_pyramid_free(&t->hist), fv_pyramid_free(&t->l);
+    free(t->rgbd0), free(t->n_prev), free(t->n_cur), free(t);
+}
+static void *aa_setup(void)
+{
+    aa_st *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    fv_camera_desc cd;
+    fv_camera_desc_default(&cd);
+    cd.width = W, cd.height = H;
+    /* 30 deg/s of yaw at 90 Hz: 1/3 deg a frame */
+    const float a = 0.5f * (1.0f / 3.0f) * 3.14159265f / 180.0f;
+    const fv_pose p0 = {{0, 0, 0}, {0, 0, 0, 1}}, p1 = {{0, 0, 0}, {0, sinf(a), 0, cosf(a)}};
+    if (fv_camera_setup(&t->cur, &cd, &p0) || fv_camera_setup(&t->prev, &cd, &p1) || fv_pyramid_init(&t->hist, W, H) ||
+        fv_pyramid_init(&t->l, W, H))
+        return aa_free(t), NULL;
+    const fv_pyr_level *h0 = &t->hist.lv[0], *c0 = &t->l.lv[0];
+    const size_t n = (size_t)c0->stride * H;
+    if (!(t->rgbd0 = fplane(4 * n)) || !(t->n_prev = malloc((size_t)W * H)) || !(t->n_cur = malloc((size_t)W * H)))
+        return aa_free(t), NULL;
+    uint32_t s = 5;
+    /* history: a converged wall 5 m away; current: its jittered samples, every pixel */
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            fill_rgbd(h0->rgbd + 4 * ((size_t)y * h0->stride + x), 1, &s, 5.0f, 5.0f);
+            h0->wgt[(size_t)y * h0->stride + x] = 1.0f;
+            fill_rgbd(t->rgbd0 + 4 * ((size_t)y * c0->stride + x), 1, &s, 4.99f, 5.01f);
+            c0->wgt[(size_t)y * c0->stride + x] = 1.0f;
+            t->n_prev[(size_t)y * W + x] = (uint8_t)(1 + rnd(&s) % FV_TAA_AA_MAX_N);
+        }
+    fv_taa_frame_setup(&t->f, &t->cur, &t->prev, &t->hist, 0.03f);
+    fv_taa_frame_setup(&t->still, &t->cur, &t->cur, &t->hist, 0.03f);
+    t->a.n_prev = t->n_prev, t->a.n_cur = t->n_cur, t->a.stride = W, t->a.ox = 0.3125f, t->a.oy = 0.6875f;
+    memcpy(t->l.lv[0].rgbd, t->rgbd0, 4 * n * sizeof(float));
+    return t;
+}
+static void aa_reset(void *st)
+{
+    aa_st *t = st;
+    const size_t n = (size_t)t->l.lv[0].stride * H;
+    memcpy(t->l.lv[0].rgbd, t->rgbd0, 4 * n * sizeof(float));
+}
+static void aa_tiles(aa_st *t, const fv_taa_frame *f, const checkasm_dsp *d, int row0, int rows)
+{
+    for (int k = 0; k < rows; k++) {
+        const int i = (row0 + k) % (AA_T * AA_T);
+        const int x0 = (W / 2 / FV_TILE - AA_T / 2 + i % AA_T) * FV_TILE, y0 = (H / 2 / FV_TILE - AA_T / 2 + i / AA_T) * FV_TILE;
+        d->taa.taa_aa(f, &t->a, &t->l.lv[0], x0, y0, FV_TILE, FV_TILE);
+    }
+}
+static void aa_turn_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    aa_st *t = st;
+    aa_tiles(t, &t->f, d, row0, rows);
+}
+static void aa_still_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    aa_st *t = st;
+    aa_tiles(t, &t->still, d, row0, rows);
+}
+
 /* ---- depth of field ---- */
 typedef struct {
     float *rgbd, *coc, *a4, *b4, *c4, *out, *t;
@@ -658,6 +733,10 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"push_row", "1280x1440, 1440 rows", {F(pp.push_row), 0}, H, push_setup, NULL, push_run, push_free},
     {"taa_blend+taa_fill", "1280x1440, 7200 16x16 tiles, still head", {F(taa.taa_blend), F(taa.taa_fill)}, TX * TY, taa_setup,
      taa_reset, taa_run, taa_free},
+    {"taa_aa", "1280x1440, 144 16x16 fovea tiles, head turning 30 deg/s", {F(taa.taa_aa), 0}, AA_T * AA_T, aa_setup,
+     aa_reset, aa_turn_run, aa_free},
+    {"taa_aa_still", "1280x1440, 144 16x16 fovea tiles, still head", {F(taa.taa_aa), 0}, AA_T * AA_T, aa_setup,
+     aa_reset, aa_still_run, aa_free},
     {"dof_coc_row", "1280x1440, 1440 rows", {F(dof.dof_coc_row), 0}, H, dof_setup, NULL, coc_run, dof_free},
     {"dof_nearblk_row", "1280x1440, 1440 rows, 4x4 blocks", {F(dof.dof_nearblk_row), 0}, H, dof_setup, NULL,
      nearblk_run, dof_free},

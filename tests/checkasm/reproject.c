@@ -34,7 +34,7 @@ static void compare(const float *ref, const float *got, size_t count, int per_px
 
 /* ------------------------------------------------------------------ tables */
 
-static const char *const names[] = {"taa_blend", "taa_fill", "taa_still"};
+static const char *const names[] = {"taa_blend", "taa_fill", "taa_still", "taa_aa"};
 
 /* Every ISA this build has an init for must implement every kernel (checkasm.h); the C table
  * holds the references. Also seeds the module's inputs. */
@@ -47,6 +47,7 @@ static void test_tables(void **state)
     assert_true(ref.taa_blend == fv_taa_blend_c);
     assert_true(ref.taa_fill == fv_taa_fill_c);
     assert_true(ref.taa_still == fv_taa_still_c);
+    assert_true(ref.taa_aa == fv_taa_aa_tile_c);
     CHECKASM_CHECK_ISA_TABLES("reproject", fv_reproject_dsp, &ref, names);
 }
 
@@ -315,9 +316,166 @@ static void test_taa_still(void **state)
     printf("[ checkasm ] taa_still: %d ISA version(s) tested\n", tested);
 }
 
+/* ------------------------------------------------------------------ the fovea's anti-aliasing */
+
+/* taa_aa on tiles of a W x H image (level 0 all samples, as the AA tiles are): history weights
+ * per wmode (0/1, random with holes, all 0, or all 1 but a few holes so Catmull-Rom's 16 texels
+ * are often complete), the history read from the pyramid or from a snapshot copy of its level 0
+ * (the still head's h_* view), counts 0 .. FV_TAA_AA_MAX_N (max included), tiles anywhere
+ * (image edges, partial tw / th < 16). Everything the kernel may write (the whole level 0 and
+ * the whole count plane) is compared. */
+static long aa_blended, aa_hist, aa_max_n; /* how often the paths really ran (C reference) */
+typedef struct {
+    int W, H, motion, snap, no_prev, no_frame;
+    const fv_taa_frame *f;
+    const fv_pyramid *hist;
+    const uint8_t *n_prev;
+} aa_case;
+
+static void run_aa(fv_taa_aa_fn fn, const char *isa, const aa_case *c)
+{
+    const int W = c->W, H = c->H;
+    int tw = 1 + (int)(fv_test_rand(&checkasm_rng) % 16), th = 1 + (int)(fv_test_rand(&checkasm_rng) % 16);
+    if (fv_test_rand(&checkasm_rng) % 2) /* whole tiles half the time */
+        tw = th = 16;
+    tw = tw < W ? tw : W, th = th < H ? th : H;
+    const unsigned e = (unsigned)(fv_test_rand(&checkasm_rng) % 4); /* at the image's edges, or anywhere */
+    int x0 = (int)(fv_test_rand(&checkasm_rng) % (unsigned)(W - tw + 1));
+    int y0 = (int)(fv_test_rand(&checkasm_rng) % (unsigned)(H - th + 1));
+    x0 = e == 1 ? 0 : e == 2 ? W - tw : x0;
+    y0 = e == 1 ? H - th : e == 2 ? 0 : y0;
+    fv_pyramid cur;
+    assert_int_equal(fv_pyramid_init(&cur, W, H), 0);
+    fv_pyr_level *L = &cur.lv[0];
+    const size_t n = (size_t)L->stride * (size_t)(H + 2); /* the level with its border */
+    float *base = L->rgbd - 4 * (L->stride + 1);
+    for (size_t i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) { /* some +-0 (which zero min / max pick never shows: hc + alpha (s - hc)) */
+            const float u = rnd(), r = rnd();
+            base[4 * i + k] = u < 0.04f ? 0.0f : u < 0.08f ? -0.0f : r;
+        }
+        const float v = rnd(), r1 = rnd();
+        base[4 * i + 3] = v < 0.15f ? 0.3f + 30.0f * r1 : v < 0.2f ? 1000.0f : 3.0f * (1.0f + 0.04f * (r1 - 0.5f));
+    }
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            L->wgt[(ptrdiff_t)y * L->stride + x] = 1.0f;
+    float *ref = malloc(4 * n * sizeof(float)), *in = malloc(4 * n * sizeof(float));
+    assert_non_null(ref);
+    assert_non_null(in);
+    memcpy(in, base, 4 * n * sizeof(float));
+    uint8_t *nc_base, *nt_base;
+    const size_t nn = (size_t)W * (size_t)H;
+    uint8_t *nr = checkasm_out_u8(nn, (int)(fv_test_rand(&checkasm_rng) % 4), &nc_base);
+    uint8_t *nt = checkasm_out_u8(nn, (int)(fv_test_rand(&checkasm_rng) % 4), &nt_base);
+    memset(nr, 0xa5, nn), memset(nt, 0xa5, nn); /* counts outside the tile must stay */
+    fv_taa_aa_frame a;
+    memset(&a, 0, sizeof a);
+    a.n_prev = c->no_prev ? NULL : c->n_prev;
+    a.stride = W;
+    a.ox = rnd(), a.oy = rnd();
+    float *snap = NULL;
+    if (c->snap && c->hist) { /* level 0 with its border ring, as fv_taa_aa_snapshot copies it */
+        const fv_pyr_level *h0 = &c->hist->lv[0];
+        const int bw = W + 2, bh = H + 2;
+        snap = malloc((size_t)bw * (size_t)bh * 5 * sizeof(float));
+        assert_non_null(snap);
+        for (int y = -1; y <= H; y++) {
+            const ptrdiff_t o = (ptrdiff_t)y * h0->stride - 1, r = (ptrdiff_t)(y + 1) * bw;
+            memcpy(snap + 4 * r, h0->rgbd + 4 * o, (size_t)bw * 4 * sizeof(float));
+            memcpy(snap + (size_t)bw * (size_t)bh * 4 + r, h0->wgt + o, (size_t)bw * sizeof(float));
+        }
+        a.h_rgbd = snap, a.h_wgt = snap + (size_t)bw * (size_t)bh * 4, a.h_stride = bw, a.h_x0 = -1, a.h_y0 = -1;
+    }
+    const fv_taa_frame *f = c->no_frame ? NULL : c->f;
+    a.n_cur = nr;
+    fv_taa_aa_tile_c(f, &a, L, x0, y0, tw, th);
+    memcpy(ref, base, 4 * n * sizeof(float));
+    for (int y = 0; y < th; y++)
+        for (int x = 0; x < tw; x++) {
+            const uint8_t k = nr[(size_t)(y0 + y) * (size_t)W + (size_t)(x0 + x)];
+            aa_hist += k > 1, aa_max_n += k == FV_TAA_AA_MAX_N;
+            const ptrdiff_t o = (ptrdiff_t)(y0 + y + 1) * L->stride + x0 + x + 1;
+            aa_blended += memcmp(in + 4 * o, ref + 4 * o, 3 * sizeof(float)) != 0;
+        }
+    memcpy(base, in, 4 * n * sizeof(float));
+    a.n_cur = nt;
+    fn(f, &a, L, x0, y0, tw, th);
+    char ctx[160];
+    snprintf(ctx, sizeof ctx, "%s taa_aa %dx%d tile %dx%d at (%d, %d) motion=%s snapshot=%d no_prev=%d no_frame=%d", isa,
+             W, H, tw, th, x0, y0, motion_name[c->motion], c->snap, c->no_prev, c->no_frame);
+    checkasm_compare(ref, base, 4 * n, CHECKASM_F32, 4, CHECKASM_EXACT, "%s (pixels)", ctx);
+    checkasm_compare(nr, nt, nn, CHECKASM_U8, 1, CHECKASM_EXACT, "%s (counts)", ctx);
+    checkasm_check_guards(nt, nn, isa, "taa_aa", tw);
+    assert_finite(ref, 4 * n, "taa_aa", tw);
+    free(nc_base), free(nt_base), free(ref), free(in), free(snap);
+    fv_pyramid_free(&cur);
+}
+
+static void test_taa_aa(void **state)
+{
+    (void)state;
+    int tested = 0;
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "taa_aa"))
+            continue;
+        fv_reproject_dsp d;
+        fv_reproject_dsp_init(&d, isa);
+        if (!d.taa_aa || d.taa_aa == fv_taa_aa_tile_c)
+            fail_msg("taa_aa: %s has no version of its own", fv_isa_name(isa));
+        checkasm_rng = 0xaa14ull; /* the same inputs for every ISA */
+        int runs = 0;
+        static const int dims[][2] = { { 67, 53 }, { 40, 37 }, { 16, 16 }, { 5, 3 } };
+        for (int di = 0; di < 4; di++)
+            for (int wmode = 0; wmode < 4; wmode++)
+                for (int motion = 0; motion < 3; motion++) {
+                    const int W = dims[di][0], H = dims[di][1];
+                    fv_pyramid hist;
+                    random_history(&hist, W, H, wmode < 3 ? wmode : 0);
+                    for (int y = -1; y <= H; y++) /* colours +-0 too (run_aa's samples have them) */
+                        for (int x = -1; x <= W; x++) {
+                            float *t = hist.lv[0].rgbd + 4 * ((ptrdiff_t)y * hist.lv[0].stride + x);
+                            for (int ch = 0; ch < 3; ch++) {
+                                const float u = rnd();
+                                t[ch] = u < 0.1f ? 0.0f : u < 0.2f ? -0.0f : t[ch];
+                            }
+                        }
+                    if (wmode == 3) /* all samples but a few holes */
+                        for (int y = 0; y < H; y++)
+                            for (int x = 0; x < W; x++)
+                                hist.lv[0].wgt[(ptrdiff_t)y * hist.lv[0].stride + x] = rnd() < 0.03f ? 0.0f : 1.0f;
+                    fv_camera cur, prev;
+                    random_cameras(&cur, &prev, W, H, motion);
+                    fv_taa_frame f;
+                    fv_taa_frame_setup(&f, &cur, &prev, &hist, 0.03f);
+                    uint8_t *np = malloc((size_t)W * (size_t)H);
+                    assert_non_null(np);
+                    for (int i = 0; i < W * H; i++) { /* counts 0 .. MAX_N, the cap often */
+                        const unsigned r = (unsigned)(fv_test_rand(&checkasm_rng) % 24);
+                        np[i] = (uint8_t)(r > FV_TAA_AA_MAX_N ? FV_TAA_AA_MAX_N : r);
+                    }
+                    for (int r = 0; r < 24; r++) {
+                        aa_case c = { W, H, motion, r % 3 == 1, r == 7, r == 13, &f, &hist, np };
+                        run_aa(d.taa_aa, fv_isa_name(isa), &c);
+                        runs++;
+                    }
+                    free(np);
+                    fv_pyramid_free(&hist);
+                }
+        printf("[ checkasm ] taa_aa: %-7s == c on %d tiles (bit-exact); %ld pixels blended with history, %ld "
+               "changed, %ld at n = %d\n", fv_isa_name(isa), runs, aa_hist, aa_blended, aa_max_n, FV_TAA_AA_MAX_N);
+        assert_true(aa_hist > 5000 && aa_blended > 5000 && aa_max_n > 500);
+        aa_blended = aa_hist = aa_max_n = 0;
+        tested++;
+    }
+    printf("[ checkasm ] taa_aa: %d ISA version(s) tested\n", tested);
+}
+
 const struct CMUnitTest checkasm_reproject_tests[] = {
     cmocka_unit_test(test_tables),
     cmocka_unit_test(test_taa_blocks),
     cmocka_unit_test(test_taa_still),
+    cmocka_unit_test(test_taa_aa),
     {0},
 };
