@@ -170,6 +170,14 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
      * lanes past n keep an earlier packet's values: finite, unused). Locals: the stores to pk
      * would make the compiler reload h. */
     const unsigned *geom = h->geom, *primv = h->prim;
+    /* A packet of misses only (most of a small object's frame: FlightHelmet, DepthOfFieldExample)
+     * has nothing to shade and no lane to blacken; pk is left as it is (its material rows still
+     * hold what pk_scene / pk_geom say). */
+    unsigned any = 0;
+    for (int q = 0; q < n; q++)
+        any |= geom[q] != RTC_INVALID_GEOMETRY_ID;
+    if (!any)
+        return;
     if (n == FV_SHADE_LANES) {
         pk.u = h->u, pk.v = h->v, pk.t = h->t;
         for (int k = 0; k < 3; k++) pk.dir[k] = h->dir[k];
