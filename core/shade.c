@@ -130,6 +130,31 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
                   shadows ? lit : NULL, 1, rgb);
 }
 
+/* A textured mesh's slots as the packet gather walks them, looked up once per run of lanes on
+ * the mesh: the slots sampled here (a texture, and not the same texels as an earlier slot) in
+ * order, each slot's texture (NULL: none) and, per sampled slot j, bit i set where slot i's
+ * texture has the same layout (fv_tex_same_layout). */
+typedef struct {
+    const fv_mesh_rec *m;
+    int n, slot[FV_SLOTS];
+    const fv_texture *tex[FV_SLOTS];
+    unsigned same_layout[FV_SLOTS];
+} slot_plan_t;
+
+static void slot_plan(const fv_scene *s, const fv_mesh_rec *m, slot_plan_t *p)
+{
+    p->m = m, p->n = 0;
+    for (int j = 0; j < FV_SLOTS; j++) {
+        const int id = slot_texture(m, j);
+        p->tex[j] = id >= 0 ? &s->textures[id] : NULL;
+        p->same_layout[j] = 0;
+        if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
+        p->slot[p->n++] = j;
+        for (int i = 0; i < j; i++)
+            if (p->tex[i] && fv_tex_same_layout(p->tex[i], p->tex[j])) p->same_layout[j] |= 1u << i;
+    }
+}
+
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
 {
     /* the mesh looked up once per run of lanes on it (a packet mostly hits one or two) */
@@ -173,10 +198,18 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     /* A packet of misses only (most of a small object's frame: FlightHelmet, DepthOfFieldExample)
      * has nothing to shade and no lane to blacken; pk is left as it is (its material rows still
      * hold what pk_scene / pk_geom say). */
-    unsigned any = 0;
-    for (int q = 0; q < n; q++)
-        any |= geom[q] != RTC_INVALID_GEOMETRY_ID;
-    if (!any)
+    _Static_assert(RTC_INVALID_GEOMETRY_ID == ~0u, "the AND of the ids is ~0u for misses only");
+    typedef unsigned u32x4 __attribute__((vector_size(16))); /* GCC / clang vectors: SSE2, NEON */
+    u32x4 all4 = {~0u, ~0u, ~0u, ~0u};
+    int q4 = 0;
+    for (; q4 + 4 <= n; q4 += 4) { /* 8-lane packets where Embree has no 16-wide path */
+        u32x4 g4;
+        memcpy(&g4, geom + q4, sizeof g4);
+        all4 &= g4;
+    }
+    unsigned all = all4[0] & all4[1] & all4[2] & all4[3];
+    for (; q4 < n; q4++) all &= geom[q4];
+    if (all == RTC_INVALID_GEOMETRY_ID)
         return;
     if (n == FV_SHADE_LANES) {
         pk.u = h->u, pk.v = h->v, pk.t = h->t;
@@ -232,6 +265,7 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             pk.nrm_at[q] = attr[prim].n; /* read by the kernel (NRM9) */
         }
     }
+    slot_plan_t plan = {.m = NULL}; /* the textured mesh of the last textured lane */
     const fv_mesh_rec *plain_m = NULL; /* the mesh whose material plain holds */
     fv_brdf_mat plain = {{0, 0, 0}, 0, 0, 0};
     float plain_occ = 1.0f, plain_emit[3] = {0, 0, 0};
@@ -253,19 +287,20 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             const float fp = px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
+            if (m != plan.m)
+                slot_plan(s, m, &plan);
             int jp = -1; /* the last slot whose taps were computed here */
             float psu = 0.0f, psv = 0.0f, plod = 0.0f;
-            for (int j = 0; j < FV_SLOTS; j++) {
-                const int id = slot_texture(m, j);
-                if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
+            for (int k = 0; k < plan.n; k++) {
+                const int j = plan.slot[k];
                 float su, sv;
                 slot_uv(m, j, tu, tv, &su, &sv);
                 const float lj = lod + m->lod_bias[j];
-                const fv_texture *tj = &s->textures[id];
+                const fv_texture *tj = plan.tex[j];
                 /* maps of one size sampled at the same point (no own texture transform): the
                  * same texel offsets and weights in another texture */
-                if (jp >= 0 && su == psu && sv == psv && lj == plod && fv_tex_same_layout(&s->textures[slot_texture(m, jp)], tj))
-                    fv_tex_taps_rebase(&s->textures[slot_texture(m, jp)], tj, &taps[jp][q], &taps[j][q]);
+                if (jp >= 0 && su == psu && sv == psv && lj == plod && (plan.same_layout[j] >> jp & 1))
+                    fv_tex_taps_rebase(plan.tex[jp], tj, &taps[jp][q], &taps[j][q]);
                 else
                     fv_tex_taps_at(tj, su, sv, lj, &taps[j][q]), jp = j, psu = su, psv = sv, plod = lj;
                 fv_tex_taps_prefetch(&taps[j][q]);
@@ -293,12 +328,13 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const fv_mesh_rec *m = &s->meshes[h->geom[q]];
         float texel[FV_SLOTS][4];
         const float *tx[FV_SLOTS] = {NULL, NULL, NULL, NULL, NULL};
+        if (m != plan.m)
+            slot_plan(s, m, &plan);
+        for (int k = 0; k < plan.n; k++)
+            fv_tex_blend(&taps[plan.slot[k]][q], texel[plan.slot[k]]);
         for (int j = 0; j < FV_SLOTS; j++)
-            if (slot_texture(m, j) >= 0) {
-                if (m->slot_src[j] == j)
-                    fv_tex_blend(&taps[j][q], texel[j]);
+            if (plan.tex[j])
                 tx[j] = texel[m->slot_src[j]];
-            }
         fv_brdf_mat mat;
         float occ, emit[3];
         const float u = h->u[q], v = h->v[q];
