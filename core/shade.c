@@ -191,26 +191,21 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     static _Thread_local unsigned pk_geom;
     fv_tex_taps taps[FV_SLOTS][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
-    /* the lanes' ray data: a full packet's read in place by the kernel, a short one's copied (the
-     * lanes past n keep an earlier packet's values: finite, unused). Locals: the stores to pk
-     * would make the compiler reload h. */
-    const unsigned *geom = h->geom, *primv = h->prim;
+    const unsigned *geom = h->geom, *primv = h->prim; /* locals: the stores to pk would make the compiler reload h */
+    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0; /* the last lane's mesh; lanes on other meshes */
+    for (int q = 0; q < n; q++) {
+        const unsigned g = geom[q];
+        if (g == RTC_INVALID_GEOMETRY_ID) continue;
+        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
+        g0 = g;
+    }
     /* A packet of misses only (most of a small object's frame: FlightHelmet, DepthOfFieldExample)
      * has nothing to shade and no lane to blacken; pk is left as it is (its material rows still
      * hold what pk_scene / pk_geom say). */
-    _Static_assert(RTC_INVALID_GEOMETRY_ID == ~0u, "the AND of the ids is ~0u for misses only");
-    typedef unsigned u32x4 __attribute__((vector_size(16))); /* GCC / clang vectors: SSE2, NEON */
-    u32x4 all4 = {~0u, ~0u, ~0u, ~0u};
-    int q4 = 0;
-    for (; q4 + 4 <= n; q4 += 4) { /* 8-lane packets where Embree has no 16-wide path */
-        u32x4 g4;
-        memcpy(&g4, geom + q4, sizeof g4);
-        all4 &= g4;
-    }
-    unsigned all = all4[0] & all4[1] & all4[2] & all4[3];
-    for (; q4 < n; q4++) all &= geom[q4];
-    if (all == RTC_INVALID_GEOMETRY_ID)
+    if (g0 == RTC_INVALID_GEOMETRY_ID)
         return;
+    /* the lanes' ray data: a full packet's read in place by the kernel, a short one's copied (the
+     * lanes past n keep an earlier packet's values: finite, unused) */
     if (n == FV_SHADE_LANES) {
         pk.u = h->u, pk.v = h->v, pk.t = h->t;
         for (int k = 0; k < 3; k++) pk.dir[k] = h->dir[k];
@@ -228,13 +223,6 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     /* A packet usually hits one mesh: an untextured mesh without vertex colours then has one
      * material for every lane, broadcast to all 16 (material_at's values, computed once), and
      * each lane only needs its corner normals. */
-    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0;
-    for (int q = 0; q < n; q++) {
-        const unsigned g = geom[q];
-        if (g == RTC_INVALID_GEOMETRY_ID) continue;
-        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
-        g0 = g;
-    }
     const fv_mesh_rec *um = !mixed && g0 < s->mesh_count ? &s->meshes[g0] : NULL;
     if (um && (um->tex_ref >= 0 || um->col)) um = NULL;
     if (um && (pk_scene != s->serial || pk_geom != g0)) {
@@ -265,7 +253,8 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             pk.nrm_at[q] = attr[prim].n; /* read by the kernel (NRM9) */
         }
     }
-    slot_plan_t plan = {.m = NULL}; /* the textured mesh of the last textured lane */
+    slot_plan_t plan; /* the textured mesh of the last textured lane */
+    plan.m = NULL;
     const fv_mesh_rec *plain_m = NULL; /* the mesh whose material plain holds */
     fv_brdf_mat plain = {{0, 0, 0}, 0, 0, 0};
     float plain_occ = 1.0f, plain_emit[3] = {0, 0, 0};
