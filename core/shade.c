@@ -130,6 +130,31 @@ void fv_scene_shade(const fv_scene *s, unsigned geom_id, unsigned prim_id, float
                   shadows ? lit : NULL, 1, rgb);
 }
 
+/* A textured mesh's slots as the packet gather walks them, looked up once per run of lanes on
+ * the mesh: the slots sampled here (a texture, and not the same texels as an earlier slot) in
+ * order, each slot's texture (NULL: none) and, per sampled slot j, bit i set where slot i's
+ * texture has the same layout (fv_tex_same_layout). */
+typedef struct {
+    const fv_mesh_rec *m;
+    int n, slot[FV_SLOTS];
+    const fv_texture *tex[FV_SLOTS];
+    unsigned same_layout[FV_SLOTS];
+} slot_plan_t;
+
+static void slot_plan(const fv_scene *s, const fv_mesh_rec *m, slot_plan_t *p)
+{
+    p->m = m, p->n = 0;
+    for (int j = 0; j < FV_SLOTS; j++) {
+        const int id = slot_texture(m, j);
+        p->tex[j] = id >= 0 ? &s->textures[id] : NULL;
+        p->same_layout[j] = 0;
+        if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
+        p->slot[p->n++] = j;
+        for (int i = 0; i < j; i++)
+            if (p->tex[i] && fv_tex_same_layout(p->tex[i], p->tex[j])) p->same_layout[j] |= 1u << i;
+    }
+}
+
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
 {
     /* the mesh looked up once per run of lanes on it (a packet mostly hits one or two) */
@@ -166,10 +191,21 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     static _Thread_local unsigned pk_geom;
     fv_tex_taps taps[FV_SLOTS][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
+    const unsigned *geom = h->geom, *primv = h->prim; /* locals: the stores to pk would make the compiler reload h */
+    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0; /* the last lane's mesh; lanes on other meshes */
+    for (int q = 0; q < n; q++) {
+        const unsigned g = geom[q];
+        if (g == RTC_INVALID_GEOMETRY_ID) continue;
+        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
+        g0 = g;
+    }
+    /* A packet of misses only (most of a small object's frame: FlightHelmet, DepthOfFieldExample)
+     * has nothing to shade and no lane to blacken; pk is left as it is (its material rows still
+     * hold what pk_scene / pk_geom say). */
+    if (g0 == RTC_INVALID_GEOMETRY_ID)
+        return;
     /* the lanes' ray data: a full packet's read in place by the kernel, a short one's copied (the
-     * lanes past n keep an earlier packet's values: finite, unused). Locals: the stores to pk
-     * would make the compiler reload h. */
-    const unsigned *geom = h->geom, *primv = h->prim;
+     * lanes past n keep an earlier packet's values: finite, unused) */
     if (n == FV_SHADE_LANES) {
         pk.u = h->u, pk.v = h->v, pk.t = h->t;
         for (int k = 0; k < 3; k++) pk.dir[k] = h->dir[k];
@@ -187,13 +223,6 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     /* A packet usually hits one mesh: an untextured mesh without vertex colours then has one
      * material for every lane, broadcast to all 16 (material_at's values, computed once), and
      * each lane only needs its corner normals. */
-    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0;
-    for (int q = 0; q < n; q++) {
-        const unsigned g = geom[q];
-        if (g == RTC_INVALID_GEOMETRY_ID) continue;
-        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
-        g0 = g;
-    }
     const fv_mesh_rec *um = !mixed && g0 < s->mesh_count ? &s->meshes[g0] : NULL;
     if (um && (um->tex_ref >= 0 || um->col)) um = NULL;
     if (um && (pk_scene != s->serial || pk_geom != g0)) {
@@ -224,6 +253,8 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             pk.nrm_at[q] = attr[prim].n; /* read by the kernel (NRM9) */
         }
     }
+    slot_plan_t plan; /* the textured mesh of the last textured lane */
+    plan.m = NULL;
     const fv_mesh_rec *plain_m = NULL; /* the mesh whose material plain holds */
     fv_brdf_mat plain = {{0, 0, 0}, 0, 0, 0};
     float plain_occ = 1.0f, plain_emit[3] = {0, 0, 0};
@@ -245,19 +276,20 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
             const float fp = px_tan / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
             float tu, tv, lod;
             tex_coords(m, prim, u, v, 1.0f - u - v, dir, t, fp, &tu, &tv, &lod);
+            if (m != plan.m)
+                slot_plan(s, m, &plan);
             int jp = -1; /* the last slot whose taps were computed here */
             float psu = 0.0f, psv = 0.0f, plod = 0.0f;
-            for (int j = 0; j < FV_SLOTS; j++) {
-                const int id = slot_texture(m, j);
-                if (id < 0 || m->slot_src[j] != j) continue; /* none, or the same texels as an earlier slot */
+            for (int k = 0; k < plan.n; k++) {
+                const int j = plan.slot[k];
                 float su, sv;
                 slot_uv(m, j, tu, tv, &su, &sv);
                 const float lj = lod + m->lod_bias[j];
-                const fv_texture *tj = &s->textures[id];
+                const fv_texture *tj = plan.tex[j];
                 /* maps of one size sampled at the same point (no own texture transform): the
                  * same texel offsets and weights in another texture */
-                if (jp >= 0 && su == psu && sv == psv && lj == plod && fv_tex_same_layout(&s->textures[slot_texture(m, jp)], tj))
-                    fv_tex_taps_rebase(&s->textures[slot_texture(m, jp)], tj, &taps[jp][q], &taps[j][q]);
+                if (jp >= 0 && su == psu && sv == psv && lj == plod && (plan.same_layout[j] >> jp & 1))
+                    fv_tex_taps_rebase(plan.tex[jp], tj, &taps[jp][q], &taps[j][q]);
                 else
                     fv_tex_taps_at(tj, su, sv, lj, &taps[j][q]), jp = j, psu = su, psv = sv, plod = lj;
                 fv_tex_taps_prefetch(&taps[j][q]);
@@ -285,12 +317,13 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
         const fv_mesh_rec *m = &s->meshes[h->geom[q]];
         float texel[FV_SLOTS][4];
         const float *tx[FV_SLOTS] = {NULL, NULL, NULL, NULL, NULL};
+        if (m != plan.m)
+            slot_plan(s, m, &plan);
+        for (int k = 0; k < plan.n; k++)
+            fv_tex_blend(&taps[plan.slot[k]][q], texel[plan.slot[k]]);
         for (int j = 0; j < FV_SLOTS; j++)
-            if (slot_texture(m, j) >= 0) {
-                if (m->slot_src[j] == j)
-                    fv_tex_blend(&taps[j][q], texel[j]);
+            if (plan.tex[j])
                 tx[j] = texel[m->slot_src[j]];
-            }
         fv_brdf_mat mat;
         float occ, emit[3];
         const float u = h->u[q], v = h->v[q];

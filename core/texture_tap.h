@@ -31,15 +31,13 @@ static inline int fv_tex_wrap_index(int i, int side, fv_wrap mode)
     return i < 0 ? 0 : i >= side ? side - 1 : i;
 }
 
-/* Bilinear with the texture's wrap modes; uv (0,0) is the first texel of the first row (glTF).
- * A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. nearest: the texel holding
+/* Bilinear with the texture's wrap modes; uv (0,0) is the first texel of the first row (glTF),
+ * u and v already folded by fv_tex_wrap_coord (in [0, 1]). A bilinear tap: the four texels (00, 10, 01, 11) and the fractions. nearest: the texel holding
  * the point, as all four with fractions 0 (the blend then gives its bits exactly). */
-static inline void fv_tex_tap_at(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp, int nearest)
+static inline void fv_tex_tap_wrapped(const fv_texture *t, int l, float u, float v, fv_tex_tap *tp, int nearest)
 {
     const int w = t->w[l], h = t->h[l];
     const float *px = t->level[l];
-    u = fv_tex_wrap_coord(u, t->wrap_s);
-    v = fv_tex_wrap_coord(v, t->wrap_t);
     const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
     const float xf = floorf(x), yf = floorf(y);
     tp->fx = x - xf, tp->fy = y - yf;
@@ -80,15 +78,17 @@ static inline void fv_tex_taps_at(const fv_texture *t, float u, float v, float l
     tp->f = 0.0f;
     if (t->mip == FV_MIP_NONE) lod = 0.0f;
     else if (t->mip == FV_MIP_NEAREST) lod = floorf(lod + 0.5f);
+    /* the wrap does not depend on the level: folded once for both */
+    u = fv_tex_wrap_coord(u, t->wrap_s), v = fv_tex_wrap_coord(v, t->wrap_t);
     if (lod >= top) {
-        fv_tex_tap_at(t, t->levels - 1, u, v, &tp->tap[0], nearest);
+        fv_tex_tap_wrapped(t, t->levels - 1, u, v, &tp->tap[0], nearest);
         return;
     }
     const int l0 = (int)lod;
     tp->f = lod - (float)l0;
-    fv_tex_tap_at(t, l0, u, v, &tp->tap[0], nearest);
+    fv_tex_tap_wrapped(t, l0, u, v, &tp->tap[0], nearest);
     if (tp->f > 0.0f)
-        fv_tex_tap_at(t, l0 + 1, u, v, &tp->tap[1], nearest);
+        fv_tex_tap_wrapped(t, l0 + 1, u, v, &tp->tap[1], nearest);
 }
 
 /* Textures of the same size, wrap modes and filters: fv_tex_taps_at of one at (u, v, lod) is the
