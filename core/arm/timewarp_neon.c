@@ -1,8 +1,9 @@
 /* fovea: the timewarp kernel, NEON: 4 display pixels a step, the float steps in vector code,
  * the source reads per lane (NEON has no gather), the bilinear tap on bytes in output order
  * (tap4).
- * Same IEEE steps as the reference, in its order; max / min are written as the reference's
- * compares (vmaxq_f32 would propagate NaN where the reference does not). */
+ * Same IEEE steps as the reference, in its order. Its selects (a > b ? a : b) against a constant
+ * bound are FMAXNM / FMINNM: they return the number where the other operand is a (quiet) NaN,
+ * as the select does (FMAX would propagate it); the two operands variable (mx) stay compares. */
 #include <arm_neon.h>
 #include <string.h>
 
@@ -16,13 +17,17 @@ typedef struct {
 } tw4;
 
 static inline float32x4_t gt_sel(float32x4_t a, float32x4_t b) { return vbslq_f32(vcgtq_f32(a, b), a, b); }
-static inline float32x4_t lt_sel(float32x4_t a, float32x4_t b) { return vbslq_f32(vcltq_f32(a, b), a, b); }
-static inline float32x4_t clamp4(float32x4_t v, float32x4_t hi) { return lt_sel(gt_sel(v, vdupq_n_f32(0.0f)), hi); }
+/* a > b ? a : b for a constant b > 0 (the operands come out of arithmetic: never a signalling
+ * NaN, which FMAXNM would not drop) */
+static inline float32x4_t max_bound(float32x4_t a, float32x4_t b) { return vmaxnmq_f32(a, b); }
+/* the reference's clamp: v > 0 ? v : 0 (NaN -> 0; -0 -> +0, as FMAXNM(-0, +0) = +0), then
+ * v < hi ? v : hi on a number */
+static inline float32x4_t clamp4(float32x4_t v, float32x4_t hi) { return vminnmq_f32(vmaxnmq_f32(v, vdupq_n_f32(0.0f)), hi); }
 
 static inline void proj4(const tw4 *c, float32x4_t A0, float32x4_t A1, float32x4_t A2, float32x4_t w, float32x4_t *u,
                          float32x4_t *v)
 {
-    const float32x4_t nz = gt_sel(vaddq_f32(A2, vmulq_f32(c->t2, w)), c->zmin);
+    const float32x4_t nz = max_bound(vaddq_f32(A2, vmulq_f32(c->t2, w)), c->zmin);
     const float32x4_t inv = vdivq_f32(c->one, nz);
     *u = vmulq_f32(vaddq_f32(A0, vmulq_f32(c->t0, w)), inv);
     *v = vmulq_f32(vaddq_f32(A1, vmulq_f32(c->t1, w)), inv);
@@ -39,7 +44,7 @@ static inline float32x4_t fetch_w4(const tw4 *c, float32x4_t A2, float32x4_t u, 
     const int32x4_t ix = vcvtq_s32_f32(clamp4(u, c->wm1)), iy = vcvtq_s32_f32(clamp4(v, c->hm1));
     const int32x4_t g = gather_u16(c->invd, vaddq_s32(vmulq_s32(iy, c->istride), ix));
     const float32x4_t ws = vmulq_f32(vcvtq_f32_s32(g), c->wscale);
-    const float32x4_t den = gt_sel(vsubq_f32(c->one, vmulq_f32(c->t2, ws)), c->denmin);
+    const float32x4_t den = max_bound(vsubq_f32(c->one, vmulq_f32(c->t2, ws)), c->denmin);
     return vdivq_f32(vmulq_f32(A2, ws), den);
 }
 
