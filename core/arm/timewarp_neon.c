@@ -1,7 +1,9 @@
 /* fovea: the timewarp kernel, NEON: 4 display pixels a step, the float steps in vector code,
- * the source reads per lane (NEON has no gather), the bilinear tap in 32-bit integer lanes.
- * Same IEEE steps as the reference, in its order; max / min are written as the reference's
- * compares (vmaxq_f32 would propagate NaN where the reference does not). */
+ * the source reads per lane (NEON has no gather), the bilinear tap on bytes in output order
+ * (tap4).
+ * Same IEEE steps as the reference, in its order. Its selects (a > b ? a : b) against a constant
+ * bound are FMAXNM / FMINNM: they return the number where the other operand is a (quiet) NaN,
+ * as the select does (FMAX would propagate it); the two operands variable (mx) stay compares. */
 #include <arm_neon.h>
 #include <string.h>
 
@@ -9,19 +11,23 @@
 
 typedef struct {
     float32x4_t t0, t1, t2, zmin, one, denmin, wscale, tol, wm1, hm1, half, k128;
-    int32x4_t wm1i, hm1i, istride, rstride;
+    int32x4_t hm1i, istride, rstride;
     const uint16_t *invd;
     const uint8_t *rgb;
 } tw4;
 
 static inline float32x4_t gt_sel(float32x4_t a, float32x4_t b) { return vbslq_f32(vcgtq_f32(a, b), a, b); }
-static inline float32x4_t lt_sel(float32x4_t a, float32x4_t b) { return vbslq_f32(vcltq_f32(a, b), a, b); }
-static inline float32x4_t clamp4(float32x4_t v, float32x4_t hi) { return lt_sel(gt_sel(v, vdupq_n_f32(0.0f)), hi); }
+/* a > b ? a : b for a constant b > 0 (the operands come out of arithmetic: never a signalling
+ * NaN, which FMAXNM would not drop) */
+static inline float32x4_t max_bound(float32x4_t a, float32x4_t b) { return vmaxnmq_f32(a, b); }
+/* the reference's clamp: v > 0 ? v : 0 (NaN -> 0; -0 -> +0, as FMAXNM(-0, +0) = +0), then
+ * v < hi ? v : hi on a number */
+static inline float32x4_t clamp4(float32x4_t v, float32x4_t hi) { return vminnmq_f32(vmaxnmq_f32(v, vdupq_n_f32(0.0f)), hi); }
 
 static inline void proj4(const tw4 *c, float32x4_t A0, float32x4_t A1, float32x4_t A2, float32x4_t w, float32x4_t *u,
                          float32x4_t *v)
 {
-    const float32x4_t nz = gt_sel(vaddq_f32(A2, vmulq_f32(c->t2, w)), c->zmin);
+    const float32x4_t nz = max_bound(vaddq_f32(A2, vmulq_f32(c->t2, w)), c->zmin);
     const float32x4_t inv = vdivq_f32(c->one, nz);
     *u = vmulq_f32(vaddq_f32(A0, vmulq_f32(c->t0, w)), inv);
     *v = vmulq_f32(vaddq_f32(A1, vmulq_f32(c->t1, w)), inv);
@@ -33,58 +39,62 @@ static inline int32x4_t gather_u16(const uint16_t *p, int32x4_t i)
                           p[vgetq_lane_s32(i, 3)]};
     return vld1q_s32(v);
 }
-static inline int32x4_t gather_w32(const uint8_t *p, int32x4_t o)
-{
-    int32_t v[4];
-    memcpy(&v[0], p + vgetq_lane_s32(o, 0), 4);
-    memcpy(&v[1], p + vgetq_lane_s32(o, 1), 4);
-    memcpy(&v[2], p + vgetq_lane_s32(o, 2), 4);
-    memcpy(&v[3], p + vgetq_lane_s32(o, 3), 4);
-    return vld1q_s32(v);
-}
-
 static inline float32x4_t fetch_w4(const tw4 *c, float32x4_t A2, float32x4_t u, float32x4_t v)
 {
     const int32x4_t ix = vcvtq_s32_f32(clamp4(u, c->wm1)), iy = vcvtq_s32_f32(clamp4(v, c->hm1));
     const int32x4_t g = gather_u16(c->invd, vaddq_s32(vmulq_s32(iy, c->istride), ix));
     const float32x4_t ws = vmulq_f32(vcvtq_f32_s32(g), c->wscale);
-    const float32x4_t den = gt_sel(vsubq_f32(c->one, vmulq_f32(c->t2, ws)), c->denmin);
+    const float32x4_t den = max_bound(vsubq_f32(c->one, vmulq_f32(c->t2, ws)), c->denmin);
     return vdivq_f32(vmulq_f32(A2, ws), den);
 }
 
-static inline int32x4_t chan(int32x4_t g, int sh)
-{
-    return vandq_s32(vreinterpretq_s32_u32(vshlq_u32(vreinterpretq_u32_s32(g), vdupq_n_s32(-sh))), vdupq_n_s32(255));
-}
-
-static inline int32x4_t lerp_chan(int32x4_t g00, int32x4_t g10, int32x4_t g01, int32x4_t g11, int sh, int32x4_t fx,
-                                  int32x4_t fy)
-{
-    const int32x4_t c00 = chan(g00, sh), c10 = chan(g10, sh), c01 = chan(g01, sh), c11 = chan(g11, sh);
-    const int32x4_t top = vaddq_s32(vshlq_n_s32(c00, 7), vmulq_s32(vsubq_s32(c10, c00), fx));
-    const int32x4_t bot = vaddq_s32(vshlq_n_s32(c01, 7), vmulq_s32(vsubq_s32(c11, c01), fx));
-    const int32x4_t s = vaddq_s32(vshlq_n_s32(top, 7), vmulq_s32(vsubq_s32(bot, top), fy));
-    return vshrq_n_s32(vaddq_s32(s, vdupq_n_s32(8192)), 14);
-}
-
+/* the bilinear tap of 4 pixels, 12 output bytes. Each lane's corners come from one 8-byte load
+ * a row at its x0 (bytes x0's RGB, then x0 + 1's: at the right edge x0 + 1 is past the row, but
+ * there fx = 0 and the reference reads x0 twice, so the byte is weighted by 0; 5 bytes past the
+ * last pixel at most, inside FV_TW_RGB_PAD). Byte shuffles put the corners in output byte order,
+ * then the reference's integer sums as c00 (128 - fx) + c10 fx (u16) and top (128 - fy) +
+ * bot fy (u32): the same integers, all non-negative, so (s + 8192) >> 14 is a rounding narrow. */
 static inline void tap4(const tw4 *c, uint8_t *dst, float32x4_t u, float32x4_t v)
 {
+    static const uint8_t k_c0[16] = {0, 1, 2, 8, 9, 10, 16, 17, 18, 24, 25, 26, 255, 255, 255, 255};
+    static const uint8_t k_c1[16] = {3, 4, 5, 11, 12, 13, 19, 20, 21, 27, 28, 29, 255, 255, 255, 255};
+    static const uint8_t k_fx[16] = {0, 0, 0, 4, 4, 4, 8, 8, 8, 12, 12, 12, 255, 255, 255, 255};
+    static const uint8_t k_fy0[16] = {0, 255, 0, 255, 0, 255, 4, 255, 4, 255, 4, 255, 8, 255, 8, 255};
+    static const uint8_t k_fy1[16] = {8, 255, 12, 255, 12, 255, 12, 255, 255, 255, 255, 255, 255, 255, 255, 255};
     const float32x4_t bu = clamp4(vsubq_f32(u, c->half), c->wm1), bv = clamp4(vsubq_f32(v, c->half), c->hm1);
     const int32x4_t x0 = vcvtq_s32_f32(bu), y0 = vcvtq_s32_f32(bv);
     const int32x4_t fx = vcvtq_s32_f32(vmulq_f32(vsubq_f32(bu, vcvtq_f32_s32(x0)), c->k128));
     const int32x4_t fy = vcvtq_s32_f32(vmulq_f32(vsubq_f32(bv, vcvtq_f32_s32(y0)), c->k128));
-    const int32x4_t x1 = vsubq_s32(x0, vreinterpretq_s32_u32(vcgtq_s32(c->wm1i, x0))); /* + 1 inside */
-    const int32x4_t y1 = vsubq_s32(y0, vreinterpretq_s32_u32(vcgtq_s32(c->hm1i, y0)));
-    const int32x4_t r0 = vmulq_s32(y0, c->rstride), r1 = vmulq_s32(y1, c->rstride);
-    const int32x4_t b0 = vmulq_n_s32(x0, 3), b1 = vmulq_n_s32(x1, 3);
-    const int32x4_t g00 = gather_w32(c->rgb, vaddq_s32(r0, b0)), g10 = gather_w32(c->rgb, vaddq_s32(r0, b1));
-    const int32x4_t g01 = gather_w32(c->rgb, vaddq_s32(r1, b0)), g11 = gather_w32(c->rgb, vaddq_s32(r1, b1));
-    int32_t ch[3][4];
-    for (int k = 0; k < 3; k++)
-        vst1q_s32(ch[k], lerp_chan(g00, g10, g01, g11, 8 * k, fx, fy));
-    for (int p = 0; p < 4; p++)
-        for (int k = 0; k < 3; k++)
-            dst[3 * p + k] = (uint8_t)ch[k][p];
+    const int32x4_t y1 = vsubq_s32(y0, vreinterpretq_s32_u32(vcgtq_s32(c->hm1i, y0))); /* + 1 inside */
+    const int32x4_t b0 = vmulq_n_s32(x0, 3);
+    const int32x4_t o0 = vmlaq_s32(b0, y0, c->rstride), o1 = vmlaq_s32(b0, y1, c->rstride);
+    const uint8_t *p = c->rgb;
+    const uint8x16x2_t w0 = {{vcombine_u8(vld1_u8(p + vgetq_lane_s32(o0, 0)), vld1_u8(p + vgetq_lane_s32(o0, 1))),
+                              vcombine_u8(vld1_u8(p + vgetq_lane_s32(o0, 2)), vld1_u8(p + vgetq_lane_s32(o0, 3)))}};
+    const uint8x16x2_t w1 = {{vcombine_u8(vld1_u8(p + vgetq_lane_s32(o1, 0)), vld1_u8(p + vgetq_lane_s32(o1, 1))),
+                              vcombine_u8(vld1_u8(p + vgetq_lane_s32(o1, 2)), vld1_u8(p + vgetq_lane_s32(o1, 3)))}};
+    const uint8x16_t i0 = vld1q_u8(k_c0), i1 = vld1q_u8(k_c1);
+    const uint8x16_t c00 = vqtbl2q_u8(w0, i0), c10 = vqtbl2q_u8(w0, i1);
+    const uint8x16_t c01 = vqtbl2q_u8(w1, i0), c11 = vqtbl2q_u8(w1, i1);
+    const uint8x16_t wx1 = vqtbl1q_u8(vreinterpretq_u8_s32(fx), vld1q_u8(k_fx)), wx0 = vsubq_u8(vdupq_n_u8(128), wx1);
+    const uint16x8_t top_l = vmlal_u8(vmull_u8(vget_low_u8(c00), vget_low_u8(wx0)), vget_low_u8(c10), vget_low_u8(wx1));
+    const uint16x8_t top_h = vmlal_high_u8(vmull_high_u8(c00, wx0), c10, wx1);
+    const uint16x8_t bot_l = vmlal_u8(vmull_u8(vget_low_u8(c01), vget_low_u8(wx0)), vget_low_u8(c11), vget_low_u8(wx1));
+    const uint16x8_t bot_h = vmlal_high_u8(vmull_high_u8(c01, wx0), c11, wx1);
+    /* fy per output byte as u16: bytes 0-7, then 8-11 */
+    const uint16x8_t wy1l = vreinterpretq_u16_u8(vqtbl1q_u8(vreinterpretq_u8_s32(fy), vld1q_u8(k_fy0)));
+    const uint16x8_t wy1h = vreinterpretq_u16_u8(vqtbl1q_u8(vreinterpretq_u8_s32(fy), vld1q_u8(k_fy1)));
+    const uint16x8_t k128 = vdupq_n_u16(128), wy0l = vsubq_u16(k128, wy1l);
+    const uint16x4_t wy0h = vsub_u16(vget_low_u16(k128), vget_low_u16(wy1h));
+    const uint32x4_t s0 = vmlal_u16(vmull_u16(vget_low_u16(top_l), vget_low_u16(wy0l)), vget_low_u16(bot_l), vget_low_u16(wy1l));
+    const uint32x4_t s1 = vmlal_high_u16(vmull_high_u16(top_l, wy0l), bot_l, wy1l);
+    const uint32x4_t s2 = vmlal_u16(vmull_u16(vget_low_u16(top_h), wy0h), vget_low_u16(bot_h), vget_low_u16(wy1h));
+    const uint8x8_t b01 = vmovn_u16(vrshrn_high_n_u32(vrshrn_n_u32(s0, 14), s1, 14));
+    const uint16x4_t n2 = vrshrn_n_u32(s2, 14);
+    const uint8x8_t b2 = vmovn_u16(vcombine_u16(n2, n2));
+    vst1_u8(dst, b01);
+    const uint32_t tail = vget_lane_u32(vreinterpret_u32_u8(b2), 0);
+    memcpy(dst + 8, &tail, 4);
 }
 
 static int tw_row_neon(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s)
@@ -97,7 +107,7 @@ static int tw_row_neon(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_
     c.wscale = vdupq_n_f32(m->w_scale), c.tol = vdupq_n_f32(m->tol);
     c.wm1 = vdupq_n_f32((float)(s->w - 1)), c.hm1 = vdupq_n_f32((float)(s->h - 1));
     c.half = vdupq_n_f32(0.5f), c.k128 = vdupq_n_f32(128.0f);
-    c.wm1i = vdupq_n_s32(s->w - 1), c.hm1i = vdupq_n_s32(s->h - 1);
+    c.hm1i = vdupq_n_s32(s->h - 1);
     c.istride = vdupq_n_s32((int32_t)s->invd_stride), c.rstride = vdupq_n_s32((int32_t)s->rgb_stride);
     c.invd = s->invd, c.rgb = s->rgb;
     const float32x4_t r0 = vdupq_n_f32(r[0]), r1 = vdupq_n_f32(r[1]), r2 = vdupq_n_f32(r[2]);

@@ -1,10 +1,10 @@
 /* fovea checkasm: the timewarp kernels (timewarp_dsp.h), every ISA version against the C
  * reference, bit for bit: tw_row (bytes and disocclusion count) on maps from random head motions
  * (small turns and steps, a turn past 90 degrees that puts source points behind the eye, steps
- * that hit the depth conversion's floor), sources with depth edges, flat depth, the nearest and
- * the farthest depth codes; every row length from 1 up with tails, offsets into the row, the
- * first and last rows; tw_spans on random pieces (lengths 1 up, phases 0 and 63, exact-size
- * source rows); tw_minmax on random rectangles. Then the block warp (core/timewarp.c) on every
+ * that hit the depth conversion's floor, maps with a NaN), sources with depth edges, flat depth,
+ * the nearest and the farthest depth codes; every row length from 1 up with tails, offsets into
+ * the row, the first and last rows; tw_spans on random pieces (lengths 1 up, phases 0 and 63,
+ * exact-size source rows); tw_minmax on random rectangles. Then the block warp (core/timewarp.c) on every
  * ISA against the per-pixel C reference within its contract (timewarp.h): translated pixels
  * within FV_TW_BLOCK_POS_PX of the reference's tap and within the value bound, the others and
  * the disocclusion count exact. Outputs canaried; source planes exact-size plus the contract's
@@ -87,7 +87,7 @@ static void test_tw_row(void **state)
             continue;
         fv_timewarp_dsp d;
         fv_timewarp_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
-        for (int trial = 0; trial < 48; trial++) {
+        for (int trial = 0; trial < 52; trial++) {
             const int mode = trial & 3;
             fill_src(rgb, invd, mode);
             const float turn = trial % 12 == 11 ? 200.0f : trial % 3 == 0 ? 2.0f : 20.0f;
@@ -101,6 +101,14 @@ static void test_tw_row(void **state)
             assert_int_equal(fv_camera_setup(&cb, &cd, &pb), 0);
             fv_tw_map m;
             fv_tw_setup(&m, &cb, &ca, 0.05f);
+            /* NaN maps: the reference's selects turn a NaN into the bound (Z floor, depth
+             * floor, clamps); max / min instructions that propagate NaN would not */
+            if (trial == 48 || trial == 49)
+                m.a0[2] = NAN;
+            else if (trial == 50)
+                m.a0[0] = NAN;
+            else if (trial == 51)
+                m.t[2] = NAN;
             const fv_tw_src s = {rgb, (ptrdiff_t)SW * 3, invd, SW, SW, SH};
             for (int n = 1; n <= SW; n += n < 20 ? 1 : 7) {
                 const int x0 = (int)(checkasm_rand() % (uint64_t)(SW - n + 1));
