@@ -1,4 +1,5 @@
-/* fovea: the packet shading kernel, NEON: 4 lanes a vector, the body of core/shade_tmpl.h.
+/* fovea: the packet shading kernel, NEON: 4 lanes a vector, core/shade_tmpl.h's body for the head light (and
+ * over 8 KHR lights), its own light loop below.
  * Bit-identical to the C reference (IEEE operations in its order: vdivq / vsqrtq, no FMA). */
 /* the template's loops over x, y, z peeled (as -O3 would): at -O2 gcc kept them as loops over
  * arrays of vectors on the stack (brdf_lights 2720 -> 2196 instructions a packet, brdf 1372 -> 890) */
