@@ -439,6 +439,24 @@ static void test_fused_periphery_vs_chain(void **st)
     rig_free(&b);
 }
 
+/* Runs r on 1, 2 and 5 threads with the C kernels and the best ISA's, each time from a zeroed
+ * output, and asserts every run's rows equal ref's (row stride ref_stride pixels) bit for bit. */
+static void assert_same_any_threads_isa(rig *r, const float *ref, ptrdiff_t ref_stride)
+{
+    const int threads[] = {1, 2, 5};
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 2; i++) {
+            fv_pool *pool = fv_pool_create(threads[k]);
+            assert_non_null(pool);
+            memset(r->out, 0, (size_t)r->pyr.lv[0].stride * H * 4 * sizeof(float));
+            rig_run(r, pool, i ? ~0u : FV_ISA_C);
+            for (int y = 0; y < H; y++)
+                assert_memory_equal(r->out + 4 * (size_t)y * r->pyr.lv[0].stride, ref + 4 * (ptrdiff_t)y * ref_stride,
+                                    W * 4 * sizeof(float));
+            fv_pool_destroy(pool);
+        }
+}
+
 /* The fused periphery path (contrast enhancement off) gives the same bits for 1, 2 and 5 threads
  * and for the C kernels and the best ISA's. */
 static void test_fused_threads_and_isas_identical(void **st)
@@ -451,18 +469,7 @@ static void test_fused_threads_and_isas_identical(void **st)
     assert_non_null(ref);
     rig_run(&r, NULL, FV_ISA_C);
     memcpy(ref, r.out, n * sizeof(float));
-    const int threads[] = {1, 2, 5};
-    for (int k = 0; k < 3; k++)
-        for (int i = 0; i < 2; i++) {
-            fv_pool *pool = fv_pool_create(threads[k]);
-            assert_non_null(pool);
-            memset(r.out, 0, n * sizeof(float));
-            rig_run(&r, pool, i ? ~0u : FV_ISA_C);
-            for (int y = 0; y < H; y++)
-                assert_memory_equal(r.out + 4 * (size_t)y * r.pyr.lv[0].stride, ref + 4 * (size_t)y * r.pyr.lv[0].stride,
-                                    W * 4 * sizeof(float));
-            fv_pool_destroy(pool);
-        }
+    assert_same_any_threads_isa(&r, ref, r.pyr.lv[0].stride);
     free(ref);
     rig_free(&r);
 }
@@ -482,18 +489,7 @@ static void test_band_hblur_vs_pass(void **st)
         rig_init(&b, receding_floor, FV_DOF_STRONG, 1.5f, gaze[g][0], gaze[g][1]);
         b.prm.hblur_pass = 1;
         rig_run(&b, NULL, FV_ISA_C);
-        const int threads[] = {1, 2, 5};
-        for (int k = 0; k < 3; k++)
-            for (int i = 0; i < 2; i++) {
-                fv_pool *pool = fv_pool_create(threads[k]);
-                assert_non_null(pool);
-                memset(a.out, 0, (size_t)a.pyr.lv[0].stride * H * 4 * sizeof(float));
-                rig_run(&a, pool, i ? ~0u : FV_ISA_C);
-                for (int y = 0; y < H; y++)
-                    assert_memory_equal(a.out + 4 * (size_t)y * a.pyr.lv[0].stride, b.out + 4 * (size_t)y * b.pyr.lv[0].stride,
-                                        W * 4 * sizeof(float));
-                fv_pool_destroy(pool);
-            }
+        assert_same_any_threads_isa(&a, b.out, b.pyr.lv[0].stride);
         rig_free(&a);
         rig_free(&b);
     }
