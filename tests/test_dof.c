@@ -594,6 +594,112 @@ static void test_threads_and_isas_identical(void **st)
     rig_free(&r);
 }
 
+/* A scene without any near field (everything behind the focus range): the frame's quarter-
+ * resolution layer is empty and the combine gets no near layer at all. */
+static void far_only(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = 2.0f + 0.05f * (float)((x * 3 + y * 5) % 37);
+}
+
+/* Near field only in a strip of rows 100..107 (block rows 25, 26), far behind it: block rows have
+ * different largest radii, so the band pipeline's per-row reach differs from the frame's. */
+static void near_strip(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = y >= 100 && y < 108 && x >= 30 && x < 170 ? 0.25f + 0.01f * (float)(x % 7) : 4.0f;
+}
+
+/* The band pipeline (the CoC pass and the fused pass of the bands outside the centre rectangle's
+ * rows in one job, weier_pipe.c) against the passes one after another (prm.band_passes): bound 0,
+ * for 1, 2 and 5 threads and C / best ISA, on scenes with near field everywhere (busy), a near
+ * field whose radius grows towards the top (receding floor, strong), none (far only: the combine
+ * gets no near layer) and a narrow strip (per-row reach below the frame's); the gaze and r1 so
+ * that the free bands are above the centre, below it, on both sides, or all of them (the gaze off
+ * the image). */
+static void test_pipeline_vs_band_passes(void **st)
+{
+    (void)st;
+    const struct {
+        scene_fn scene;
+        fv_dof_preset preset;
+        float focus_m, gx, gy, r1;
+    } cases[] = {
+        {busy, FV_DOF_MEDIUM, 1.0f, 70.0f, 60.0f, 15.0f},           {busy, FV_DOF_MEDIUM, 1.0f, 23.0f, 151.0f, 60.0f},
+        {receding_floor, FV_DOF_STRONG, 1.5f, 100.0f, 80.0f, 15.0f}, {receding_floor, FV_DOF_STRONG, 1.5f, 100.0f, 20.0f, 15.0f},
+        {far_only, FV_DOF_STRONG, 1.0f, 100.0f, 80.0f, 15.0f},       {near_strip, FV_DOF_STRONG, 1.5f, 100.0f, 30.0f, 15.0f},
+        {near_strip, FV_DOF_STRONG, 1.5f, 100.0f, -200.0f, 15.0f},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        rig a, b;
+        rig_init(&a, cases[k].scene, cases[k].preset, cases[k].focus_m, cases[k].gx, cases[k].gy);
+        rig_init(&b, cases[k].scene, cases[k].preset, cases[k].focus_m, cases[k].gx, cases[k].gy);
+        a.v.r0_px = b.v.r0_px = cases[k].r1 * 0.5f;
+        a.v.r1_px = b.v.r1_px = cases[k].r1;
+        b.prm.band_passes = 1;
+        rig_run(&b, NULL, FV_ISA_C);
+        assert_same_any_threads_isa(&a, b.out, b.pyr.lv[0].stride);
+        rig_free(&a);
+        rig_free(&b);
+    }
+}
+
+/* The pipeline's order, from its per-band spans on the workers' tracks ("dof coc band", "dof
+ * fused band", arg = the band): every band's CoC work once; the fused pass of exactly the bands
+ * with no row in the centre rectangle (gaze y = 80, r1 = 15: rows [17, 143), bands 1..8 wait for
+ * the frame), each after the CoC work of the bands up to b + 3 that it reads (the quarter-
+ * resolution near layer's reach) and, on one thread, before that of band b + 4, so that its
+ * level 0 rows are at most four bands (64 rows) old. On 2 and 5 threads the same dependency by
+ * the spans' times. Fails without the pipeline (no such spans: the CoC pass ran first). */
+static void test_pipeline_order(void **st)
+{
+    (void)st;
+    const int th = (H + 15) / 16, threads[] = {1, 2, 5};
+    for (int n = 0; n < 3; n++) {
+        rig r;
+        rig_init(&r, busy, FV_DOF_MEDIUM, 1.0f, 100.0f, 80.0f);
+        r.v.r0_px = 8.0f, r.v.r1_px = 15.0f;
+        fv_prof *prof = fv_prof_create(threads[n], 4096);
+        fv_pool *pool = fv_pool_create(threads[n]);
+        assert_non_null(prof);
+        assert_non_null(pool);
+        r.v.prof = prof;
+        rig_run(&r, pool, ~0u);
+        int64_t coc_end[16], fused_start[16];
+        int coc_n[16] = {0}, fused_n[16] = {0}, seq[64], nseq = 0;
+        for (int s = 0; s < threads[n]; s++)
+            for (size_t i = 0; i < fv_prof_count(prof, s); i++) {
+                const fv_prof_event *e = fv_prof_event_at(prof, s, i);
+                const int coc = !strcmp(e->name, "dof coc band"), fused = !strcmp(e->name, "dof fused band");
+                if (!coc && !fused)
+                    continue;
+                assert_true(e->arg >= 0 && e->arg < th);
+                if (coc)
+                    coc_n[e->arg]++, coc_end[e->arg] = e->t1_ns;
+                else
+                    fused_n[e->arg]++, fused_start[e->arg] = e->t0_ns;
+                if (threads[n] == 1 && nseq < 64)
+                    seq[nseq++] = coc ? e->arg : 100 + e->arg; /* slot 0's events in order */
+            }
+        for (int b = 0; b < th; b++) {
+            assert_int_equal(coc_n[b], 1);
+            assert_int_equal(fused_n[b], b == 0 || b == th - 1); /* the free bands */
+            if (fused_n[b])
+                assert_true(fused_start[b] >= coc_end[fv_mini(b + 3, th - 1)]);
+        }
+        if (threads[n] == 1) { /* in order: coc 0..3, fused 0, coc 4..9, fused 9 */
+            const int want[] = {0, 1, 2, 3, 100, 4, 5, 6, 7, 8, 9, 109};
+            assert_int_equal(nseq, 12);
+            assert_memory_equal(seq, want, sizeof want);
+        }
+        fv_pool_destroy(pool);
+        fv_prof_destroy(prof);
+        rig_free(&r);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -612,6 +718,8 @@ int main(void)
         cmocka_unit_test(test_fused_threads_and_isas_identical),
         cmocka_unit_test(test_band_hblur_vs_pass),
         cmocka_unit_test(test_coc_plane_centre_only),
+        cmocka_unit_test(test_pipeline_vs_band_passes),
+        cmocka_unit_test(test_pipeline_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

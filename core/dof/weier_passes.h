@@ -4,6 +4,7 @@
 #define FOVEA_DOF_WEIER_PASSES_H
 
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -59,7 +60,8 @@ typedef struct {
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
     const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
     int enh_on;                /* contrast enhancement runs */
-    float *band_ms;            /* per band: worker time (ms) in the filter, the combine, the output, the CoC rows (4 each) */
+    float *band_ms;            /* per band (BAND_MS each): worker time (ms) in the fused pass's filter, combine,
+                                * output and recomputed CoC rows, the CoC pass, the quarter-resolution passes */
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
     /* the periphery's far blur at half resolution (the level 1 grid), up-sampled once per row */
     int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
@@ -70,7 +72,22 @@ typedef struct {
     float *hband;              /* the per-thread band rows of it, after the row slots */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
     xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
+    /* the band pipeline (fvw_pipe_task): the CoC pass and the fused pass of the bands outside the
+     * centre rectangle's rows in one job, so that those bands' level 0 rows are read from memory
+     * once; the centre's bands (which need the whole frame's largest near radius) afterwards */
+    int pipe;                  /* on (the default path: hblur_fused and not prm.band_passes) */
+    int pc0, pc1;              /* the bands [pc0, pc1) hold a centre row: fused after the pipeline */
+    int32_t *l_rowr;           /* per block row: its largest block radius l_r, at least 0 */
+    int32_t *pflag;            /* per band: PIPE_COC | PIPE_LV once those steps are done (under pmu) */
+    int coc_upto, lv_upto;     /* the bands [0, coc_upto) have PIPE_COC, [0, lv_upto) PIPE_LV */
+    pthread_mutex_t pmu;       /* guards pflag and the two counters */
+    pthread_cond_t pcv;        /* a counter moved */
 } fvw_ctx;
+
+#define BAND_MS 6
+#define PIPE_COC 1
+#define PIPE_LV 2
+#define LREACH_MAX (FV_DOF_RMAX / LOW) /* the largest block radius: floor(FV_DOF_RMAX / 4) */
 
 
 static inline float fvw_t_of(const fvw_ctx *x, float fx, float fy)
@@ -125,8 +142,12 @@ void fvw_dilate_tiles(fvw_ctx *x);
 /* weier_filter.c: stage "dof_filter" (bands); the vertical pass runs the combine row by row */
 void fvw_hpass_band(void *ctx, int band, int tid);
 void fvw_lvpass_band(void *ctx, int band, int tid);
+void fvw_lhpass_band(fvw_ctx *x, int band);
 void fvw_hblur_band(void *ctx, int band, int tid);
 void fvw_vcombine_band(void *ctx, int band, int tid);
+/* weier_pipe.c: the band pipeline, task k of x->th + 3 (fv_pool_run) */
+void fvw_pipe_task(void *ctx, int k, int tid);
+int fvw_pipe_free(const fvw_ctx *x, int band); /* band has no centre row: the pipeline fuses it */
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
 void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
