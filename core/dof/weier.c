@@ -172,9 +172,19 @@ static int ensure_aux(fv_dof_work *wk, int threads, int hblur)
     return 0;
 }
 
-/* the band pipeline's second phase: band pc0 + i */
-static void fvw_hpass_centre(void *ctx, int i, int tid) { fvw_hpass_band(ctx, ((fvw_ctx *)ctx)->pc0 + i, tid); }
-static void fvw_vcombine_centre(void *ctx, int i, int tid) { fvw_vcombine_band(ctx, ((fvw_ctx *)ctx)->pc0 + i, tid); }
+/* after the band pipeline: band pc0 + i unless the pipeline made it */
+static void fvw_hpass_centre(void *ctx, int i, int tid)
+{
+    fvw_ctx *x = ctx;
+    if (!(x->pflag[x->pc0 + i] & PIPE_HP))
+        fvw_hpass_band(x, x->pc0 + i, tid);
+}
+static void fvw_vcombine_centre(void *ctx, int i, int tid)
+{
+    fvw_ctx *x = ctx;
+    if (!(x->pflag[x->pc0 + i] & PIPE_FUSED))
+        fvw_vcombine_band(x, x->pc0 + i, tid);
+}
 
 void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
                   const fv_dof_dsp *dsp, fv_dof_times *t)
@@ -232,10 +242,10 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
         /* the CoC pass and the fused pass of the free bands in one job (its span is the coc
          * stage's; the stage times below split it by the workers' measured shares) */
         memset(x->pflag, 0, (size_t)x->th * sizeof(int32_t));
-        x->coc_upto = x->lv_upto = 0;
+        x->coc_upto = x->lv_upto = x->h_upto = 0;
         pthread_mutex_init(&x->pmu, NULL);
         pthread_cond_init(&x->pcv, NULL);
-        fv_pool_run(pool, x->th + 3, fvw_pipe_task, x);
+        fv_pool_run(pool, x->th + 4, fvw_pipe_task, x);
         pthread_cond_destroy(&x->pcv);
         pthread_mutex_destroy(&x->pmu);
     } else
@@ -248,7 +258,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
      * the workers' measured share */
     const int64_t tf = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     int64_t t2;
-    if (x->pipe) { /* the centre's bands: horizontal pass, then fused */
+    if (x->pipe) { /* the centre's bands the pipeline left: horizontal pass, then fused */
         const int nc = x->pc1 - x->pc0;
         fv_pool_run(pool, nc, fvw_hpass_centre, x);
         t2 = fv_time_ns();
@@ -267,7 +277,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
         double f[2] = {0}, c[2] = {0}, o[2] = {0}, k[2] = {0}, kp = 0.0, lp = 0.0;
         for (int b = 0; b < x->th; b++) {
             const float *m = x->band_ms + BAND_MS * b;
-            const int ph = x->pipe && fvw_pipe_free(x, b) ? 0 : 1;
+            const int ph = x->pipe && (x->pflag[b] & PIPE_FUSED) ? 0 : 1;
             f[ph] += m[0], c[ph] += m[1], o[ph] += m[2], k[ph] += m[3];
             kp += m[4], lp += m[5];
         }

@@ -515,9 +515,11 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
             }
             near_upsample_row(x, tid, y, lup, &lup_da, &lup_db, na, nb);
             /* the same bits as the passes one after another: outside the centre rectangle only
-             * dof_periph_row reads lup (the disc is inside it), for which a row of 0s is NULL;
-             * in it (after the whole frame's CoC) NULL as before when the frame has no near block */
-            if (x->pipe && (centre_row ? x->l_reach < 0 : lup_da >= lup_db))
+             * dof_periph_row reads lup (the disc is inside it), for which a row of 0s is NULL. In
+             * it the combine gets the row of 0s where those passes gave NULL (no near block in the
+             * frame): then the full-resolution near layer is +0 too (no tile has a near radius),
+             * and n + t (s 0 - n) of n = +0 is +0: the same bits */
+            if (x->pipe && !centre_row && lup_da >= lup_db)
                 lup = NULL;
         }
         if (enh)

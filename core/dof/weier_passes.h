@@ -78,15 +78,18 @@ typedef struct {
     int pipe;                  /* on (the default path: hblur_fused and not prm.band_passes) */
     int pc0, pc1;              /* the bands [pc0, pc1) hold a centre row: fused after the pipeline */
     int32_t *l_rowr;           /* per block row: its largest block radius l_r, at least 0 */
-    int32_t *pflag;            /* per band: PIPE_COC | PIPE_LV once those steps are done (under pmu) */
-    int coc_upto, lv_upto;     /* the bands [0, coc_upto) have PIPE_COC, [0, lv_upto) PIPE_LV */
+    int32_t *pflag;            /* per band: PIPE_* bits of the steps done (under pmu) */
+    int coc_upto, lv_upto, h_upto; /* the bands [0, n) have PIPE_COC / PIPE_LV / PIPE_H */
     pthread_mutex_t pmu;       /* guards pflag and the two counters */
     pthread_cond_t pcv;        /* a counter moved */
 } fvw_ctx;
 
 #define BAND_MS 6
-#define PIPE_COC 1
-#define PIPE_LV 2
+#define PIPE_COC 1   /* CoC pass and quarter-resolution horizontal rows */
+#define PIPE_LV 2    /* quarter-resolution vertical pass */
+#define PIPE_H 4     /* the centre's step (made or skipped): tile dilation and horizontal pass */
+#define PIPE_HP 8    /* ... made in the pipeline */
+#define PIPE_FUSED 16 /* the fused pass made in the pipeline */
 #define LREACH_MAX (FV_DOF_RMAX / LOW) /* the largest block radius: floor(FV_DOF_RMAX / 4) */
 
 
@@ -139,6 +142,7 @@ void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps
 /* weier_coc.c: stage "coc" (bands of TILE rows; then the tiles' reach) */
 void fvw_coc_band(void *ctx, int band, int tid);
 void fvw_dilate_tiles(fvw_ctx *x);
+void fvw_dilate_row(fvw_ctx *x, int ty, int dn); /* tile row ty with near reach dn tiles (the band pipeline) */
 /* weier_filter.c: stage "dof_filter" (bands); the vertical pass runs the combine row by row */
 void fvw_hpass_band(void *ctx, int band, int tid);
 void fvw_lvpass_band(void *ctx, int band, int tid);

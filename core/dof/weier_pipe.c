@@ -1,44 +1,62 @@
-/* fovea: the layered filter's band pipeline (issue 14): the CoC pass and the fused pass of the
- * bands outside the centre rectangle's rows run as one job, band k's CoC work a few bands ahead of
- * the fused pass that reads the same level 0 rows, so those rows come from cache the second time
- * (level 0 is 29.5 MB an eye at 1280x1440; read twice before).
+/* fovea: the layered filter's band pipeline (issue 14): the CoC pass, the centre's horizontal
+ * pass and the fused pass run as one job over bands of 16 rows, each band's fused pass a few bands
+ * behind its CoC work, so the level 0 rows it reads (29.5 MB an eye at 1280x1440, read two or
+ * three times before) come from cache the second time.
  *
- * Task k (of th + PIPE_LAG, claimed in order by fv_pool_run's counter):
+ * Task k (of th + 4, claimed in order by fv_pool_run's counter):
  *   1. k < th: the CoC pass of band k (fvw_coc_band) and its quarter-resolution horizontal rows
  *      (fvw_lhpass_band, each block row to its own largest radius);
- *   2. the quarter-resolution vertical pass of band k - 2, once step 1 is done for every band up
- *      to k (its block rows read up to LREACH_MAX = 6 block rows away: bands k - 4 .. k);
- *   3. the fused pass of band b = k - 3 if no row of it is in the centre rectangle, once step 2
+ *   2. j = k - 2: the quarter-resolution vertical pass of band j, once step 1 is done for every
+ *      band up to k (its block rows read up to LREACH_MAX = 6 block rows away: bands j-2 .. j+2);
+ *      then, if band j holds centre rows and the near reach is known (below), tile row j's
+ *      dilation (reads the tile rows j-2 .. j+2) and band j's horizontal pass;
+ *   3. the fused pass of band b = k - 3 if none of its rows is in the centre rectangle, once step 2
  *      is done up to b + 1 (the near layer up-sampled reads block rows up to 4 b + 4, the half-
- *      resolution blur's halo the half-resolution CoC of band b + 1).
- * The centre's bands wait for the whole frame: their tile dilation reaches as far as the frame's
- * largest near radius (fvw_dilate_tiles), and a tile it marks runs the near box even for radius-0
- * near pixels, so a narrower dilation would change bits. Nothing the free bands read depends on
- * it (no full-resolution near or far layer outside the centre rectangle).
+ *      resolution blur's halo the half-resolution CoC of band b + 1);
+ *   4. the fused pass of the centre band b = k - 4 if the horizontal passes of bands b-2 .. b+2
+ *      (the vertical Gaussian's and near box's reach, 24 rows) were made in step 2.
+ * The near reach: a tile's dilation spans ceil(rmax / 16) tiles, rmax the frame's largest near
+ * radius (fvw_dilate_tiles), and a tile it marks runs the near box even for radius-0 near pixels,
+ * so a narrower or wider dilation changes bits. rmax is at most FV_DOF_RMAX = 24: once a tile row
+ * up to j + 2 has a radius above 16, the span is 2 tiles whatever the rest of the frame holds, and
+ * the centre's bands from j on run in the pipeline; before that (and for a frame whose near radii
+ * stay at or below 16) they wait for the whole frame and run after the job, as before. Nothing the
+ * free bands read depends on it (no full-resolution near or far layer outside the centre
+ * rectangle).
  *
- * A task waits only for steps of tasks with a smaller index, which were claimed before it and are
- * running on other threads (fv_pool_run runs every claimed item to its end), so the job always
- * makes progress, on one thread in plain order. Each band's data is a function of the frame only
- * (the per-row reach in steps 1-2 is exact: the near box kernels skip taps beyond a source's
- * radius, so any reach at least the largest radius gives the same bits), so the output is the same
- * for any thread count and the same as the passes one after another (prm.band_passes). */
+ * A task waits only for steps of tasks with a smaller index, which were claimed before it and run
+ * on other threads (fv_pool_run runs every claimed item to its end), so the job always makes
+ * progress, on one thread in plain order. Which step runs where is a function of the frame, and
+ * each band's data too (the per-row reach in steps 1-2 is exact: the near box kernels skip taps
+ * beyond a source's radius), so the output is the same for any thread count and the same as the
+ * passes one after another (prm.band_passes). */
 #include "dof/weier_passes.h"
 
 #include "base/clock.h"
 
+/* the fused pass of a free band runs PIPE_LAG tasks after its CoC work, a centre band's one more */
 #define PIPE_LAG 3
 
 int fvw_pipe_free(const fvw_ctx *x, int band) { return band < x->pc0 || band >= x->pc1; }
 
-/* marks step `bit` of band done and advances that step's counter over the bands done in order */
-static void pipe_done(fvw_ctx *x, int band, int bit)
+/* the counter of step bit (PIPE_COC, PIPE_LV, PIPE_H), NULL for the other bits */
+static int *upto_of(fvw_ctx *x, int bit)
+{
+    return bit == PIPE_COC ? &x->coc_upto : bit == PIPE_LV ? &x->lv_upto : bit == PIPE_H ? &x->h_upto : NULL;
+}
+
+/* marks step `bit` of band done (with `extra` bits) and advances that step's counter over the
+ * bands done in order */
+static void pipe_done(fvw_ctx *x, int band, int bit, int extra)
 {
     pthread_mutex_lock(&x->pmu);
-    x->pflag[band] |= bit;
-    int *upto = bit == PIPE_COC ? &x->coc_upto : &x->lv_upto;
-    while (*upto < x->th && (x->pflag[*upto] & bit))
-        ++*upto;
-    pthread_cond_broadcast(&x->pcv);
+    x->pflag[band] |= bit | extra;
+    int *upto = upto_of(x, bit);
+    if (upto) {
+        while (*upto < x->th && (x->pflag[*upto] & bit))
+            ++*upto;
+        pthread_cond_broadcast(&x->pcv);
+    }
     pthread_mutex_unlock(&x->pmu);
 }
 
@@ -47,10 +65,30 @@ static void pipe_wait(fvw_ctx *x, int band, int bit)
 {
     band = band < x->th - 1 ? band : x->th - 1;
     pthread_mutex_lock(&x->pmu);
-    const int *upto = bit == PIPE_COC ? &x->coc_upto : &x->lv_upto;
+    const int *upto = upto_of(x, bit);
     while (*upto <= band)
         pthread_cond_wait(&x->pcv, &x->pmu);
     pthread_mutex_unlock(&x->pmu);
+}
+
+/* the centre band j's horizontal pass runs in the pipeline: the near reach is 2 tiles for sure
+ * (a tile row up to j + 2 has a near radius above 16; step 1 is done up to there) */
+static int reach_known(const fvw_ctx *x, int j)
+{
+    for (int ty = 0; ty <= j + 2 && ty < x->th; ty++)
+        for (int tx = 0; tx < x->tw; tx++)
+            if (x->t_near_own[ty * x->tw + tx] > (float)TILE)
+                return 1;
+    return 0;
+}
+
+/* band b (in the centre) is fused in the pipeline: the horizontal passes it reads were made there */
+static int centre_fusable(const fvw_ctx *x, int b)
+{
+    for (int j = b - 2 > x->pc0 ? b - 2 : x->pc0; j <= b + 2 && j < x->pc1; j++)
+        if (!(x->pflag[j] & PIPE_HP))
+            return 0;
+    return 1;
 }
 
 void fvw_pipe_task(void *ctx, int k, int tid)
@@ -67,15 +105,22 @@ void fvw_pipe_task(void *ctx, int k, int tid)
         x->band_ms[BAND_MS * k + 5] = (float)((double)(t2 - t1) * 1e-6);
         if (prof)
             fv_prof_span(prof, tid, tid, "dof coc band", t0, t2, k);
-        pipe_done(x, k, PIPE_COC);
+        pipe_done(x, k, PIPE_COC, 0);
     }
     const int j = k - 2;
     if (j >= 0 && j < x->th) {
         pipe_wait(x, j + 2, PIPE_COC);
-        const int64_t t0 = fv_time_ns();
+        int64_t t0 = fv_time_ns();
         fvw_lvpass_band(x, j, tid);
+        pipe_done(x, j, PIPE_LV, 0);
+        int made = 0;
+        if (!fvw_pipe_free(x, j) && reach_known(x, j)) {
+            fvw_dilate_row(x, j, 2);
+            fvw_hpass_band(x, j, tid);
+            made = PIPE_HP;
+        }
         x->band_ms[BAND_MS * j + 5] += (float)((double)(fv_time_ns() - t0) * 1e-6);
-        pipe_done(x, j, PIPE_LV);
+        pipe_done(x, j, PIPE_H, made);
     }
     const int b = k - PIPE_LAG;
     if (b >= 0 && b < x->th && fvw_pipe_free(x, b)) {
@@ -84,5 +129,20 @@ void fvw_pipe_task(void *ctx, int k, int tid)
         fvw_vcombine_band(x, b, tid);
         if (prof)
             fv_prof_span(prof, tid, tid, "dof fused band", t0, fv_time_ns(), b);
+        pipe_done(x, b, PIPE_FUSED, 0);
+    }
+    const int c = k - PIPE_LAG - 1;
+    if (c >= 0 && c < x->th && !fvw_pipe_free(x, c)) {
+        pipe_wait(x, c + 2, PIPE_H); /* implies PIPE_LV up to c + 2 */
+        pthread_mutex_lock(&x->pmu);
+        const int go = centre_fusable(x, c);
+        pthread_mutex_unlock(&x->pmu);
+        if (go) {
+            const int64_t t0 = prof ? fv_time_ns() : 0;
+            fvw_vcombine_band(x, c, tid);
+            if (prof)
+                fv_prof_span(prof, tid, tid, "dof fused band", t0, fv_time_ns(), c);
+            pipe_done(x, c, PIPE_FUSED, 0);
+        }
     }
 }
