@@ -50,12 +50,16 @@
  * vertical pass, the combine (dof_periph_row beyond the disc) and the output. With contrast
  * enhancement (or prm.chain_periphery / hblur_pass) the half-resolution blur is a pass of its own
  * over the whole image, before the fused pass.
+ * On the default path these passes run as one band pipeline (weier_pipe.c): each band's fused
+ * pass a few bands behind its CoC work, so that level 0 is read from memory once; the centre's
+ * bands join it once the frame's near reach is known, else they follow it (prm.band_passes: the
+ * passes one after another, the same bits).
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *
  * Files, one per stage: this one is the driver (scratch, constant tables, the order of the
  * passes, stage times); weier_coc.c the CoC pass, weier_filter.c the blur passes, combine.c the
- * combine; weier_passes.h is their shared context. */
+ * combine, weier_pipe.c the band pipeline; weier_passes.h is their shared context. */
 #include "dof/weier_passes.h"
 
 #include <math.h>
@@ -252,6 +256,8 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
         fv_pool_run(pool, x->th, fvw_coc_band, x);
     const int64_t tp = fv_time_ns();
     fvw_dilate_tiles(x);
+    if (x->pipe)
+        fvw_pipe_settle(x);
     const int64_t t1 = fv_dof_stage_end(v, FV_STAGE_COC, t0);
     /* the combine (and with v->conv the conversion to the display format) runs fused into the
      * vertical pass: one dof_filter span holds them, and each one's share of the fused time is

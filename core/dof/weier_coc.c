@@ -120,6 +120,7 @@ void fvw_dilate_tiles(fvw_ctx *x)
         rmax = x->t_near_own[i] > rmax ? x->t_near_own[i] : rmax;
     const int dn = (int)ceilf(rmax / TILE), df = (FV_DOF_RMAX + TILE - 1) / TILE;
     float *tmp = fvw_slot(x, 0, 2); /* thread 0's row buffers 2.. (free between the passes) */
+    x->near_tiles = dn;
     tile_max(x->t_near, x->t_near_own, tmp, x->tw, x->th, dn);
     tile_max(x->t_fsig, x->t_fsig_own, tmp, x->tw, x->th, df);
     int lr = -1; /* -1: no near block at all */

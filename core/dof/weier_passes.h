@@ -57,6 +57,7 @@ typedef struct {
     int32_t *l_nn;             /* per block row: the blocks [l_nn[2 by], l_nn[2 by + 1]) holding a pixel that is not near */
     int32_t *l_span;           /* per row of l_v: its texels [l_span[2 by], l_span[2 by + 1]) that are not all 0 */
     int l_reach;               /* the largest radius there */
+    int near_tiles;            /* the tile dilation's near reach in tiles (fvw_dilate_tiles) */
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
     const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
     int enh_on;                /* contrast enhancement runs */
@@ -90,6 +91,7 @@ typedef struct {
 #define PIPE_H 4     /* the centre's step (made or skipped): tile dilation and horizontal pass */
 #define PIPE_HP 8    /* ... made in the pipeline */
 #define PIPE_FUSED 16 /* the fused pass made in the pipeline */
+#define PIPE_D2 32   /* the centre's step took the near reach as 2 tiles (known), else 1 (guessed) */
 #define LREACH_MAX (FV_DOF_RMAX / LOW) /* the largest block radius: floor(FV_DOF_RMAX / 4) */
 
 
@@ -151,6 +153,7 @@ void fvw_hblur_band(void *ctx, int band, int tid);
 void fvw_vcombine_band(void *ctx, int band, int tid);
 /* weier_pipe.c: the band pipeline, task k of x->th + 3 (fv_pool_run) */
 void fvw_pipe_task(void *ctx, int k, int tid);
+void fvw_pipe_settle(fvw_ctx *x); /* after the job and fvw_dilate_tiles: drops the centre's guessed work if wrong */
 int fvw_pipe_free(const fvw_ctx *x, int band); /* band has no centre row: the pipeline fuses it */
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
