@@ -52,8 +52,8 @@
  * over the whole image, before the fused pass.
  * On the default path these passes run as one band pipeline (weier_pipe.c): each band's fused
  * pass a few bands behind its CoC work, so that level 0 is read from memory once; the centre's
- * bands join it once the frame's near reach is known, else they follow it (prm.band_passes: the
- * passes one after another, the same bits).
+ * bands with a guessed tile dilation, made again after it if the guess was wrong (prm.band_passes:
+ * the passes one after another, the same bits).
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *
@@ -235,7 +235,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->cy0 = fv_clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = fv_clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
     x->hband = wk->rows + (size_t)fv_pool_threads(pool) * NSLOT * 4 * (size_t)x->w;
     /* the band pipeline (weier_pipe.c) on the default path: the bands [pc0, pc1) hold the centre
-     * rectangle's rows and are fused after it */
+     * rectangle's rows (horizontal pass, fused a band later than the others) */
     x->pipe = x->hblur_fused && !v->prm->band_passes;
     x->pc0 = x->pc1 = 0;
     if (x->cy0 < x->cy1)
@@ -243,8 +243,8 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     memset(x->band_ms, 0, BAND_MS * (size_t)x->th * sizeof(float));
     const int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
     if (x->pipe) {
-        /* the CoC pass and the fused pass of the free bands in one job (its span is the coc
-         * stage's; the stage times below split it by the workers' measured shares) */
+        /* the CoC, horizontal, quarter-resolution and fused passes in one job (its span is the
+         * coc stage's; the stage times below split it by the workers' measured shares) */
         memset(x->pflag, 0, (size_t)x->th * sizeof(int32_t));
         x->coc_upto = x->lv_upto = x->h_upto = 0;
         pthread_mutex_init(&x->pmu, NULL);
@@ -264,7 +264,7 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
      * the workers' measured share */
     const int64_t tf = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
     int64_t t2;
-    if (x->pipe) { /* the centre's bands the pipeline left: horizontal pass, then fused */
+    if (x->pipe) { /* the centre's bands the pipeline's guess got wrong (none, usually) */
         const int nc = x->pc1 - x->pc0;
         fv_pool_run(pool, nc, fvw_hpass_centre, x);
         t2 = fv_time_ns();

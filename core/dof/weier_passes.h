@@ -73,15 +73,15 @@ typedef struct {
     float *hband;              /* the per-thread band rows of it, after the row slots */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
     xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
-    /* the band pipeline (fvw_pipe_task): the CoC pass and the fused pass of the bands outside the
-     * centre rectangle's rows in one job, so that those bands' level 0 rows are read from memory
-     * once; the centre's bands (which need the whole frame's largest near radius) afterwards */
+    /* the band pipeline (fvw_pipe_task): the CoC, horizontal, quarter-resolution and fused passes
+     * in one job, each band's fused pass a few bands behind its CoC work, so that level 0 is read
+     * from memory once */
     int pipe;                  /* on (the default path: hblur_fused and not prm.band_passes) */
-    int pc0, pc1;              /* the bands [pc0, pc1) hold a centre row: fused after the pipeline */
+    int pc0, pc1;              /* the bands [pc0, pc1) hold a centre row: horizontal pass, fused a band later */
     int32_t *l_rowr;           /* per block row: its largest block radius l_r, at least 0 */
     int32_t *pflag;            /* per band: PIPE_* bits of the steps done (under pmu) */
     int coc_upto, lv_upto, h_upto; /* the bands [0, n) have PIPE_COC / PIPE_LV / PIPE_H */
-    pthread_mutex_t pmu;       /* guards pflag and the two counters */
+    pthread_mutex_t pmu;       /* guards pflag and the three counters */
     pthread_cond_t pcv;        /* a counter moved */
 } fvw_ctx;
 
@@ -151,10 +151,10 @@ void fvw_lvpass_band(void *ctx, int band, int tid);
 void fvw_lhpass_band(fvw_ctx *x, int band);
 void fvw_hblur_band(void *ctx, int band, int tid);
 void fvw_vcombine_band(void *ctx, int band, int tid);
-/* weier_pipe.c: the band pipeline, task k of x->th + 3 (fv_pool_run) */
+/* weier_pipe.c: the band pipeline, task k of x->th + 4 (fv_pool_run) */
 void fvw_pipe_task(void *ctx, int k, int tid);
 void fvw_pipe_settle(fvw_ctx *x); /* after the job and fvw_dilate_tiles: drops the centre's guessed work if wrong */
-int fvw_pipe_free(const fvw_ctx *x, int band); /* band has no centre row: the pipeline fuses it */
+int fvw_pipe_free(const fvw_ctx *x, int band); /* band has no centre row */
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
 void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
