@@ -23,7 +23,9 @@
 /* Stage spans and the counter hook use the pipeline's stage ids (core/stage.h), plus one past
  * them for the whole frame. A stage fused into another's pass has no span of its own: the
  * reprojection runs inside the ray-casting tiles (its spans are on the workers' tracks) and the
- * layered filter's combine inside its vertical pass (the dof_filter span holds both). */
+ * layered filter's combine inside its vertical pass (the dof_filter span holds both; with its band
+ * pipeline the coc span holds the CoC, filter and combine work of the bands the pipeline fuses,
+ * core/dof/weier_pipe.c). */
 #define FV_PROF_FRAME FV_STAGE_COUNT        /* the whole fv_pipeline_render */
 #define FV_PROF_STAGES (FV_STAGE_COUNT + 1) /* ids a stage span or hook call may carry */
 const char *fv_prof_stage_name(int stage);  /* fv_stage_names[stage], "frame"; "?" otherwise */

@@ -594,6 +594,186 @@ static void test_threads_and_isas_identical(void **st)
     rig_free(&r);
 }
 
+/* A scene without any near field (everything behind the focus range): the frame's quarter-
+ * resolution layer is empty and the combine gets no near layer at all. */
+static void far_only(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = 2.0f + 0.05f * (float)((x * 3 + y * 5) % 37);
+}
+
+/* Near field only in a strip of rows 100..107 (block rows 25, 26), far behind it: block rows have
+ * different largest radii, so the band pipeline's per-row reach differs from the frame's. */
+static void near_strip(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = y >= 100 && y < 108 && x >= 30 && x < 170 ? 0.25f + 0.01f * (float)(x % 7) : 4.0f;
+}
+
+/* Near field at 0.15 m over the top 20 rows (a radius of 24 px with the strong preset: the
+ * dilation's reach is 2 tiles from the first band on), the busy scene below. */
+static void near_top(int x, int y, float px[4])
+{
+    busy(x, y, px);
+    if (y < 20)
+        px[3] = 0.15f;
+}
+
+/* near_strip plus a patch of near pixels of radius 1 (1 m, focus 1.5 m, strong) in rows 56..63:
+ * band 3 has near work, but the frame's reach (2 tiles) is known only from the strip's tile row
+ * 6, so its horizontal pass is made after the pipeline, and with the gaze at y = 78 (r1 = 15) the
+ * disc's rows from 64 on read it through the near box. */
+static void near_strip_patch(int x, int y, float px[4])
+{
+    near_strip(x, y, px);
+    if (y >= 56 && y < 64 && x >= 90 && x < 110)
+        px[3] = 1.0f;
+}
+
+/* near_top's near rows over a far background (4 m) with near pixels of radius 0 (c = -0.9 px at
+ * 0.75 m, focus 1 m, strong) on a third of the rows 40..70: with the gaze at y = 56 and r1 = 15 they
+ * lie in the transition ring, where a tile the dilation marks (2 tiles from the top rows' 24 px
+ * radius) blends them in as their own near layer and an unmarked one does not. */
+static void near_top_ring(int x, int y, float px[4])
+{
+    for (int c = 0; c < 3; c++)
+        px[c] = tex(x, y, c);
+    px[3] = y < 20 ? 0.15f : y >= 40 && y <= 70 && (x + y) % 3 == 0 ? 0.75f : 4.0f;
+}
+
+/* near_top_ring's radius-0 ring pixels (rows 40..70) with a near row of radius 2 px (0.6 m) in
+ * tile row 1 and a radius of 24 px (0.15 m) only in the bottom rows 140..159: with the gaze at
+ * y = 56 the ring's tile row 3 is 2 tiles from the radius-2 row, the frame's dilation spans 2 tiles
+ * (marking it) but the pipeline learns that only at band 6, so bands 0..5 guess 1 tile and are
+ * made again after the job. */
+static void ring_late(int x, int y, float px[4])
+{
+    near_top_ring(x, y, px);
+    if (y < 20)
+        px[3] = 4.0f;
+    if (y >= 16 && y < 32)
+        px[3] = 0.6f;
+    if (y >= 140)
+        px[3] = 0.15f;
+}
+
+/* ring_late without the bottom rows' near field: the frame's dilation spans 1 tile (largest radius
+ * 2 px), which the pipeline's guess gets right; the ring's tile row 3 stays unmarked. */
+static void ring_small(int x, int y, float px[4])
+{
+    ring_late(x, y, px);
+    if (y >= 140)
+        px[3] = 4.0f;
+}
+
+/* The band pipeline (the CoC pass, the centre's horizontal pass and the fused pass in one job,
+ * weier_pipe.c) against the passes one after another (prm.band_passes): bound 0, for 1, 2 and 5
+ * threads and C / best ISA, on scenes with near field everywhere (busy), a near field whose
+ * radius grows towards the top (receding floor, strong), none (far only: the combine gets no near
+ * layer), a narrow strip (per-row reach below the frame's; a radius of 17 px from tile row 6 on,
+ * so with the gaze at y = 120 the centre bands 6..9 run in the pipeline and 3..5 after it; with a
+ * patch of radius-1 near pixels in band 3 and the gaze at y = 78, band 4 after it, because band
+ * 3's horizontal pass, which it reads, is made after it), a near top
+ * (the centre's bands all in the pipeline), the near top with radius-0 near pixels in the
+ * transition ring (the pipeline's tile dilation must span exactly the frame's 2 tiles), and those
+ * ring pixels 2 tiles from a radius-2 near row, with a radius of 24 px only at the bottom (the
+ * guessed reach of 1 tile is wrong: bands 0..5 are made again after the job) or nowhere (the
+ * guess is right and kept); the gaze
+ * and r1 so that the free bands are above the centre, below it, on both sides, all of them (the
+ * gaze off the image) or none. */
+static void test_pipeline_vs_band_passes(void **st)
+{
+    (void)st;
+    const struct {
+        scene_fn scene;
+        fv_dof_preset preset;
+        float focus_m, gx, gy, r1;
+    } cases[] = {
+        {busy, FV_DOF_MEDIUM, 1.0f, 70.0f, 60.0f, 15.0f},           {busy, FV_DOF_MEDIUM, 1.0f, 23.0f, 151.0f, 60.0f},
+        {receding_floor, FV_DOF_STRONG, 1.5f, 100.0f, 80.0f, 15.0f}, {receding_floor, FV_DOF_STRONG, 1.5f, 100.0f, 20.0f, 15.0f},
+        {far_only, FV_DOF_STRONG, 1.0f, 100.0f, 80.0f, 15.0f},       {near_strip, FV_DOF_STRONG, 1.5f, 100.0f, 30.0f, 15.0f},
+        {near_strip, FV_DOF_STRONG, 1.5f, 100.0f, -200.0f, 15.0f},   {near_strip, FV_DOF_STRONG, 1.5f, 100.0f, 120.0f, 15.0f},
+        {near_top, FV_DOF_STRONG, 1.0f, 100.0f, 80.0f, 15.0f},       {near_top, FV_DOF_STRONG, 1.0f, 100.0f, 80.0f, 60.0f},
+        {near_strip_patch, FV_DOF_STRONG, 1.5f, 100.0f, 78.0f, 15.0f}, {near_top_ring, FV_DOF_STRONG, 1.0f, 100.0f, 56.0f, 15.0f},
+        {ring_late, FV_DOF_STRONG, 1.0f, 100.0f, 56.0f, 15.0f},      {ring_small, FV_DOF_STRONG, 1.0f, 100.0f, 56.0f, 15.0f},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        rig a, b;
+        rig_init(&a, cases[k].scene, cases[k].preset, cases[k].focus_m, cases[k].gx, cases[k].gy);
+        rig_init(&b, cases[k].scene, cases[k].preset, cases[k].focus_m, cases[k].gx, cases[k].gy);
+        a.v.r0_px = b.v.r0_px = cases[k].r1 * 0.5f;
+        a.v.r1_px = b.v.r1_px = cases[k].r1;
+        b.prm.band_passes = 1;
+        rig_run(&b, NULL, FV_ISA_C);
+        assert_same_any_threads_isa(&a, b.out, b.pyr.lv[0].stride);
+        rig_free(&a);
+        rig_free(&b);
+    }
+}
+
+/* The pipeline's order, from its per-band spans on the workers' tracks ("dof coc band", "dof
+ * fused band", arg = the band): every band's CoC work once; the fused pass, with the gaze at
+ * y = 80 and r1 = 15 (centre rows [17, 143): bands 1..8 hold centre rows), of the free bands 0 and
+ * 9 three bands after their CoC work, and of the centre bands four bands after it when the frame's
+ * near reach is known early (near_top, strong: a radius of 24 px in band 0) or not at all in the
+ * job when it is not (busy, medium: radii up to 5 px, so the reach is known only after the whole
+ * frame). Each fused band after the CoC work of the bands up to b + 3 (b + 4 in the centre) that it
+ * reads and, on one thread, in the order below, so that its level 0 rows are at most four or five
+ * bands (64-80 rows) old. On 2 and 5 threads the same dependency by the spans' times. Fails
+ * without the pipeline (no such spans: the CoC pass ran first). */
+static void test_pipeline_order(void **st)
+{
+    (void)st;
+    const int th = (H + 15) / 16, threads[] = {1, 2, 5};
+    /* slot 0's events on one thread: CoC work of band b as b, its fused pass as 100 + b */
+    const int want[] = {0, 1, 2, 3, 100, 4, 5, 101, 6, 102, 7, 103, 8, 104, 9, 105, 106, 107, 109, 108};
+    for (int sc = 0; sc < 2; sc++)
+        for (int n = 0; n < 3; n++) {
+            rig r;
+            rig_init(&r, sc ? near_top : busy, sc ? FV_DOF_STRONG : FV_DOF_MEDIUM, 1.0f, 100.0f, 80.0f);
+            r.v.r0_px = 8.0f, r.v.r1_px = 15.0f;
+            fv_prof *prof = fv_prof_create(threads[n], 4096);
+            fv_pool *pool = fv_pool_create(threads[n]);
+            assert_non_null(prof);
+            assert_non_null(pool);
+            r.v.prof = prof;
+            rig_run(&r, pool, ~0u);
+            int64_t coc_end[16], fused_start[16];
+            int coc_n[16] = {0}, fused_n[16] = {0}, seq[64], nseq = 0;
+            for (int s = 0; s < threads[n]; s++)
+                for (size_t i = 0; i < fv_prof_count(prof, s); i++) {
+                    const fv_prof_event *e = fv_prof_event_at(prof, s, i);
+                    const int coc = !strcmp(e->name, "dof coc band"), fused = !strcmp(e->name, "dof fused band");
+                    if (!coc && !fused)
+                        continue;
+                    assert_true(e->arg >= 0 && e->arg < th);
+                    if (coc)
+                        coc_n[e->arg]++, coc_end[e->arg] = e->t1_ns;
+                    else
+                        fused_n[e->arg]++, fused_start[e->arg] = e->t0_ns;
+                    if (threads[n] == 1 && nseq < 64)
+                        seq[nseq++] = coc ? e->arg : 100 + e->arg; /* slot 0's events in order */
+                }
+            for (int b = 0; b < th; b++) {
+                const int free_band = b == 0 || b == th - 1;
+                assert_int_equal(coc_n[b], 1);
+                assert_int_equal(fused_n[b], 1);
+                if (fused_n[b])
+                    assert_true(fused_start[b] >= coc_end[fv_mini(b + (free_band ? 3 : 4), th - 1)]);
+            }
+            if (threads[n] == 1) {
+                const int nw = (int)(sizeof want / sizeof *want);
+                assert_int_equal(nseq, nw);
+                assert_memory_equal(seq, want, (size_t)nw * sizeof *want);
+            }
+            fv_pool_destroy(pool);
+            fv_prof_destroy(prof);
+            rig_free(&r);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -612,6 +792,8 @@ int main(void)
         cmocka_unit_test(test_fused_threads_and_isas_identical),
         cmocka_unit_test(test_band_hblur_vs_pass),
         cmocka_unit_test(test_coc_plane_centre_only),
+        cmocka_unit_test(test_pipeline_vs_band_passes),
+        cmocka_unit_test(test_pipeline_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

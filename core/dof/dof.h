@@ -45,6 +45,8 @@ typedef struct fv_dof_params {
                             * level blend, combine) that dof_periph_row replaced; tests compare them */
     int hblur_pass;        /* weier: 1 = the periphery's half-resolution blur as a pass over the whole
                             * image (the path the per-band rows of the fused pass replaced) */
+    int band_passes;       /* weier: 1 = the CoC pass over the whole image before the fused pass (the
+                            * order the band pipeline replaced: level 0 read twice); tests compare */
     fv_focus_params focus; /* focus estimation; focus.fixed_m > 0 fixes it */
 } fv_dof_params;
 void fv_dof_params_default(fv_dof_params *p);

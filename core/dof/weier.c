@@ -50,12 +50,16 @@
  * vertical pass, the combine (dof_periph_row beyond the disc) and the output. With contrast
  * enhancement (or prm.chain_periphery / hblur_pass) the half-resolution blur is a pass of its own
  * over the whole image, before the fused pass.
+ * On the default path these passes run as one band pipeline (weier_pipe.c): each band's fused
+ * pass a few bands behind its CoC work, so that level 0 is read from memory once; the centre's
+ * bands with a guessed tile dilation, made again after it if the guess was wrong (prm.band_passes:
+ * the passes one after another, the same bits).
  * Every pass splits the image into bands of 16 rows; each pixel depends only on the inputs and
  * its coordinates, so the image is identical for any thread count.
  *
  * Files, one per stage: this one is the driver (scratch, constant tables, the order of the
  * passes, stage times); weier_coc.c the CoC pass, weier_filter.c the blur passes, combine.c the
- * combine; weier_passes.h is their shared context. */
+ * combine, weier_pipe.c the band pipeline; weier_passes.h is their shared context. */
 #include "dof/weier_passes.h"
 
 #include <math.h>
@@ -141,7 +145,7 @@ static int ensure_aux(fv_dof_work *wk, int threads, int hblur)
     const int w = wk->w, h = wk->h;
     const int tw = (w + TILE - 1) / TILE, th = (h + TILE - 1) / TILE;
     const size_t lw = (size_t)(w + LOW - 1) / LOW, lh = (size_t)(h + LOW - 1) / LOW;
-    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 4 * lh + 4 * (size_t)th +
+    const size_t aux = tables_len(w) + 4 * (size_t)tw * th + lw * lh * (4 + 1 + 1 + 4 + 1 + 1 + 4) + 5 * lh + (BAND_MS + 1) * (size_t)th +
                        (hblur ? 5 : 1) * (size_t)half_w(w) * (size_t)half_w(h);
     if (wk->aux_len < aux) {
         free(wk->aux);
@@ -170,6 +174,20 @@ static int ensure_aux(fv_dof_work *wk, int threads, int hblur)
         wk->rows_len = rows;
     }
     return 0;
+}
+
+/* after the band pipeline: band pc0 + i unless the pipeline made it */
+static void fvw_hpass_centre(void *ctx, int i, int tid)
+{
+    fvw_ctx *x = ctx;
+    if (!(x->pflag[x->pc0 + i] & PIPE_HP))
+        fvw_hpass_band(x, x->pc0 + i, tid);
+}
+static void fvw_vcombine_centre(void *ctx, int i, int tid)
+{
+    fvw_ctx *x = ctx;
+    if (!(x->pflag[x->pc0 + i] & PIPE_FUSED))
+        fvw_vcombine_band(x, x->pc0 + i, tid);
 }
 
 void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t out_stride, fv_pool *pool,
@@ -206,7 +224,9 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->l_v = a, a += 4 * nl;
     x->l_span = (int32_t *)(void *)a, a += 2 * x->lh; /* int32 and float have the same size */
     x->l_nn = (int32_t *)(void *)a, a += 2 * x->lh;
-    x->band_ms = a, a += 4 * x->th;
+    x->l_rowr = (int32_t *)(void *)a, a += x->lh;
+    x->band_ms = a, a += BAND_MS * x->th;
+    x->pflag = (int32_t *)(void *)a, a += x->th;
     x->hcoc = a, a += (ptrdiff_t)x->hw * x->hh;
     x->hblur = x->hblur_fused ? NULL : a; /* last: allocated only when needed */
     /* the centre rectangle: the transition disc plus the kernels' reach */
@@ -214,30 +234,78 @@ void fv_dof_weier(const fv_dof_view *v, fv_dof_work *wk, float *out, ptrdiff_t o
     x->cx0 = fv_clampi((int)floorf(v->gaze_x - reach), 0, x->w), x->cx1 = fv_clampi((int)ceilf(v->gaze_x + reach), 0, x->w);
     x->cy0 = fv_clampi((int)floorf(v->gaze_y - reach), 0, x->h), x->cy1 = fv_clampi((int)ceilf(v->gaze_y + reach), 0, x->h);
     x->hband = wk->rows + (size_t)fv_pool_threads(pool) * NSLOT * 4 * (size_t)x->w;
+    /* the band pipeline (weier_pipe.c) on the default path: the bands [pc0, pc1) hold the centre
+     * rectangle's rows (horizontal pass, fused a band later than the others) */
+    x->pipe = x->hblur_fused && !v->prm->band_passes;
+    x->pc0 = x->pc1 = 0;
+    if (x->cy0 < x->cy1)
+        x->pc0 = x->cy0 / TILE, x->pc1 = (x->cy1 + TILE - 1) / TILE;
+    memset(x->band_ms, 0, BAND_MS * (size_t)x->th * sizeof(float));
     const int64_t t0 = fv_dof_stage_begin(v, FV_STAGE_COC);
-    fv_pool_run(pool, x->th, fvw_coc_band, x);
+    if (x->pipe) {
+        /* the CoC, horizontal, quarter-resolution and fused passes in one job (its span is the
+         * coc stage's; the stage times below split it by the workers' measured shares) */
+        memset(x->pflag, 0, (size_t)x->th * sizeof(int32_t));
+        x->coc_upto = x->lv_upto = x->h_upto = 0;
+        pthread_mutex_init(&x->pmu, NULL);
+        pthread_cond_init(&x->pcv, NULL);
+        fv_pool_run(pool, x->th + 4, fvw_pipe_task, x);
+        pthread_cond_destroy(&x->pcv);
+        pthread_mutex_destroy(&x->pmu);
+    } else
+        fv_pool_run(pool, x->th, fvw_coc_band, x);
+    const int64_t tp = fv_time_ns();
     fvw_dilate_tiles(x);
+    if (x->pipe)
+        fvw_pipe_settle(x);
     const int64_t t1 = fv_dof_stage_end(v, FV_STAGE_COC, t0);
     /* the combine (and with v->conv the conversion to the display format) runs fused into the
      * vertical pass: one dof_filter span holds them, and each one's share of the fused time is
      * the workers' measured share */
     const int64_t tf = fv_dof_stage_begin(v, FV_STAGE_DOF_FILTER);
-    fv_pool_run(pool, x->th, fvw_hpass_band, x);
-    fv_pool_run(pool, x->th, fvw_lvpass_band, x);
-    fv_pool_run(pool, x->th, fvw_hblur_band, x);
-    const int64_t t2 = fv_time_ns();
-    fv_pool_run(pool, x->th, fvw_vcombine_band, x);
+    int64_t t2;
+    if (x->pipe) { /* the centre's bands the pipeline's guess got wrong (none, usually) */
+        const int nc = x->pc1 - x->pc0;
+        fv_pool_run(pool, nc, fvw_hpass_centre, x);
+        t2 = fv_time_ns();
+        fv_pool_run(pool, nc, fvw_vcombine_centre, x);
+    } else {
+        fv_pool_run(pool, x->th, fvw_hpass_band, x);
+        fv_pool_run(pool, x->th, fvw_lvpass_band, x);
+        fv_pool_run(pool, x->th, fvw_hblur_band, x);
+        t2 = fv_time_ns();
+        fv_pool_run(pool, x->th, fvw_vcombine_band, x);
+    }
     const int64_t t3 = fv_dof_stage_end(v, FV_STAGE_DOF_FILTER, tf);
     if (t) {
-        double f = 0.0, c = 0.0, o = 0.0, k = 0.0;
-        for (int b = 0; b < x->th; b++)
-            f += x->band_ms[4 * b], c += x->band_ms[4 * b + 1], o += x->band_ms[4 * b + 2], k += x->band_ms[4 * b + 3];
-        const double fused = (double)(t3 - t2) * 1e-6, all = f + c + o + k;
+        /* per phase the workers' shares: [0] the pipeline (band pipeline only), [1] the fused
+         * pass after it (or the only one) */
+        double f[2] = {0}, c[2] = {0}, o[2] = {0}, k[2] = {0}, kp = 0.0, lp = 0.0;
+        for (int b = 0; b < x->th; b++) {
+            const float *m = x->band_ms + BAND_MS * b;
+            const int ph = x->pipe && (x->pflag[b] & PIPE_FUSED) ? 0 : 1;
+            f[ph] += m[0], c[ph] += m[1], o[ph] += m[2], k[ph] += m[3];
+            kp += m[4], lp += m[5];
+        }
+        double coc = 0.0, filter = 0.0, comb = 0.0, outp = 0.0;
+        if (x->pipe) {
+            const double wall = (double)(tp - t0) * 1e-6, all = f[0] + c[0] + o[0] + k[0] + kp + lp;
+            if (all > 0.0)
+                coc += wall * (k[0] + kp) / all, filter += wall * (f[0] + lp) / all, comb += wall * c[0] / all,
+                    outp += wall * o[0] / all;
+            else
+                coc += wall;
+            coc += (double)(t1 - tp) * 1e-6; /* the tile dilation */
+        } else
+            coc += (double)(t1 - t0) * 1e-6;
+        const double fused = (double)(t3 - t2) * 1e-6, all = f[1] + c[1] + o[1] + k[1];
         /* the CoC rows the fused pass recomputes belong to the coc stage */
-        t->coc_ms = (double)(t1 - t0) * 1e-6 + (all > 0.0 ? fused * k / all : 0.0);
-        t->filter_ms = (double)(t2 - tf) * 1e-6 + (all > 0.0 ? fused * f / all : fused);
-        t->combine_ms = all > 0.0 ? fused * c / all : 0.0;
-        t->output_ms = v->conv ? (all > 0.0 ? fused * o / all : 0.0) : NAN;
+        coc += all > 0.0 ? fused * k[1] / all : 0.0;
+        filter += (double)(t2 - tf) * 1e-6 + (all > 0.0 ? fused * f[1] / all : fused);
+        comb += all > 0.0 ? fused * c[1] / all : 0.0;
+        outp += all > 0.0 ? fused * o[1] / all : 0.0;
+        t->coc_ms = coc, t->filter_ms = filter, t->combine_ms = comb;
+        t->output_ms = v->conv ? outp : NAN;
     }
     return;
 fail:

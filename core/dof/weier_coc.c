@@ -94,6 +94,23 @@ static void tile_max(float *restrict dst, const float *src, float *restrict tmp,
         }
 }
 
+/* Tile row ty of the dilation below for a near reach of dn tiles, as a square window (the same
+ * values: max is exact in any order); reads the own values of tile rows ty - 2 .. ty + 2. */
+void fvw_dilate_row(fvw_ctx *x, int ty, int dn)
+{
+    const int df = (FV_DOF_RMAX + TILE - 1) / TILE;
+    for (int tx = 0; tx < x->tw; tx++) {
+        float mn = 0.0f, mf = 0.0f;
+        for (int j = fv_maxi(ty - dn, 0); j <= fv_mini(ty + dn, x->th - 1); j++)
+            for (int i = fv_maxi(tx - dn, 0); i <= fv_mini(tx + dn, x->tw - 1); i++)
+                mn = x->t_near_own[j * x->tw + i] > mn ? x->t_near_own[j * x->tw + i] : mn;
+        for (int j = fv_maxi(ty - df, 0); j <= fv_mini(ty + df, x->th - 1); j++)
+            for (int i = fv_maxi(tx - df, 0); i <= fv_mini(tx + df, x->tw - 1); i++)
+                mf = x->t_fsig_own[j * x->tw + i] > mf ? x->t_fsig_own[j * x->tw + i] : mf;
+        x->t_near[ty * x->tw + tx] = mn, x->t_fsig[ty * x->tw + tx] = mf;
+    }
+}
+
 /* Each tile learns the largest near radius / far sigma of the tiles within reach (a max is
  * separable: the same values as the square window). */
 void fvw_dilate_tiles(fvw_ctx *x)
@@ -103,6 +120,7 @@ void fvw_dilate_tiles(fvw_ctx *x)
         rmax = x->t_near_own[i] > rmax ? x->t_near_own[i] : rmax;
     const int dn = (int)ceilf(rmax / TILE), df = (FV_DOF_RMAX + TILE - 1) / TILE;
     float *tmp = fvw_slot(x, 0, 2); /* thread 0's row buffers 2.. (free between the passes) */
+    x->near_tiles = dn;
     tile_max(x->t_near, x->t_near_own, tmp, x->tw, x->th, dn);
     tile_max(x->t_fsig, x->t_fsig_own, tmp, x->tw, x->th, df);
     int lr = -1; /* -1: no near block at all */

@@ -129,13 +129,34 @@ void fvw_hpass_band(void *ctx, int band, int tid)
             x->dsp->dof_nearbox_row(nh, nr, nw, s4, sr, sw, x->w, i0, i1 - i0, reach);
         }
     }
-    /* the quarter-resolution rows of this band */
-    if (x->l_reach >= 0)
+    /* the quarter-resolution rows of this band (the band pipeline made them after its CoC work) */
+    if (x->l_reach >= 0 && !x->pipe)
         for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
             const ptrdiff_t o = (ptrdiff_t)by * x->lw;
             x->dsp->dof_nearbox_row(x->l_h + 4 * o, x->l_hr + o, x->l_hw + o, x->l_src + 4 * o, x->l_r + o, x->l_w + o,
                                     x->lw, 0, x->lw, x->l_reach);
         }
+}
+
+/* The band pipeline's quarter-resolution horizontal rows of a band, right after its CoC work:
+ * each block row to its own largest radius (at least 0) instead of the frame's, which the
+ * pipeline does not know yet. The same bits: dof_nearbox_row adds only the taps within a
+ * source's radius, and no source of the row has a larger one; a row without near blocks gets
+ * what the frame's reach gives it (+0 sums, radius +0, weight 1). Also records that radius for
+ * the vertical pass (l_rowr). */
+void fvw_lhpass_band(fvw_ctx *x, int band)
+{
+    const int y0 = band * TILE, y1 = fv_mini(y0 + TILE, x->h);
+    for (int by = y0 / LOW; by < (y1 + LOW - 1) / LOW; by++) {
+        const ptrdiff_t o = (ptrdiff_t)by * x->lw;
+        float rmax = 0.0f;
+        for (int i = 0; i < x->lw; i++)
+            rmax = x->l_r[o + i] > rmax ? x->l_r[o + i] : rmax;
+        const int reach = (int)rmax;
+        x->l_rowr[by] = reach;
+        x->dsp->dof_nearbox_row(x->l_h + 4 * o, x->l_hr + o, x->l_hw + o, x->l_src + 4 * o, x->l_r + o, x->l_w + o,
+                                x->lw, 0, x->lw, reach);
+    }
 }
 
 /* The quarter-resolution vertical pass (rows of blocks, a band of them per task). */
@@ -147,7 +168,15 @@ void fvw_lvpass_band(void *ctx, int band, int tid)
         int lo = x->lw, hi = 0;
         float *o = x->l_v + 4 * (ptrdiff_t)by * x->lw;
         memset(o, 0, (size_t)x->lw * 4 * sizeof(float));
-        const int reach = x->l_reach, jlo = by - reach > 0 ? -reach : -by, jhi = by + reach < x->lh ? reach : x->lh - 1 - by;
+        /* the band pipeline: the largest radius of the block rows within LREACH_MAX (the frame's
+         * is not known yet; taps beyond a row's radius add +0: the same bits) */
+        int reach = x->l_reach;
+        if (x->pipe) {
+            reach = 0;
+            for (int r = fv_maxi(by - LREACH_MAX, 0); r <= fv_mini(by + LREACH_MAX, x->lh - 1); r++)
+                reach = x->l_rowr[r] > reach && x->l_rowr[r] >= (by > r ? by - r : r - by) ? x->l_rowr[r] : reach;
+        }
+        const int jlo = by - reach > 0 ? -reach : -by, jhi = by + reach < x->lh ? reach : x->lh - 1 - by;
         for (int j = jlo; j <= jhi; j++) {
             const ptrdiff_t q = (ptrdiff_t)(by + j) * x->lw;
             near_box_tap(o, x->l_h + 4 * q, x->l_hr + q, x->l_hw + q, (float)(j < 0 ? -j : j), x->lw);
@@ -387,7 +416,10 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         filter_ns += (double)(fv_time_ns() - th0);
     }
     int lup_da = 0, lup_db = 0; /* the up-sampled near row's span that is not 0 */
-    if (x->l_reach >= 0)
+    /* the band pipeline runs the bands outside the centre rectangle before the frame's l_reach is
+     * known: it up-samples every row and passes the combine NULL where the row is all 0 (below) */
+    const int lup_on = x->pipe || x->l_reach >= 0;
+    if (lup_on)
         memset(fvw_slot(x, tid, 14), 0, (size_t)x->w * 4 * sizeof(float));
     for (int y = y0; y < y1; y++) {
         int64_t ta = fv_time_ns();
@@ -470,7 +502,7 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
             }
         }
         float *lup = NULL;
-        if (x->l_reach >= 0) {
+        if (lup_on) {
             lup = fvw_slot(x, tid, 14);
             /* read only by pixels that are not near (c >= 0: the blocks l_nn spans) and, by the
              * chain's combine, across the disc */
@@ -482,6 +514,13 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
                     na = na < tx0 ? na : tx0, nb = nb > tx1 ? nb : tx1;
             }
             near_upsample_row(x, tid, y, lup, &lup_da, &lup_db, na, nb);
+            /* the same bits as the passes one after another: outside the centre rectangle only
+             * dof_periph_row reads lup (the disc is inside it), for which a row of 0s is NULL. In
+             * it the combine gets the row of 0s where those passes gave NULL (no near block in the
+             * frame): then the full-resolution near layer is +0 too (no tile has a near radius),
+             * and n + t (s 0 - n) of n = +0 is +0: the same bits */
+            if (x->pipe && !centre_row && lup_da >= lup_db)
+                lup = NULL;
         }
         if (enh)
             fvw_enhance_row(x, tid, y, sharp, trow, enh);
@@ -505,9 +544,9 @@ void fvw_vcombine_band(void *ctx, int band, int tid)
         combine_ns += (double)(tc - tb);
         output_ns += (double)(td - tc);
     }
-    x->band_ms[4 * band] = (float)(filter_ns * 1e-6);
-    x->band_ms[4 * band + 1] = (float)(combine_ns * 1e-6);
-    x->band_ms[4 * band + 2] = (float)(output_ns * 1e-6);
-    x->band_ms[4 * band + 3] = (float)(coc_ns * 1e-6);
+    x->band_ms[BAND_MS * band] = (float)(filter_ns * 1e-6);
+    x->band_ms[BAND_MS * band + 1] = (float)(combine_ns * 1e-6);
+    x->band_ms[BAND_MS * band + 2] = (float)(output_ns * 1e-6);
+    x->band_ms[BAND_MS * band + 3] = (float)(coc_ns * 1e-6);
 }
 

@@ -4,6 +4,7 @@
 #define FOVEA_DOF_WEIER_PASSES_H
 
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -56,10 +57,12 @@ typedef struct {
     int32_t *l_nn;             /* per block row: the blocks [l_nn[2 by], l_nn[2 by + 1]) holding a pixel that is not near */
     int32_t *l_span;           /* per row of l_v: its texels [l_span[2 by], l_span[2 by + 1]) that are not all 0 */
     int l_reach;               /* the largest radius there */
+    int near_tiles;            /* the tile dilation's near reach in tiles (fvw_dilate_tiles) */
     int up_levels;             /* periphery far blur: pyramid levels 1..up_levels are read */
     const float *lambda;       /* CoC -> continuous pyramid level (LAMBDA_N entries) */
     int enh_on;                /* contrast enhancement runs */
-    float *band_ms;            /* per band: worker time (ms) in the filter, the combine, the output, the CoC rows (4 each) */
+    float *band_ms;            /* per band (BAND_MS each): worker time (ms) in the fused pass's filter, combine,
+                                * output and recomputed CoC rows, the CoC pass, the quarter-resolution passes */
     xtaps xt[MAX_UP_LEVEL + 1]; /* up-sampling taps by 2^L, L = 1..MAX_UP_LEVEL */
     /* the periphery's far blur at half resolution (the level 1 grid), up-sampled once per row */
     int half_on;               /* level 1 exists: the periphery outside the transition disc uses it */
@@ -70,7 +73,26 @@ typedef struct {
     float *hband;              /* the per-thread band rows of it, after the row slots */
     const float *lambda_h;     /* CoC -> continuous level - 1 (>= 0), for the half grid */
     xtaps xh[MAX_UP_LEVEL];    /* up-sampling taps by 2^k to the half grid, k = 1..MAX_UP_LEVEL - 1 */
+    /* the band pipeline (fvw_pipe_task): the CoC, horizontal, quarter-resolution and fused passes
+     * in one job, each band's fused pass a few bands behind its CoC work, so that level 0 is read
+     * from memory once */
+    int pipe;                  /* on (the default path: hblur_fused and not prm.band_passes) */
+    int pc0, pc1;              /* the bands [pc0, pc1) hold a centre row: horizontal pass, fused a band later */
+    int32_t *l_rowr;           /* per block row: its largest block radius l_r, at least 0 */
+    int32_t *pflag;            /* per band: PIPE_* bits of the steps done (under pmu) */
+    int coc_upto, lv_upto, h_upto; /* the bands [0, n) have PIPE_COC / PIPE_LV / PIPE_H */
+    pthread_mutex_t pmu;       /* guards pflag and the three counters */
+    pthread_cond_t pcv;        /* a counter moved */
 } fvw_ctx;
+
+#define BAND_MS 6
+#define PIPE_COC 1   /* CoC pass and quarter-resolution horizontal rows */
+#define PIPE_LV 2    /* quarter-resolution vertical pass */
+#define PIPE_H 4     /* the centre's step (made or skipped): tile dilation and horizontal pass */
+#define PIPE_HP 8    /* ... made in the pipeline */
+#define PIPE_FUSED 16 /* the fused pass made in the pipeline */
+#define PIPE_D2 32   /* the centre's step took the near reach as 2 tiles (known), else 1 (guessed) */
+#define LREACH_MAX (FV_DOF_RMAX / LOW) /* the largest block radius: floor(FV_DOF_RMAX / 4) */
 
 
 static inline float fvw_t_of(const fvw_ctx *x, float fx, float fy)
@@ -122,11 +144,17 @@ void fvw_upsample_row(const fv_dof_dsp *dsp, const img4 *src, int L, const xtaps
 /* weier_coc.c: stage "coc" (bands of TILE rows; then the tiles' reach) */
 void fvw_coc_band(void *ctx, int band, int tid);
 void fvw_dilate_tiles(fvw_ctx *x);
+void fvw_dilate_row(fvw_ctx *x, int ty, int dn); /* tile row ty with near reach dn tiles (the band pipeline) */
 /* weier_filter.c: stage "dof_filter" (bands); the vertical pass runs the combine row by row */
 void fvw_hpass_band(void *ctx, int band, int tid);
 void fvw_lvpass_band(void *ctx, int band, int tid);
+void fvw_lhpass_band(fvw_ctx *x, int band);
 void fvw_hblur_band(void *ctx, int band, int tid);
 void fvw_vcombine_band(void *ctx, int band, int tid);
+/* weier_pipe.c: the band pipeline, task k of x->th + 4 (fv_pool_run) */
+void fvw_pipe_task(void *ctx, int k, int tid);
+void fvw_pipe_settle(fvw_ctx *x); /* after the job and fvw_dilate_tiles: drops the centre's guessed work if wrong */
+int fvw_pipe_free(const fvw_ctx *x, int band); /* band has no centre row */
 /* combine.c: stage "combine", one row */
 void fvw_enhance_row(const fvw_ctx *x, int tid, int y, const float *sharp, const float *trow, float *restrict enh);
 void fvw_combine_row(const fvw_ctx *x, float *restrict dst, const float *sharp, const float *coc, const float *far, const float *near,
