@@ -14,14 +14,14 @@
 #include <math.h>
 #include <string.h>
 
-static _Thread_local fv_blend_lane *rec; /* the packet being traced, or NULL */
+static _Thread_local fv_blend_packet *rec; /* the packet being traced, or NULL */
 
 int fv_scene_has_blend(const fv_scene *s) { return s && s->has_blend; }
 
-void fv_blend_begin(fv_blend_lane lanes[16])
+void fv_blend_begin(fv_blend_packet *p)
 {
-    for (int q = 0; q < 16; q++) lanes[q].n = 0;
-    rec = lanes;
+    p->used = 0;
+    rec = p;
 }
 
 void fv_blend_end(void) { rec = NULL; }
@@ -35,7 +35,9 @@ static int nearer(float ta, unsigned ga, unsigned pa, float tb, unsigned gb, uns
 void fv_blend_record(unsigned ray_id, unsigned geom, unsigned prim, float u, float v, float t)
 {
     if (!rec || ray_id >= 16) return;
-    fv_blend_lane *l = &rec[ray_id];
+    fv_blend_lane *l = &rec->lane[ray_id];
+    if (!(rec->used >> ray_id & 1u)) /* the ray's first layer */
+        rec->used |= 1u << ray_id, l->n = 0;
     for (unsigned k = 0; k < l->n; k++)
         if (l->geom[k] == geom && l->prim[k] == prim) return; /* the same primitive again */
     unsigned slot = l->n;
@@ -50,12 +52,13 @@ void fv_blend_record(unsigned ray_id, unsigned geom, unsigned prim, float u, flo
     l->geom[slot] = geom, l->prim[slot] = prim, l->u[slot] = u, l->v[slot] = v, l->t[slot] = t;
 }
 
-void fv_blend_composite(const fv_scene *s, const fv_blend_lane lanes[16], unsigned *geom, float *tfar,
+void fv_blend_composite(const fv_scene *s, const fv_blend_packet *p, unsigned *geom, float *tfar,
                         const float *const org[3], const float *const dir[3], int n, float px_tan, const float eye[3],
                         const float background[3], float rgb[3][16])
 {
-    for (int q = 0; q < n; q++) {
-        const fv_blend_lane *l = &lanes[q];
+    for (unsigned r = p->used & (n >= 16 ? 0xffffu : (1u << n) - 1u); r; r &= r - 1) {
+        const int q = __builtin_ctz(r);
+        const fv_blend_lane *l = &p->lane[q];
         if (!l->n) continue;
         const int miss = geom[q] == RTC_INVALID_GEOMETRY_ID;
         const float t_opaque = miss ? INFINITY : tfar[q];

@@ -12,13 +12,41 @@
 
 const float fv_background_rgb[3] = {0.02f, 0.025f, 0.035f};
 
+/* Whether this library traces rtcIntersect16 at all: natively (its AVX-512 path) or, built with
+ * AVX-512 kernels but run on a CPU without them, through its ray-stream filter, which with the
+ * coherent flag traces the 16 rays as one frustum (on an AVX2 host measured ~1.5x faster than two
+ * rtcIntersect8 hybrid packets, which is Embree's packet traversal: docs/raystage.md 2026-11-28).
+ * A library built without 16-wide kernels refuses the call (RTC_ERROR_INVALID_OPERATION): asked
+ * once, with a packet of no valid lane on an empty scene. */
+static int intersect16_works(RTCDevice d)
+{
+    if (rtcGetDeviceProperty(d, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED))
+        return 1;
+    RTCScene sc = rtcNewScene(d);
+    if (!sc)
+        return 0;
+    rtcCommitScene(sc);
+    (void)rtcGetDeviceError(d); /* clear */
+    struct RTCIntersectContext ictx;
+    rtcInitIntersectContext(&ictx);
+    ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    _Alignas(64) struct RTCRayHit16 rh;
+    _Alignas(64) int valid[16];
+    memset(&rh, 0, sizeof rh);
+    memset(valid, 0, sizeof valid);
+    rtcIntersect16(valid, sc, &ictx, &rh);
+    const int ok = rtcGetDeviceError(d) == RTC_ERROR_NONE;
+    rtcReleaseScene(sc);
+    return ok;
+}
+
 int fv_raycast_packet_width(void)
 {
     static atomic_int width; /* 0: not asked yet; every device of one library answers the same */
     int w = atomic_load_explicit(&width, memory_order_relaxed);
     if (!w) {
         RTCDevice d = rtcNewDevice(NULL);
-        w = d && rtcGetDeviceProperty(d, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
+        w = d && intersect16_works(d) ? 16 : 8;
         if (d)
             rtcReleaseDevice(d);
         atomic_store_explicit(&width, w, memory_order_relaxed);
@@ -78,6 +106,48 @@ static const float lane_inf[16] = {INFINITY, INFINITY, INFINITY, INFINITY, INFIN
 static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
 #define lane_valid(j) (lane_valid_all + (j))
 
+/* One sample: a hit's colour and view depth (t: dir.z_eye = -1), or the background at the miss
+ * depth. */
+static inline __attribute__((always_inline)) void write1(float *dst, unsigned geom, float t, const float rgb[3][16], int q)
+{
+    if (geom == RTC_INVALID_GEOMETRY_ID) {
+        dst[0] = fv_background_rgb[0], dst[1] = fv_background_rgb[1], dst[2] = fv_background_rgb[2];
+        dst[3] = FV_DEPTH_MISS_M;
+    } else {
+        dst[0] = rgb[0][q], dst[1] = rgb[1][q], dst[2] = rgb[2][q];
+        dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;
+    }
+}
+
+/* Lanes q .. q+3 as 4 pixels in a row (a 4x2 block's full row: px[q + i] = px[q] + i, px[q]
+ * at x = 4j; without that, (y, 15) and (y + 1, 0) would pass as neighbours): written from one
+ * address, all hits or all misses without a test per pixel (1; else 0 and nothing written). */
+static inline __attribute__((always_inline)) int write4(float *dst, const uint8_t *px, const unsigned *geom, const float *t,
+                         const float rgb[3][16], int q)
+{
+    uint32_t run;
+    memcpy(&run, px, 4);
+    if ((px[0] & 3) || run != (uint32_t)px[0] * 0x01010101u + 0x03020100u) /* x = 4j .. 4j+3, one row */
+        return 0;
+    const unsigned misses = (geom[0] == RTC_INVALID_GEOMETRY_ID) | (geom[1] == RTC_INVALID_GEOMETRY_ID) << 1 |
+                            (geom[2] == RTC_INVALID_GEOMETRY_ID) << 2 | (geom[3] == RTC_INVALID_GEOMETRY_ID) << 3;
+    if (!misses) { /* written out: the compiler kept the loop of 4 */
+#define FV_HIT1(i)                                                                                             \
+    dst[4 * (i)] = rgb[0][q + (i)], dst[4 * (i) + 1] = rgb[1][q + (i)], dst[4 * (i) + 2] = rgb[2][q + (i)],         \
+    dst[4 * (i) + 3] = t[i] < FV_DEPTH_MISS_M ? t[i] : FV_DEPTH_MISS_M
+        FV_HIT1(0), FV_HIT1(1), FV_HIT1(2), FV_HIT1(3);
+#undef FV_HIT1
+    } else if (misses == 15) {
+        const float bg[4] = {fv_background_rgb[0], fv_background_rgb[1], fv_background_rgb[2], FV_DEPTH_MISS_M};
+        memcpy(dst, bg, sizeof bg), memcpy(dst + 4, bg, sizeof bg);
+        memcpy(dst + 8, bg, sizeof bg), memcpy(dst + 12, bg, sizeof bg);
+    } else {
+        for (int i = 0; i < 4; i++)
+            write1(dst + 4 * i, geom[i], t[i], rgb, q + i);
+    }
+    return 1;
+}
+
 /* Packets of N lanes (Embree's RTCRayHitN: one routine for both widths). A tile's packets are all
  * traced first, then all shaded, then written: the triangle records and image lines of every hit,
  * prefetched right after its packet was traced, have the rest of the tile's tracing to arrive
@@ -117,24 +187,22 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
     static void write_##N(const fv_pyr_level *l0, const struct RTCRayHit##N *rh, const float rgb[3][16],      \
                           const uint8_t *px, int k, int x0, int y0)                                           \
     {                                                                                                         \
-        for (int q = 0; q < k; q++) {                                                                         \
+        for (int q = 0; q < k;) {                                                                             \
             const int p = px[q];                                                                              \
             float *dst = l0->rgbd + 4 * ((y0 + (p >> 4)) * l0->stride + x0 + (p & 15));                       \
-            if (rh->hit.geomID[q] == RTC_INVALID_GEOMETRY_ID) {                                               \
-                dst[0] = fv_background_rgb[0], dst[1] = fv_background_rgb[1], dst[2] = fv_background_rgb[2];  \
-                dst[3] = FV_DEPTH_MISS_M;                                                                     \
-            } else { /* t is the view depth: dir.z_eye = -1 */                                                \
-                const float t = rh->ray.tfar[q];                                                              \
-                dst[0] = rgb[0][q], dst[1] = rgb[1][q], dst[2] = rgb[2][q];                                   \
-                dst[3] = t < FV_DEPTH_MISS_M ? t : FV_DEPTH_MISS_M;                                           \
+            if (q + 4 <= k && write4(dst, px + q, rh->hit.geomID + q, rh->ray.tfar + q, rgb, q)) {               \
+                q += 4;                                                                                       \
+                continue;                                                                                     \
             }                                                                                                 \
+            write1(dst, rh->hit.geomID[q], rh->ray.tfar[q], rgb, q);                                          \
+            q++;                                                                                              \
         }                                                                                                     \
     }                                                                                                         \
     /* Per thread: a whole tile's packets (20 KiB) and their colours. */                                     \
     static _Thread_local _Alignas(64) struct RTCRayHit##N tile_rh_##N[FV_TILE_PACKETS(N)];                   \
     static _Thread_local _Alignas(64) float tile_rgb_##N[FV_TILE_PACKETS(N)][3][16];                         \
     static _Thread_local float tile_org_##N[3] = {NAN, NAN, NAN};                                            \
-    static _Thread_local fv_blend_lane tile_blend_##N[FV_TILE_PACKETS(N)][16]; /* alpha BLEND: blend.c */     \
+    static _Thread_local fv_blend_packet tile_blend_##N[FV_TILE_PACKETS(N)]; /* alpha BLEND: blend.c */     \
     static void packets_##N(const fv_scene *scene, const fv_camera *cam, const fv_render_dsp *dsp,           \
                             const fv_pyr_level *l0, int x0, int y0, const uint8_t *px, int n, float ox, float oy,  \
                             int64_t *shade_ns, void (*before_write)(void *), void *bw_ctx)                 \
@@ -159,7 +227,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
         const int np = (n + N - 1) / N, blend = fv_scene_has_blend(scene);                                    \
         for (int b = 0; b < np; b++) {                                                                        \
             if (blend)                                                                                        \
-                fv_blend_begin(tile_blend_##N[b]);                                                            \
+                fv_blend_begin(&tile_blend_##N[b]);                                                            \
             trace_##N(scene, cam, dsp, &rc, &ictx, &rh[b], valid, px + b * N, n - b * N < N ? n - b * N : N,     \
                       x0, y0);                                                                                \
         }                                                                                                     \
@@ -173,7 +241,7 @@ static const int lane_valid_all[32] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -
                                   cam->eye_pos, tile_rgb_##N[b]);                                             \
             if (blend) { /* blended layers over the shaded hits (misses become the nearest layer's hits) */    \
                 const float *const dirs[3] = {rh[b].ray.dir_x, rh[b].ray.dir_y, rh[b].ray.dir_z};             \
-                fv_blend_composite(scene, tile_blend_##N[b], rh[b].hit.geomID, rh[b].ray.tfar, NULL, dirs,     \
+                fv_blend_composite(scene, &tile_blend_##N[b], rh[b].hit.geomID, rh[b].ray.tfar, NULL, dirs,     \
                                    n - b * N < N ? n - b * N : N, cam->px_tan, cam->eye_pos, fv_background_rgb, \
                                    tile_rgb_##N[b]);                                                          \
             }                                                                                                 \

@@ -39,8 +39,8 @@ static inline void fv_ray8_set(struct RTCRayHit8 *rh, int k, const float org[3],
 
 struct fv_render_dsp;
 
-/* The packet width the ray stage traces with: 16 (rtcIntersect16) where this Embree has native
- * 16-wide packets (its AVX-512 path), else 8. */
+/* The packet width the ray stage traces with: 16 (rtcIntersect16) where this Embree traces
+ * 16-wide packets (natively, or through its stream filter on a CPU without AVX-512), else 8. */
 int fv_raycast_packet_width(void);
 /* The pixels of a tile whose bits are set in rows[y] (bit x; y < th, x < tw) as (y << 4 | x), in
  * 4x2-block order (coherent packets); their count. px needs 8 bytes of slack past the count.

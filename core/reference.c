@@ -104,7 +104,7 @@ static void ref_tile(void *ctx, int index, int thread_id)
     int valid[8], lane_px[8], lane_s[8];
     /* alpha BLEND as the ray stage does it (core/blend.h), from each ray's own origin */
     const int blend = fv_scene_has_blend(j->scene);
-    fv_blend_lane bl[16];
+    fv_blend_packet bl;
     int k = 0;
     long rays = 0;
     /* per pixel: ray -1 is the pinhole ray (depth), 0..spp-1 the lens samples, in this order,
@@ -142,7 +142,7 @@ static void ref_tile(void *ctx, int index, int thread_id)
         for (int q = k; q < 8; q++)
             valid[q] = 0;
         if (blend)
-            fv_blend_begin(bl);
+            fv_blend_begin(&bl);
         fv_scene_intersect8(j->scene, valid, &ictx, &rh);
         if (blend)
             fv_blend_end();
@@ -170,7 +170,7 @@ static void ref_tile(void *ctx, int index, int thread_id)
         if (blend) {
             const float *const orgs[3] = {rh.ray.org_x, rh.ray.org_y, rh.ray.org_z};
             const float *const dirs[3] = {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
-            fv_blend_composite(j->scene, bl, rh.hit.geomID, rh.ray.tfar, orgs, dirs, k, cam->px_tan, cam->eye_pos,
+            fv_blend_composite(j->scene, &bl, rh.hit.geomID, rh.ray.tfar, orgs, dirs, k, cam->px_tan, cam->eye_pos,
                                fv_background_rgb, rgb);
         }
         for (int q = 0; q < k; q++) {

@@ -157,20 +157,25 @@ static void slot_plan(const fv_scene *s, const fv_mesh_rec *m, slot_plan_t *p)
 
 void fv_scene_shade_prefetch(const fv_scene *s, const unsigned *geom, const unsigned *prim, int n)
 {
-    /* the mesh looked up once per run of lanes on it (a packet mostly hits one or two) */
-    const fv_mesh_rec *m = NULL;
+    /* the mesh's arrays looked up once per run of lanes on it (a packet mostly hits one or two) */
+    const fv_tri_attr *attr = NULL;
+    const fv_tri_face *face = NULL;
+    const float *tan = NULL;
+    size_t tris = 0;
     unsigned mg = RTC_INVALID_GEOMETRY_ID;
     for (int q = 0; q < n; q++) {
         const unsigned g = geom[q], p = prim[q];
         if (g >= s->mesh_count) continue; /* a miss */
-        if (g != mg)
-            m = &s->meshes[g], mg = g;
-        if (p >= m->tri_count) continue;
-        __builtin_prefetch(&m->attr[p]);
-        if (m->face)
-            __builtin_prefetch(&m->face[p]);
-        if (m->tan) /* a normal map's corner tangents (48 bytes) */
-            __builtin_prefetch(&m->tan[12 * (size_t)p]), __builtin_prefetch(&m->tan[12 * (size_t)p + 11]);
+        if (g != mg) {
+            const fv_mesh_rec *m = &s->meshes[g];
+            attr = m->attr, face = m->face, tan = m->tan, tris = m->tri_count, mg = g;
+        }
+        if (p >= tris) continue;
+        __builtin_prefetch(&attr[p]);
+        if (face)
+            __builtin_prefetch(&face[p]);
+        if (tan) /* a normal map's corner tangents (48 bytes) */
+            __builtin_prefetch(&tan[12 * (size_t)p]), __builtin_prefetch(&tan[12 * (size_t)p + 11]);
     }
 }
 
@@ -192,18 +197,31 @@ void fv_scene_shade_packet(const fv_scene *s, const fv_shade_dsp *dsp, const fv_
     fv_tex_taps taps[FV_SLOTS][FV_SHADE_LANES]; /* slot (base colour, maps), lane */
     unsigned hits = 0, black = 0, textured = 0;
     const unsigned *geom = h->geom, *primv = h->prim; /* locals: the stores to pk would make the compiler reload h */
-    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0; /* the last lane's mesh; lanes on other meshes */
-    for (int q = 0; q < n; q++) {
-        const unsigned g = geom[q];
-        if (g == RTC_INVALID_GEOMETRY_ID) continue;
-        mixed |= g0 != RTC_INVALID_GEOMETRY_ID && g != g0;
-        g0 = g;
+    /* g0: the first hit lane's mesh; mixed: a hit on another mesh. A packet of misses only (most of
+     * a small object's frame: FlightHelmet, DepthOfFieldExample) has nothing to shade and no lane to
+     * blacken; pk is left as it is (its material rows still hold what pk_scene / pk_geom say). A
+     * full packet's tests are passes without a branch per lane (vectorised). */
+    unsigned g0 = RTC_INVALID_GEOMETRY_ID, mixed = 0;
+    if (n == FV_SHADE_LANES) {
+        unsigned any = 0;
+        for (int q = 0; q < FV_SHADE_LANES; q++)
+            any |= geom[q] != RTC_INVALID_GEOMETRY_ID;
+        if (!any)
+            return;
     }
-    /* A packet of misses only (most of a small object's frame: FlightHelmet, DepthOfFieldExample)
-     * has nothing to shade and no lane to blacken; pk is left as it is (its material rows still
-     * hold what pk_scene / pk_geom say). */
+    for (int q = 0; q < n; q++)
+        if (geom[q] != RTC_INVALID_GEOMETRY_ID) {
+            g0 = geom[q];
+            break;
+        }
     if (g0 == RTC_INVALID_GEOMETRY_ID)
         return;
+    if (n == FV_SHADE_LANES)
+        for (int q = 0; q < FV_SHADE_LANES; q++)
+            mixed |= (geom[q] != RTC_INVALID_GEOMETRY_ID) & (geom[q] != g0);
+    else
+        for (int q = 0; q < n; q++)
+            mixed |= (geom[q] != RTC_INVALID_GEOMETRY_ID) & (geom[q] != g0);
     /* the lanes' ray data: a full packet's read in place by the kernel, a short one's copied (the
      * lanes past n keep an earlier packet's values: finite, unused) */
     if (n == FV_SHADE_LANES) {

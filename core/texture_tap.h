@@ -106,10 +106,19 @@ static inline int fv_tex_same_layout(const fv_texture *a, const fv_texture *b)
 static inline void fv_tex_taps_rebase(const fv_texture *from, const fv_texture *to, const fv_tex_taps *src,
                                       fv_tex_taps *dst)
 {
-    *dst = *src;
-    for (int l = 0; l < (src->f > 0.0f ? 2 : 1); l++)
-        for (int i = 0; i < 4; i++)
-            dst->tap[l].p[i] = to->level[0] + (src->tap[l].p[i] - from->level[0]);
+    /* the bases in locals: a store of a texel pointer could alias the textures' level pointers,
+     * which the compiler then reloaded for every tap */
+    const float *const from0 = from->level[0], *const to0 = to->level[0];
+    const int levels = src->f > 0.0f ? 2 : 1;
+    dst->f = src->f;
+    for (int l = 0; l < levels; l++) {
+        const fv_tex_tap *a = &src->tap[l];
+        fv_tex_tap *b = &dst->tap[l];
+        b->fx = a->fx, b->fy = a->fy;
+        const float *const p0 = to0 + (a->p[0] - from0), *const p1 = to0 + (a->p[1] - from0);
+        const float *const p2 = to0 + (a->p[2] - from0), *const p3 = to0 + (a->p[3] - from0);
+        b->p[0] = p0, b->p[1] = p1, b->p[2] = p2, b->p[3] = p3;
+    }
 }
 
 static inline void fv_tex_taps_prefetch(const fv_tex_taps *tp)

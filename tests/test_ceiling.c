@@ -173,6 +173,57 @@ static void test_tile_moves_eye(void **state)
     fv_scene_free(s);
 }
 
+/* A sparse tile's samples land on their own pixels and nowhere else: each sampled pixel holds
+ * what the full tile gave it, the others (and the next tile's) keep a sentinel. The rows put
+ * (1, 13..15) right before (2, 0) in the packets' pixel order, consecutive offsets across a row
+ * end (a write of 4 pixels from one address must not take them for one run), and full rows of 4
+ * with hits and misses (the wall ends inside the tile at this eye). */
+static void test_sparse_tile_writes(void **state)
+{
+    (void)state;
+    fv_scene *s = scene_make();
+    fv_render_dsp dsp;
+    fv_render_dsp_init(&dsp, FV_ISA_C);
+    fv_pyramid pyr;
+    assert_int_equal(fv_pyramid_init(&pyr, W, H), 0);
+    fv_camera cam;
+    camera_make(&cam);
+    const fv_pyr_level *l0 = &pyr.lv[0];
+    uint32_t all[FV_TILE], rows[FV_TILE] = {0};
+    for (int y = 0; y < FV_TILE; y++)
+        all[y] = ~0u;
+    rows[1] = 0xe000u | 0x00f0u | 0x0001u; /* x 13-15, 4-7, 0 */
+    rows[2] = 0x0001u | 0x0f00u;           /* x 0, 8-11 */
+    rows[3] = 0x8000u;
+    rows[6] = 0xffffu, rows[7] = 0x5555u, rows[12] = 0x1248u, rows[15] = 0xf00fu;
+    for (int x0 = 0; x0 <= 48; x0 += 48) { /* a tile with misses (0) and one on the card and wall */
+        const int y0 = 16;
+        assert_int_equal(fv_raycast_tile(s, &cam, &dsp, &pyr.lv[0], x0, y0, 16, 16, all, NULL), 256);
+        float want[16][16][4];
+        for (int y = 0; y < 16; y++)
+            for (int x = 0; x < 16; x++)
+                for (int c = 0; c < 4; c++)
+                    want[y][x][c] = l0->rgbd[4 * ((y0 + y) * l0->stride + x0 + x) + c];
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                for (int c = 0; c < 4; c++)
+                    l0->rgbd[4 * (y * l0->stride + x) + c] = -7.0f;
+        int n = 0;
+        for (int y = 0; y < 16; y++)
+            n += __builtin_popcount(rows[y]);
+        assert_int_equal(fv_raycast_tile(s, &cam, &dsp, &pyr.lv[0], x0, y0, 16, 16, rows, NULL), n);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const int in = x >= x0 && x < x0 + 16 && y >= y0 && y < y0 + 16 && (rows[y - y0] >> (x - x0) & 1u);
+                for (int c = 0; c < 4; c++)
+                    assert_float_equal(l0->rgbd[4 * (y * l0->stride + x) + c], in ? want[y - y0][x - x0][c] : -7.0f,
+                                       0.0f);
+            }
+    }
+    fv_pyramid_free(&pyr);
+    fv_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -180,6 +231,7 @@ int main(void)
         cmocka_unit_test(test_full_frame_8),
         cmocka_unit_test(test_sampled),
         cmocka_unit_test(test_tile_moves_eye),
+        cmocka_unit_test(test_sparse_tile_writes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1446,8 +1446,8 @@ static void test_gltf_alpha_blend(void **state)
         }
         struct RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
-        fv_blend_lane lanes[16];
-        fv_blend_begin(lanes);
+        fv_blend_packet lanes;
+        fv_blend_begin(&lanes);
         fv_scene_intersect16(s, valid, &ctx, &rh);
         fv_blend_end();
         fv_shade_dsp dsp;
@@ -1458,7 +1458,7 @@ static void test_gltf_alpha_blend(void **state)
         fv_scene_shade_packet(s, &dsp, &hp, 16, 0.001f, eye, rgb);
         const float bg[3] = {0.02f, 0.025f, 0.035f};
         const float *const dirs[3] = {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
-        fv_blend_composite(s, lanes, rh.hit.geomID, rh.ray.tfar, NULL, dirs, 16, 0.001f, eye, bg, rgb);
+        fv_blend_composite(s, &lanes, rh.hit.geomID, rh.ray.tfar, NULL, dirs, 16, 0.001f, eye, bg, rgb);
         for (int q = 0; q < 16; q++) {
             const int i = q % 3;
             if (i == 2 || (i == 1 && stacked)) { /* a miss stays a miss (with the green pane moved, x = 1.5
