@@ -200,39 +200,113 @@ static inline __m128i span16(const uint8_t *s0, const uint8_t *s1, __m128i wx, _
     return _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512));
 }
 
-static void tw_spans_avx2(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+/* bytes [k, n) of a piece in 16-byte steps, the last one overlapping (n >= 16), else one by one */
+static inline __attribute__((always_inline)) void span_tail(uint8_t *o, const uint8_t *s0, const uint8_t *s1, int k,
+                                                            int n, int fx, int fy)
+{
+    const __m128i wx = _mm_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm_set1_epi16((short)(fy << 9));
+    const __m128i k512 = _mm_set1_epi16(512);
+    for (; k + 16 <= n; k += 16)
+        _mm_storeu_si128((__m128i *)(void *)(o + k), span16(s0 + k, s1 + k, wx, wy, k512));
+    if (k < n && n >= 16) { /* the last 16 again, overlapping: the same bytes */
+        _mm_storeu_si128((__m128i *)(void *)(o + n - 16), span16(s0 + n - 16, s1 + n - 16, wx, wy, k512));
+        k = n;
+    }
+    for (; k < n; k++)
+        o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+}
+
+/* one piece: n bytes at phase (fx, fy) from s0, s1 into o; pf: prefetched as the piece is read
+ * (its bytes from pf on: the source a few rows below), or s0 */
+static inline __attribute__((always_inline)) void span_piece(uint8_t *o, const uint8_t *s0, const uint8_t *s1, const uint8_t *pf, int n, int fx, int fy)
 {
     const __m256i k512 = _mm256_set1_epi16(512);
+    const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
+    int k = 0;
+    for (; k + 32 <= n; k += 32) {
+        _mm_prefetch((const char *)(pf + k), _MM_HINT_T0);
+        const __m256i a = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k));
+        const __m256i b = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k + 3));
+        const __m256i c = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k));
+        const __m256i e = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k + 3));
+        const __m256i h0l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(a, b), wx);
+        const __m256i h0h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(a, b), wx);
+        const __m256i h1l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(c, e), wx);
+        const __m256i h1h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(c, e), wx);
+        const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
+        const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
+        _mm256_storeu_si256((__m256i *)(void *)(o + k),
+                            _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512)));
+    }
+    _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
+    if (k < n)
+        span_tail(o, s0, s1, k, n, fx, fy);
+}
+
+static void tw_spans_avx2(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+{
     for (int i = 0; i < count; i++) {
         const fv_tw_piece *p = &pieces[i];
-        const uint8_t *s0 = p->s0, *s1 = p->s1;
-        uint8_t *o = dst + p->dst;
-        const int n = p->n, fx = p->fx, fy = p->fy;
-        const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
-        int k = 0;
-        for (; k + 32 <= n; k += 32) {
+        span_piece(dst + p->dst, p->s0, p->s1, p->s0, p->n, p->fx, p->fy);
+    }
+}
+
+/* tw_runs' 32-byte steps of a piece: the lower row's horizontal pass kept in h for the next
+ * row (reuse: this row's upper pass is there already); nt: aligned stores around the cache */
+static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const uint8_t *s0, const uint8_t *s1,
+                                                            const uint8_t *pf, int n32, __m256i wx, __m256i wy,
+                                                            int16_t *h, int reuse, int nt)
+{
+    const __m256i k512 = _mm256_set1_epi16(512);
+    for (int k = 0; k < n32; k += 32) {
+        _mm_prefetch((const char *)(pf + k), _MM_HINT_T0);
+        __m256i h0l, h0h;
+        if (reuse) {
+            h0l = _mm256_loadu_si256((const __m256i *)(const void *)(h + k));
+            h0h = _mm256_loadu_si256((const __m256i *)(const void *)(h + k + 16));
+        } else {
             const __m256i a = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k));
             const __m256i b = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k + 3));
-            const __m256i c = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k));
-            const __m256i e = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k + 3));
-            const __m256i h0l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(a, b), wx);
-            const __m256i h0h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(a, b), wx);
-            const __m256i h1l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(c, e), wx);
-            const __m256i h1h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(c, e), wx);
-            const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
-            const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
-            _mm256_storeu_si256((__m256i *)(void *)(o + k),
-                                _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512)));
+            h0l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(a, b), wx);
+            h0h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(a, b), wx);
         }
-        const __m128i wx4 = _mm256_castsi256_si128(wx), wy4 = _mm256_castsi256_si128(wy), k5 = _mm256_castsi256_si128(k512);
-        for (; k + 16 <= n; k += 16)
-            _mm_storeu_si128((__m128i *)(void *)(o + k), span16(s0 + k, s1 + k, wx4, wy4, k5));
-        if (k < n && n >= 16) { /* the last 16 again, overlapping: the same bytes */
-            _mm_storeu_si128((__m128i *)(void *)(o + n - 16), span16(s0 + n - 16, s1 + n - 16, wx4, wy4, k5));
-            k = n;
-        }
-        for (; k < n; k++)
-            o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+        const __m256i c = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k));
+        const __m256i e = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k + 3));
+        const __m256i h1l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(c, e), wx);
+        const __m256i h1h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(c, e), wx);
+        _mm256_storeu_si256((__m256i *)(void *)(h + k), h1l);
+        _mm256_storeu_si256((__m256i *)(void *)(h + k + 16), h1h);
+        const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
+        const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
+        const __m256i v = _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512));
+        if (nt)
+            _mm256_stream_si256((__m256i *)(void *)(o + k), v);
+        else
+            _mm256_storeu_si256((__m256i *)(void *)(o + k), v);
+    }
+}
+
+static void tw_runs_avx2(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
+                         ptrdiff_t pf_end, int16_t *hbuf)
+{
+    for (int i = 0; i < count; i++) {
+        fv_tw_run *r = &runs[i];
+        int fx, fy;
+        int64_t off;
+        const uint8_t *s0 = fv_tw_run_piece(r, rgb, stride, &fx, &fy, &off), *s1 = fy ? s0 + stride : s0;
+        const uint8_t *pf = off + 4 * stride < pf_end ? s0 + 3 * stride : s0;
+        const int n = r->n, n32 = n & ~31, reuse = r->hoff == off && r->hfx == fx;
+        uint8_t *o = dst + r->dst;
+        int16_t *h = hbuf + r->dst;
+        const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
+        if ((uintptr_t)o & 31)
+            reuse ? run_steps(o, s0, s1, pf, n32, wx, wy, h, 1, 0) : run_steps(o, s0, s1, pf, n32, wx, wy, h, 0, 0);
+        else
+            reuse ? run_steps(o, s0, s1, pf, n32, wx, wy, h, 1, 1) : run_steps(o, s0, s1, pf, n32, wx, wy, h, 0, 1);
+        r->hoff = n32 ? (fy ? off + stride : off) : -1, r->hfx = fx;
+        _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
+        if (n32 < n) /* the tail, without the kept pass */
+            span_tail(o, s0, s1, n32, n, fx, fy);
     }
 }
 
@@ -278,5 +352,6 @@ void fv_timewarp_dsp_init_avx2(fv_timewarp_dsp *d)
     d->tw_stream = tw_stream_avx2;
     d->tw_row = tw_row_avx2;
     d->tw_spans = tw_spans_avx2;
+    d->tw_runs = tw_runs_avx2;
     d->tw_minmax = tw_minmax_avx2;
 }
