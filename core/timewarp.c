@@ -580,7 +580,7 @@ long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t d
      * others as items (a clamped translated block, or a run of per-pixel parts in one call: the
      * kernel interleaves 64 pixels) */
     fv_tw_run run[MAXE];
-    /* the row's other columns composed in cache, then streamed (tw_stream); tw_runs' kept passes */
+    /* a row's columns composed in cache, then streamed (tw_stream); tw_runs' kept passes */
     _Alignas(32) uint8_t row[3 * CHUNK * FV_TW_BLOCK_W];
     _Alignas(32) int16_t hbuf[3 * CHUNK * FV_TW_BLOCK_W];
     struct { const fv_tw_block *b; const fv_tw_map *m; int xa, xb; } item[MAXE]; /* b NULL: per-pixel columns [xa, xb) */
@@ -636,9 +636,7 @@ long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t d
                         prev_slow = !b->fast;
                     }
                 }
-                /* the runners straight into the display image (around the cache, as tw_stream) */
-                uint8_t *drow = dst + (ptrdiff_t)y * dst_stride + 3 * x0;
-                d->tw_runs(drow, run, nr, src->rgb, stride, (ptrdiff_t)src->h * stride, hbuf);
+                d->tw_runs(row, run, nr, src->rgb, stride, (ptrdiff_t)src->h * stride, hbuf);
                 int np = 0;
                 for (int k = 0; k < ni; k++) {
                     const fv_tw_block *b = item[k].b;
@@ -650,10 +648,7 @@ long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t d
                                            src);
                 }
                 d->tw_spans(row, pc, np);
-                for (int k = 0; k < ni; k++) { /* the items' columns */
-                    const int xa = item[k].b ? item[k].b->x0 : item[k].xa, xb = item[k].b ? item[k].b->x1 : item[k].xb;
-                    d->tw_stream(drow + 3 * (xa - x0), row + 3 * (xa - x0), 3 * (xb - xa));
-                }
+                d->tw_stream(dst + (ptrdiff_t)y * dst_stride + 3 * x0, row, 3 * (x1 - x0));
             }
         }
     }

@@ -38,9 +38,7 @@
  *   its fixed-point translation (fv_tw_run_piece: phases fx, fy and source rows s0, s1 into
  *   rgb, a plane of rows of stride bytes), resampled exactly as tw_spans resamples that piece into
  *   dst + r->dst (r->n bytes), then r stepped to the next row (fv_tw_run_piece does). The same
- *   reads as tw_spans' pieces. dst is the display image's row: the x86 versions store around the
- *   cache where a vector is aligned (as tw_stream; the caller fences with tw_stream(NULL, NULL,
- *   0)). Hints that change no byte: the source 3 rows below a piece's is prefetched where that
+ *   reads as tw_spans' pieces. Hints that change no byte: the source 3 rows below a piece's is prefetched where that
  *   row lies above pf_end (a byte offset into rgb: the plane's end), and the ISA versions keep a
  *   piece's horizontal pass of its lower row (s1 at fx) in hbuf + 2 r->dst (bytes; scratch of
  *   2 r->n bytes a run, the runs' ranges apart, 32-byte aligned where r->dst is 16-byte

@@ -252,10 +252,10 @@ static void tw_spans_avx2(uint8_t *restrict dst, const fv_tw_piece *pieces, int 
 }
 
 /* tw_runs' 32-byte steps of a piece: the lower row's horizontal pass kept in h for the next
- * row (reuse: this row's upper pass is there already); nt: aligned stores around the cache */
+ * row (reuse: this row's upper pass is there already) */
 static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const uint8_t *s0, const uint8_t *s1,
                                                             const uint8_t *pf, int n32, __m256i wx, __m256i wy,
-                                                            int16_t *h, int reuse, int nt)
+                                                            int16_t *h, int reuse)
 {
     const __m256i k512 = _mm256_set1_epi16(512);
     for (int k = 0; k < n32; k += 32) {
@@ -279,10 +279,7 @@ static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const ui
         const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
         const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
         const __m256i v = _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512));
-        if (nt)
-            _mm256_stream_si256((__m256i *)(void *)(o + k), v);
-        else
-            _mm256_storeu_si256((__m256i *)(void *)(o + k), v);
+        _mm256_storeu_si256((__m256i *)(void *)(o + k), v);
     }
 }
 
@@ -299,10 +296,10 @@ static void tw_runs_avx2(uint8_t *restrict dst, fv_tw_run *runs, int count, cons
         uint8_t *o = dst + r->dst;
         int16_t *h = hbuf + r->dst;
         const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
-        if ((uintptr_t)o & 31)
-            reuse ? run_steps(o, s0, s1, pf, n32, wx, wy, h, 1, 0) : run_steps(o, s0, s1, pf, n32, wx, wy, h, 0, 0);
+        if (reuse)
+            run_steps(o, s0, s1, pf, n32, wx, wy, h, 1);
         else
-            reuse ? run_steps(o, s0, s1, pf, n32, wx, wy, h, 1, 1) : run_steps(o, s0, s1, pf, n32, wx, wy, h, 0, 1);
+            run_steps(o, s0, s1, pf, n32, wx, wy, h, 0);
         r->hoff = n32 ? (fy ? off + stride : off) : -1, r->hfx = fx;
         _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
         if (n32 < n) /* the tail, without the kept pass */

@@ -185,10 +185,10 @@ static void tw_spans_sse41(uint8_t *restrict dst, const fv_tw_piece *pieces, int
 }
 
 /* tw_runs' 16-byte steps of a piece: the lower row's horizontal pass kept in h for the next
- * row (reuse: this row's upper pass is there already); nt: aligned stores around the cache */
+ * row (reuse: this row's upper pass is there already) */
 static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const uint8_t *s0, const uint8_t *s1,
                                                             const uint8_t *pf, int n16, __m128i wx, __m128i wy,
-                                                            int16_t *h, int reuse, int nt)
+                                                            int16_t *h, int reuse)
 {
     const __m128i k512 = _mm_set1_epi16(512);
     for (int k = 0; k < n16; k += 16) {
@@ -211,10 +211,7 @@ static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const ui
         const __m128i vl = _mm_add_epi16(h0l, _mm_mulhrs_epi16(_mm_sub_epi16(h1l, h0l), wy));
         const __m128i vh = _mm_add_epi16(h0h, _mm_mulhrs_epi16(_mm_sub_epi16(h1h, h0h), wy));
         const __m128i v = _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512));
-        if (nt)
-            _mm_stream_si128((__m128i *)(void *)(o + k), v);
-        else
-            _mm_storeu_si128((__m128i *)(void *)(o + k), v);
+        _mm_storeu_si128((__m128i *)(void *)(o + k), v);
     }
 }
 
@@ -231,10 +228,10 @@ static void tw_runs_sse41(uint8_t *restrict dst, fv_tw_run *runs, int count, con
         uint8_t *o = dst + r->dst;
         int16_t *h = hbuf + r->dst;
         const __m128i wx = _mm_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm_set1_epi16((short)(fy << 9));
-        if ((uintptr_t)o & 15)
-            reuse ? run_steps(o, s0, s1, pf, n16, wx, wy, h, 1, 0) : run_steps(o, s0, s1, pf, n16, wx, wy, h, 0, 0);
+        if (reuse)
+            run_steps(o, s0, s1, pf, n16, wx, wy, h, 1);
         else
-            reuse ? run_steps(o, s0, s1, pf, n16, wx, wy, h, 1, 1) : run_steps(o, s0, s1, pf, n16, wx, wy, h, 0, 1);
+            run_steps(o, s0, s1, pf, n16, wx, wy, h, 0);
         r->hoff = n16 ? (fy ? off + stride : off) : -1, r->hfx = fx;
         _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
         int k = n16;
