@@ -283,27 +283,34 @@ static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const ui
     }
 }
 
+/* the tail of a run's piece (off the 32-byte steps: rare, out of the loop's registers) */
+static __attribute__((noinline)) void run_tail(uint8_t *o, const uint8_t *s0, const uint8_t *s1, int k, int n, int fx,
+                                               int fy)
+{
+    span_tail(o, s0, s1, k, n, fx, fy);
+}
+
 static void tw_runs_avx2(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
                          ptrdiff_t pf_end, int16_t *hbuf)
 {
-    for (int i = 0; i < count; i++) {
-        fv_tw_run *r = &runs[i];
+    const int64_t pf_lim = (int64_t)pf_end - 4 * (int64_t)stride, pf_d = 3 * (int64_t)stride;
+    for (fv_tw_run *r = runs, *e = runs + count; r < e; r++) {
         int fx, fy;
         int64_t off;
-        const uint8_t *s0 = fv_tw_run_piece(r, rgb, stride, &fx, &fy, &off), *s1 = fy ? s0 + stride : s0;
-        const uint8_t *pf = off + 4 * stride < pf_end ? s0 + 3 * stride : s0;
-        const int n = r->n, n32 = n & ~31, reuse = r->hoff == off && r->hfx == fx;
+        const uint8_t *s0 = fv_tw_run_piece(r, rgb, stride, &fx, &fy, &off), *s1 = s0 + (fy ? stride : 0);
+        const uint8_t *pf = s0 + (off < pf_lim ? pf_d : 0);
+        const int n = r->n, n32 = n & ~31, reuse = (r->hoff == off) & (r->hfx == fx);
+        r->hoff = n32 ? off + (fy ? stride : 0) : -1, r->hfx = fx;
         uint8_t *o = dst + r->dst;
         int16_t *h = hbuf + r->dst;
-        const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
+        const __m256i wx = _mm256_set1_epi16((short)(fx * 255 + 64)), wy = _mm256_set1_epi16((short)(fy << 9));
         if (reuse)
             run_steps(o, s0, s1, pf, n32, wx, wy, h, 1);
         else
             run_steps(o, s0, s1, pf, n32, wx, wy, h, 0);
-        r->hoff = n32 ? (fy ? off + stride : off) : -1, r->hfx = fx;
         _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
-        if (n32 < n) /* the tail, without the kept pass */
-            span_tail(o, s0, s1, n32, n, fx, fy);
+        if (n32 < n)
+            run_tail(o, s0, s1, n32, n, fx, fy);
     }
 }
 
