@@ -283,7 +283,31 @@ static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const ui
     }
 }
 
-/* the tail of a run's piece (off the 32-byte steps: rare, out of the loop's registers) */
+/* one 16-byte step at k, as run_steps (a grid cell's 48 bytes: 32 + 16) */
+static inline __attribute__((always_inline)) void run_step16(uint8_t *o, const uint8_t *s0, const uint8_t *s1, int k,
+                                                             __m256i wx, __m256i wy, int16_t *h, int reuse)
+{
+    const __m128i wx4 = _mm256_castsi256_si128(wx), wy4 = _mm256_castsi256_si128(wy), k512 = _mm_set1_epi16(512);
+    __m128i h0l, h0h;
+    if (reuse) {
+        h0l = _mm_loadu_si128((const __m128i *)(const void *)(h + k));
+        h0h = _mm_loadu_si128((const __m128i *)(const void *)(h + k + 8));
+    } else {
+        const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(s0 + k));
+        const __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(s0 + k + 3));
+        h0l = _mm_maddubs_epi16(_mm_unpacklo_epi8(a, b), wx4), h0h = _mm_maddubs_epi16(_mm_unpackhi_epi8(a, b), wx4);
+    }
+    const __m128i c = _mm_loadu_si128((const __m128i *)(const void *)(s1 + k));
+    const __m128i d = _mm_loadu_si128((const __m128i *)(const void *)(s1 + k + 3));
+    const __m128i h1l = _mm_maddubs_epi16(_mm_unpacklo_epi8(c, d), wx4), h1h = _mm_maddubs_epi16(_mm_unpackhi_epi8(c, d), wx4);
+    _mm_storeu_si128((__m128i *)(void *)(h + k), h1l);
+    _mm_storeu_si128((__m128i *)(void *)(h + k + 8), h1h);
+    const __m128i vl = _mm_add_epi16(h0l, _mm_mulhrs_epi16(_mm_sub_epi16(h1l, h0l), wy4));
+    const __m128i vh = _mm_add_epi16(h0h, _mm_mulhrs_epi16(_mm_sub_epi16(h1h, h0h), wy4));
+    _mm_storeu_si128((__m128i *)(void *)(o + k), _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512)));
+}
+
+/* the last bytes of a run's piece (off the 16-byte steps: rare, out of the loop's registers) */
 static __attribute__((noinline)) void run_tail(uint8_t *o, const uint8_t *s0, const uint8_t *s1, int k, int n, int fx,
                                                int fy)
 {
@@ -299,18 +323,23 @@ static void tw_runs_avx2(uint8_t *restrict dst, fv_tw_run *runs, int count, cons
         int64_t off;
         const uint8_t *s0 = fv_tw_run_piece(r, rgb, stride, &fx, &fy, &off), *s1 = s0 + (fy ? stride : 0);
         const uint8_t *pf = s0 + (off < pf_lim ? pf_d : 0);
-        const int n = r->n, n32 = n & ~31, reuse = (r->hoff == off) & (r->hfx == fx);
-        r->hoff = n32 ? off + (fy ? stride : 0) : -1, r->hfx = fx;
+        const int n = r->n, n32 = n & ~31, n16 = n & ~15, reuse = (r->hoff == off) & (r->hfx == fx);
+        r->hoff = n16 ? off + (fy ? stride : 0) : -1, r->hfx = fx;
         uint8_t *o = dst + r->dst;
         int16_t *h = hbuf + r->dst;
         const __m256i wx = _mm256_set1_epi16((short)(fx * 255 + 64)), wy = _mm256_set1_epi16((short)(fy << 9));
-        if (reuse)
+        if (reuse) {
             run_steps(o, s0, s1, pf, n32, wx, wy, h, 1);
-        else
+            if (n16 > n32)
+                run_step16(o, s0, s1, n32, wx, wy, h, 1);
+        } else {
             run_steps(o, s0, s1, pf, n32, wx, wy, h, 0);
+            if (n16 > n32)
+                run_step16(o, s0, s1, n32, wx, wy, h, 0);
+        }
         _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
-        if (n32 < n)
-            run_tail(o, s0, s1, n32, n, fx, fy);
+        if (n16 < n)
+            run_tail(o, s0, s1, n16, n, fx, fy);
     }
 }
 
