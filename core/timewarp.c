@@ -576,7 +576,8 @@ long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t d
     fv_tw_block plan[MAXE];
     fv_tw_piece pc[MAXE];
     /* the entries covering the row, rebuilt where that set changes: the inner translated blocks
-     * as runners (their translation stepped a row at a time: a piece costs a few adds), the
+     * as runners (tw_runs steps their translation a row at a time and keeps each one's
+     * lower-row horizontal pass for the next row), the
      * others as items (a clamped translated block, or a run of per-pixel parts in one call: the
      * kernel interleaves 64 pixels) */
     fv_tw_run run[MAXE];
