@@ -147,7 +147,7 @@ static void depth_range(const fv_timewarp_dsp *d, const fv_tw_src *s, const fv_t
 
 /* Row translations in fixed point: 1/64 px with 16 more bits, offset by a multiple of 2^22 that
  * keeps them positive (shifts of negatives are the compiler's choice in C) */
-#define TW_QBIAS ((int64_t)1 << 52)
+#define TW_QBIAS (FV_TW_RUN_BIAS << 22)
 static inline void row_offsets(int64_t qu, int64_t qv, int *ox, int *oy, int *fx, int *fy)
 {
     const int64_t u = (qu + TW_QBIAS + 32768) >> 16, v = (qv + TW_QBIAS + 32768) >> 16; /* 1/64 px, rounded */
@@ -520,13 +520,6 @@ static int bound_entries(const fv_tw_src *src, fv_tw_block *plan, const fv_tw_ma
 
 #define FV_TW_PREFETCH_ROWS 3
 
-/* an inner translated block on the rows being warped: its row translation (in row_offsets'
- * biased fixed point, with its rounding term) and step, its source columns and its bytes */
-typedef struct {
-    int64_t qu, qv, dqu, dqv;
-    int col, dst, n, npf; /* 3 x0; its bytes in the row buffer and their count; lines prefetched */
-} tw_runner;
-
 /* one row of a translated block: its clamped columns written here, the rest as a piece for
  * tw_spans; the source position is clamped to the source as the reference's. o holds columns
  * from xo on. 1 when a piece. */
@@ -583,14 +576,17 @@ long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t d
     fv_tw_block plan[MAXE];
     fv_tw_piece pc[MAXE];
     /* the entries covering the row, rebuilt where that set changes: the inner translated blocks
-     * as runners (their translation stepped a row at a time: a piece costs a few adds), the
+     * as runners (tw_runs steps their translation a row at a time and keeps each one's
+     * lower-row horizontal pass for the next row), the
      * others as items (a clamped translated block, or a run of per-pixel parts in one call: the
      * kernel interleaves 64 pixels) */
-    tw_runner run[MAXE];
+    fv_tw_run run[MAXE];
+    /* a row's columns composed in cache, then streamed (tw_stream); tw_runs' kept passes */
+    _Alignas(32) uint8_t row[3 * CHUNK * FV_TW_BLOCK_W];
+    _Alignas(32) int16_t hbuf[3 * CHUNK * FV_TW_BLOCK_W];
     struct { const fv_tw_block *b; const fv_tw_map *m; int xa, xb; } item[MAXE]; /* b NULL: per-pixel columns [xa, xb) */
     fv_tw_map cells[TW_CELLS * CHUNK]; /* with a lens: the cells' maps */
     const fv_tw_map *pmap[MAXE];       /* each plan entry's map */
-    uint8_t row[3 * CHUNK * FV_TW_BLOCK_W]; /* a row's columns composed in cache, then streamed (tw_stream) */
     const ptrdiff_t stride = src->rgb_stride;
     long holes = 0, budget_left = budget_px, rem_px = (long)(y1 - y0) * src->w;
     for (int by = y0 / BH; by * BH < y1; by++) {
@@ -623,13 +619,15 @@ long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t d
                         next = c > y && c < next ? c : next;
                         if (!(b->y0 <= y && y < b->y1))
                             continue;
-                        if (b->inner) {
-                            tw_runner *r = &run[nr++];
+                        if (b->inner) { /* block_row without its clamps: the same pieces (TW_QBIAS is
+                                         * FV_TW_RUN_BIAS in 1/2^22 px) */
+                            fv_tw_run *r = &run[nr++];
                             r->qu = b->qu + (int64_t)(y - b->y0) * b->dqu + TW_QBIAS + 32768;
                             r->qv = b->qv + (int64_t)(y - b->y0) * b->dqv + TW_QBIAS + 32768;
                             r->dqu = b->dqu, r->dqv = b->dqv;
-                            r->col = 3 * b->x0, r->dst = 3 * (b->x0 - x0), r->n = 3 * (b->x1 - b->x0);
-                            r->npf = (r->n + 3 + 63) / 64;
+                            r->off = (int64_t)y * stride + 3 * b->x0 - FV_TW_RUN_BIAS * ((int64_t)stride + 3);
+                            r->dst = 3 * (b->x0 - x0), r->n = 3 * (b->x1 - b->x0);
+                            r->hoff = -1, r->hfx = 0;
                         } else if (b->fast)
                             item[ni].b = b, item[ni++].xa = 0;
                         else if (prev_slow && item[ni - 1].m == pmap[i])
@@ -639,22 +637,8 @@ long fv_tw_warp_rows_bounded(const fv_timewarp_dsp *d, uint8_t *dst, ptrdiff_t d
                         prev_slow = !b->fast;
                     }
                 }
+                d->tw_runs(row, run, nr, src->rgb, stride, (ptrdiff_t)src->h * stride, hbuf);
                 int np = 0;
-                const uint8_t *srow = src->rgb + (ptrdiff_t)y * stride;
-                for (int k = 0; k < nr; k++) { /* block_row without its clamps: the same piece */
-                    tw_runner *r = &run[k];
-                    const int64_t u = r->qu >> 16, v = r->qv >> 16; /* row_offsets */
-                    const int ox = (int)(u >> 6) - (int)(TW_QBIAS >> 22), oy = (int)(v >> 6) - (int)(TW_QBIAS >> 22);
-                    const int fx = (int)(u & 63), fy = (int)(v & 63);
-                    r->qu += r->dqu, r->qv += r->dqv;
-                    fv_tw_piece *p = &pc[np++];
-                    const uint8_t *s0 = srow + (ptrdiff_t)oy * stride + r->col + 3 * (ptrdiff_t)ox;
-                    p->s0 = s0, p->s1 = fy ? s0 + stride : s0;
-                    p->dst = r->dst, p->n = r->n, p->fx = fx, p->fy = fy;
-                    if (y + oy + FV_TW_PREFETCH_ROWS + 1 < src->h) /* as block_row */
-                        for (int j = 0; j < r->npf; j++)
-                            __builtin_prefetch(s0 + FV_TW_PREFETCH_ROWS * stride + 64 * j);
-                }
                 for (int k = 0; k < ni; k++) {
                     const fv_tw_block *b = item[k].b;
                     if (b) {

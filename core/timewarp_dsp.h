@@ -33,6 +33,20 @@
  *   vqrdmulh steps). Reads s0[0, n + 3), s1[0, n + 3), nothing more. Every ISA version gives the
  *   reference's bytes.
  *
+ * tw_runs: the block warp's inner translated blocks on one display row (the "runners" of
+ *   core/timewarp.c): for each run r of runs[0, count), in order, its piece for this row from
+ *   its fixed-point translation (fv_tw_run_piece: phases fx, fy and source rows s0, s1 into
+ *   rgb, a plane of rows of stride bytes), resampled exactly as tw_spans resamples that piece into
+ *   dst + r->dst (r->n bytes), then r stepped to the next row (fv_tw_run_piece does). The same
+ *   reads as tw_spans' pieces. Hints that change no byte: the source 3 rows below a piece's is prefetched where that
+ *   row lies above pf_end (a byte offset into rgb: the plane's end), and the ISA versions keep a
+ *   piece's horizontal pass of its lower row (s1 at fx) in hbuf + 2 r->dst (bytes; scratch of
+ *   2 r->n bytes a run, the runs' ranges apart, 32-byte aligned where r->dst is 16-byte
+ *   aligned) with its key in r->hoff, r->hfx, so the next row, which mostly reads that row as
+ *   its upper one at the same phase, reuses it (half the multiplies). r->hoff = -1 (a run set
+ *   up, or after the C reference, which keeps nothing): nothing kept. Every ISA version gives
+ *   the reference's bytes and steps the runs as it does.
+ *
  * tw_stream: copies n bytes from src (a row just composed in cache) to dst (the display image),
  *   exact; the x86 versions store around the cache (non-temporal stores): the display image is
  *   not read back by this thread, and a store that misses the cache would otherwise read the
@@ -80,12 +94,28 @@ typedef struct fv_tw_piece {
     int fx, fy;             /* 0..63 */
 } fv_tw_piece;
 typedef void (*fv_tw_spans_fn)(uint8_t *restrict dst, const fv_tw_piece *pieces, int count);
+/* a translated block's rows: the translation of the next row to warp in 1/2^22 px, offset by
+ * FV_TW_RUN_BIAS px and with the rounding to 1/64 px added (fv_tw_run_piece), its step a row,
+ * and the source byte offset of the block's first column on that row at translation zero less
+ * the bias's (FV_TW_RUN_BIAS (stride + 3)): the offset stays an integer, never a pointer out of
+ * the plane */
+#define FV_TW_RUN_BIAS ((int64_t)1 << 30)
+typedef struct fv_tw_run {
+    int64_t qu, qv, dqu, dqv;
+    int64_t off;
+    int64_t hoff; /* the horizontal pass kept (tw_runs): its source row's offset (as off), -1 none */
+    int hfx;      /* and its phase */
+    int dst, n;   /* display bytes [dst, dst + n) of the row */
+} fv_tw_run;
+typedef void (*fv_tw_runs_fn)(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
+                              ptrdiff_t pf_end, int16_t *hbuf);
 typedef void (*fv_tw_minmax_fn)(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2]);
 typedef void (*fv_tw_stream_fn)(uint8_t *restrict dst, const uint8_t *restrict src, int n);
 
 typedef struct fv_timewarp_dsp {
     fv_tw_row_fn tw_row;
     fv_tw_spans_fn tw_spans;
+    fv_tw_runs_fn tw_runs;
     fv_tw_minmax_fn tw_minmax;
     fv_tw_stream_fn tw_stream;
 } fv_timewarp_dsp;
@@ -95,6 +125,8 @@ void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask);
 /* ---- internal: reference, shared per-pixel steps and per-ISA fillers ---- */
 int fv_tw_row_c(uint8_t *restrict dst, int x0, int y, int n, const fv_tw_map *m, const fv_tw_src *s);
 void fv_tw_spans_c(uint8_t *restrict dst, const fv_tw_piece *pieces, int count);
+void fv_tw_runs_c(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
+                  ptrdiff_t pf_end, int16_t *hbuf);
 void fv_tw_minmax_c(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2]);
 void fv_tw_stream_c(uint8_t *restrict dst, const uint8_t *restrict src, int n);
 
@@ -105,6 +137,21 @@ static inline uint8_t fv_tw_span_px(int a, int b, int c, int d, int fx, int fy)
     const int p = (h1 - h0) * (fy << 9) + 16384; /* |p| < 2^30 */
     const int v = h0 + (p >= 0 ? p >> 15 : -((-p + 32767) >> 15)); /* floor, as psraw */
     return (uint8_t)((v * 512 + 16384) >> 15);
+}
+
+/* tw_runs' step: run r's piece on this row (source rows s0, s1 = s0 + stride or, when fy = 0,
+ * s0 again; phases fx, fy; its source offset in *off for the prefetch), then r on the next row.
+ * u = qu >> 16 is the translation in 1/64 px plus 64 FV_TW_RUN_BIAS (qu biased so it stays
+ * positive: right shifts of negatives are the compiler's choice in C) */
+static inline const uint8_t *fv_tw_run_piece(fv_tw_run *r, const uint8_t *rgb, ptrdiff_t stride, int *fx, int *fy,
+                                             int64_t *off)
+{
+    const int64_t u = r->qu >> 16, v = r->qv >> 16;
+    r->qu += r->dqu, r->qv += r->dqv;
+    *fx = (int)(u & 63), *fy = (int)(v & 63);
+    *off = r->off + (v >> 6) * (int64_t)stride + 3 * (u >> 6);
+    r->off += stride;
+    return rgb + *off;
 }
 
 static inline float fv_tw_clampf(float v, float hi)

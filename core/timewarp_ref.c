@@ -26,6 +26,21 @@ void fv_tw_spans_c(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
     }
 }
 
+void fv_tw_runs_c(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
+                  ptrdiff_t pf_end, int16_t *hbuf)
+{
+    (void)pf_end, (void)hbuf;
+    for (int i = 0; i < count; i++) {
+        runs[i].hoff = -1;
+        int fx, fy;
+        int64_t off;
+        const uint8_t *s0 = fv_tw_run_piece(&runs[i], rgb, stride, &fx, &fy, &off), *s1 = fy ? s0 + stride : s0;
+        uint8_t *o = dst + runs[i].dst;
+        for (int k = 0; k < runs[i].n; k++)
+            o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+    }
+}
+
 void fv_tw_minmax_c(const uint16_t *p, ptrdiff_t stride, int w, int h, unsigned out[2])
 {
     unsigned lo = 65535, hi = 0;
@@ -48,6 +63,7 @@ void fv_timewarp_dsp_init(fv_timewarp_dsp *d, unsigned isa_mask)
 {
     d->tw_row = fv_tw_row_c;
     d->tw_spans = fv_tw_spans_c;
+    d->tw_runs = fv_tw_runs_c;
     d->tw_minmax = fv_tw_minmax_c;
     d->tw_stream = fv_tw_stream_c;
     const unsigned avail = isa_mask & fv_cpu_isas();

@@ -169,23 +169,90 @@ static inline uint8x16_t span16(const uint8_t *s0, const uint8_t *s1, uint8x8_t 
     return vcombine_u8(vqrshrun_n_s16(vl, 6), vqrshrun_n_s16(vh, 6));
 }
 
+/* one piece: n bytes at phase (fx, fy) from s0, s1 into o; pf: prefetched as the piece is read
+ * (its bytes from pf on: the source a few rows below), or s0 */
+static inline __attribute__((always_inline)) void span_piece(uint8_t *o, const uint8_t *s0, const uint8_t *s1, const uint8_t *pf, int n, int fx, int fy)
+{
+    const uint8x8_t w0 = vdup_n_u8((uint8_t)(64 - fx)), w1 = vdup_n_u8((uint8_t)fx);
+    const int16x8_t wy = vdupq_n_s16((int16_t)(fy << 9));
+    int k = 0;
+    for (; k + 16 <= n; k += 16) {
+        if (!(k & 63))
+            __builtin_prefetch(pf + k);
+        vst1q_u8(o + k, span16(s0 + k, s1 + k, w0, w1, wy));
+    }
+    __builtin_prefetch(pf + n + 2); /* the piece's last source byte */
+    if (k < n && n >= 16) {
+        vst1q_u8(o + n - 16, span16(s0 + n - 16, s1 + n - 16, w0, w1, wy));
+        k = n;
+    }
+    for (; k < n; k++)
+        o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+}
+
 static void tw_spans_neon(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
 {
     for (int i = 0; i < count; i++) {
         const fv_tw_piece *p = &pieces[i];
-        const int n = p->n, fx = p->fx, fy = p->fy;
+        span_piece(dst + p->dst, p->s0, p->s1, p->s0, p->n, p->fx, p->fy);
+    }
+}
+
+/* tw_runs' 16-byte steps of a piece: the lower row's horizontal pass kept in h for the next
+ * row (reuse: this row's upper pass is there already) */
+static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const uint8_t *s0, const uint8_t *s1,
+                                                            const uint8_t *pf, int n16, uint8x8_t w0, uint8x8_t w1,
+                                                            int16x8_t wy, int16_t *h, int reuse)
+{
+    for (int k = 0; k < n16; k += 16) {
+        if (!(k & 63))
+            __builtin_prefetch(pf + k);
+        int16x8_t h0l, h0h;
+        if (reuse) {
+            h0l = vld1q_s16(h + k), h0h = vld1q_s16(h + k + 8);
+        } else {
+            const uint8x16_t a = vld1q_u8(s0 + k), b = vld1q_u8(s0 + k + 3);
+            h0l = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_low_u8(a), w0), vget_low_u8(b), w1));
+            h0h = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_high_u8(a), w0), vget_high_u8(b), w1));
+        }
+        const uint8x16_t c = vld1q_u8(s1 + k), d = vld1q_u8(s1 + k + 3);
+        const int16x8_t h1l = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_low_u8(c), w0), vget_low_u8(d), w1));
+        const int16x8_t h1h = vreinterpretq_s16_u16(vmlal_u8(vmull_u8(vget_high_u8(c), w0), vget_high_u8(d), w1));
+        vst1q_s16(h + k, h1l), vst1q_s16(h + k + 8, h1h);
+        const int16x8_t vl = vaddq_s16(h0l, vqrdmulhq_s16(vsubq_s16(h1l, h0l), wy));
+        const int16x8_t vh = vaddq_s16(h0h, vqrdmulhq_s16(vsubq_s16(h1h, h0h), wy));
+        vst1q_u8(o + k, vcombine_u8(vqrshrun_n_s16(vl, 6), vqrshrun_n_s16(vh, 6)));
+    }
+}
+
+/* plain stores: the intrinsics have no non-temporal store (as tw_stream_neon) */
+static void tw_runs_neon(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
+                         ptrdiff_t pf_end, int16_t *hbuf)
+{
+    for (int i = 0; i < count; i++) {
+        fv_tw_run *r = &runs[i];
+        int fx, fy;
+        int64_t off;
+        const uint8_t *s0 = fv_tw_run_piece(r, rgb, stride, &fx, &fy, &off), *s1 = fy ? s0 + stride : s0;
+        const uint8_t *pf = off + 4 * stride < pf_end ? s0 + 3 * stride : s0;
+        const int n = r->n, n16 = n & ~15, reuse = r->hoff == off && r->hfx == fx;
+        uint8_t *o = dst + r->dst;
+        int16_t *h = hbuf + r->dst;
         const uint8x8_t w0 = vdup_n_u8((uint8_t)(64 - fx)), w1 = vdup_n_u8((uint8_t)fx);
         const int16x8_t wy = vdupq_n_s16((int16_t)(fy << 9));
-        uint8_t *o = dst + p->dst;
-        int k = 0;
-        for (; k + 16 <= n; k += 16)
-            vst1q_u8(o + k, span16(p->s0 + k, p->s1 + k, w0, w1, wy));
-        if (k < n && n >= 16) {
-            vst1q_u8(o + n - 16, span16(p->s0 + n - 16, p->s1 + n - 16, w0, w1, wy));
+        if (reuse)
+            run_steps(o, s0, s1, pf, n16, w0, w1, wy, h, 1);
+        else
+            run_steps(o, s0, s1, pf, n16, w0, w1, wy, h, 0);
+        r->hoff = n16 ? (fy ? off + stride : off) : -1, r->hfx = fx;
+        __builtin_prefetch(pf + n + 2); /* the piece's last source byte */
+        int k = n16;
+        if (k < n && n >= 16) { /* the last 16 again, overlapping, without the kept pass: the same bytes */
+            vst1q_u8(o + n - 16, span16(s0 + n - 16, s1 + n - 16, w0, w1, wy));
             k = n;
         }
         for (; k < n; k++)
-            o[k] = fv_tw_span_px(p->s0[k], p->s0[k + 3], p->s1[k], p->s1[k + 3], fx, fy);
+            o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
     }
 }
 
@@ -226,5 +293,6 @@ void fv_timewarp_dsp_init_neon(fv_timewarp_dsp *d)
     d->tw_stream = tw_stream_neon;
     d->tw_row = tw_row_neon;
     d->tw_spans = tw_spans_neon;
+    d->tw_runs = tw_runs_neon;
     d->tw_minmax = tw_minmax_neon;
 }

@@ -200,39 +200,146 @@ static inline __m128i span16(const uint8_t *s0, const uint8_t *s1, __m128i wx, _
     return _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512));
 }
 
-static void tw_spans_avx2(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+/* bytes [k, n) of a piece in 16-byte steps, the last one overlapping (n >= 16), else one by one */
+static inline __attribute__((always_inline)) void span_tail(uint8_t *o, const uint8_t *s0, const uint8_t *s1, int k,
+                                                            int n, int fx, int fy)
+{
+    const __m128i wx = _mm_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm_set1_epi16((short)(fy << 9));
+    const __m128i k512 = _mm_set1_epi16(512);
+    for (; k + 16 <= n; k += 16)
+        _mm_storeu_si128((__m128i *)(void *)(o + k), span16(s0 + k, s1 + k, wx, wy, k512));
+    if (k < n && n >= 16) { /* the last 16 again, overlapping: the same bytes */
+        _mm_storeu_si128((__m128i *)(void *)(o + n - 16), span16(s0 + n - 16, s1 + n - 16, wx, wy, k512));
+        k = n;
+    }
+    for (; k < n; k++)
+        o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+}
+
+/* one piece: n bytes at phase (fx, fy) from s0, s1 into o; pf: prefetched as the piece is read
+ * (its bytes from pf on: the source a few rows below), or s0 */
+static inline __attribute__((always_inline)) void span_piece(uint8_t *o, const uint8_t *s0, const uint8_t *s1, const uint8_t *pf, int n, int fx, int fy)
 {
     const __m256i k512 = _mm256_set1_epi16(512);
+    const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
+    int k = 0;
+    for (; k + 32 <= n; k += 32) {
+        _mm_prefetch((const char *)(pf + k), _MM_HINT_T0);
+        const __m256i a = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k));
+        const __m256i b = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k + 3));
+        const __m256i c = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k));
+        const __m256i e = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k + 3));
+        const __m256i h0l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(a, b), wx);
+        const __m256i h0h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(a, b), wx);
+        const __m256i h1l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(c, e), wx);
+        const __m256i h1h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(c, e), wx);
+        const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
+        const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
+        _mm256_storeu_si256((__m256i *)(void *)(o + k),
+                            _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512)));
+    }
+    _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
+    if (k < n)
+        span_tail(o, s0, s1, k, n, fx, fy);
+}
+
+static void tw_spans_avx2(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+{
     for (int i = 0; i < count; i++) {
         const fv_tw_piece *p = &pieces[i];
-        const uint8_t *s0 = p->s0, *s1 = p->s1;
-        uint8_t *o = dst + p->dst;
-        const int n = p->n, fx = p->fx, fy = p->fy;
-        const __m256i wx = _mm256_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm256_set1_epi16((short)(fy << 9));
-        int k = 0;
-        for (; k + 32 <= n; k += 32) {
+        span_piece(dst + p->dst, p->s0, p->s1, p->s0, p->n, p->fx, p->fy);
+    }
+}
+
+/* tw_runs' 32-byte steps of a piece: the lower row's horizontal pass kept in h for the next
+ * row (reuse: this row's upper pass is there already) */
+static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const uint8_t *s0, const uint8_t *s1,
+                                                            const uint8_t *pf, int n32, __m256i wx, __m256i wy,
+                                                            int16_t *h, int reuse)
+{
+    const __m256i k512 = _mm256_set1_epi16(512);
+    for (int k = 0; k < n32; k += 32) {
+        _mm_prefetch((const char *)(pf + k), _MM_HINT_T0);
+        __m256i h0l, h0h;
+        if (reuse) {
+            h0l = _mm256_loadu_si256((const __m256i *)(const void *)(h + k));
+            h0h = _mm256_loadu_si256((const __m256i *)(const void *)(h + k + 16));
+        } else {
             const __m256i a = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k));
             const __m256i b = _mm256_loadu_si256((const __m256i *)(const void *)(s0 + k + 3));
-            const __m256i c = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k));
-            const __m256i e = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k + 3));
-            const __m256i h0l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(a, b), wx);
-            const __m256i h0h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(a, b), wx);
-            const __m256i h1l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(c, e), wx);
-            const __m256i h1h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(c, e), wx);
-            const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
-            const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
-            _mm256_storeu_si256((__m256i *)(void *)(o + k),
-                                _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512)));
+            h0l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(a, b), wx);
+            h0h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(a, b), wx);
         }
-        const __m128i wx4 = _mm256_castsi256_si128(wx), wy4 = _mm256_castsi256_si128(wy), k5 = _mm256_castsi256_si128(k512);
-        for (; k + 16 <= n; k += 16)
-            _mm_storeu_si128((__m128i *)(void *)(o + k), span16(s0 + k, s1 + k, wx4, wy4, k5));
-        if (k < n && n >= 16) { /* the last 16 again, overlapping: the same bytes */
-            _mm_storeu_si128((__m128i *)(void *)(o + n - 16), span16(s0 + n - 16, s1 + n - 16, wx4, wy4, k5));
-            k = n;
+        const __m256i c = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k));
+        const __m256i e = _mm256_loadu_si256((const __m256i *)(const void *)(s1 + k + 3));
+        const __m256i h1l = _mm256_maddubs_epi16(_mm256_unpacklo_epi8(c, e), wx);
+        const __m256i h1h = _mm256_maddubs_epi16(_mm256_unpackhi_epi8(c, e), wx);
+        _mm256_storeu_si256((__m256i *)(void *)(h + k), h1l);
+        _mm256_storeu_si256((__m256i *)(void *)(h + k + 16), h1h);
+        const __m256i vl = _mm256_add_epi16(h0l, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1l, h0l), wy));
+        const __m256i vh = _mm256_add_epi16(h0h, _mm256_mulhrs_epi16(_mm256_sub_epi16(h1h, h0h), wy));
+        const __m256i v = _mm256_packus_epi16(_mm256_mulhrs_epi16(vl, k512), _mm256_mulhrs_epi16(vh, k512));
+        _mm256_storeu_si256((__m256i *)(void *)(o + k), v);
+    }
+}
+
+/* one 16-byte step at k, as run_steps (a grid cell's 48 bytes: 32 + 16) */
+static inline __attribute__((always_inline)) void run_step16(uint8_t *o, const uint8_t *s0, const uint8_t *s1, int k,
+                                                             __m256i wx, __m256i wy, int16_t *h, int reuse)
+{
+    const __m128i wx4 = _mm256_castsi256_si128(wx), wy4 = _mm256_castsi256_si128(wy), k512 = _mm_set1_epi16(512);
+    __m128i h0l, h0h;
+    if (reuse) {
+        h0l = _mm_loadu_si128((const __m128i *)(const void *)(h + k));
+        h0h = _mm_loadu_si128((const __m128i *)(const void *)(h + k + 8));
+    } else {
+        const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(s0 + k));
+        const __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(s0 + k + 3));
+        h0l = _mm_maddubs_epi16(_mm_unpacklo_epi8(a, b), wx4), h0h = _mm_maddubs_epi16(_mm_unpackhi_epi8(a, b), wx4);
+    }
+    const __m128i c = _mm_loadu_si128((const __m128i *)(const void *)(s1 + k));
+    const __m128i d = _mm_loadu_si128((const __m128i *)(const void *)(s1 + k + 3));
+    const __m128i h1l = _mm_maddubs_epi16(_mm_unpacklo_epi8(c, d), wx4), h1h = _mm_maddubs_epi16(_mm_unpackhi_epi8(c, d), wx4);
+    _mm_storeu_si128((__m128i *)(void *)(h + k), h1l);
+    _mm_storeu_si128((__m128i *)(void *)(h + k + 8), h1h);
+    const __m128i vl = _mm_add_epi16(h0l, _mm_mulhrs_epi16(_mm_sub_epi16(h1l, h0l), wy4));
+    const __m128i vh = _mm_add_epi16(h0h, _mm_mulhrs_epi16(_mm_sub_epi16(h1h, h0h), wy4));
+    _mm_storeu_si128((__m128i *)(void *)(o + k), _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512)));
+}
+
+/* the last bytes of a run's piece (off the 16-byte steps: rare, out of the loop's registers) */
+static __attribute__((noinline)) void run_tail(uint8_t *o, const uint8_t *s0, const uint8_t *s1, int k, int n, int fx,
+                                               int fy)
+{
+    span_tail(o, s0, s1, k, n, fx, fy);
+}
+
+static void tw_runs_avx2(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
+                         ptrdiff_t pf_end, int16_t *hbuf)
+{
+    const int64_t pf_lim = (int64_t)pf_end - 4 * (int64_t)stride, pf_d = 3 * (int64_t)stride;
+    for (fv_tw_run *r = runs, *e = runs + count; r < e; r++) {
+        int fx, fy;
+        int64_t off;
+        const uint8_t *s0 = fv_tw_run_piece(r, rgb, stride, &fx, &fy, &off), *s1 = s0 + (fy ? stride : 0);
+        const uint8_t *pf = s0 + (off < pf_lim ? pf_d : 0);
+        const int n = r->n, n32 = n & ~31, n16 = n & ~15, reuse = (r->hoff == off) & (r->hfx == fx);
+        r->hoff = n16 ? off + (fy ? stride : 0) : -1, r->hfx = fx;
+        uint8_t *o = dst + r->dst;
+        int16_t *h = hbuf + r->dst;
+        const __m256i wx = _mm256_set1_epi16((short)(fx * 255 + 64)), wy = _mm256_set1_epi16((short)(fy << 9));
+        if (reuse) {
+            run_steps(o, s0, s1, pf, n32, wx, wy, h, 1);
+            if (n16 > n32)
+                run_step16(o, s0, s1, n32, wx, wy, h, 1);
+        } else {
+            run_steps(o, s0, s1, pf, n32, wx, wy, h, 0);
+            if (n16 > n32)
+                run_step16(o, s0, s1, n32, wx, wy, h, 0);
         }
-        for (; k < n; k++)
-            o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+        _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
+        if (n16 < n)
+            run_tail(o, s0, s1, n16, n, fx, fy);
     }
 }
 
@@ -278,5 +385,6 @@ void fv_timewarp_dsp_init_avx2(fv_timewarp_dsp *d)
     d->tw_stream = tw_stream_avx2;
     d->tw_row = tw_row_avx2;
     d->tw_spans = tw_spans_avx2;
+    d->tw_runs = tw_runs_avx2;
     d->tw_minmax = tw_minmax_avx2;
 }

@@ -154,24 +154,93 @@ static inline __m128i span16(const uint8_t *s0, const uint8_t *s1, __m128i wx, _
     return _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512));
 }
 
-static void tw_spans_sse41(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+/* one piece: n bytes at phase (fx, fy) from s0, s1 into o; pf: prefetched as the piece is read
+ * (its bytes from pf on: the source a few rows below), or s0 */
+static inline __attribute__((always_inline)) void span_piece(uint8_t *o, const uint8_t *s0, const uint8_t *s1, const uint8_t *pf, int n, int fx, int fy)
 {
     const __m128i k512 = _mm_set1_epi16(512);
+    const __m128i wx = _mm_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm_set1_epi16((short)(fy << 9));
+    int k = 0;
+    for (; k + 16 <= n; k += 16) {
+        if (!(k & 63))
+            _mm_prefetch((const char *)(pf + k), _MM_HINT_T0);
+        _mm_storeu_si128((__m128i *)(void *)(o + k), span16(s0 + k, s1 + k, wx, wy, k512));
+    }
+    _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
+    if (n >= 16 && k < n) { /* the last 16 again, overlapping: the bytes are the same */
+        k = n - 16;
+        _mm_storeu_si128((__m128i *)(void *)(o + k), span16(s0 + k, s1 + k, wx, wy, k512));
+        k = n;
+    }
+    for (; k < n; k++)
+        o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
+}
+
+static void tw_spans_sse41(uint8_t *restrict dst, const fv_tw_piece *pieces, int count)
+{
     for (int i = 0; i < count; i++) {
         const fv_tw_piece *p = &pieces[i];
-        const int n = p->n, fx = p->fx, fy = p->fy;
+        span_piece(dst + p->dst, p->s0, p->s1, p->s0, p->n, p->fx, p->fy);
+    }
+}
+
+/* tw_runs' 16-byte steps of a piece: the lower row's horizontal pass kept in h for the next
+ * row (reuse: this row's upper pass is there already) */
+static inline __attribute__((always_inline)) void run_steps(uint8_t *o, const uint8_t *s0, const uint8_t *s1,
+                                                            const uint8_t *pf, int n16, __m128i wx, __m128i wy,
+                                                            int16_t *h, int reuse)
+{
+    const __m128i k512 = _mm_set1_epi16(512);
+    for (int k = 0; k < n16; k += 16) {
+        if (!(k & 63))
+            _mm_prefetch((const char *)(pf + k), _MM_HINT_T0);
+        __m128i h0l, h0h;
+        if (reuse) {
+            h0l = _mm_loadu_si128((const __m128i *)(const void *)(h + k));
+            h0h = _mm_loadu_si128((const __m128i *)(const void *)(h + k + 8));
+        } else {
+            const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(s0 + k));
+            const __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(s0 + k + 3));
+            h0l = _mm_maddubs_epi16(_mm_unpacklo_epi8(a, b), wx), h0h = _mm_maddubs_epi16(_mm_unpackhi_epi8(a, b), wx);
+        }
+        const __m128i c = _mm_loadu_si128((const __m128i *)(const void *)(s1 + k));
+        const __m128i d = _mm_loadu_si128((const __m128i *)(const void *)(s1 + k + 3));
+        const __m128i h1l = _mm_maddubs_epi16(_mm_unpacklo_epi8(c, d), wx), h1h = _mm_maddubs_epi16(_mm_unpackhi_epi8(c, d), wx);
+        _mm_storeu_si128((__m128i *)(void *)(h + k), h1l);
+        _mm_storeu_si128((__m128i *)(void *)(h + k + 8), h1h);
+        const __m128i vl = _mm_add_epi16(h0l, _mm_mulhrs_epi16(_mm_sub_epi16(h1l, h0l), wy));
+        const __m128i vh = _mm_add_epi16(h0h, _mm_mulhrs_epi16(_mm_sub_epi16(h1h, h0h), wy));
+        const __m128i v = _mm_packus_epi16(_mm_mulhrs_epi16(vl, k512), _mm_mulhrs_epi16(vh, k512));
+        _mm_storeu_si128((__m128i *)(void *)(o + k), v);
+    }
+}
+
+static void tw_runs_sse41(uint8_t *restrict dst, fv_tw_run *runs, int count, const uint8_t *rgb, ptrdiff_t stride,
+                          ptrdiff_t pf_end, int16_t *hbuf)
+{
+    for (int i = 0; i < count; i++) {
+        fv_tw_run *r = &runs[i];
+        int fx, fy;
+        int64_t off;
+        const uint8_t *s0 = fv_tw_run_piece(r, rgb, stride, &fx, &fy, &off), *s1 = fy ? s0 + stride : s0;
+        const uint8_t *pf = off + 4 * stride < pf_end ? s0 + 3 * stride : s0;
+        const int n = r->n, n16 = n & ~15, reuse = r->hoff == off && r->hfx == fx;
+        uint8_t *o = dst + r->dst;
+        int16_t *h = hbuf + r->dst;
         const __m128i wx = _mm_set1_epi16((short)(fx << 8 | (64 - fx))), wy = _mm_set1_epi16((short)(fy << 9));
-        uint8_t *o = dst + p->dst;
-        int k = 0;
-        for (; k + 16 <= n; k += 16)
-            _mm_storeu_si128((__m128i *)(void *)(o + k), span16(p->s0 + k, p->s1 + k, wx, wy, k512));
-        if (n >= 16 && k < n) { /* the last 16 again, overlapping: the bytes are the same */
-            k = n - 16;
-            _mm_storeu_si128((__m128i *)(void *)(o + k), span16(p->s0 + k, p->s1 + k, wx, wy, k512));
+        if (reuse)
+            run_steps(o, s0, s1, pf, n16, wx, wy, h, 1);
+        else
+            run_steps(o, s0, s1, pf, n16, wx, wy, h, 0);
+        r->hoff = n16 ? (fy ? off + stride : off) : -1, r->hfx = fx;
+        _mm_prefetch((const char *)(pf + n + 2), _MM_HINT_T0); /* the piece's last source byte */
+        int k = n16;
+        if (k < n && n >= 16) { /* the last 16 again, overlapping, without the kept pass: the same bytes */
+            _mm_storeu_si128((__m128i *)(void *)(o + n - 16), span16(s0 + n - 16, s1 + n - 16, wx, wy, _mm_set1_epi16(512)));
             k = n;
         }
         for (; k < n; k++)
-            o[k] = fv_tw_span_px(p->s0[k], p->s0[k + 3], p->s1[k], p->s1[k + 3], fx, fy);
+            o[k] = fv_tw_span_px(s0[k], s0[k + 3], s1[k], s1[k + 3], fx, fy);
     }
 }
 
@@ -216,5 +285,6 @@ void fv_timewarp_dsp_init_sse41(fv_timewarp_dsp *d)
     d->tw_stream = tw_stream_sse41;
     d->tw_row = tw_row_sse41;
     d->tw_spans = tw_spans_sse41;
+    d->tw_runs = tw_runs_sse41;
     d->tw_minmax = tw_minmax_sse41;
 }

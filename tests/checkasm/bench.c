@@ -648,6 +648,36 @@ static void tw_free(void *st)
     free(t->rgb), free(t->dst), free(t->invd), free(t);
 }
 
+/* tw_runs: the block warp's translated rows as a one-refresh turn gives them (timewarp.c's
+ * runners): 40 runs of 32 px a row, each translated by a few px at its own phase, stepping a
+ * source row a display row with a slow vertical drift (the kept passes reused most rows) */
+static void runs_setup(const tw_st *t, fv_tw_run *r, int y)
+{
+    for (int i = 0; i < W / 32; i++) {
+        const int64_t one = (int64_t)1 << 22;
+        r[i].qu = (int64_t)(2 * one + i * one / 37) + (FV_TW_RUN_BIAS << 22) + 32768;
+        r[i].qv = (int64_t)(-one - i * one / 53) + (FV_TW_RUN_BIAS << 22) + 32768;
+        r[i].dqu = 0, r[i].dqv = one / 300 + i * one / 20000;
+        r[i].off = (int64_t)y * W * 3 + 3 * 32 * i - FV_TW_RUN_BIAS * ((int64_t)W * 3 + 3);
+        r[i].hoff = -1, r[i].hfx = 0, r[i].dst = 96 * i, r[i].n = 96;
+    }
+    (void)t;
+}
+static void tw_runs_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    tw_st *t = st;
+    fv_tw_run r[W / 32];
+    static int16_t hbuf[W * 3];
+    int y = 2 + row0 % (H - 12);
+    runs_setup(t, r, y);
+    for (int k = 0; k < rows; k++, y++) {
+        if (y >= H - 10) /* the runs read a few rows below: start again at the top */
+            runs_setup(t, r, y = 2);
+        d->tw.tw_runs(t->dst + (size_t)y * W * 3, r, W / 32, t->rgb, (ptrdiff_t)W * 3, (ptrdiff_t)H * W * 3, hbuf);
+    }
+    d->tw.tw_stream(NULL, NULL, 0);
+}
+
 /* ---- shading: a full frame's packets of 16 hits, head light (range, FlightHelmet) and two
  * KHR lights (DepthOfFieldExample has KHR lights) ---- */
 #define SH_PACKETS (W * H / FV_SHADE_LANES)
@@ -768,6 +798,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"et_box3_row", "640x480, 478 rows", {F(et.et_box3_row), 0}, EH - 2, et_setup, NULL, box3_run, et_free},
     {"rgb8_row", "1280-px rows in cache, 1440 out", {F(out.rgb8_row), 0}, H, out_setup, NULL, out_run, out_free},
     {"tw_row", "1280x1440, 1440 rows, 1 refresh of a 30 deg/s turn", {F(tw.tw_row), 0}, H, tw_setup, NULL, tw_run,
+     tw_free},
+    {"tw_runs", "1280x1440, 1440 rows of 40 translated 32-px runs", {F(tw.tw_runs), 0}, H, tw_setup, NULL, tw_runs_run,
      tw_free},
 };
 const int checkasm_bench_count = (int)(sizeof checkasm_bench_kernels / sizeof checkasm_bench_kernels[0]);

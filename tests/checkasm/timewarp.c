@@ -4,7 +4,9 @@
  * that hit the depth conversion's floor, maps with a NaN), sources with depth edges, flat depth,
  * the nearest and the farthest depth codes; every row length from 1 up with tails, offsets into
  * the row, the first and last rows; tw_spans on random pieces (lengths 1 up, phases 0 and 63,
- * exact-size source rows); tw_minmax on random rectangles. Then the block warp (core/timewarp.c) on every
+ * exact-size source rows); tw_runs over consecutive rows (the kept horizontal passes reused
+ * and invalidated, aligned and unaligned display rows) against the C reference and against
+ * tw_spans on the pieces of the translation's definition; tw_minmax on random rectangles. Then the block warp (core/timewarp.c) on every
  * ISA against the per-pixel C reference within its contract (timewarp.h): translated pixels
  * within FV_TW_BLOCK_POS_PX of the reference's tap and within the value bound, the others and
  * the disocclusion count exact. Outputs canaried; source planes exact-size plus the contract's
@@ -18,7 +20,7 @@
 #include "camera.h"
 #include "timewarp.h"
 
-static const char *const names[] = {"tw_row", "tw_spans", "tw_minmax", "tw_stream"};
+static const char *const names[] = {"tw_row", "tw_spans", "tw_runs", "tw_minmax", "tw_stream"};
 
 static void test_tables(void **state)
 {
@@ -183,6 +185,98 @@ static void test_tw_spans(void **state)
                 free(src[i][0]), free(src[i][1]);
         }
     }
+}
+
+/* tw_runs on every ISA, several consecutive rows of the same runs (a run whose translation
+ * steps one source row a row at a fixed phase reuses its kept pass), against the C reference
+ * (bytes, the runs stepped alike) and the C reference against tw_spans on the pieces of the
+ * runs' definition (timewarp_dsp.h): row k of run r translates by (qu + k dqu) / 2^22 px,
+ * rounded to 1/64 px. Display rows with their 64 bytes around and the gaps between runs
+ * compared too (nothing written there), at offsets that are and are not vector-aligned. */
+static void test_tw_runs(void **state)
+{
+    (void)state;
+    enum { RN_SW = 97, RN_SH = 40, RN_MAXR = 7, RN_ROWS = 9, RN_GUARD = 64 };
+    const ptrdiff_t stride = 3 * RN_SW;
+    uint8_t *rgb = malloc((size_t)stride * RN_SH);
+    assert_non_null(rgb);
+    for (int k = 0; checkasm_isas[k]; k++) {
+        const unsigned isa = checkasm_isas[k];
+        if (!checkasm_cpu_runs(isa, "tw_runs"))
+            continue;
+        fv_timewarp_dsp d;
+        fv_timewarp_dsp_init(&d, isa == FV_ISA_AVX2 ? FV_ISA_SSE41 | FV_ISA_AVX2 : isa);
+        for (int trial = 0; trial < 200; trial++) {
+            for (ptrdiff_t i = 0; i < stride * RN_SH; i++) {
+                const uint64_t v = checkasm_rand();
+                rgb[i] = (uint8_t)(trial % 4 == 0 ? (v & 1) * 255 : v);
+            }
+            const int nr = 1 + (int)(checkasm_rand() % RN_MAXR);
+            fv_tw_run rr[RN_MAXR], rt[RN_MAXR];
+            int64_t q0[RN_MAXR][2]; /* the unbiased first-row translations, 1/2^22 px */
+            int len = trial % 3 ? (int)(checkasm_rand() % 40) : 0, x0[RN_MAXR], y0 = 4 + (int)(checkasm_rand() % 8);
+            for (int i = 0; i < nr; i++) {
+                /* lengths: the warp's 48, 96, 192 bytes (16, 32, 64 px) or any 1..200 */
+                const uint64_t r = checkasm_rand();
+                const int n = r % 4 == 0 ? 48 : r % 4 == 1 ? 96 : r % 4 == 2 ? 192 : 1 + (int)((r >> 8) % 200);
+                const int px = (n + 2) / 3; /* display columns the run's bytes cover, near enough */
+                x0[i] = 3 + (int)((r >> 16) % (uint64_t)(RN_SW - px - 10 > 1 ? RN_SW - px - 10 : 1));
+                /* translations within +-3 px; steps: none (reuse every row), a phase a few rows
+                 * (reuse mostly), or a source row and a bit a row (never the same row again) */
+                q0[i][0] = (int64_t)((checkasm_rand() % 6001) - 3000) * ((int64_t)1 << 22) / 1000;
+                q0[i][1] = (int64_t)((checkasm_rand() % 6001) - 3000) * ((int64_t)1 << 22) / 1000;
+                const int kind = (int)(checkasm_rand() % 3);
+                const int64_t du = kind == 0 ? 0 : kind == 1 ? ((int64_t)1 << 22) / 200 : ((int64_t)1 << 22) * 13 / 10;
+                const int64_t dv = kind == 0 ? 0 : kind == 1 ? -((int64_t)1 << 22) / 150 : ((int64_t)1 << 22) * 11 / 10;
+                fv_tw_run *o = &rr[i];
+                o->qu = q0[i][0] + (FV_TW_RUN_BIAS << 22) + 32768, o->qv = q0[i][1] + (FV_TW_RUN_BIAS << 22) + 32768;
+                o->dqu = du, o->dqv = kind == 2 ? dv : dv / 3;
+                o->off = (int64_t)y0 * stride + 3 * x0[i] - FV_TW_RUN_BIAS * ((int64_t)stride + 3);
+                o->hoff = -1, o->hfx = 0;
+                if (trial % 3 == 0) /* 16-byte multiples: the aligned stores */
+                    len = (len + 15) & ~15;
+                o->dst = len, o->n = n;
+                len += n + (int)(checkasm_rand() % 9) * (trial % 3 == 0 ? 16 : 1);
+            }
+            memcpy(rt, rr, sizeof rr);
+            const int shift = trial % 3 == 0 ? 0 : trial % 3 == 1 ? 32 : 5 + trial % 11;
+            const size_t all = (size_t)RN_GUARD + 64 + (size_t)len + RN_GUARD;
+            uint8_t *bufr = aligned_alloc(64, (all + 63) & ~(size_t)63), *buft = aligned_alloc(64, (all + 63) & ~(size_t)63);
+            uint8_t *bufs = aligned_alloc(64, (all + 63) & ~(size_t)63);
+            int16_t *hb = malloc(((size_t)len + 16) * sizeof *hb);
+            assert_true(bufr && buft && bufs && hb);
+            for (size_t i = 0; i < all; i++)
+                bufr[i] = buft[i] = bufs[i] = (uint8_t)(0xa5 ^ i);
+            uint8_t *dr = bufr + RN_GUARD + shift, *dt = buft + RN_GUARD + shift, *ds = bufs + RN_GUARD + shift;
+            for (int row = 0; row < RN_ROWS; row++) {
+                const ptrdiff_t pf_end = (ptrdiff_t)(RN_SH - 1) * stride; /* rows below not read: the hint only */
+                fv_tw_runs_c(dr, rr, nr, rgb, stride, pf_end, hb);
+                d.tw_runs(dt, rt, nr, rgb, stride, pf_end, hb);
+                checkasm_compare(bufr, buft, all, CHECKASM_U8, 1, CHECKASM_EXACT, "%s tw_runs trial=%d row=%d runs=%d",
+                                 fv_isa_name(isa), trial, row, nr);
+                for (int i = 0; i < nr; i++)
+                    if (rr[i].qu != rt[i].qu || rr[i].qv != rt[i].qv || rr[i].off != rt[i].off)
+                        fail_msg("%s tw_runs trial=%d row=%d run=%d: stepped differently", fv_isa_name(isa), trial, row, i);
+                /* the definition: tw_spans on the pieces of the rounded translation */
+                fv_tw_piece pc[RN_MAXR];
+                for (int i = 0; i < nr; i++) {
+                    const double tu = floor(((double)q0[i][0] + (double)row * (double)rr[i].dqu) / 65536.0 + 0.5);
+                    const double tv = floor(((double)q0[i][1] + (double)row * (double)rr[i].dqv) / 65536.0 + 0.5);
+                    const int ox = (int)floor(tu / 64.0), oy = (int)floor(tv / 64.0);
+                    pc[i].fx = (int)(tu - 64.0 * ox), pc[i].fy = (int)(tv - 64.0 * oy);
+                    pc[i].s0 = rgb + (y0 + row + oy) * stride + 3 * (x0[i] + ox);
+                    pc[i].s1 = pc[i].fy ? pc[i].s0 + stride : pc[i].s0;
+                    pc[i].dst = rr[i].dst, pc[i].n = rr[i].n;
+                    assert_true(y0 + row + oy >= 0 && y0 + row + oy + 1 < RN_SH && x0[i] + ox >= 0);
+                }
+                fv_tw_spans_c(ds, pc, nr);
+                checkasm_compare(bufs, bufr, all, CHECKASM_U8, 1, CHECKASM_EXACT, "tw_runs C against tw_spans trial=%d row=%d",
+                                 trial, row);
+            }
+            free(bufr), free(buft), free(bufs), free(hb);
+        }
+    }
+    free(rgb);
 }
 
 /* tw_spans' C reference against the bilinear value it rounds: within 1 level of
@@ -495,6 +589,7 @@ const struct CMUnitTest checkasm_timewarp_tests[] = {
     cmocka_unit_test(test_tw_row),
     cmocka_unit_test(test_tw_spans),
     cmocka_unit_test(test_tw_spans_formula),
+    cmocka_unit_test(test_tw_runs),
     cmocka_unit_test(test_tw_minmax),
     cmocka_unit_test(test_tw_stream),
     cmocka_unit_test(test_block_warp),
