@@ -286,74 +286,123 @@ static inline __attribute__((always_inline)) void group_taps(const struct fv_taa
 /* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). The
  * history pixels stay as loaded, two per 256-bit register; their depths are taken out in the
  * lane order 0, 2, 4, 6, 1, 3, 5, 7 (two shuffles), checked in that order, and only the depth
- * lanes of the stored pixels are replaced. */
-static inline __attribute__((always_inline)) int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                                const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
+ * lanes of the stored pixels are replaced.
+ * Per block, not per row (branch taa9): the span of whole steps, the columns' uc * NX and pixel
+ * centres and the frame's constants are the same for every row of the block (the flow is the
+ * block's), so they are made once; a row costs its B = N0 + vc NY and its steps. The products
+ * uc * NX are the reference's (B + uc NX adds the same float), so the bits do not change. */
+#define FILL_MAX_STEPS 8 /* w <= 64 */
+static void taa_fill_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk, float *wgt_blk,
+                          ptrdiff_t stride, int x0, int y0, int w, int h)
 {
-    const int sx0 = x0 + t->flow_x;
+    int ilo, ihi;
+    taa_fill_span(f, t, x0, w, &ilo, &ihi);
+    const int sx0 = x0 + t->flow_x, nstep = ihi - ilo >= 8 ? (ihi - ilo) / 8 : 0, iend = ilo + 8 * nstep;
+    const int identity = f->identity;
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const float *hrgbd = L->rgbd, *hwgt = L->wgt;
+    const ptrdiff_t hstride = L->stride;
+    const float prev_h = f->prev_h;
+    const float N0[3] = {f->N0[0], f->N0[1], f->N0[2]}, NY[3] = {f->NY[0], f->NY[1], f->NY[2]};
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), mhalf = _mm256_set1_ps(-0.5f);
-    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);       /* lane -> pixel of the depth order */
-    const __m256i to_linear = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);   /* depth order -> pixel order */
-    const __m256i pair_mask0 = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), pair_mask1 = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
-    const __m256i pair_mask2 = _mm256_setr_epi32(4, 4, 4, 4, 5, 5, 5, 5), pair_mask3 = _mm256_setr_epi32(6, 6, 6, 6, 7, 7, 7, 7);
-    __m256 T2[3], Bk[3], NX[3];
-    for (int k = 0; k < 3; k++)
-        T2[k] = _mm256_set1_ps(f->T2[k]), Bk[k] = _mm256_set1_ps(B[k]), NX[k] = _mm256_set1_ps(f->NX[k]);
-    const __m256 pyv = _mm256_set1_ps(py), zmin = _mm256_set1_ps(1e-4f), one = _mm256_set1_ps(1.0f);
-    int i = ilo;
-    for (; i + 8 <= ihi; i += 8) {
-        const __m256 w = _mm256_loadu_ps(wgt + i);
-        const int sx = sx0 + i;
-        const __m256 ws = _mm256_loadu_ps(hw + sx);
-        __m256 m = _mm256_and_ps(_mm256_cmp_ps(w, zero, _CMP_EQ_OQ), _mm256_cmp_ps(ws, zero, _CMP_GT_OQ));
-        if (!_mm256_movemask_ps(m))
+    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);     /* lane -> pixel of the depth order */
+    const __m256i to_linear = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7); /* depth order -> pixel order */
+    const __m256 T20 = _mm256_set1_ps(f->T2[0]), T21 = _mm256_set1_ps(f->T2[1]), T22 = _mm256_set1_ps(f->T2[2]);
+    const __m256 zmin = _mm256_set1_ps(1e-4f), one = _mm256_set1_ps(1.0f);
+    /* per step: uc NX[0..2] and the pixel centres, in the depth order */
+    __m256 cu0[FILL_MAX_STEPS], cu1[FILL_MAX_STEPS], cu2[FILL_MAX_STEPS], cpx[FILL_MAX_STEPS];
+    if (!identity)
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 8 * s;
+            const __m256 uc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(sx0 + i), order)), half);
+            cu0[s] = _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[0]));
+            cu1[s] = _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[1]));
+            cu2[s] = _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[2]));
+            cpx[s] = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x0 + i), order)), half);
+        }
+    for (int r = 0; r < h; r++) {
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const int sy = y0 + r + t->flow_y;
+        if (!(sy >= 0 && (float)sy < prev_h))
             continue;
-        const float *src = hrow + 4 * sx;
-        /* pixels 0|1, 2|3, 4|5, 6|7 (named, not an array: GCC copied an array through the stack in
-         * 16-byte halves, and the 32-byte reloads then missed store forwarding) */
-        __m256 p0 = _mm256_loadu_ps(src), p1 = _mm256_loadu_ps(src + 8), p2 = _mm256_loadu_ps(src + 16),
-               p3 = _mm256_loadu_ps(src + 24);
-        if (!f->identity) {
-            const __m256 a = _mm256_unpackhi_ps(p0, p1), b = _mm256_unpackhi_ps(p2, p3);
-            const __m256 D = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 2, 3, 2)); /* depths 0, 2, 4, 6 | 1, 3, 5, 7 */
-            const __m256i lane = order;
-            const __m256 uc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(sx), lane)), half);
-            const __m256 pxc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x0 + i), lane)), half);
-            __m256 c[3];
-            for (int k = 0; k < 3; k++)
-                c[k] = _mm256_add_ps(T2[k], _mm256_mul_ps(D, _mm256_add_ps(Bk[k], _mm256_mul_ps(uc, NX[k]))));
-            const __m256 z = c[2];
-            const __m256 rz = _mm256_div_ps(one, z);
-            const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(c[0], rz), pxc);
-            const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(c[1], rz), pyv);
-            const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
-                                                          _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ))),
-                                            _mm256_cmp_ps(z, zmin, _CMP_GT_OQ));
-            m = _mm256_and_ps(m, _mm256_permutevar8x32_ps(ok, to_linear));
+        const float vc = (float)sy + 0.5f;
+        const float B[3] = {N0[0] + vc * NY[0], N0[1] + vc * NY[1], N0[2] + vc * NY[2]};
+        const ptrdiff_t ho = (ptrdiff_t)sy * hstride;
+        const float *hw = hwgt + ho, *hrow = hrgbd + 4 * ho;
+        const float py = (float)(y0 + r) + 0.5f;
+        const __m256 B0 = _mm256_set1_ps(B[0]), B1 = _mm256_set1_ps(B[1]), B2 = _mm256_set1_ps(B[2]);
+        const __m256 pyv = _mm256_set1_ps(py);
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 8 * s, sx = sx0 + i;
+            const __m256 wv = _mm256_loadu_ps(wgt + i);
+            const __m256 ws = _mm256_loadu_ps(hw + sx);
+            __m256 m = _mm256_and_ps(_mm256_cmp_ps(wv, zero, _CMP_EQ_OQ), _mm256_cmp_ps(ws, zero, _CMP_GT_OQ));
             if (!_mm256_movemask_ps(m))
                 continue;
-            /* this view's depth into lanes 3 and 7 of each pixel pair (z's element k of each half) */
-            p0 = _mm256_blend_ps(p0, _mm256_permute_ps(z, 0x00), 0x88);
-            p1 = _mm256_blend_ps(p1, _mm256_permute_ps(z, 0x55), 0x88);
-            p2 = _mm256_blend_ps(p2, _mm256_permute_ps(z, 0xaa), 0x88);
-            p3 = _mm256_blend_ps(p3, _mm256_permute_ps(z, 0xff), 0x88);
-        }
-        float *o = rgbd + 4 * i;
-        if (_mm256_movemask_ps(m) == 0xff) {
-            _mm256_storeu_ps(o, p0), _mm256_storeu_ps(o + 8, p1);
-            _mm256_storeu_ps(o + 16, p2), _mm256_storeu_ps(o + 24, p3);
-            _mm256_storeu_ps(wgt + i, ws);
-        } else {
-#define ST(k, pk) _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), pk, _mm256_permutevar8x32_ps(m, pair_mask##k)))
-            ST(0, p0), ST(1, p1), ST(2, p2), ST(3, p3);
+            const float *src = hrow + 4 * sx;
+            /* pixels 0|1, 2|3, 4|5, 6|7 (named, not an array: GCC copied an array through the stack in
+             * 16-byte halves, and the 32-byte reloads then missed store forwarding) */
+            __m256 p0 = _mm256_loadu_ps(src), p1 = _mm256_loadu_ps(src + 8), p2 = _mm256_loadu_ps(src + 16),
+                   p3 = _mm256_loadu_ps(src + 24);
+            if (!identity) {
+                const __m256 a = _mm256_unpackhi_ps(p0, p1), b = _mm256_unpackhi_ps(p2, p3);
+                const __m256 D = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 2, 3, 2)); /* depths 0, 2, 4, 6 | 1, 3, 5, 7 */
+                const __m256 cU = _mm256_add_ps(T20, _mm256_mul_ps(D, _mm256_add_ps(B0, cu0[s])));
+                const __m256 cV = _mm256_add_ps(T21, _mm256_mul_ps(D, _mm256_add_ps(B1, cu1[s])));
+                const __m256 z = _mm256_add_ps(T22, _mm256_mul_ps(D, _mm256_add_ps(B2, cu2[s])));
+                const __m256 rz = _mm256_div_ps(one, z);
+                const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(cU, rz), cpx[s]);
+                const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(cV, rz), pyv);
+                const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
+                                                              _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ))),
+                                                _mm256_cmp_ps(z, zmin, _CMP_GT_OQ));
+                m = _mm256_and_ps(m, _mm256_permutevar8x32_ps(ok, to_linear));
+                if (!_mm256_movemask_ps(m))
+                    continue;
+                /* this view's depth into lanes 3 and 7 of each pixel pair (z's element k of each half) */
+                p0 = _mm256_blend_ps(p0, _mm256_permute_ps(z, 0x00), 0x88);
+                p1 = _mm256_blend_ps(p1, _mm256_permute_ps(z, 0x55), 0x88);
+                p2 = _mm256_blend_ps(p2, _mm256_permute_ps(z, 0xaa), 0x88);
+                p3 = _mm256_blend_ps(p3, _mm256_permute_ps(z, 0xff), 0x88);
+            }
+            float *o = rgbd + 4 * i;
+            if (_mm256_movemask_ps(m) == 0xff) {
+                _mm256_storeu_ps(o, p0), _mm256_storeu_ps(o + 8, p1);
+                _mm256_storeu_ps(o + 16, p2), _mm256_storeu_ps(o + 24, p3);
+                _mm256_storeu_ps(wgt + i, ws);
+            } else {
+                /* each pixel pair's two mask lanes over its four floats */
+                const __m256i mi = _mm256_castps_si256(m);
+                const __m256i lo = _mm256_unpacklo_epi32(mi, mi), hi = _mm256_unpackhi_epi32(mi, mi);
+                /* lo: pixels 0, 0, 1, 1 | 4, 4, 5, 5; hi: 2, 2, 3, 3 | 6, 6, 7, 7 */
+                const __m256i m0 = _mm256_unpacklo_epi64(lo, lo), m1 = _mm256_unpackhi_epi64(lo, lo);
+                const __m256i m2 = _mm256_unpacklo_epi64(hi, hi), m3 = _mm256_unpackhi_epi64(hi, hi);
+                /* m0: 0 x4 | 4 x4, m1: 1 x4 | 5 x4, m2: 2 x4 | 6 x4, m3: 3 x4 | 7 x4 */
+#define ST(k, pk, mk) _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), pk, _mm256_castsi256_ps(mk)))
+                ST(0, p0, _mm256_permute2x128_si256(m0, m1, 0x20)); /* pixels 0 | 1 */
+                ST(1, p1, _mm256_permute2x128_si256(m2, m3, 0x20)); /* 2 | 3 */
+                ST(2, p2, _mm256_permute2x128_si256(m0, m1, 0x31)); /* 4 | 5 */
+                ST(3, p3, _mm256_permute2x128_si256(m2, m3, 0x31)); /* 6 | 7 */
 #undef ST
-            _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
+                _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(wv, ws, m));
+            }
         }
     }
-    return i;
+    if (ilo == 0 && iend == w)
+        return;
+    /* the rows' edges outside the whole steps, pixel by pixel (each pixel's fill is independent of
+     * the others', so doing them after the steps gives the same bits) */
+    for (int r = 0; r < h; r++) {
+        const float *hw, *hrow;
+        float B[3];
+        if (!(hrow = taa_fill_setup(f, t, y0 + r, &hw, B)))
+            continue;
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const float py = (float)(y0 + r) + 0.5f;
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, iend, w);
+    }
 }
-
-TAA_FILL_BLOCK(taa_fill_avx2, fill_vec_avx2)
 
 /* ------------------------------------------------------------------ the still head's blend */
 
