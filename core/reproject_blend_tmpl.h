@@ -22,8 +22,7 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
     /* The samples of up to 16 rows are listed first and grouped afterwards: the groups' vector
      * loads of the lists would otherwise wait on the just-made 4-byte stores (store forwarding
      * fails; perf showed 7 % of the AVX2 blend on one such load). */
-    int32_t off[64 * TAA_CHUNK_ROWS + TAA_GROUP_LANES], xs[64 * TAA_CHUNK_ROWS + TAA_GROUP_LANES],
-        ys[64 * TAA_CHUNK_ROWS + TAA_GROUP_LANES];
+    int32_t off[64 * TAA_CHUNK_ROWS + 8], xs[64 * TAA_CHUNK_ROWS + 8], ys[64 * TAA_CHUNK_ROWS + 8];
     taa_group ring[TAA_GROUP_RING];
     unsigned head = 0, tail = 0;
     for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
@@ -31,6 +30,10 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
         for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
             uint64_t m = sample_mask(wgt_blk + r * stride, w);
             const int32_t ro = (int32_t)(r * stride), y = y0 + r;
+#ifdef TAA_LIST_ROW /* the ISA's listing: the same entries (it may write up to 7 past them) */
+            n = TAA_LIST_ROW(m, ro, x0, y, w, rgbd_blk + 4 * (ptrdiff_t)ro, off, xs, ys, n);
+            continue;
+#endif
             while (m) {
                 const int i = __builtin_ctzll(m);
                 m &= m - 1;
