@@ -28,12 +28,12 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
     for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
         int n = 0;
         for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
-            uint64_t m = sample_mask(wgt_blk + r * stride, w);
             const int32_t ro = (int32_t)(r * stride), y = y0 + r;
 #ifdef TAA_LIST_ROW /* the ISA's listing: the same entries (it may write up to 7 past them) */
-            n = TAA_LIST_ROW(m, ro, x0, y, w, rgbd_blk + 4 * (ptrdiff_t)ro, off, xs, ys, n);
+            n = TAA_LIST_ROW(wgt_blk + r * stride, ro, x0, y, w, rgbd_blk + 4 * (ptrdiff_t)ro, off, xs, ys, n);
             continue;
 #endif
+            uint64_t m = sample_mask(wgt_blk + r * stride, w);
             while (m) {
                 const int i = __builtin_ctzll(m);
                 m &= m - 1;

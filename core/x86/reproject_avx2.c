@@ -366,19 +366,25 @@ static const uint64_t taa_list_lut[256] = {
     0x0000000706050403ull, 0x0000070605040300ull, 0x0000070605040301ull, 0x0007060504030100ull,
     0x0000070605040302ull, 0x0007060504030200ull, 0x0007060504030201ull, 0x0706050403020100ull,
 };
-static inline __attribute__((always_inline)) int list_row_avx2(uint64_t m, int32_t ro, int32_t x0, int32_t y, int w,
+static inline __attribute__((always_inline)) int list_row_avx2(const float *wgt, int32_t ro, int32_t x0, int32_t y, int w,
                                                                const float *rgbd_row, int32_t *off, int32_t *xs,
                                                                int32_t *ys, int n)
 {
     for (int i = 0; i < w; i += 16)
         _mm_prefetch((const char *)(rgbd_row + 4 * i), _MM_HINT_T0), _mm_prefetch((const char *)(rgbd_row + 4 * i + 32), _MM_HINT_T0);
-    const __m256i vy = _mm256_set1_epi32(y);
+    const __m256i vy = _mm256_set1_epi32(y), vro = _mm256_set1_epi32(ro), vx0 = _mm256_set1_epi32(x0);
+    const __m256 one = _mm256_set1_ps(1.0f);
     for (int i = 0; i < w; i += 8) {
-        const unsigned mb = (unsigned)(m >> i) & 0xffu;
+        unsigned mb;
+        if (i + 8 <= w)
+            mb = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(wgt + i), one, _CMP_EQ_OQ));
+        else
+            for (int k = mb = 0; i + k < w; k++)
+                mb |= (unsigned)(wgt[i + k] == 1.0f) << k;
         const __m256i idx = _mm256_add_epi32(_mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)&taa_list_lut[mb])),
                                              _mm256_set1_epi32(i));
-        _mm256_storeu_si256((__m256i *)(off + n), _mm256_add_epi32(idx, _mm256_set1_epi32(ro)));
-        _mm256_storeu_si256((__m256i *)(xs + n), _mm256_add_epi32(idx, _mm256_set1_epi32(x0)));
+        _mm256_storeu_si256((__m256i *)(off + n), _mm256_add_epi32(idx, vro));
+        _mm256_storeu_si256((__m256i *)(xs + n), _mm256_add_epi32(idx, vx0));
         _mm256_storeu_si256((__m256i *)(ys + n), vy);
         n += __builtin_popcount(mb);
     }
