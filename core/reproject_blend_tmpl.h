@@ -9,6 +9,11 @@
  *                      projects n <= TAA_GROUP_LANES listed samples, adds their flow, prefetches
  *                      their history; 0 when none needs taps
  *   group_taps(f, t, rgbd, const taa_group *g)  the group's taps and blends
+ * and optionally
+ *   TAA_LIST_ROW(wgt_row, ro, x0, y, w, rgbd_row, off, xs, ys, n)
+ *                      lists the row's samples (weight 1) into off / xs / ys from n on, in pixel
+ *                      order, returns the new n; may write up to 7 entries past it (the arrays
+ *                      have room); without it, a tzcnt loop over sample_mask's bits
  * Blends change only their own samples' colours, which no projection reads: the result does not
  * depend on the distance. */
 #define TAA_CHUNK_ROWS 16 /* rows listed before their groups run (64 x 16 samples at most) */
