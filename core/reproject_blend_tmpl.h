@@ -9,6 +9,11 @@
  *                      projects n <= TAA_GROUP_LANES listed samples, adds their flow, prefetches
  *                      their history; 0 when none needs taps
  *   group_taps(f, t, rgbd, const taa_group *g)  the group's taps and blends
+ * and optionally
+ *   TAA_LIST_ROW(wgt_row, ro, x0, y, w, rgbd_row, off, xs, ys, n)
+ *                      lists the row's samples (weight 1) into off / xs / ys from n on, in pixel
+ *                      order, returns the new n; may write up to 7 entries past it (the arrays
+ *                      have room); without it, a tzcnt loop over sample_mask's bits
  * Blends change only their own samples' colours, which no projection reads: the result does not
  * depend on the distance. */
 #define TAA_CHUNK_ROWS 16 /* rows listed before their groups run (64 x 16 samples at most) */
@@ -22,15 +27,18 @@ static void TAA_FN(taa_blend)(const struct fv_taa_frame *f, const struct fv_taa_
     /* The samples of up to 16 rows are listed first and grouped afterwards: the groups' vector
      * loads of the lists would otherwise wait on the just-made 4-byte stores (store forwarding
      * fails; perf showed 7 % of the AVX2 blend on one such load). */
-    int32_t off[64 * TAA_CHUNK_ROWS + TAA_GROUP_LANES], xs[64 * TAA_CHUNK_ROWS + TAA_GROUP_LANES],
-        ys[64 * TAA_CHUNK_ROWS + TAA_GROUP_LANES];
+    int32_t off[64 * TAA_CHUNK_ROWS + 8], xs[64 * TAA_CHUNK_ROWS + 8], ys[64 * TAA_CHUNK_ROWS + 8];
     taa_group ring[TAA_GROUP_RING];
     unsigned head = 0, tail = 0;
     for (int r0 = 0; r0 < h; r0 += TAA_CHUNK_ROWS) {
         int n = 0;
         for (int r = r0; r < h && r < r0 + TAA_CHUNK_ROWS; r++) {
-            uint64_t m = sample_mask(wgt_blk + r * stride, w);
             const int32_t ro = (int32_t)(r * stride), y = y0 + r;
+#ifdef TAA_LIST_ROW /* the ISA's listing: the same entries (it may write up to 7 past them) */
+            n = TAA_LIST_ROW(wgt_blk + r * stride, ro, x0, y, w, rgbd_blk + 4 * (ptrdiff_t)ro, off, xs, ys, n);
+            continue;
+#endif
+            uint64_t m = sample_mask(wgt_blk + r * stride, w);
             while (m) {
                 const int i = __builtin_ctzll(m);
                 m &= m - 1;

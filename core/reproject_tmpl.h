@@ -244,7 +244,8 @@ static inline const float *taa_fill_setup(const struct fv_taa_frame *f, const st
     return L->rgbd + 4 * o;
 }
 
-/* The fill of a block, defined by each ISA from its vector body
+/* The fill of a block from a vector body (the C reference's, with none; the ISA files now write
+ * their own per-block fill instead, with the row-independent set-up hoisted: branch taa9)
  *   int vec(f, t, rgbd, wgt, hrow, hw, B, x0, py, ilo, ihi)
  * which fills pixels ilo, ilo + step, ... of the contiguous span [ilo, ihi) (taa_fill_span) and
  * returns the first pixel it did not do; the scalar form does the row's edges and the rest. */

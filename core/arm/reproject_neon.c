@@ -245,52 +245,96 @@ static inline void group_taps(const struct fv_taa_frame *f, const struct fv_taa_
 #include "../reproject_blend_tmpl.h"
 
 /* The fill, four pixels at a time (vld4 / vst4 de-interleave r, g, b, depth): each lane does the
- * reference's operations (taa_fill_px). */
-static inline int fill_vec_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                              const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
+ * reference's operations (taa_fill_px). Per block, not per row (as the x86 fills, branch taa9):
+ * the span of whole steps, the columns' uc * NX and pixel centres and the frame's constants are
+ * made once per block (the flow is the block's); a row costs its B = N0 + vc NY and its steps; the
+ * rows' edges come after. B + uc NX adds the reference's product: the same bits. */
+#define FILL_MAX_STEPS 16 /* w <= 64 */
+static void taa_fill_neon(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk, float *wgt_blk,
+                          ptrdiff_t stride, int x0, int y0, int w, int h)
 {
-    const int sx0 = x0 + t->flow_x;
+    int ilo, ihi;
+    taa_fill_span(f, t, x0, w, &ilo, &ihi);
+    const int sx0 = x0 + t->flow_x, nstep = ihi - ilo >= 4 ? (ihi - ilo) / 4 : 0, iend = ilo + 4 * nstep;
+    const int identity = f->identity;
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const float *hrgbd = L->rgbd, *hwgt = L->wgt;
+    const ptrdiff_t hstride = L->stride;
+    const float prev_h = f->prev_h;
+    const float N0[3] = {f->N0[0], f->N0[1], f->N0[2]}, NY[3] = {f->NY[0], f->NY[1], f->NY[2]};
     const float32x4_t zero = vdupq_n_f32(0.0f), half = vdupq_n_f32(0.5f), mhalf = vdupq_n_f32(-0.5f);
+    const float32x4_t T20 = vdupq_n_f32(f->T2[0]), T21 = vdupq_n_f32(f->T2[1]), T22 = vdupq_n_f32(f->T2[2]);
+    const float32x4_t zmin = vdupq_n_f32(1e-4f), one = vdupq_n_f32(1.0f);
     static const int32_t lanes[4] = {0, 1, 2, 3};
     const int32x4_t lane = vld1q_s32(lanes);
-    int i = ilo;
-    for (; i + 4 <= ihi; i += 4) {
-        const float32x4_t w = vld1q_f32(wgt + i);
-        const int sx = sx0 + i;
-        const float32x4_t ws = vld1q_f32(hw + sx);
-        uint32x4_t m = vandq_u32(vceqq_f32(w, zero), vcgtq_f32(ws, zero));
-        if (!vmaxvq_u32(m))
+    float32x4_t cu0[FILL_MAX_STEPS], cu1[FILL_MAX_STEPS], cu2[FILL_MAX_STEPS], cpx[FILL_MAX_STEPS];
+    if (!identity)
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 4 * s;
+            const float32x4_t uc = vaddq_f32(vcvtq_f32_s32(vaddq_s32(vdupq_n_s32(sx0 + i), lane)), half);
+            cu0[s] = vmulq_f32(uc, vdupq_n_f32(f->NX[0]));
+            cu1[s] = vmulq_f32(uc, vdupq_n_f32(f->NX[1]));
+            cu2[s] = vmulq_f32(uc, vdupq_n_f32(f->NX[2]));
+            cpx[s] = vaddq_f32(vcvtq_f32_s32(vaddq_s32(vdupq_n_s32(x0 + i), lane)), half);
+        }
+    for (int r = 0; r < h; r++) {
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const int sy = y0 + r + t->flow_y;
+        if (!(sy >= 0 && (float)sy < prev_h))
             continue;
-        float32x4x4_t px = vld4q_f32(hrow + 4 * sx); /* r, g, b, D of four texels */
-        if (!f->identity) {
-            const float32x4_t D = px.val[3];
-            const float32x4_t uc = vaddq_f32(vcvtq_f32_s32(vaddq_s32(vdupq_n_s32(sx), lane)), half);
-            const float32x4_t pxc = vaddq_f32(vcvtq_f32_s32(vaddq_s32(vdupq_n_s32(x0 + i), lane)), half);
-            float32x4_t c[3];
-            for (int k = 0; k < 3; k++)
-                c[k] = vaddq_f32(vdupq_n_f32(f->T2[k]),
-                                 vmulq_f32(D, vaddq_f32(vdupq_n_f32(B[k]), vmulq_f32(uc, vdupq_n_f32(f->NX[k])))));
-            const float32x4_t rz = vdivq_f32(vdupq_n_f32(1.0f), c[2]);
-            const float32x4_t ex = vsubq_f32(vmulq_f32(c[0], rz), pxc);
-            const float32x4_t ey = vsubq_f32(vmulq_f32(c[1], rz), vdupq_n_f32(py));
-            const uint32x4_t ok = vandq_u32(vandq_u32(vcleq_f32(ex, half), vcgeq_f32(ex, mhalf)),
-                                            vandq_u32(vcleq_f32(ey, half), vcgeq_f32(ey, mhalf)));
-            m = vandq_u32(m, vandq_u32(vcgtq_f32(c[2], vdupq_n_f32(1e-4f)), ok));
+        const float vc = (float)sy + 0.5f;
+        const float32x4_t B0 = vdupq_n_f32(N0[0] + vc * NY[0]), B1 = vdupq_n_f32(N0[1] + vc * NY[1]),
+                          B2 = vdupq_n_f32(N0[2] + vc * NY[2]);
+        const ptrdiff_t ho = (ptrdiff_t)sy * hstride;
+        const float *hw = hwgt + ho, *hrow = hrgbd + 4 * ho;
+        const float32x4_t pyv = vdupq_n_f32((float)(y0 + r) + 0.5f);
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 4 * s, sx = sx0 + i;
+            const float32x4_t wv = vld1q_f32(wgt + i);
+            const float32x4_t ws = vld1q_f32(hw + sx);
+            uint32x4_t m = vandq_u32(vceqq_f32(wv, zero), vcgtq_f32(ws, zero));
             if (!vmaxvq_u32(m))
                 continue;
-            px.val[3] = c[2];
+            float32x4x4_t px = vld4q_f32(hrow + 4 * sx); /* r, g, b, D of four texels */
+            if (!identity) {
+                const float32x4_t D = px.val[3];
+                const float32x4_t U = vaddq_f32(T20, vmulq_f32(D, vaddq_f32(B0, cu0[s])));
+                const float32x4_t V = vaddq_f32(T21, vmulq_f32(D, vaddq_f32(B1, cu1[s])));
+                const float32x4_t z = vaddq_f32(T22, vmulq_f32(D, vaddq_f32(B2, cu2[s])));
+                const float32x4_t rz = vdivq_f32(one, z);
+                const float32x4_t ex = vsubq_f32(vmulq_f32(U, rz), cpx[s]);
+                const float32x4_t ey = vsubq_f32(vmulq_f32(V, rz), pyv);
+                const uint32x4_t ok = vandq_u32(vandq_u32(vcleq_f32(ex, half), vcgeq_f32(ex, mhalf)),
+                                                vandq_u32(vcleq_f32(ey, half), vcgeq_f32(ey, mhalf)));
+                m = vandq_u32(m, vandq_u32(vcgtq_f32(z, zmin), ok));
+                if (!vmaxvq_u32(m))
+                    continue;
+                px.val[3] = z;
+            }
+            float *o = rgbd + 4 * i;
+            float32x4x4_t old = vld4q_f32(o);
+            old.val[0] = vbslq_f32(m, px.val[0], old.val[0]);
+            old.val[1] = vbslq_f32(m, px.val[1], old.val[1]);
+            old.val[2] = vbslq_f32(m, px.val[2], old.val[2]);
+            old.val[3] = vbslq_f32(m, px.val[3], old.val[3]);
+            vst4q_f32(o, old);
+            vst1q_f32(wgt + i, vbslq_f32(m, ws, wv));
         }
-        float *o = rgbd + 4 * i;
-        float32x4x4_t old = vld4q_f32(o);
-        for (int k = 0; k < 4; k++)
-            old.val[k] = vbslq_f32(m, px.val[k], old.val[k]);
-        vst4q_f32(o, old);
-        vst1q_f32(wgt + i, vbslq_f32(m, ws, w));
     }
-    return i;
+    if (ilo == 0 && iend == w)
+        return;
+    /* the rows' edges outside the whole steps, pixel by pixel (each pixel's fill is independent) */
+    for (int r = 0; r < h; r++) {
+        const float *hw, *hrow;
+        float B[3];
+        if (!(hrow = taa_fill_setup(f, t, y0 + r, &hw, B)))
+            continue;
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const float py = (float)(y0 + r) + 0.5f;
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, iend, w);
+    }
 }
-
-TAA_FILL_BLOCK(taa_fill_neon, fill_vec_neon)
 
 /* ------------------------------------------------------------------ the still head's blend */
 

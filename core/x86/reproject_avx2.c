@@ -122,17 +122,18 @@ static inline __attribute__((always_inline)) unsigned group_project(const struct
         rz = _mm256_div_ps(one, z);
         valid = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
     } else {
-        __m256 c[3];
-        for (int k = 0; k < 3; k++) {
-            const __m256 b = _mm256_add_ps(_mm256_set1_ps(f->M0[k]), _mm256_mul_ps(py, _mm256_set1_ps(f->MY[k])));
-            c[k] = _mm256_add_ps(_mm256_set1_ps(f->T[k]),
-                                 _mm256_mul_ps(D, _mm256_add_ps(b, _mm256_mul_ps(pxc, _mm256_set1_ps(f->MX[k])))));
-        }
-        z = c[2];
+        /* written out (GCC kept a loop over k with its broadcasts, 42 instructions a group) */
+#define ROWK(k) _mm256_add_ps(_mm256_set1_ps(f->T[k]),                                                              \
+                              _mm256_mul_ps(D, _mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(f->M0[k]),                \
+                                                                           _mm256_mul_ps(py, _mm256_set1_ps(f->MY[k]))), \
+                                                             _mm256_mul_ps(pxc, _mm256_set1_ps(f->MX[k])))))
+        const __m256 cU = ROWK(0), cV = ROWK(1);
+        z = ROWK(2);
+#undef ROWK
         valid = _mm256_cmp_ps(z, _mm256_set1_ps(1e-4f), _CMP_GT_OQ);
         rz = _mm256_div_ps(one, z);
-        u = _mm256_mul_ps(c[0], rz);
-        v = _mm256_mul_ps(c[1], rz);
+        u = _mm256_mul_ps(cU, rz);
+        v = _mm256_mul_ps(cV, rz);
     }
     valid = _mm256_and_ps(valid, _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ),
                                                              _mm256_cmp_ps(u, _mm256_set1_ps(f->prev_w), _CMP_LT_OQ)),
@@ -141,21 +142,28 @@ static inline __attribute__((always_inline)) unsigned group_project(const struct
     const unsigned vm = (unsigned)_mm256_movemask_ps(valid) & ((1u << n) - 1u);
     if (!vm)
         return 0;
-    { /* the flow sums, in sample order as the reference adds them */
-        float du[8], dv[8];
-        _mm256_storeu_ps(du, _mm256_sub_ps(u, pxc));
-        _mm256_storeu_ps(dv, _mm256_sub_ps(v, py));
-        float sx = *fdx, sy = *fdy, sn = *fn;
+    { /* the flow sums, in sample order as the reference adds them: (dx, dy) pairs, one 2-lane add
+       * per sample (lanes 2 and 3 of the accumulator carry garbage, never read) */
+        const __m256 du = _mm256_sub_ps(u, pxc), dv = _mm256_sub_ps(v, py);
+        const __m256 lo = _mm256_unpacklo_ps(du, dv), hi = _mm256_unpackhi_ps(du, dv);
+        /* pairs of samples 0, 1 | 4, 5 and 2, 3 | 6, 7 */
+        const __m128 p01 = _mm256_castps256_ps128(lo), p23 = _mm256_castps256_ps128(hi);
+        const __m128 p45 = _mm256_extractf128_ps(lo, 1), p67 = _mm256_extractf128_ps(hi, 1);
+        __m128 acc = _mm_setr_ps(*fdx, *fdy, 0.0f, 0.0f);
         if (vm == 0xffu) {
-            for (int k = 0; k < 8; k++) /* unrolled by the compiler: no branch per lane */
-                sx = sx + du[k], sy = sy + dv[k], sn = sn + 1.0f;
+            acc = _mm_add_ps(acc, p01), acc = _mm_add_ps(acc, _mm_movehl_ps(p01, p01));
+            acc = _mm_add_ps(acc, p23), acc = _mm_add_ps(acc, _mm_movehl_ps(p23, p23));
+            acc = _mm_add_ps(acc, p45), acc = _mm_add_ps(acc, _mm_movehl_ps(p45, p45));
+            acc = _mm_add_ps(acc, p67), acc = _mm_add_ps(acc, _mm_movehl_ps(p67, p67));
         } else {
-            for (unsigned m = vm; m; m &= m - 1) {
-                const int k = __builtin_ctz(m);
-                sx = sx + du[k], sy = sy + dv[k], sn = sn + 1.0f;
-            }
+            const __m128 pr[8] = {p01, _mm_movehl_ps(p01, p01), p23, _mm_movehl_ps(p23, p23),
+                                  p45, _mm_movehl_ps(p45, p45), p67, _mm_movehl_ps(p67, p67)};
+            for (unsigned m = vm; m; m &= m - 1)
+                acc = _mm_add_ps(acc, pr[__builtin_ctz(m)]);
         }
-        *fdx = sx, *fdy = sy, *fn = sn;
+        *fdx = _mm_cvtss_f32(acc), *fdy = _mm_cvtss_f32(_mm_shuffle_ps(acc, acc, 1));
+        /* sn + 1 per sample is exact on integers below 2^24: the count at once */
+        *fn = *fn + (float)__builtin_popcount(vm);
     }
     if (keep_sample)
         return 0; /* history has no weight here: the samples stay exactly as traced */
@@ -192,12 +200,17 @@ static inline __attribute__((always_inline)) unsigned group_project(const struct
                                    _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(u, half))));
     o00 = _mm256_and_si256(o00, _mm256_castps_si256(single)); /* other lanes read texel (0, 0) */
     _mm256_storeu_si256((__m256i *)g->oi, o00);
-    for (int k = 0; k < 8; k++) { /* unrolled; idle lanes prefetch texel (0, 0), harmless */
-        const float *c = L->rgbd + 4 * (ptrdiff_t)g->oi[k], *wr = L->wgt + g->oi[k];
-        _mm_prefetch((const char *)c, _MM_HINT_T0);
-        _mm_prefetch((const char *)(c + 4 * L->stride), _MM_HINT_T0);
-        _mm_prefetch((const char *)wr, _MM_HINT_T0);
-        _mm_prefetch((const char *)(wr + L->stride), _MM_HINT_T0);
+    { /* idle lanes prefetch texel (0, 0), harmless; written out (GCC kept a 12-instruction loop) */
+        const char *c0 = (const char *)L->rgbd, *c1 = (const char *)(L->rgbd + 4 * L->stride);
+        const char *w0 = (const char *)L->wgt, *w1 = (const char *)(L->wgt + L->stride);
+#define PF(k)                                                                                        \
+        do {                                                                                         \
+            const ptrdiff_t o_ = (ptrdiff_t)g->oi[k];                                                \
+            _mm_prefetch(c0 + 16 * o_, _MM_HINT_T0), _mm_prefetch(c1 + 16 * o_, _MM_HINT_T0);        \
+            _mm_prefetch(w0 + 4 * o_, _MM_HINT_T0), _mm_prefetch(w1 + 4 * o_, _MM_HINT_T0);          \
+        } while (0)
+        PF(0); PF(1); PF(2); PF(3); PF(4); PF(5); PF(6); PF(7);
+#undef PF
     }
     memcpy(g->off, off, sizeof g->off);
     g->R = R, g->G = G, g->B = B, g->D = D, g->u = u, g->v = v, g->z = z, g->inv_tol = inv_tol;
@@ -245,15 +258,20 @@ static inline __attribute__((always_inline)) void group_taps(const struct fv_taa
     if (!bm)
         return; /* no valid history: the samples stand alone */
     const __m256 alpha = _mm256_max_ps(_mm256_sub_ps(one, accw), _mm256_set1_ps(t->alpha)); /* a1 > alpha ? a1 : alpha */
-    const __m256 px[3] = {g->R, g->G, g->B};
     __m256 res[3];
-    for (int c = 0; c < 3; c++) {
-        const __m256 acc = _mm256_add_ps(zero, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w00, ct[c]), _mm256_mul_ps(w01, cb[c])),
-                                                             _mm256_add_ps(_mm256_mul_ps(w10, ct[4 + c]), _mm256_mul_ps(w11, cb[4 + c]))));
-        const __m256 hh = _mm256_div_ps(acc, accw);
-        /* lanes without history keep their colour (stored back unchanged below) */
-        res[c] = _mm256_blendv_ps(px[c], _mm256_add_ps(hh, _mm256_mul_ps(alpha, _mm256_sub_ps(px[c], hh))), ok);
-    }
+    /* written out (GCC kept a loop over the channels with px[] on the stack) */
+#define CHAN(c, pxc)                                                                                          \
+    do {                                                                                                      \
+        const __m256 acc = _mm256_add_ps(zero, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w00, ct[c]), _mm256_mul_ps(w01, cb[c])), \
+                                                             _mm256_add_ps(_mm256_mul_ps(w10, ct[4 + c]), _mm256_mul_ps(w11, cb[4 + c])))); \
+        const __m256 hh = _mm256_div_ps(acc, accw);                                                           \
+        /* lanes without history keep their colour (stored back unchanged below) */                          \
+        res[c] = _mm256_blendv_ps(pxc, _mm256_add_ps(hh, _mm256_mul_ps(alpha, _mm256_sub_ps(pxc, hh))), ok);   \
+    } while (0)
+    CHAN(0, g->R);
+    CHAN(1, g->G);
+    CHAN(2, g->B);
+#undef CHAN
     /* back to pixels (r, g, b, depth: the depth stays the sample's), lanes k | k + 4 */
     __m256 pk[4];
     SOA4(res[0], res[1], res[2], g->D, pk[0], pk[1], pk[2], pk[3]);
@@ -278,6 +296,101 @@ static inline __attribute__((always_inline)) void group_taps(const struct fv_taa
 #undef ST
 }
 
+/* The listing of a row's samples (reproject_blend_tmpl.h), eight pixels a step: the byte indices of
+ * the set bits of each mask byte from a table (2 KiB), widened and stored whole; n advances by the
+ * byte's popcount. ~10 instructions per 8 pixels instead of ~14 per sample with tzcnt. The row's
+ * pixels are prefetched once (hot after shading in the pipeline; cold in checkasm --bench). */
+static const uint64_t taa_list_lut[256] = {
+    0x0000000000000000ull, 0x0000000000000000ull, 0x0000000000000001ull, 0x0000000000000100ull,
+    0x0000000000000002ull, 0x0000000000000200ull, 0x0000000000000201ull, 0x0000000000020100ull,
+    0x0000000000000003ull, 0x0000000000000300ull, 0x0000000000000301ull, 0x0000000000030100ull,
+    0x0000000000000302ull, 0x0000000000030200ull, 0x0000000000030201ull, 0x0000000003020100ull,
+    0x0000000000000004ull, 0x0000000000000400ull, 0x0000000000000401ull, 0x0000000000040100ull,
+    0x0000000000000402ull, 0x0000000000040200ull, 0x0000000000040201ull, 0x0000000004020100ull,
+    0x0000000000000403ull, 0x0000000000040300ull, 0x0000000000040301ull, 0x0000000004030100ull,
+    0x0000000000040302ull, 0x0000000004030200ull, 0x0000000004030201ull, 0x0000000403020100ull,
+    0x0000000000000005ull, 0x0000000000000500ull, 0x0000000000000501ull, 0x0000000000050100ull,
+    0x0000000000000502ull, 0x0000000000050200ull, 0x0000000000050201ull, 0x0000000005020100ull,
+    0x0000000000000503ull, 0x0000000000050300ull, 0x0000000000050301ull, 0x0000000005030100ull,
+    0x0000000000050302ull, 0x0000000005030200ull, 0x0000000005030201ull, 0x0000000503020100ull,
+    0x0000000000000504ull, 0x0000000000050400ull, 0x0000000000050401ull, 0x0000000005040100ull,
+    0x0000000000050402ull, 0x0000000005040200ull, 0x0000000005040201ull, 0x0000000504020100ull,
+    0x0000000000050403ull, 0x0000000005040300ull, 0x0000000005040301ull, 0x0000000504030100ull,
+    0x0000000005040302ull, 0x0000000504030200ull, 0x0000000504030201ull, 0x0000050403020100ull,
+    0x0000000000000006ull, 0x0000000000000600ull, 0x0000000000000601ull, 0x0000000000060100ull,
+    0x0000000000000602ull, 0x0000000000060200ull, 0x0000000000060201ull, 0x0000000006020100ull,
+    0x0000000000000603ull, 0x0000000000060300ull, 0x0000000000060301ull, 0x0000000006030100ull,
+    0x0000000000060302ull, 0x0000000006030200ull, 0x0000000006030201ull, 0x0000000603020100ull,
+    0x0000000000000604ull, 0x0000000000060400ull, 0x0000000000060401ull, 0x0000000006040100ull,
+    0x0000000000060402ull, 0x0000000006040200ull, 0x0000000006040201ull, 0x0000000604020100ull,
+    0x0000000000060403ull, 0x0000000006040300ull, 0x0000000006040301ull, 0x0000000604030100ull,
+    0x0000000006040302ull, 0x0000000604030200ull, 0x0000000604030201ull, 0x0000060403020100ull,
+    0x0000000000000605ull, 0x0000000000060500ull, 0x0000000000060501ull, 0x0000000006050100ull,
+    0x0000000000060502ull, 0x0000000006050200ull, 0x0000000006050201ull, 0x0000000605020100ull,
+    0x0000000000060503ull, 0x0000000006050300ull, 0x0000000006050301ull, 0x0000000605030100ull,
+    0x0000000006050302ull, 0x0000000605030200ull, 0x0000000605030201ull, 0x0000060503020100ull,
+    0x0000000000060504ull, 0x0000000006050400ull, 0x0000000006050401ull, 0x0000000605040100ull,
+    0x0000000006050402ull, 0x0000000605040200ull, 0x0000000605040201ull, 0x0000060504020100ull,
+    0x0000000006050403ull, 0x0000000605040300ull, 0x0000000605040301ull, 0x0000060504030100ull,
+    0x0000000605040302ull, 0x0000060504030200ull, 0x0000060504030201ull, 0x0006050403020100ull,
+    0x0000000000000007ull, 0x0000000000000700ull, 0x0000000000000701ull, 0x0000000000070100ull,
+    0x0000000000000702ull, 0x0000000000070200ull, 0x0000000000070201ull, 0x0000000007020100ull,
+    0x0000000000000703ull, 0x0000000000070300ull, 0x0000000000070301ull, 0x0000000007030100ull,
+    0x0000000000070302ull, 0x0000000007030200ull, 0x0000000007030201ull, 0x0000000703020100ull,
+    0x0000000000000704ull, 0x0000000000070400ull, 0x0000000000070401ull, 0x0000000007040100ull,
+    0x0000000000070402ull, 0x0000000007040200ull, 0x0000000007040201ull, 0x0000000704020100ull,
+    0x0000000000070403ull, 0x0000000007040300ull, 0x0000000007040301ull, 0x0000000704030100ull,
+    0x0000000007040302ull, 0x0000000704030200ull, 0x0000000704030201ull, 0x0000070403020100ull,
+    0x0000000000000705ull, 0x0000000000070500ull, 0x0000000000070501ull, 0x0000000007050100ull,
+    0x0000000000070502ull, 0x0000000007050200ull, 0x0000000007050201ull, 0x0000000705020100ull,
+    0x0000000000070503ull, 0x0000000007050300ull, 0x0000000007050301ull, 0x0000000705030100ull,
+    0x0000000007050302ull, 0x0000000705030200ull, 0x0000000705030201ull, 0x0000070503020100ull,
+    0x0000000000070504ull, 0x0000000007050400ull, 0x0000000007050401ull, 0x0000000705040100ull,
+    0x0000000007050402ull, 0x0000000705040200ull, 0x0000000705040201ull, 0x0000070504020100ull,
+    0x0000000007050403ull, 0x0000000705040300ull, 0x0000000705040301ull, 0x0000070504030100ull,
+    0x0000000705040302ull, 0x0000070504030200ull, 0x0000070504030201ull, 0x0007050403020100ull,
+    0x0000000000000706ull, 0x0000000000070600ull, 0x0000000000070601ull, 0x0000000007060100ull,
+    0x0000000000070602ull, 0x0000000007060200ull, 0x0000000007060201ull, 0x0000000706020100ull,
+    0x0000000000070603ull, 0x0000000007060300ull, 0x0000000007060301ull, 0x0000000706030100ull,
+    0x0000000007060302ull, 0x0000000706030200ull, 0x0000000706030201ull, 0x0000070603020100ull,
+    0x0000000000070604ull, 0x0000000007060400ull, 0x0000000007060401ull, 0x0000000706040100ull,
+    0x0000000007060402ull, 0x0000000706040200ull, 0x0000000706040201ull, 0x0000070604020100ull,
+    0x0000000007060403ull, 0x0000000706040300ull, 0x0000000706040301ull, 0x0000070604030100ull,
+    0x0000000706040302ull, 0x0000070604030200ull, 0x0000070604030201ull, 0x0007060403020100ull,
+    0x0000000000070605ull, 0x0000000007060500ull, 0x0000000007060501ull, 0x0000000706050100ull,
+    0x0000000007060502ull, 0x0000000706050200ull, 0x0000000706050201ull, 0x0000070605020100ull,
+    0x0000000007060503ull, 0x0000000706050300ull, 0x0000000706050301ull, 0x0000070605030100ull,
+    0x0000000706050302ull, 0x0000070605030200ull, 0x0000070605030201ull, 0x0007060503020100ull,
+    0x0000000007060504ull, 0x0000000706050400ull, 0x0000000706050401ull, 0x0000070605040100ull,
+    0x0000000706050402ull, 0x0000070605040200ull, 0x0000070605040201ull, 0x0007060504020100ull,
+    0x0000000706050403ull, 0x0000070605040300ull, 0x0000070605040301ull, 0x0007060504030100ull,
+    0x0000070605040302ull, 0x0007060504030200ull, 0x0007060504030201ull, 0x0706050403020100ull,
+};
+static inline __attribute__((always_inline)) int list_row_avx2(const float *wgt, int32_t ro, int32_t x0, int32_t y, int w,
+                                                               const float *rgbd_row, int32_t *off, int32_t *xs,
+                                                               int32_t *ys, int n)
+{
+    for (int i = 0; i < w; i += 16)
+        _mm_prefetch((const char *)(rgbd_row + 4 * i), _MM_HINT_T0), _mm_prefetch((const char *)(rgbd_row + 4 * i + 32), _MM_HINT_T0);
+    const __m256i vy = _mm256_set1_epi32(y), vro = _mm256_set1_epi32(ro), vx0 = _mm256_set1_epi32(x0);
+    const __m256 one = _mm256_set1_ps(1.0f);
+    for (int i = 0; i < w; i += 8) {
+        unsigned mb;
+        if (i + 8 <= w)
+            mb = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(wgt + i), one, _CMP_EQ_OQ));
+        else
+            for (int k = mb = 0; i + k < w; k++)
+                mb |= (unsigned)(wgt[i + k] == 1.0f) << k;
+        const __m256i idx = _mm256_add_epi32(_mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)&taa_list_lut[mb])),
+                                             _mm256_set1_epi32(i));
+        _mm256_storeu_si256((__m256i *)(off + n), _mm256_add_epi32(idx, vro));
+        _mm256_storeu_si256((__m256i *)(xs + n), _mm256_add_epi32(idx, vx0));
+        _mm256_storeu_si256((__m256i *)(ys + n), vy);
+        n += __builtin_popcount(mb);
+    }
+    return n;
+}
+#define TAA_LIST_ROW list_row_avx2
 #define TAA_GROUP_LANES 8
 #define TAA_GROUP_DIST 2 /* groups (16 samples) between a group's projection and its taps */
 #define TAA_GROUP_RING 4
@@ -286,74 +399,123 @@ static inline __attribute__((always_inline)) void group_taps(const struct fv_taa
 /* The fill, eight pixels at a time: each lane does the reference's operations (taa_fill_px). The
  * history pixels stay as loaded, two per 256-bit register; their depths are taken out in the
  * lane order 0, 2, 4, 6, 1, 3, 5, 7 (two shuffles), checked in that order, and only the depth
- * lanes of the stored pixels are replaced. */
-static inline __attribute__((always_inline)) int fill_vec_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                                const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
+ * lanes of the stored pixels are replaced.
+ * Per block, not per row (branch taa9): the span of whole steps, the columns' uc * NX and pixel
+ * centres and the frame's constants are the same for every row of the block (the flow is the
+ * block's), so they are made once; a row costs its B = N0 + vc NY and its steps. The products
+ * uc * NX are the reference's (B + uc NX adds the same float), so the bits do not change. */
+#define FILL_MAX_STEPS 8 /* w <= 64 */
+static void taa_fill_avx2(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk, float *wgt_blk,
+                          ptrdiff_t stride, int x0, int y0, int w, int h)
 {
-    const int sx0 = x0 + t->flow_x;
+    int ilo, ihi;
+    taa_fill_span(f, t, x0, w, &ilo, &ihi);
+    const int sx0 = x0 + t->flow_x, nstep = ihi - ilo >= 8 ? (ihi - ilo) / 8 : 0, iend = ilo + 8 * nstep;
+    const int identity = f->identity;
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const float *hrgbd = L->rgbd, *hwgt = L->wgt;
+    const ptrdiff_t hstride = L->stride;
+    const float prev_h = f->prev_h;
+    const float N0[3] = {f->N0[0], f->N0[1], f->N0[2]}, NY[3] = {f->NY[0], f->NY[1], f->NY[2]};
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), mhalf = _mm256_set1_ps(-0.5f);
-    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);       /* lane -> pixel of the depth order */
-    const __m256i to_linear = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);   /* depth order -> pixel order */
-    const __m256i pair_mask0 = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), pair_mask1 = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
-    const __m256i pair_mask2 = _mm256_setr_epi32(4, 4, 4, 4, 5, 5, 5, 5), pair_mask3 = _mm256_setr_epi32(6, 6, 6, 6, 7, 7, 7, 7);
-    __m256 T2[3], Bk[3], NX[3];
-    for (int k = 0; k < 3; k++)
-        T2[k] = _mm256_set1_ps(f->T2[k]), Bk[k] = _mm256_set1_ps(B[k]), NX[k] = _mm256_set1_ps(f->NX[k]);
-    const __m256 pyv = _mm256_set1_ps(py), zmin = _mm256_set1_ps(1e-4f), one = _mm256_set1_ps(1.0f);
-    int i = ilo;
-    for (; i + 8 <= ihi; i += 8) {
-        const __m256 w = _mm256_loadu_ps(wgt + i);
-        const int sx = sx0 + i;
-        const __m256 ws = _mm256_loadu_ps(hw + sx);
-        __m256 m = _mm256_and_ps(_mm256_cmp_ps(w, zero, _CMP_EQ_OQ), _mm256_cmp_ps(ws, zero, _CMP_GT_OQ));
-        if (!_mm256_movemask_ps(m))
+    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);     /* lane -> pixel of the depth order */
+    const __m256i to_linear = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7); /* depth order -> pixel order */
+    const __m256 T20 = _mm256_set1_ps(f->T2[0]), T21 = _mm256_set1_ps(f->T2[1]), T22 = _mm256_set1_ps(f->T2[2]);
+    const __m256 zmin = _mm256_set1_ps(1e-4f), one = _mm256_set1_ps(1.0f);
+    /* per step: uc NX[0..2] and the pixel centres, in the depth order */
+    __m256 cu0[FILL_MAX_STEPS], cu1[FILL_MAX_STEPS], cu2[FILL_MAX_STEPS], cpx[FILL_MAX_STEPS];
+    if (!identity)
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 8 * s;
+            const __m256 uc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(sx0 + i), order)), half);
+            cu0[s] = _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[0]));
+            cu1[s] = _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[1]));
+            cu2[s] = _mm256_mul_ps(uc, _mm256_set1_ps(f->NX[2]));
+            cpx[s] = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x0 + i), order)), half);
+        }
+    for (int r = 0; r < h; r++) {
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const int sy = y0 + r + t->flow_y;
+        if (!(sy >= 0 && (float)sy < prev_h))
             continue;
-        const float *src = hrow + 4 * sx;
-        /* pixels 0|1, 2|3, 4|5, 6|7 (named, not an array: GCC copied an array through the stack in
-         * 16-byte halves, and the 32-byte reloads then missed store forwarding) */
-        __m256 p0 = _mm256_loadu_ps(src), p1 = _mm256_loadu_ps(src + 8), p2 = _mm256_loadu_ps(src + 16),
-               p3 = _mm256_loadu_ps(src + 24);
-        if (!f->identity) {
-            const __m256 a = _mm256_unpackhi_ps(p0, p1), b = _mm256_unpackhi_ps(p2, p3);
-            const __m256 D = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 2, 3, 2)); /* depths 0, 2, 4, 6 | 1, 3, 5, 7 */
-            const __m256i lane = order;
-            const __m256 uc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(sx), lane)), half);
-            const __m256 pxc = _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x0 + i), lane)), half);
-            __m256 c[3];
-            for (int k = 0; k < 3; k++)
-                c[k] = _mm256_add_ps(T2[k], _mm256_mul_ps(D, _mm256_add_ps(Bk[k], _mm256_mul_ps(uc, NX[k]))));
-            const __m256 z = c[2];
-            const __m256 rz = _mm256_div_ps(one, z);
-            const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(c[0], rz), pxc);
-            const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(c[1], rz), pyv);
-            const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
-                                                          _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ))),
-                                            _mm256_cmp_ps(z, zmin, _CMP_GT_OQ));
-            m = _mm256_and_ps(m, _mm256_permutevar8x32_ps(ok, to_linear));
+        const float vc = (float)sy + 0.5f;
+        const float B[3] = {N0[0] + vc * NY[0], N0[1] + vc * NY[1], N0[2] + vc * NY[2]};
+        const ptrdiff_t ho = (ptrdiff_t)sy * hstride;
+        const float *hw = hwgt + ho, *hrow = hrgbd + 4 * ho;
+        const float py = (float)(y0 + r) + 0.5f;
+        const __m256 B0 = _mm256_set1_ps(B[0]), B1 = _mm256_set1_ps(B[1]), B2 = _mm256_set1_ps(B[2]);
+        const __m256 pyv = _mm256_set1_ps(py);
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 8 * s, sx = sx0 + i;
+            const __m256 wv = _mm256_loadu_ps(wgt + i);
+            const __m256 ws = _mm256_loadu_ps(hw + sx);
+            __m256 m = _mm256_and_ps(_mm256_cmp_ps(wv, zero, _CMP_EQ_OQ), _mm256_cmp_ps(ws, zero, _CMP_GT_OQ));
             if (!_mm256_movemask_ps(m))
                 continue;
-            /* this view's depth into lanes 3 and 7 of each pixel pair (z's element k of each half) */
-            p0 = _mm256_blend_ps(p0, _mm256_permute_ps(z, 0x00), 0x88);
-            p1 = _mm256_blend_ps(p1, _mm256_permute_ps(z, 0x55), 0x88);
-            p2 = _mm256_blend_ps(p2, _mm256_permute_ps(z, 0xaa), 0x88);
-            p3 = _mm256_blend_ps(p3, _mm256_permute_ps(z, 0xff), 0x88);
-        }
-        float *o = rgbd + 4 * i;
-        if (_mm256_movemask_ps(m) == 0xff) {
-            _mm256_storeu_ps(o, p0), _mm256_storeu_ps(o + 8, p1);
-            _mm256_storeu_ps(o + 16, p2), _mm256_storeu_ps(o + 24, p3);
-            _mm256_storeu_ps(wgt + i, ws);
-        } else {
-#define ST(k, pk) _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), pk, _mm256_permutevar8x32_ps(m, pair_mask##k)))
-            ST(0, p0), ST(1, p1), ST(2, p2), ST(3, p3);
+            const float *src = hrow + 4 * sx;
+            /* pixels 0|1, 2|3, 4|5, 6|7 (named, not an array: GCC copied an array through the stack in
+             * 16-byte halves, and the 32-byte reloads then missed store forwarding) */
+            __m256 p0 = _mm256_loadu_ps(src), p1 = _mm256_loadu_ps(src + 8), p2 = _mm256_loadu_ps(src + 16),
+                   p3 = _mm256_loadu_ps(src + 24);
+            if (!identity) {
+                const __m256 a = _mm256_unpackhi_ps(p0, p1), b = _mm256_unpackhi_ps(p2, p3);
+                const __m256 D = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 2, 3, 2)); /* depths 0, 2, 4, 6 | 1, 3, 5, 7 */
+                const __m256 cU = _mm256_add_ps(T20, _mm256_mul_ps(D, _mm256_add_ps(B0, cu0[s])));
+                const __m256 cV = _mm256_add_ps(T21, _mm256_mul_ps(D, _mm256_add_ps(B1, cu1[s])));
+                const __m256 z = _mm256_add_ps(T22, _mm256_mul_ps(D, _mm256_add_ps(B2, cu2[s])));
+                const __m256 rz = _mm256_div_ps(one, z);
+                const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(cU, rz), cpx[s]);
+                const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(cV, rz), pyv);
+                const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ex, half, _CMP_LE_OQ), _mm256_cmp_ps(ex, mhalf, _CMP_GE_OQ)),
+                                                              _mm256_and_ps(_mm256_cmp_ps(ey, half, _CMP_LE_OQ), _mm256_cmp_ps(ey, mhalf, _CMP_GE_OQ))),
+                                                _mm256_cmp_ps(z, zmin, _CMP_GT_OQ));
+                m = _mm256_and_ps(m, _mm256_permutevar8x32_ps(ok, to_linear));
+                if (!_mm256_movemask_ps(m))
+                    continue;
+                /* this view's depth into lanes 3 and 7 of each pixel pair (z's element k of each half) */
+                p0 = _mm256_blend_ps(p0, _mm256_permute_ps(z, 0x00), 0x88);
+                p1 = _mm256_blend_ps(p1, _mm256_permute_ps(z, 0x55), 0x88);
+                p2 = _mm256_blend_ps(p2, _mm256_permute_ps(z, 0xaa), 0x88);
+                p3 = _mm256_blend_ps(p3, _mm256_permute_ps(z, 0xff), 0x88);
+            }
+            float *o = rgbd + 4 * i;
+            if (_mm256_movemask_ps(m) == 0xff) {
+                _mm256_storeu_ps(o, p0), _mm256_storeu_ps(o + 8, p1);
+                _mm256_storeu_ps(o + 16, p2), _mm256_storeu_ps(o + 24, p3);
+                _mm256_storeu_ps(wgt + i, ws);
+            } else {
+                /* each pixel pair's two mask lanes over its four floats */
+                const __m256i mi = _mm256_castps_si256(m);
+                const __m256i lo = _mm256_unpacklo_epi32(mi, mi), hi = _mm256_unpackhi_epi32(mi, mi);
+                /* lo: pixels 0, 0, 1, 1 | 4, 4, 5, 5; hi: 2, 2, 3, 3 | 6, 6, 7, 7 */
+                const __m256i m0 = _mm256_unpacklo_epi64(lo, lo), m1 = _mm256_unpackhi_epi64(lo, lo);
+                const __m256i m2 = _mm256_unpacklo_epi64(hi, hi), m3 = _mm256_unpackhi_epi64(hi, hi);
+                /* m0: 0 x4 | 4 x4, m1: 1 x4 | 5 x4, m2: 2 x4 | 6 x4, m3: 3 x4 | 7 x4 */
+#define ST(k, pk, mk) _mm256_storeu_ps(o + 8 * k, _mm256_blendv_ps(_mm256_loadu_ps(o + 8 * k), pk, _mm256_castsi256_ps(mk)))
+                ST(0, p0, _mm256_permute2x128_si256(m0, m1, 0x20)); /* pixels 0 | 1 */
+                ST(1, p1, _mm256_permute2x128_si256(m2, m3, 0x20)); /* 2 | 3 */
+                ST(2, p2, _mm256_permute2x128_si256(m0, m1, 0x31)); /* 4 | 5 */
+                ST(3, p3, _mm256_permute2x128_si256(m2, m3, 0x31)); /* 6 | 7 */
 #undef ST
-            _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(w, ws, m));
+                _mm256_storeu_ps(wgt + i, _mm256_blendv_ps(wv, ws, m));
+            }
         }
     }
-    return i;
+    if (ilo == 0 && iend == w)
+        return;
+    /* the rows' edges outside the whole steps, pixel by pixel (each pixel's fill is independent of
+     * the others', so doing them after the steps gives the same bits) */
+    for (int r = 0; r < h; r++) {
+        const float *hw, *hrow;
+        float B[3];
+        if (!(hrow = taa_fill_setup(f, t, y0 + r, &hw, B)))
+            continue;
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const float py = (float)(y0 + r) + 0.5f;
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, iend, w);
+    }
 }
-
-TAA_FILL_BLOCK(taa_fill_avx2, fill_vec_avx2)
 
 /* ------------------------------------------------------------------ the still head's blend */
 

@@ -205,56 +205,97 @@ static inline void group_taps(const struct fv_taa_frame *f, const struct fv_taa_
 #define TAA_GROUP_RING 8
 #include "../reproject_blend_tmpl.h"
 
-/* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px). */
-static inline int fill_vec_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd, float *wgt,
-                              const float *hrow, const float *hw, const float B[3], int x0, float py, int ilo, int ihi)
+/* The fill, four pixels at a time: each lane does the reference's operations (taa_fill_px).
+ * Per block, not per row (as the AVX2 fill, branch taa9): the span of whole steps, the columns'
+ * uc * NX and pixel centres and the frame's constants are made once per block (the flow is the
+ * block's); a row costs its B = N0 + vc NY and its steps; the rows' edges come after. B + uc NX adds
+ * the reference's product: the same bits. */
+#define FILL_MAX_STEPS 16 /* w <= 64 */
+static void taa_fill_sse41(const struct fv_taa_frame *f, const struct fv_taa_tile *t, float *rgbd_blk, float *wgt_blk,
+                           ptrdiff_t stride, int x0, int y0, int w, int h)
 {
-    const int sx0 = x0 + t->flow_x;
+    int ilo, ihi;
+    taa_fill_span(f, t, x0, w, &ilo, &ihi);
+    const int sx0 = x0 + t->flow_x, nstep = ihi - ilo >= 4 ? (ihi - ilo) / 4 : 0, iend = ilo + 4 * nstep;
+    const int identity = f->identity;
+    const fv_pyr_level *L = &f->hist->lv[0];
+    const float *hrgbd = L->rgbd, *hwgt = L->wgt;
+    const ptrdiff_t hstride = L->stride;
+    const float prev_h = f->prev_h;
+    const float N0[3] = {f->N0[0], f->N0[1], f->N0[2]}, NY[3] = {f->NY[0], f->NY[1], f->NY[2]};
     const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), mhalf = _mm_set1_ps(-0.5f);
+    const __m128 T20 = _mm_set1_ps(f->T2[0]), T21 = _mm_set1_ps(f->T2[1]), T22 = _mm_set1_ps(f->T2[2]);
+    const __m128 zmin = _mm_set1_ps(1e-4f), one = _mm_set1_ps(1.0f);
     const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
-    int i = ilo;
-    for (; i + 4 <= ihi; i += 4) {
-        const __m128 w = _mm_loadu_ps(wgt + i);
-        const int sx = sx0 + i;
-        const __m128 ws = _mm_loadu_ps(hw + sx);
-        __m128 m = _mm_and_ps(_mm_cmpeq_ps(w, zero), _mm_cmpgt_ps(ws, zero));
-        if (!_mm_movemask_ps(m))
+    __m128 cu0[FILL_MAX_STEPS], cu1[FILL_MAX_STEPS], cu2[FILL_MAX_STEPS], cpx[FILL_MAX_STEPS];
+    if (!identity)
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 4 * s;
+            const __m128 uc = _mm_add_ps(_mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(sx0 + i), lane)), half);
+            cu0[s] = _mm_mul_ps(uc, _mm_set1_ps(f->NX[0]));
+            cu1[s] = _mm_mul_ps(uc, _mm_set1_ps(f->NX[1]));
+            cu2[s] = _mm_mul_ps(uc, _mm_set1_ps(f->NX[2]));
+            cpx[s] = _mm_add_ps(_mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x0 + i), lane)), half);
+        }
+    for (int r = 0; r < h; r++) {
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const int sy = y0 + r + t->flow_y;
+        if (!(sy >= 0 && (float)sy < prev_h))
             continue;
-        const float *src = hrow + 4 * sx;
-        __m128 r = _mm_loadu_ps(src), g = _mm_loadu_ps(src + 4), b = _mm_loadu_ps(src + 8), z = _mm_loadu_ps(src + 12);
-        _MM_TRANSPOSE4_PS(r, g, b, z); /* now r, g, b, D of the four texels */
-        if (!f->identity) {
-            const __m128 D = z;
-            const __m128 uc = _mm_add_ps(_mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(sx), lane)), half);
-            const __m128 pxc = _mm_add_ps(_mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x0 + i), lane)), half);
-            const __m128 U = _mm_add_ps(_mm_set1_ps(f->T2[0]),
-                                        _mm_mul_ps(D, _mm_add_ps(_mm_set1_ps(B[0]), _mm_mul_ps(uc, _mm_set1_ps(f->NX[0])))));
-            const __m128 V = _mm_add_ps(_mm_set1_ps(f->T2[1]),
-                                        _mm_mul_ps(D, _mm_add_ps(_mm_set1_ps(B[1]), _mm_mul_ps(uc, _mm_set1_ps(f->NX[1])))));
-            z = _mm_add_ps(_mm_set1_ps(f->T2[2]),
-                           _mm_mul_ps(D, _mm_add_ps(_mm_set1_ps(B[2]), _mm_mul_ps(uc, _mm_set1_ps(f->NX[2])))));
-            const __m128 rz = _mm_div_ps(_mm_set1_ps(1.0f), z);
-            const __m128 ex = _mm_sub_ps(_mm_mul_ps(U, rz), pxc), ey = _mm_sub_ps(_mm_mul_ps(V, rz), _mm_set1_ps(py));
-            const __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(ex, half), _mm_cmpge_ps(ex, mhalf)),
-                                         _mm_and_ps(_mm_cmple_ps(ey, half), _mm_cmpge_ps(ey, mhalf)));
-            m = _mm_and_ps(m, _mm_and_ps(_mm_cmpgt_ps(z, _mm_set1_ps(1e-4f)), ok));
+        const float vc = (float)sy + 0.5f;
+        const __m128 B0 = _mm_set1_ps(N0[0] + vc * NY[0]), B1 = _mm_set1_ps(N0[1] + vc * NY[1]),
+                     B2 = _mm_set1_ps(N0[2] + vc * NY[2]);
+        const ptrdiff_t ho = (ptrdiff_t)sy * hstride;
+        const float *hw = hwgt + ho, *hrow = hrgbd + 4 * ho;
+        const __m128 pyv = _mm_set1_ps((float)(y0 + r) + 0.5f);
+        for (int s = 0; s < nstep; s++) {
+            const int i = ilo + 4 * s, sx = sx0 + i;
+            const __m128 wv = _mm_loadu_ps(wgt + i);
+            const __m128 ws = _mm_loadu_ps(hw + sx);
+            __m128 m = _mm_and_ps(_mm_cmpeq_ps(wv, zero), _mm_cmpgt_ps(ws, zero));
             if (!_mm_movemask_ps(m))
                 continue;
-        }
-        _MM_TRANSPOSE4_PS(r, g, b, z); /* back to four pixels (r, g, b, depth) */
-        float *o = rgbd + 4 * i;
+            const float *src = hrow + 4 * sx;
+            __m128 r0 = _mm_loadu_ps(src), g0 = _mm_loadu_ps(src + 4), b0 = _mm_loadu_ps(src + 8), z = _mm_loadu_ps(src + 12);
+            _MM_TRANSPOSE4_PS(r0, g0, b0, z); /* now r, g, b, D of the four texels */
+            if (!identity) {
+                const __m128 D = z;
+                const __m128 U = _mm_add_ps(T20, _mm_mul_ps(D, _mm_add_ps(B0, cu0[s])));
+                const __m128 V = _mm_add_ps(T21, _mm_mul_ps(D, _mm_add_ps(B1, cu1[s])));
+                z = _mm_add_ps(T22, _mm_mul_ps(D, _mm_add_ps(B2, cu2[s])));
+                const __m128 rz = _mm_div_ps(one, z);
+                const __m128 ex = _mm_sub_ps(_mm_mul_ps(U, rz), cpx[s]), ey = _mm_sub_ps(_mm_mul_ps(V, rz), pyv);
+                const __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(ex, half), _mm_cmpge_ps(ex, mhalf)),
+                                             _mm_and_ps(_mm_cmple_ps(ey, half), _mm_cmpge_ps(ey, mhalf)));
+                m = _mm_and_ps(m, _mm_and_ps(_mm_cmpgt_ps(z, zmin), ok));
+                if (!_mm_movemask_ps(m))
+                    continue;
+            }
+            _MM_TRANSPOSE4_PS(r0, g0, b0, z); /* back to four pixels (r, g, b, depth) */
+            float *o = rgbd + 4 * i;
 #define PUT(k, v) _mm_storeu_ps(o + 4 * k, _mm_blendv_ps(_mm_loadu_ps(o + 4 * k), v, _mm_shuffle_ps(m, m, k * 0x55)))
-        PUT(0, r);
-        PUT(1, g);
-        PUT(2, b);
-        PUT(3, z);
+            PUT(0, r0);
+            PUT(1, g0);
+            PUT(2, b0);
+            PUT(3, z);
 #undef PUT
-        _mm_storeu_ps(wgt + i, _mm_blendv_ps(w, ws, m));
+            _mm_storeu_ps(wgt + i, _mm_blendv_ps(wv, ws, m));
+        }
     }
-    return i;
+    if (ilo == 0 && iend == w)
+        return;
+    /* the rows' edges outside the whole steps, pixel by pixel (each pixel's fill is independent) */
+    for (int r = 0; r < h; r++) {
+        const float *hw, *hrow;
+        float B[3];
+        if (!(hrow = taa_fill_setup(f, t, y0 + r, &hw, B)))
+            continue;
+        float *rgbd = rgbd_blk + 4 * r * stride, *wgt = wgt_blk + r * stride;
+        const float py = (float)(y0 + r) + 0.5f;
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, 0, ilo);
+        taa_fill_px(f, t, rgbd, wgt, hrow, hw, B, x0, py, iend, w);
+    }
 }
-
-TAA_FILL_BLOCK(taa_fill_sse41, fill_vec_sse41)
 
 /* ------------------------------------------------------------------ the still head's blend */
 

@@ -127,6 +127,7 @@ typedef struct {
     fv_sampler smp;
     fv_taa_params prm;
     fv_taa_frame f;
+    fv_camera prev; /* taa_turn: the previous frame's camera, 1/3 deg of yaw away */
 } taa_st;
 static void taa_free(void *st)
 {
@@ -176,6 +177,24 @@ static void *taa_setup(void)
         }
     }
     fv_taa_frame_setup(&t->f, &t->cam, &t->cam, &t->hist, t->prm.depth_tol);
+    return t;
+}
+/* The same inputs with the head turning 30 deg/s (1/3 deg of yaw a 90 Hz frame): the production
+ * path of a moving head (projection, the fill's check, flows of ~4-8 px), the wall's depth within
+ * the tolerance so the taps and the fill really take the history. */
+static void *taa_turn_setup(void)
+{
+    taa_st *t = taa_setup();
+    if (!t)
+        return NULL;
+    fv_camera_desc cd;
+    fv_camera_desc_default(&cd);
+    cd.width = W, cd.height = H;
+    const float a = 0.5f * (1.0f / 3.0f) * 3.14159265f / 180.0f;
+    const fv_pose p1 = {{0, 0, 0}, {0, sinf(a), 0, cosf(a)}};
+    if (fv_camera_setup(&t->prev, &cd, &p1))
+        return taa_free(t), NULL;
+    fv_taa_frame_setup(&t->f, &t->cam, &t->prev, &t->hist, t->prm.depth_tol);
     return t;
 }
 static void taa_reset(void *st)
@@ -763,6 +782,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
     {"push_row", "1280x1440, 1440 rows", {F(pp.push_row), 0}, H, push_setup, NULL, push_run, push_free},
     {"taa_blend+taa_fill", "1280x1440, 7200 16x16 tiles, still head", {F(taa.taa_blend), F(taa.taa_fill)}, TX * TY, taa_setup,
      taa_reset, taa_run, taa_free},
+    {"taa_turn", "1280x1440, 7200 16x16 tiles, head turning 30 deg/s", {F(taa.taa_blend), F(taa.taa_fill)}, TX * TY,
+     taa_turn_setup, taa_reset, taa_run, taa_free},
     {"taa_aa", "1280x1440, 144 16x16 fovea tiles, head turning 30 deg/s", {F(taa.taa_aa), 0}, AA_T * AA_T, aa_setup,
      aa_reset, aa_turn_run, aa_free},
     {"taa_aa_still", "1280x1440, 144 16x16 fovea tiles, still head", {F(taa.taa_aa), 0}, AA_T * AA_T, aa_setup,
