@@ -328,6 +328,21 @@ static inline __attribute__((always_inline)) void pb_rows(float *blur, const flo
                      act, p, mode);
 }
 
+/* the 4 pairs of a block (b = blur + 4 i) whose pixels' levels are L0 = b (u0 = r0, u1 = r1) or,
+ * where hi, b + 1 (u0 = r1, u1 = r2); r0..r2 at pixel i */
+static inline __attribute__((always_inline)) void pb_rows2(float *b, const float *r0, const float *r1,
+                                                           const float *r2, __m256 hi, __m256 f, __m256 t,
+                                                           __m256 mix, __m256 act, int bits, int mode)
+{
+#pragma GCC unroll 4
+    for (int p = 0; p < 4; p++)
+        if (mode != PB_SEL || (bits & (0x11 << p))) {
+            const __m256 h = SPREAD(hi, p), v1 = _mm256_loadu_ps(r1 + 8 * p);
+            pb_blend(b + 8 * p, _mm256_blendv_ps(_mm256_loadu_ps(r0 + 8 * p), v1, h),
+                     _mm256_blendv_ps(v1, _mm256_loadu_ps(r2 + 8 * p), h), f, t, mix, act, p, mode);
+        }
+}
+
 /* the block's mode from its act and mix masks (pair order) */
 static inline int pb_mode(int bits, __m256 mix)
 {
@@ -462,6 +477,20 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
 #define PBR(md) pb_rows(blur, r0, r1, f, t, mix, act, bits, i, md)
             PB_DISPATCH(PBR);
 #undef PBR
+            continue;
+        }
+        /* two neighbouring level pairs (a level boundary crosses the block: about half the blocks
+         * of a half-resolution row): L0 = b or b + 1, whole-pair loads of 3 rows and a select */
+        const __m256i vb = _mm256_set1_epi32(l00 - (_mm256_movemask_ps(_mm256_castsi256_ps(
+                                                      _mm256_cmpgt_epi32(_mm256_set1_epi32(l00), l0))) != 0));
+        const __m256 hi = _mm256_castsi256_ps(_mm256_cmpeq_epi32(l0, _mm256_sub_epi32(vb, _mm256_set1_epi32(-1))));
+        if (_mm256_movemask_ps(_mm256_or_ps(hi, _mm256_castsi256_ps(_mm256_cmpeq_epi32(l0, vb)))) == 255) {
+            const int b0 = _mm_cvtsi128_si32(_mm256_castsi256_si128(vb)); /* b + 1 <= need: some L0 is */
+            const float *r0 = up[b0] + 4 * (ptrdiff_t)i, *r1 = up[b0 + 1] + 4 * (ptrdiff_t)i;
+            const float *r2 = up[b0 + 2 <= a->need ? b0 + 2 : b0 + 1] + 4 * (ptrdiff_t)i;
+#define PB2(md) pb_rows2(blur + 4 * (ptrdiff_t)i, r0, r1, r2, hi, f, t, mix, act, bits, md)
+            PB_DISPATCH(PB2);
+#undef PB2
             continue;
         }
         _Alignas(32) int32_t L0[8], L1[8]; /* pair order: pair p's pixels at p and 4 + p */
