@@ -280,87 +280,130 @@ static void upsample_row_avx2(float *restrict dst, const float *tmp, int L, int 
     dof_upruns_x86(dst + 4 * (b - x0), tmp, L, sw, b, x1 - b);
 }
 
-/* pair p of the 8 pixels from i: b = mix ? b + t (pv - b) : pv, pv = u0 + f (u1 - u0), kept where
- * act; sel = 0 (a constant) where all 8 are blended and none mixes: no selects needed. */
-static inline void pb_pair(float *blur, const float *const *up, const int32_t *L0, const int32_t *L1, __m256 f,
-                           __m256 t, __m256 mix, __m256 act, int i, int p, int sel)
+/* ---- pyrblur_row ----
+ * A block's 8 per-pixel lanes are kept in pair order: lane p (low half) is pixel 2p, lane 4 + p
+ * pixel 2p + 1 (one vpermps of coc and of t a block), so the AoS pair p = pixels (2p, 2p + 1)
+ * spreads a lane over its 4 channels by one in-lane vpermilps (SPREAD) instead of a lane-crossing
+ * vpermps per pair and value. The blend of a pair: pv = u0 + f (u1 - u0), r = mix ? b + t (pv - b)
+ * : pv, b = act ? r : b (the reference's operations). mode, a constant at each call: PB_PV: all 8
+ * blended, none mixing (the periphery): b = pv; PB_MIX: all 8 blended and mixing (the far part of
+ * the transition ring): b = b + t (pv - b), no selects; PB_SEL: both selects. */
+#define PB_ORDER _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)
+static inline __attribute__((always_inline)) __m256 SPREAD(__m256 v, int p) /* p a constant once unrolled */
 {
-    const int k = 2 * p;
-    const ptrdiff_t o = 4 * (ptrdiff_t)(i + k);
-    float *b = blur + o;
-    const __m256 u0 = ld2(up[L0[k]] + o, up[L0[k + 1]] + o + 4), u1 = ld2(up[L1[k]] + o, up[L1[k + 1]] + o + 4);
-    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
-    if (!sel) {
+    switch (p) {
+    case 0: return _mm256_permute_ps(v, 0x00);
+    case 1: return _mm256_permute_ps(v, 0x55);
+    case 2: return _mm256_permute_ps(v, 0xaa);
+    default: return _mm256_permute_ps(v, 0xff);
+    }
+}
+enum { PB_PV, PB_MIX, PB_SEL };
+
+static inline __attribute__((always_inline)) void pb_blend(float *b, __m256 u0, __m256 u1, __m256 f, __m256 t,
+                                                           __m256 mix, __m256 act, int p, int mode)
+{
+    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(SPREAD(f, p), _mm256_sub_ps(u1, u0)));
+    if (mode == PB_PV) {
         _mm256_storeu_ps(b, pv);
         return;
     }
-    const __m256 bv = _mm256_loadu_ps(b);
-    const __m256 r =
-        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
-    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
-}
-
-/* pair p when all 8 pixels have the same levels L0, L1 (rows r0 = up[L0] + 4 i, r1 = up[L1] + 4 i):
- * whole-pair loads, no per-pixel row pointers. The same operations as pb_pair. */
-static inline void pb_pairu(float *blur, const float *r0, const float *r1, __m256 f, __m256 t, __m256 mix, __m256 act,
-                            int i, int p, int sel)
-{
-    float *b = blur + 4 * (ptrdiff_t)(i + 2 * p);
-    const __m256 u0 = _mm256_loadu_ps(r0 + 8 * p), u1 = _mm256_loadu_ps(r1 + 8 * p);
-    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
-    if (!sel) {
-        _mm256_storeu_ps(b, pv);
+    const __m256 bv = _mm256_loadu_ps(b), m = _mm256_add_ps(bv, _mm256_mul_ps(SPREAD(t, p), _mm256_sub_ps(pv, bv)));
+    if (mode == PB_MIX) {
+        _mm256_storeu_ps(b, m);
         return;
     }
-    const __m256 bv = _mm256_loadu_ps(b);
-    const __m256 r =
-        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
-    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, _mm256_blendv_ps(pv, m, SPREAD(mix, p)), SPREAD(act, p)));
 }
 
-/* need == 1 (the periphery beyond the transition ring, whose level 1 is the half-resolution
- * blur): L1 = 1 and L0 = 0 or 1 per pixel, so both levels load whole pairs and L0 is a select
- * (no per-pixel pointers, no branches on the levels) */
-static inline void pb_pair1(float *blur, const float *up0, const float *up1, __m256 is1, __m256 f, __m256 t,
-                            __m256 mix, __m256 act, int i, int p, int sel)
+/* the 4 pairs of a block at pixel i whose 8 pixels share the level rows r0, r1 (+ 4 i) */
+static inline __attribute__((always_inline)) void pb_rows(float *blur, const float *r0, const float *r1, __m256 f,
+                                                          __m256 t, __m256 mix, __m256 act, int bits, int i, int mode)
 {
-    const ptrdiff_t o = 4 * (ptrdiff_t)(i + 2 * p);
-    float *b = blur + o;
-    const __m256 u1 = _mm256_loadu_ps(up1 + o), u0 = _mm256_blendv_ps(_mm256_loadu_ps(up0 + o), u1, PAIR(is1, p));
-    const __m256 pv = _mm256_add_ps(u0, _mm256_mul_ps(PAIR(f, p), _mm256_sub_ps(u1, u0)));
-    if (!sel) {
-        _mm256_storeu_ps(b, pv);
-        return;
-    }
-    const __m256 bv = _mm256_loadu_ps(b);
-    const __m256 r =
-        _mm256_blendv_ps(pv, _mm256_add_ps(bv, _mm256_mul_ps(PAIR(t, p), _mm256_sub_ps(pv, bv))), PAIR(mix, p));
-    _mm256_storeu_ps(b, _mm256_blendv_ps(bv, r, PAIR(act, p)));
+    const ptrdiff_t o = 4 * (ptrdiff_t)i;
+#pragma GCC unroll 4
+    for (int p = 0; p < 4; p++)
+        if (mode != PB_SEL || (bits & (0x11 << p)))
+            pb_blend(blur + o + 8 * p, _mm256_loadu_ps(r0 + o + 8 * p), _mm256_loadu_ps(r1 + o + 8 * p), f, t, mix,
+                     act, p, mode);
 }
 
-static void pyrblur1_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
+/* the 4 pairs of a block (b = blur + 4 i) whose pixels' levels are L0 = b (u0 = r0, u1 = r1) or,
+ * where hi, b + 1 (u0 = r1, u1 = r2); r0..r2 at pixel i */
+static inline __attribute__((always_inline)) void pb_rows2(float *b, const float *r0, const float *r1,
+                                                           const float *r2, __m256 hi, __m256 f, __m256 t,
+                                                           __m256 mix, __m256 act, int bits, int mode)
+{
+#pragma GCC unroll 4
+    for (int p = 0; p < 4; p++)
+        if (mode != PB_SEL || (bits & (0x11 << p))) {
+            const __m256 h = SPREAD(hi, p), v1 = _mm256_loadu_ps(r1 + 8 * p);
+            pb_blend(b + 8 * p, _mm256_blendv_ps(_mm256_loadu_ps(r0 + 8 * p), v1, h),
+                     _mm256_blendv_ps(v1, _mm256_loadu_ps(r2 + 8 * p), h), f, t, mix, act, p, mode);
+        }
+}
+
+/* the block's mode from its act and mix masks (pair order) */
+static inline int pb_mode(int bits, __m256 mix)
+{
+    const int mb = _mm256_movemask_ps(mix);
+    return bits != 255 ? PB_SEL : !mb ? PB_PV : mb == 255 ? PB_MIX : PB_SEL;
+}
+
+#define PB_DISPATCH(call)                                                                                            \
+    do {                                                                                                             \
+        const int mode_ = pb_mode(bits, mix);                                                                        \
+        if (mode_ == PB_PV)                                                                                          \
+            call(PB_PV);                                                                                             \
+        else if (mode_ == PB_MIX)                                                                                    \
+            call(PB_MIX);                                                                                            \
+        else                                                                                                         \
+            call(PB_SEL);                                                                                            \
+    } while (0)
+
+/* need == 1 (the transition disc; the half-resolution rows' level 1): L1 = 1, L0 = 0 or 1 per
+ * pixel, so both levels load whole pairs and L0 is a select (no per-pixel pointers). need == 0:
+ * l = min(lambda, 0) = 0 (lambda >= 0), f = 0 and L0 = L1 = 0 for every pixel: no lookup. */
+static void pyrblur01_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
     const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), msign = _mm256_set1_ps(-0.0f);
-    const float *up0 = a->up[0], *up1 = a->up[1];
-    /* The level table in registers instead of a gather: l = min(lambda[k], 1) is 1 for every k
-     * from sat on; when sat <= 32 the first 32 entries are all a lookup needs. */
-    int sat = a->lambda_max + 1;
-    while (sat > 0 && a->lambda[sat - 1] >= 1.0f)
-        sat--;
-    const int regs = sat <= 32 && a->lambda_max >= 31; /* (never read past a shorter table) */
+    const __m256i order = PB_ORDER;
+    const int need1 = a->need == 1;
+    const float *up0 = a->up[0], *up1 = a->up[need1];
+    /* The level table in registers instead of a gather: when l = min(lambda[k], 1) is 1 for every
+     * k >= 32, the first 32 entries are all a lookup needs (checked 8 entries a step: a scalar
+     * scan of the 513-entry table cost as much as the blend of a 640-pixel row) */
+    int regs = need1 && a->lambda_max >= 31; /* (never read past a shorter table) */
+    if (regs) {
+        __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+        int q = 32;
+        for (; q + 8 <= a->lambda_max + 1; q += 8)
+            ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_loadu_ps(a->lambda + q), one, _CMP_GE_OQ));
+        regs = _mm256_movemask_ps(ok) == 255;
+        for (; q <= a->lambda_max; q++)
+            regs &= a->lambda[q] >= 1.0f;
+    }
     __m256 lut[4];
     for (int q = 0; q < 4; q++)
         lut[q] = regs ? _mm256_min_ps(_mm256_loadu_ps(a->lambda + 8 * q), one) : zero;
     int i = x0;
     for (; i + 8 <= x0 + n; i += 8) {
-        const __m256 c = _mm256_loadu_ps(a->coc + i), t = _mm256_loadu_ps(a->t + i);
-        const __m256 m = _mm256_andnot_ps(msign, c);
+        const __m256 c = _mm256_permutevar8x32_ps(_mm256_loadu_ps(a->coc + i), order);
+        const __m256 t = _mm256_permutevar8x32_ps(_mm256_loadu_ps(a->t + i), order);
+        const __m256 m = _mm256_andnot_ps(msign, c); /* |c| (-0 -> +0: skipped either way) */
         const __m256 act = _mm256_and_ps(_mm256_cmp_ps(m, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
         const int bits = _mm256_movemask_ps(act);
         if (!bits)
             continue;
-        const __m256 v = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(m, steps), zero), lmax);
+        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
+        if (!need1) { /* pv = u0 + 0 (u0 - u0), as the reference */
+#define PB0(md) pb_rows(blur, up0, up0, zero, t, mix, act, bits, i, md)
+            PB_DISPATCH(PB0);
+#undef PB0
+            continue;
+        }
+        const __m256 v = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(m, steps), zero), lmax); /* NaN -> 0 */
         const __m256i k = _mm256_cvttps_epi32(v);
         __m256 l;
         if (regs) {
@@ -375,34 +418,48 @@ static void pyrblur1_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a
         }
         const __m256 is1 = _mm256_cmp_ps(l, one, _CMP_GE_OQ); /* L0 = int l = 1 */
         const __m256 f = _mm256_sub_ps(l, _mm256_and_ps(is1, one));
-        const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
-        const int sel = !(bits == 255 && !_mm256_movemask_ps(mix));
-        for (int p = 0; p < 4; p++)
-            if (!sel || (bits >> (2 * p) & 3))
-                pb_pair1(blur, up0, up1, is1, f, t, mix, act, i, p, sel);
+        const int all1 = _mm256_movemask_ps(is1), o4 = 4 * i;
+        if (all1 == 255) { /* every pixel at level 1: pv = u1 + 0 (u1 - u1) */
+#define PB1(md) pb_rows(blur, up1, up1, f, t, mix, act, bits, i, md)
+            PB_DISPATCH(PB1);
+#undef PB1
+        } else if (!all1) { /* every pixel between levels 0 and 1 */
+#define PB1(md) pb_rows(blur, up0, up1, f, t, mix, act, bits, i, md)
+            PB_DISPATCH(PB1);
+#undef PB1
+        } else {
+#pragma GCC unroll 4
+            for (int p = 0; p < 4; p++)
+                if (bits & (0x11 << p)) {
+                    const __m256 u1 = _mm256_loadu_ps(up1 + o4 + 8 * p);
+                    const __m256 u0 = _mm256_blendv_ps(_mm256_loadu_ps(up0 + o4 + 8 * p), u1, SPREAD(is1, p));
+                    pb_blend(blur + o4 + 8 * p, u0, u1, f, t, mix, act, p, PB_SEL);
+                }
+        }
     }
     if (i < x0 + n)
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);
 }
 
-/* 8 pixels at a time: their scalars as 8 lanes (core/x86/dof_tmpl.h has why the clamped LUT
- * index gives the reference's levels and keeps skipped pixels' loads in bounds), then 4 pairs
- * (unrolled by hand), each computed for both pixels and kept per pixel by selects; the rest
- * 128-bit. */
+/* 8 pixels at a time: their scalars as 8 lanes in pair order (core/x86/dof_tmpl.h has why the
+ * clamped LUT index gives the reference's levels and keeps skipped pixels' loads in bounds); a
+ * block whose 8 pixels share a level pair (the CoC varies slowly: most) loads whole pairs from
+ * the two rows, others a row pointer a pixel; the rest 128-bit. */
 static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a, int x0, int n)
 {
-    if (a->need == 1) {
-        pyrblur1_row_avx2(blur, a, x0, n);
+    if (a->need <= 1) {
+        pyrblur01_row_avx2(blur, a, x0, n);
         return;
     }
     const __m256 steps = _mm256_set1_ps((float)a->lambda_steps), lmax = _mm256_set1_ps((float)a->lambda_max);
     const __m256 need = _mm256_set1_ps((float)a->need), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     const __m256 msign = _mm256_set1_ps(-0.0f);
-    const __m256i needi = _mm256_set1_epi32(a->need);
+    const __m256i needi = _mm256_set1_epi32(a->need), order = PB_ORDER;
     const float *const *up = a->up;
     int i = x0;
     for (; i + 8 <= x0 + n; i += 8) {
-        const __m256 c = _mm256_loadu_ps(a->coc + i), t = _mm256_loadu_ps(a->t + i);
+        const __m256 c = _mm256_permutevar8x32_ps(_mm256_loadu_ps(a->coc + i), order);
+        const __m256 t = _mm256_permutevar8x32_ps(_mm256_loadu_ps(a->t + i), order);
         const __m256 m = _mm256_andnot_ps(msign, c); /* |c| (-0 -> +0: skipped either way) */
         const __m256 act = _mm256_and_ps(_mm256_cmp_ps(m, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, zero, _CMP_GT_OQ));
         const int bits = _mm256_movemask_ps(act);
@@ -413,42 +470,39 @@ static void pyrblur_row_avx2(float *restrict blur, const fv_dof_pyrblur_args *a,
         const __m256i l0 = _mm256_cvttps_epi32(l);
         const __m256 f = _mm256_sub_ps(l, _mm256_cvtepi32_ps(l0));
         const __m256 mix = _mm256_and_ps(_mm256_cmp_ps(c, zero, _CMP_GT_OQ), _mm256_cmp_ps(t, one, _CMP_LT_OQ));
-        /* one level pair for all 8 (the CoC varies slowly: most blocks): rows, not pixels */
+        /* one level pair for all 8: rows, not pixels */
         const int l00 = _mm_cvtsi128_si32(_mm256_castsi256_si128(l0));
         if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(l0, _mm256_set1_epi32(l00)))) == 255) {
-            const float *r0 = up[l00] + 4 * (ptrdiff_t)i, *r1 = up[l00 < a->need ? l00 + 1 : l00] + 4 * (ptrdiff_t)i;
-            const int sel = !(bits == 255 && !_mm256_movemask_ps(mix));
-            if (!sel) {
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 0, 0);
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 1, 0);
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 2, 0);
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 3, 0);
-            } else {
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 0, 1);
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 1, 1);
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 2, 1);
-                pb_pairu(blur, r0, r1, f, t, mix, act, i, 3, 1);
-            }
+            const float *r0 = up[l00], *r1 = up[l00 < a->need ? l00 + 1 : l00];
+#define PBR(md) pb_rows(blur, r0, r1, f, t, mix, act, bits, i, md)
+            PB_DISPATCH(PBR);
+#undef PBR
             continue;
         }
-        _Alignas(32) int32_t L0[8], L1[8];
+        /* two neighbouring level pairs (a level boundary crosses the block: about half the blocks
+         * of a half-resolution row): L0 = b or b + 1, whole-pair loads of 3 rows and a select */
+        const __m256i vb = _mm256_set1_epi32(l00 - (_mm256_movemask_ps(_mm256_castsi256_ps(
+                                                      _mm256_cmpgt_epi32(_mm256_set1_epi32(l00), l0))) != 0));
+        const __m256 hi = _mm256_castsi256_ps(_mm256_cmpeq_epi32(l0, _mm256_sub_epi32(vb, _mm256_set1_epi32(-1))));
+        if (_mm256_movemask_ps(_mm256_or_ps(hi, _mm256_castsi256_ps(_mm256_cmpeq_epi32(l0, vb)))) == 255) {
+            const int b0 = _mm_cvtsi128_si32(_mm256_castsi256_si128(vb)); /* b + 1 <= need: some L0 is */
+            const float *r0 = up[b0] + 4 * (ptrdiff_t)i, *r1 = up[b0 + 1] + 4 * (ptrdiff_t)i;
+            const float *r2 = up[b0 + 2 <= a->need ? b0 + 2 : b0 + 1] + 4 * (ptrdiff_t)i;
+#define PB2(md) pb_rows2(blur + 4 * (ptrdiff_t)i, r0, r1, r2, hi, f, t, mix, act, bits, md)
+            PB_DISPATCH(PB2);
+#undef PB2
+            continue;
+        }
+        _Alignas(32) int32_t L0[8], L1[8]; /* pair order: pair p's pixels at p and 4 + p */
         _mm256_store_si256((__m256i *)L0, l0);
         _mm256_store_si256((__m256i *)L1, _mm256_sub_epi32(l0, _mm256_cmpgt_epi32(needi, l0))); /* + 1 if L0 < need */
-        if (bits == 255 && !_mm256_movemask_ps(mix)) { /* the periphery */
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 0);
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 0);
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 0);
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 0);
-            continue;
-        }
-        if (bits & 3)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 0, 1);
-        if (bits & 12)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 1, 1);
-        if (bits & 48)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 2, 1);
-        if (bits & 192)
-            pb_pair(blur, up, L0, L1, f, t, mix, act, i, 3, 1);
+#pragma GCC unroll 4
+        for (int p = 0; p < 4; p++)
+            if (bits & (0x11 << p)) {
+                const ptrdiff_t o = 4 * (ptrdiff_t)(i + 2 * p);
+                pb_blend(blur + o, ld2(up[L0[p]] + o, up[L0[4 + p]] + o + 4), ld2(up[L1[p]] + o, up[L1[4 + p]] + o + 4),
+                         f, t, mix, act, p, PB_SEL);
+            }
     }
     if (i < x0 + n)
         dof_pyrblur_row_x86(blur, a, i, x0 + n - i);

@@ -295,6 +295,7 @@ static void aa_still_run(void *st, const checkasm_dsp *d, int row0, int rows)
 typedef struct {
     float *rgbd, *coc, *a4, *b4, *c4, *out, *t;
     float *cocs, *ts; /* pyrblur: a smooth CoC and the transition ramp of t, as the pipeline's */
+    float *tsd, *hcs; /* pyrblur_spans: t of the disc (r0 106, r1 212 px), the half grid's |c| */
     uint8_t *sig;
     uint8_t *sigr; /* vgauss: sigmas in runs */
     fv_dof_gauss_tab *tab;
@@ -306,7 +307,7 @@ static void dof_free(void *st)
 {
     dof_st *t = st;
     free(t->rgbd), free(t->coc), free(t->a4), free(t->b4), free(t->c4), free(t->out), free(t->t), free(t->sig), free(t->sigr);
-    free(t->cocs), free(t->ts), free(t->tab), free(t->lambda), free(t);
+    free(t->cocs), free(t->ts), free(t->tsd), free(t->hcs), free(t->tab), free(t->lambda), free(t);
 }
 static void *dof_setup(void)
 {
@@ -317,9 +318,9 @@ static void *dof_setup(void)
     t->rgbd = fplane(4 * n), t->coc = fplane(n), t->a4 = fplane(4 * n), t->b4 = fplane(4 * n);
     t->c4 = fplane(4 * n), t->out = fplane(4 * n), t->t = fplane(n), t->sig = malloc(n), t->sigr = malloc(n);
     t->tab = malloc(sizeof *t->tab);
-    t->cocs = fplane(n), t->ts = fplane(n);
+    t->cocs = fplane(n), t->ts = fplane(n), t->tsd = fplane(n), t->hcs = fplane(n / 4);
     t->lambda = fplane(64 * LSTEPS + 1);
-    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->sigr || !t->tab || !t->lambda || !t->cocs || !t->ts)
+    if (!t->rgbd || !t->coc || !t->a4 || !t->b4 || !t->c4 || !t->out || !t->t || !t->sig || !t->sigr || !t->tab || !t->lambda || !t->cocs || !t->ts || !t->tsd || !t->hcs)
         return dof_free(t), NULL;
     for (int i = 0; i <= 64 * LSTEPS; i++) /* about log2 of the CoC */
         t->lambda[i] = i < LSTEPS ? 0.0f : fminf(5.0f, log2f((float)i / LSTEPS));
@@ -353,7 +354,11 @@ static void *dof_setup(void)
             t->cocs[i] = 6.0f * sinf((float)x * 0.043f + (float)y * 0.027f) * cosf((float)x * 0.011f - (float)y * 0.019f);
             const float dx = (float)x + 0.5f - 0.5f * W, dy = (float)y + 0.5f - 0.5f * H;
             t->ts[i] = fminf(fmaxf((sqrtf(dx * dx + dy * dy) - 170.0f) / 180.0f, 0.0f), 1.0f);
+            t->tsd[i] = fminf(fmaxf((sqrtf(dx * dx + dy * dy) - 106.0f) / 106.0f, 0.0f), 1.0f);
         }
+    for (int v = 0; v < H / 2; v++) /* the 2x2 mean |c| changes twice as fast a texel */
+        for (int u = 0; u < W / 2; u++)
+            t->hcs[(size_t)v * (W / 2) + (size_t)u] = fabsf(t->cocs[(size_t)(2 * v) * W + (size_t)(2 * u)]);
     return t;
 }
 static void coc_run(void *st, const checkasm_dsp *d, int row0, int rows)
@@ -464,6 +469,37 @@ static void pyrblur_run(void *st, const checkasm_dsp *d, int row0, int rows)
         const fv_dof_pyrblur_args a = {.coc = t->cocs + y * W, .t = t->ts + y * W, .up = up, .need = 4,
                                        .lambda = t->lambda, .lambda_steps = LSTEPS, .lambda_max = 64 * LSTEPS};
         d->dof.dof_pyrblur_row(t->out + 4 * v * W, &a, 0, W);
+    }
+}
+/* pyrblur as the pipeline calls it (core/dof/weier_filter.c; calls counted over 2 frames of
+ * range / DoF medium and FlightHelmet / strong, 2026-11-28): the transition disc's span of each
+ * full-resolution row (~340 px, ring t, need 1 on range, 3 on FlightHelmet) and the half-
+ * resolution periphery's rows (hblur_row: 390-640 texels, t = 1, the 2x2-mean |c| >= 0, need 0
+ * on 60 % of range's texels, else 1-3), about 1:2 in pixels. A cycle of 6 rows: disc need 1, half
+ * need 0, half need 1, disc need 3, half need 2, half need 0. Rows in cache, as there. */
+static void pyrblur_spans_run(void *st, const checkasm_dsp *d, int row0, int rows)
+{
+    dof_st *t = st;
+    static const int need_of[6] = {1, 0, 1, 3, 2, 0};
+    for (int k = 0; k < rows; k++) {
+        const int y = (row0 + k) % H, ph = y % 6;
+        const size_t v = (size_t)(y % 4);
+        const float *up[5] = {t->rgbd + 4 * v * W, t->a4 + 4 * v * W, t->b4 + 4 * v * W, t->c4 + 4 * v * W,
+                              t->a4 + 4 * ((v + 1) % 4) * W};
+        if (ph == 0 || ph == 3) { /* a row of the disc (radius 212 around the centre): its span */
+            const int yr = H / 2 - 211 + (y * 7) % 422;
+            const float dy = (float)yr + 0.5f - 0.5f * H, half = sqrtf(fmaxf(212.0f * 212.0f - dy * dy, 0.0f));
+            const int xa = (int)floorf(0.5f * W - half) - 1, xb = (int)ceilf(0.5f * W + half) + 1;
+            const fv_dof_pyrblur_args a = {.coc = t->cocs + (size_t)yr * W, .t = t->tsd + (size_t)yr * W, .up = up,
+                                           .need = need_of[ph], .lambda = t->lambda, .lambda_steps = LSTEPS,
+                                           .lambda_max = 64 * LSTEPS};
+            d->dof.dof_pyrblur_row(t->out + 4 * v * W, &a, xa, xb - xa);
+        } else { /* a half row: t = 1 (row 0 of the ring's t) */
+            const fv_dof_pyrblur_args a = {.coc = t->hcs + (size_t)(y / 2) * (W / 2), .t = t->ts, .up = up,
+                                           .need = need_of[ph], .lambda = t->lambda, .lambda_steps = LSTEPS,
+                                           .lambda_max = 64 * LSTEPS};
+            d->dof.dof_pyrblur_row(t->out + 4 * v * W, &a, 0, W / 2);
+        }
     }
 }
 /* the periphery beyond the disc: half-resolution blur row (with its clamped texel before it), near
@@ -807,6 +843,8 @@ const checkasm_bench_kernel checkasm_bench_kernels[] = {
      upsample_spans_run, dof_free},
     {"dof_pyrblur_row", "1440 rows in cache, 5 levels, smooth CoC, ring t", {F(dof.dof_pyrblur_row), 0}, H, dof_setup, NULL, pyrblur_run,
      dof_free},
+    {"dof_pyrblur_spans", "1440 calls as the pipeline's: disc spans (r 212), 640-px half rows", {F(dof.dof_pyrblur_row), 0}, H,
+     dof_setup, NULL, pyrblur_spans_run, dof_free},
     {"dof_combine_row", "1280x1440, 1440 rows, all layers", {F(dof.dof_combine_row), 0}, H, dof_setup, NULL, combine_run,
      dof_free},
     {"dof_periph_row", "1280x1440, 1440 rows, near layer on", {F(dof.dof_periph_row), 0}, H, dof_setup, NULL, periph_run,

@@ -434,6 +434,7 @@ static void test_upsample_row(void **state)
 /* ------------------------------------------------------------------ pyrblur_row */
 
 static long pb_active, pb_mix, pb_beyond, pb_frac; /* how often (reference, all ISAs) */
+static long pb_blk_all, pb_blk_mix; /* 8-pixel blocks from x0: all 8 blended (none mixing), all 8 mixed */
 
 /* Rows of w pixels; the span [x0, x0 + n). The level table: core/dof/weier.c's (steps 8, 512
  * entries) or a short random one (levels >= 0, some whole, some above need), so CoCs run past
@@ -521,6 +522,16 @@ static void run_pyrblur1(const fv_dof_dsp *d, const char *isa, int w, int x0, in
         for (int k = 0; k < 4; k++)
             assert_true(isfinite(r.p[4 * i + k]));
     }
+    for (int b = x0; b + 8 <= x0 + n; b += 8) { /* the AVX2 version's select-free blocks happen */
+        int na = 0, nm = 0;
+        for (int i = b; i < b + 8; i++) {
+            const float c = coc.p[i], tt = t.p[i], m = c < 0.0f ? -c : c;
+            na += m > 0.0f && tt > 0.0f;
+            nm += m > 0.0f && tt > 0.0f && c > 0.0f && tt < 1.0f;
+        }
+        pb_blk_all += na == 8 && nm == 0;
+        pb_blk_mix += nm == 8;
+    }
     for (int L = 0; L <= need; L++)
         free(up[L].base);
     free(lambda), free(coc.base), free(t.base), free(r.base), free(o.base);
@@ -544,8 +555,9 @@ static void test_pyrblur_row(void **state)
     (void)state;
     run_all("dof_pyrblur_row", run_pyrblur, offsetof(fv_dof_dsp, dof_pyrblur_row));
     printf("[ checkasm ] pyrblur pixels blended (all ISAs): %ld, mixed into the blur %ld, past the LUT's end %ld, "
-           "between two levels %ld\n",
-           pb_active, pb_mix, pb_beyond, pb_frac);
+           "between two levels %ld; 8-pixel blocks all blended %ld, all mixed %ld\n",
+           pb_active, pb_mix, pb_beyond, pb_frac, pb_blk_all, pb_blk_mix);
+    assert_true(pb_blk_all > 0 && pb_blk_mix > 0);
 }
 
 /* ------------------------------------------------------------------ nearblk_row */
